@@ -1,0 +1,5 @@
+"""Validated configuration: pydantic sections and YAML loading with line-numbered errors."""
+
+from .loader import Config, ConfigError, load_config, config_schema
+
+__all__ = ["Config", "ConfigError", "load_config", "config_schema"]

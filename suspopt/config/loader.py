@@ -1,0 +1,191 @@
+"""The top-level ``Config`` and YAML loading.
+
+Every error names the YAML key path and its line: ``case.yaml:12: vehicle.body.mass: ...``.
+Values built into the config by merging (``corner_defaults``) are reported at the line of the
+key they came from.
+"""
+
+from __future__ import annotations
+
+import difflib
+from pathlib import Path
+from typing import Any, get_args, get_origin
+
+import yaml
+from pydantic import Field, PrivateAttr, ValidationError
+
+from .base import Section
+from .road import RoadConfig
+from .simulation import Output, Simulation
+from .vehicle import Vehicle
+
+__all__ = ["Config", "ConfigError", "load_config", "load_config_text", "config_schema"]
+
+
+class ConfigError(ValueError):
+    """Bad input: the message is one line naming the file, line and key path."""
+
+
+class Config(Section):
+    """A whole suspopt study."""
+
+    vehicle: Vehicle
+    road: RoadConfig
+    simulation: Simulation
+    output: Output = Field(default_factory=Output)
+
+    _source: Path | None = PrivateAttr(None)
+    _text: str = PrivateAttr("")
+
+    @property
+    def source(self) -> Path | None:
+        """The YAML file this config came from (None when built in Python)."""
+        return self._source
+
+    @property
+    def text(self) -> str:
+        """The YAML text as written (recorded in every output file)."""
+        return self._text if self._text else yaml.safe_dump(self.model_dump(mode="json"),
+                                                            sort_keys=False)
+
+    @property
+    def base_dir(self) -> Path:
+        """Directory that relative paths in the config are resolved against."""
+        return self._source.parent if self._source is not None else Path.cwd()
+
+
+def _line_map(node: yaml.Node, prefix: tuple = (), out: dict | None = None) -> dict:
+    """Map every key path of a composed YAML tree to its 1-based line."""
+    out = {} if out is None else out
+    if isinstance(node, yaml.MappingNode):
+        for key_node, value_node in node.value:
+            path = prefix + (str(key_node.value),)
+            out[path] = key_node.start_mark.line + 1
+            _line_map(value_node, path, out)
+    elif isinstance(node, yaml.SequenceNode):
+        for i, item in enumerate(node.value):
+            path = prefix + (i,)
+            out[path] = item.start_mark.line + 1
+            _line_map(item, path, out)
+    return out
+
+
+def _line_of(loc: tuple, lines: dict) -> int | None:
+    """Line of a pydantic error location: the key itself, else where a merged value came
+    from (``corner_defaults``), else the nearest enclosing key."""
+    loc = tuple(p for p in loc if not (isinstance(p, str) and p.startswith("function-")))
+    candidates = [loc]
+    if len(loc) >= 3 and loc[:2] == ("vehicle", "corners"):
+        candidates.append(("vehicle", "corner_defaults") + loc[3:])
+    for cand in candidates:
+        if cand in lines:
+            return lines[cand]
+    for n in range(len(loc) - 1, 0, -1):
+        if loc[:n] in lines:
+            return lines[loc[:n]]
+    return None
+
+
+def _clean_loc(loc: tuple) -> tuple:
+    """Drop pydantic's union-tag entries (e.g. the ``bump_step`` in road.bump_step.height)."""
+    out = []
+    for i, part in enumerate(loc):
+        if i == 1 and loc[0] == "road" and isinstance(part, str) and len(loc) > 2:
+            continue
+        out.append(part)
+    return tuple(out)
+
+
+def _format(err: dict, lines: dict, data: Any) -> tuple[str, int | None]:
+    loc = _clean_loc(tuple(err["loc"]))
+    dotted = ".".join(str(p) for p in loc) or "(top level)"
+    msg = err["msg"]
+    if msg.startswith("Value error, "):
+        msg = msg[len("Value error, "):]
+    if err["type"] == "extra_forbidden":
+        allowed = _allowed_keys(loc[:-1])
+        close = difflib.get_close_matches(str(loc[-1]), allowed, n=3)
+        msg = "unknown key" + (f"; did you mean {', '.join(close)}?" if close else
+                               f"; allowed: {', '.join(allowed)}" if allowed else "")
+    elif err["type"] == "missing":
+        msg = "required key is missing"
+    elif "input" in err and not isinstance(err["input"], (dict, list)):
+        msg = f"{msg} (got {err['input']!r})"
+    return f"{dotted}: {msg}", _line_of(loc, lines)
+
+
+def _section_type(annotation: Any) -> Any:
+    """The pydantic model inside an annotation (``X | None``, ``dict[str, X]``, unions)."""
+    if hasattr(annotation, "model_fields"):
+        return annotation
+    for arg in get_args(annotation):
+        found = _section_type(arg)
+        if found is not None:
+            return found
+    return None
+
+
+def _allowed_keys(loc: tuple) -> list[str]:
+    """Field names of the section at ``loc`` (for 'did you mean' hints)."""
+    model: Any = Config
+    for part in loc:
+        fields = getattr(model, "model_fields", {})
+        if part in fields:
+            annotation = fields[part].annotation
+            model = _section_type(annotation)
+            if get_origin(annotation) is dict:
+                model = ("dict", model)
+        elif isinstance(model, tuple):      # a key of a dict of sections
+            model = model[1]
+        else:
+            return []
+    return sorted(getattr(model, "model_fields", {}))
+
+
+def load_config_text(text: str, source: Path | None = None) -> Config:
+    """Parse and validate YAML text; raise ConfigError with file, line and key path."""
+    name = str(source) if source is not None else "<config>"
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line = f"{mark.line + 1}" if mark is not None else "?"
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ConfigError(f"{name}:{line}: malformed YAML: {problem}") from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{name}:1: the config must be a mapping of sections "
+                          f"(vehicle, road, simulation, ...)")
+    lines = _line_map(node) if node is not None else {}
+    try:
+        base_dir = source.parent if source is not None else Path.cwd()
+        cfg = Config.model_validate(data, context={"base_dir": base_dir})
+    except ValidationError as exc:
+        # an unknown key usually explains a 'missing' one (a typo): report it first
+        first = min(exc.errors(), key=lambda e: (e["type"] != "extra_forbidden",
+                                                 _line_of(_clean_loc(tuple(e["loc"])), lines)
+                                                 or 0))
+        msg, line = _format(first, lines, data)
+        more = len(exc.errors()) - 1
+        tail = f" (+{more} more error{'s' if more > 1 else ''})" if more else ""
+        raise ConfigError(f"{name}:{line if line else '?'}: {msg}{tail}") from None
+    cfg._source = source
+    cfg._text = text
+    return cfg
+
+
+def load_config(path: str | Path) -> Config:
+    """Read and validate a YAML config file."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: no such config file") from None
+    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"{path}: cannot read config ({exc.__class__.__name__})") from None
+    return load_config_text(text, path)
+
+
+def config_schema() -> dict:
+    """JSON Schema of the config, for editors' completion and validation."""
+    return Config.model_json_schema()

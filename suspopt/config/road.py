@@ -1,0 +1,182 @@
+"""The ``road:`` section: discrete bumps, ISO 8608 random roads and measured profiles (Sec 2.5).
+
+One model per ``kind``, joined in the discriminated union :data:`RoadConfig`. All quantities SI:
+heights and lengths in m, speeds in m/s, times in s, spatial frequencies in cycles/m.
+
+The ``tracks`` key, common to every kind, says what the left and right wheels see:
+
+- ``identical`` (default): both sides drive over the same profile;
+- ``independent``: the left side gets its own random realisation (``iso8608`` only);
+- ``right_only`` / ``left_only``: the road acts on that side, the other side is flat (the thesis's
+  Ch. 3 Part 2a puts the step under the right wheels only, Table 3.14).
+
+A ``file`` road's relative ``path`` is resolved against the directory of the config file. The
+loader passes that directory as the validation context (``context={"base_dir": ...}``); then a
+missing file is reported on ``road.path`` at validation time. Without a context a relative path
+is checked when the road is generated (:func:`suspopt.road.road_inputs` raises
+``FileNotFoundError``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Literal, Union
+
+from pydantic import Field, ValidationInfo, field_validator, model_validator
+
+from .base import Section
+
+__all__ = [
+    "Tracks", "BumpStep", "BumpHalfSine", "Iso8608Road", "FileRoad", "RoadConfig",
+    "resolve_road_file",
+]
+
+Tracks = Literal["identical", "independent", "right_only", "left_only"]
+
+_Finite = Annotated[float, Field(allow_inf_nan=False)]
+_Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+_TRACKS_DESCRIPTION = (
+    "what the two sides see: 'identical' (left = right), 'independent' (left is an independent "
+    "realisation; iso8608 only), 'right_only' / 'left_only' (the other side is flat)")
+_SPEED_DESCRIPTION = "constant vehicle speed V [m/s]"
+
+
+class _Road(Section):
+    """Fields every road kind has."""
+
+    speed: _Positive = Field(description=_SPEED_DESCRIPTION)
+    tracks: Tracks = Field("identical", description=_TRACKS_DESCRIPTION)
+    wheelbase_delay: bool = Field(True, description="rear wheels meet the road (a_F + a_R)/V "
+                                  "after the front ones (Sec 2.5.2); false feeds both axles "
+                                  "at once, e.g. to compare a half car with a quarter car")
+
+
+class _DeterministicRoad(_Road):
+    """A road with a single, fixed shape: it has no second realisation for the left track."""
+
+    @field_validator("tracks")
+    @classmethod
+    def _one_realisation(cls, tracks: str) -> str:
+        if tracks == "independent":
+            raise ValueError("tracks 'independent' needs a random road (kind: iso8608); use "
+                             "'identical', 'right_only' or 'left_only'")
+        return tracks
+
+
+class BumpStep(_DeterministicRoad):
+    """Rectangular bump (step up, plateau, step down), Eq 2.103-2.104.
+
+    A wheel is raised by ``height`` from ``start`` for ``length / speed`` seconds; the rear wheels
+    see the same plateau delayed by the wheelbase over the speed (ERRATA Eq 2.104: the printed
+    rear duration ``L/(2V)`` is a slip).
+    """
+
+    kind: Literal["bump_step"] = Field(description="rectangular bump, Eq 2.103-2.104")
+    height: _Finite = Field(description="plateau height h [m]; negative for a pothole")
+    length: _Positive = Field(description="length of the raised plateau on the road [m] (the "
+                              "thesis's L, Fig. 2.21); a wheel stays on it for length/speed s")
+    start: float = Field(ge=0, allow_inf_nan=False,
+                         description="time at which the front wheels reach the bump t0 [s]")
+
+
+class BumpHalfSine(_DeterministicRoad):
+    """Half-sine bump, Eq 2.101-2.102 as corrected in ERRATA.
+
+    ``z = height sin(pi (t - start) V / length)`` for ``start <= t < start + length / V``,
+    0 otherwise. ``length`` is the base length of the bump on the road, the thesis's ``L/2``.
+    """
+
+    kind: Literal["bump_half_sine"] = Field(description="half-sine bump, Eq 2.101-2.102")
+    height: _Finite = Field(description="crest height h [m]; negative for a dip")
+    length: _Positive = Field(description="base length of the half-sine on the road L_b [m] "
+                              "(the thesis's L/2, ERRATA Eq 2.101); crossing lasts length/speed s")
+    start: float = Field(ge=0, allow_inf_nan=False,
+                         description="time at which the front wheels reach the bump t0 [s]")
+
+
+class Iso8608Road(_Road):
+    """Random road of ISO 8608 roughness by harmonic superposition, Eq 2.93, 2.97-2.100.
+
+    ``convention`` is required on purpose: the two amplitude conventions differ by a factor
+    ``sqrt(2 pi)`` (reference/standards.md) and must never be mixed silently. Use ``thesis`` in
+    configs that reproduce the thesis's tables, ``iso8608`` for roads of the standard's roughness.
+    """
+
+    kind: Literal["iso8608"] = Field(description="ISO 8608 random road, Sec 2.5.1")
+    road_class: Literal["A", "B", "C", "D", "E"] | None = Field(
+        None, description="ISO 8608 class; sets G_d(n0) to the class's geometric mean "
+        "(A 16, B 64, C 256, D 1024, E 4096 x 1e-6 m^3)")
+    level: _Positive | None = Field(
+        None, description="displacement PSD level G_d(n0) at n0 = 0.1 cycles/m [m^3]; "
+        "overrides road_class")
+    convention: Literal["iso8608", "thesis"] = Field(
+        description="amplitude convention: 'iso8608' A_i = sqrt(2 G_d(n_i) dn) (one-sided PSD, "
+        "the standard's meaning) or 'thesis' A_i = sqrt(Phi(Omega_i) dOmega / pi) (Eq 2.99; "
+        "1/sqrt(2 pi) times smaller)")
+    waviness: _Positive = Field(2.0, description="waviness w, the PSD slope exponent (Eq 2.93) [-]")
+    n_min: _Positive = Field(0.011, description="lowest spatial frequency generated [cycles/m]")
+    n_max: _Positive = Field(2.83, validate_default=True,
+                             description="highest spatial frequency generated [cycles/m]")
+    n_waves: int | None = Field(
+        None, ge=2, description="number of harmonics N, uniformly spaced from n_min to n_max "
+        "inclusive (Eq 2.100); default: the smallest N whose spacing (n_max - n_min)/(N - 1) is "
+        "at most 1/L, L the length of road the wheels travel [m], so the road does not repeat")
+    seed: int = Field(0, ge=0, description="seed of the random phases; the same seed gives the "
+                      "same road bit for bit (default 0)")
+
+    @field_validator("n_max")
+    @classmethod
+    def _band_not_empty(cls, n_max: float, info: ValidationInfo) -> float:
+        n_min = info.data.get("n_min")
+        if n_min is not None and n_min >= n_max:
+            raise ValueError(f"n_max ({n_max}) must be larger than n_min ({n_min})")
+        return n_max
+
+    @model_validator(mode="after")
+    def _check_whole(self) -> Iso8608Road:
+        # the band is checked again here for edits by assignment, which skip _band_not_empty
+        if self.n_min >= self.n_max:
+            raise ValueError(f"n_max ({self.n_max}) must be larger than n_min ({self.n_min})")
+        if self.road_class is None and self.level is None:
+            raise ValueError("give road_class (A-E) or level (G_d(n0) [m^3])")
+        return self
+
+
+class FileRoad(_DeterministicRoad):
+    """Measured or designed profile read from a CSV file of distance [m], height [m].
+
+    The file has two comma-separated columns and an optional header line. Heights are linearly
+    interpolated; outside the file's distance range the road is flat at 0.
+    """
+
+    kind: Literal["file"] = Field(description="profile read from a CSV file")
+    path: Path = Field(description="CSV file with columns distance [m], height [m] and an "
+                       "optional header line; relative to the config file's directory")
+    scale: _Finite = Field(1.0, description="factor applied to the heights [-]")
+
+    @field_validator("path")
+    @classmethod
+    def _file_exists(cls, path: Path, info: ValidationInfo) -> Path:
+        base_dir = (info.context or {}).get("base_dir")
+        if not path.is_absolute() and base_dir is None:
+            return path
+        resolved = _resolve(path, base_dir)
+        if not resolved.is_file():
+            raise ValueError(f"road profile file not found: {resolved}")
+        return path
+
+
+RoadConfig = Annotated[
+    Union[BumpStep, BumpHalfSine, Iso8608Road, FileRoad], Field(discriminator="kind")]
+
+
+def _resolve(path: Path, base_dir: Path | str | None) -> Path:
+    """``path`` if absolute, else joined to ``base_dir`` (the current directory if None)."""
+    return path if path.is_absolute() else Path(base_dir or ".") / path
+
+
+def resolve_road_file(cfg: FileRoad, base_dir: Path | str | None) -> Path:
+    """Path of a ``file`` road's CSV: absolute as given, relative to ``base_dir`` (the config
+    file's directory), or to the current directory when ``base_dir`` is None. Existence is not
+    checked here."""
+    return _resolve(cfg.path, base_dir)

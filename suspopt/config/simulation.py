@@ -1,0 +1,59 @@
+"""The ``simulation:`` and ``output:`` sections."""
+
+from __future__ import annotations
+
+from pydantic import Field, PositiveFloat, model_validator
+
+from .base import Section
+
+__all__ = ["Simulation", "Output"]
+
+
+class Simulation(Section):
+    """Fixed-step integration settings (classical 4th-order Runge-Kutta)."""
+
+    duration: PositiveFloat = Field(description="simulated time [s]")
+    dt: PositiveFloat = Field(1.0e-3, description="integration step [s]")
+    output_dt: PositiveFloat | None = Field(
+        None, description="output sample interval [s], a whole multiple of dt (default dt)")
+
+    @model_validator(mode="after")
+    def _check_steps(self) -> "Simulation":
+        if self.dt > self.duration:
+            raise ValueError("dt must not exceed duration")
+        if self.output_dt is not None:
+            ratio = self.output_dt / self.dt
+            if ratio < 1 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
+                raise ValueError(f"output_dt ({self.output_dt}) must be a whole multiple of "
+                                 f"dt ({self.dt})")
+        return self
+
+    @property
+    def n_steps(self) -> int:
+        """Number of integration steps (duration rounded to whole steps)."""
+        return int(round(self.duration / self.dt))
+
+    @property
+    def output_every(self) -> int:
+        """Integration steps per output sample."""
+        return 1 if self.output_dt is None else int(round(self.output_dt / self.dt))
+
+    @property
+    def output_rate(self) -> float:
+        """Output sample rate [Hz]."""
+        return 1.0 / (self.dt * self.output_every)
+
+
+class Output(Section):
+    """What ``suspopt simulate`` writes to HDF5."""
+
+    signals: list[str] | str = Field(
+        "all", description="signal names to store, or 'all' (every signal the model has)")
+    float32: bool = Field(False, description="store signals as float32 to halve file size")
+
+    @model_validator(mode="after")
+    def _check(self) -> "Output":
+        if isinstance(self.signals, str) and self.signals != "all":
+            raise ValueError("signals must be 'all' or a list of signal names")
+        return self
+

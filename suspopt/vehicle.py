@@ -1,0 +1,312 @@
+"""One corner-based rigid-body vehicle model; QC, HC1, HC2 and FC are presets of it.
+
+The body has a subset of the degrees of freedom {heave, roll, pitch}; corner ``i`` sits at
+``(x_i, y_i)`` (``x = +a_F`` front, ``-a_R`` rear; ``y = +b_1`` right, ``-b_2`` left) and carries
+an unsprung mass on a tyre, joined to the body by a spring and a damper. The suspension travel
+is ``ST_i = z_s + y_i φ - x_i θ - z_ui`` (Eq 2.3, 2.9, 2.17 and Eq 2.26 with the rear roll sign
+mended per ERRATA) and the tyre deflection ``TD_i = z_ui - z_road,i`` (Eq 2.4, 2.10, 2.18, 2.27).
+With forces ``F_K = k_l ST + k_nl ST^3`` (Eq 2.30-2.31), ``F_C = c dST/dt`` (Eq 2.32) and
+``F_T = k_T TD + c_T dTD/dt`` (Eq 2.28-2.29) the equations of motion of every preset
+(Eq 2.1-2.2, 2.5-2.8, 2.13-2.16, 2.19-2.25) are
+
+    M q'' = -K q - C q' + B_k r + B_c r' - J^T (k_nl ST^3) + (tyre lift-off correction)
+
+with ``q = [body DOFs, wheel heaves]`` measured from static equilibrium, ``J`` the travel map
+(``ST = J q``) and ``M`` diagonal. Anti-roll bars are torsional springs between the body roll
+and the axle roll ``(z_right - z_left)/(b_1 + b_2)`` (ERRATA for Eq 2.11-2.12 and 2.25).
+
+All parameter arrays are batched over P designs: shapes are ``(P, 1, N)`` so that they
+broadcast against states of shape ``(P, S, n)`` (``S = 1`` while integrating, ``S = T`` when
+signals are computed afterwards). Matrices identical for all designs are stored once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .config import Config
+from .config.vehicle import PRESET_BODY_DOFS, PRESET_CORNERS
+from .params import ParamView
+
+__all__ = ["VehicleModel", "build_vehicle", "modal_analysis", "ModalResult",
+           "frequency_response"]
+
+_INERTIA_FIELD = {"heave": "mass", "roll": "roll_inertia", "pitch": "pitch_inertia"}
+
+
+def _shared(a: np.ndarray) -> np.ndarray:
+    """Collapse a (P, ...) array to (1, ...) when every design has the same values."""
+    return a[:1] if a.shape[0] > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape)) else a
+
+
+def matvec(matrix_t: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``y @ matrix_t`` for states ``y (P, S, a)`` and a (1|P, a, b) transposed matrix."""
+    if matrix_t.shape[0] == 1:
+        return (y.reshape(-1, y.shape[-1]) @ matrix_t[0]).reshape(*y.shape[:-1], -1)
+    return np.matmul(y, matrix_t)
+
+
+@dataclass
+class VehicleModel:
+    """Assembled, batched vehicle (see module docstring). Units SI; angles in rad."""
+
+    preset: str
+    body_dofs: tuple[str, ...]
+    corners: tuple[str, ...]
+    P: int
+    mass: np.ndarray            # (1|P, 1, n) diagonal of M [kg, kg m^2]
+    stiffness: np.ndarray       # (1|P, n, n) K [N/m, N m/rad]
+    damping: np.ndarray         # (1|P, n, n) C [N s/m]
+    travel_map: np.ndarray      # (1|P, N, n) J: ST = J q
+    corner_x: np.ndarray        # (P, N) longitudinal corner position [m], + forward
+    corner_y: np.ndarray        # (P, N) lateral corner position [m], + right
+    unsprung_mass: np.ndarray   # (P, 1, N) [kg]
+    tyre_stiffness: np.ndarray  # (P, 1, N) [N/m]
+    tyre_damping: np.ndarray    # (P, 1, N) [N s/m]
+    spring_linear: np.ndarray   # (P, 1, N) [N/m]
+    spring_cubic: np.ndarray    # (P, 1, N) [N/m^3]
+    damper: np.ndarray          # (P, 1, N) passive damping coefficient [N s/m]
+    static_tyre_load: np.ndarray  # (P, 1, N) tyre load at rest, compression positive [N]
+    tyre_lift_off: bool
+    gravity: float
+    offsets: np.ndarray         # (N,) distance behind the front axle [m] (wheelbase delay)
+    sides: tuple[str, ...]      # 'right' | 'left' per corner
+    dof_names: tuple[str, ...]
+    bar_map: np.ndarray | None  # (1|P, B, n) anti-roll bar twist = bar_map q [rad]
+    bar_stiffness: np.ndarray | None  # (P, 1, B) [N m/rad]
+
+    @property
+    def n_dof(self) -> int:
+        return self.mass.shape[-1]
+
+    @property
+    def n_body(self) -> int:
+        return len(self.body_dofs)
+
+    @property
+    def wheels(self) -> slice:
+        """Slice of the wheel heaves in ``q``."""
+        return slice(self.n_body, self.n_body + len(self.corners))
+
+    def travel(self, q: np.ndarray) -> np.ndarray:
+        """Suspension travel ST (Eq 2.26 form) of every corner, (P, S, N) [m]; + = extension.
+        Applied to velocities it gives the travel rate."""
+        return matvec(self._travel_map_t, q)
+
+    def spring_force(self, travel: np.ndarray) -> np.ndarray:
+        """Dynamic spring force F_K = k_l ST + k_nl ST^3 (Eq 2.30-2.31) [N]."""
+        if self.has_cubic:
+            return (self.spring_linear + self.spring_cubic * travel * travel) * travel
+        return self.spring_linear * travel
+
+    def dynamic_tyre_force(self, q: np.ndarray, v: np.ndarray, road: np.ndarray,
+                           road_vel: np.ndarray) -> np.ndarray:
+        """Change of the normal tyre load from rest, compression positive [N]:
+        ``-(k_T TD + c_T TD')`` (Eq 2.28-2.29); never below minus the static load when tyres
+        may lift off (a tyre cannot pull)."""
+        w = self.wheels
+        force = self.tyre_stiffness * (road - q[..., w])
+        if self.has_tyre_damping:
+            force = force + self.tyre_damping * (road_vel - v[..., w])
+        if self.tyre_lift_off:
+            force = np.maximum(force, -self.static_tyre_load)
+        return force
+
+    def tyre_force(self, q, v, road, road_vel) -> np.ndarray:
+        """Total normal tyre load, compression positive [N] (static + dynamic)."""
+        return self.static_tyre_load + self.dynamic_tyre_force(q, v, road, road_vel)
+
+    def generalised_force(self, q: np.ndarray, v: np.ndarray, road: np.ndarray,
+                          road_vel: np.ndarray) -> np.ndarray:
+        """Right-hand side of M q'' = f: suspension, tyre and anti-roll-bar forces, (P, S, n).
+
+        Each suspension force ``F_K + F_C`` acts along the travel map (``-J^T F``), each tyre
+        force on its wheel, each anti-roll bar along its twist map (Eq 2.1-2.25).
+        """
+        force = self.spring_force(self.travel(q)) + self.damper * self.travel(v)
+        gen = -matvec(self.travel_map, force)
+        gen[..., self.wheels] += self.dynamic_tyre_force(q, v, road, road_vel)
+        if self.bar_map is not None:
+            twist = matvec(np.swapaxes(self.bar_map, 1, 2), q)
+            gen -= matvec(self.bar_map, self.bar_stiffness * twist)
+        return gen
+
+    def __post_init__(self):
+        self._travel_map_t = np.swapaxes(self.travel_map, 1, 2)
+        self.has_cubic = bool(np.any(self.spring_cubic))
+        self.has_tyre_damping = bool(np.any(self.tyre_damping))
+
+
+def _corner_geometry(pv: ParamView, preset: str, corners: tuple[str, ...]):
+    P = pv.P
+    x = np.zeros((P, len(corners)))
+    y = np.zeros((P, len(corners)))
+    body = "vehicle.body."
+    for i, name in enumerate(corners):
+        if preset in ("half_pitch", "full"):
+            x[:, i] = pv.require_positive(body + "a_front") if name[0] == "F" \
+                else -pv.require_positive(body + "a_rear")
+        if preset in ("half_roll", "full"):
+            y[:, i] = pv.require_positive(body + "b_right") if name[1] == "1" \
+                else -pv.require_positive(body + "b_left")
+    return x, y
+
+
+def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
+    """Assemble the batched model of ``cfg.vehicle`` for the designs in ``pv``."""
+    pv = pv or ParamView(cfg)
+    veh = cfg.vehicle
+    P = pv.P
+    corners = PRESET_CORNERS[veh.preset]
+    body_dofs = PRESET_BODY_DOFS[veh.preset]
+    nb, N = len(body_dofs), len(corners)
+    n = nb + N
+    x, y = _corner_geometry(pv, veh.preset, corners)
+
+    def corner_param(key: str, positive: bool = False) -> np.ndarray:
+        get = pv.require_positive if positive else pv.get
+        return np.stack([get(f"vehicle.corners.{c}.{key}") for c in corners], axis=1)
+
+    mu = corner_param("unsprung_mass", True)
+    kt, ct = corner_param("tyre.stiffness", True), corner_param("tyre.damping")
+    kl, knl = corner_param("spring.linear", True), corner_param("spring.cubic")
+    c = corner_param("damper.c")
+    for name, arr in (("tyre.damping", ct), ("damper.c", c)):
+        if np.any(arr < 0):
+            raise ValueError(f"vehicle.corners.*.{name}: must be >= 0")
+
+    mass = np.empty((P, n))
+    for j, dof in enumerate(body_dofs):
+        mass[:, j] = pv.require_positive("vehicle.body." + _INERTIA_FIELD[dof])
+    mass[:, nb:] = mu
+
+    # travel map J: ST_i = z_s + y_i φ - x_i θ - z_ui
+    J = np.zeros((P, N, n))
+    for j, dof in enumerate(body_dofs):
+        J[:, :, j] = {"heave": 1.0, "roll": y, "pitch": -x}[dof]
+    J[:, np.arange(N), nb + np.arange(N)] = -1.0
+
+    # linear matrices of the same elements, for statics, modes and frequency response
+    bar_map, bar_k = _anti_roll_bars(pv, corners, body_dofs)
+    K = np.einsum("pi,pik,pil->pkl", kl, J, J)
+    C = np.einsum("pi,pik,pil->pkl", c, J, J)
+    w = nb + np.arange(N)
+    K[:, w, w] += kt
+    C[:, w, w] += ct
+    if bar_map is not None:
+        K += np.einsum("pb,pbk,pbl->pkl", bar_k, bar_map, bar_map)
+
+    static = _static_tyre_load(mass, K, nb, N, kt, body_dofs, veh.gravity)
+    rear = np.array([cn[0] == "R" for cn in corners])
+    wheelbase = (veh.body.a_front or 0.0) + (veh.body.a_rear or 0.0)
+    offsets = np.where(rear, wheelbase, 0.0) if cfg.road.wheelbase_delay else np.zeros(N)
+    if pv.varies("vehicle.body.a_front") or pv.varies("vehicle.body.a_rear"):
+        if any(cn[0] == "R" for cn in corners):
+            raise ValueError("vehicle.body.a_front/a_rear cannot be design parameters of a model "
+                             "with a rear axle: the road's wheelbase delay is one per run")
+    sides = tuple("right" if cn[1] == "1" else "left" for cn in corners)
+    dof_names = tuple(f"body.{d}" for d in body_dofs) + tuple(f"wheel.{cn}" for cn in corners)
+    e = (slice(None), None, slice(None))
+    return VehicleModel(
+        preset=veh.preset, body_dofs=body_dofs, corners=corners, P=P,
+        mass=_shared(mass[:, None, :]), stiffness=_shared(K), damping=_shared(C),
+        travel_map=_shared(J), corner_x=x, corner_y=y,
+        unsprung_mass=mu[e], tyre_stiffness=kt[e], tyre_damping=ct[e], spring_linear=kl[e],
+        spring_cubic=knl[e], damper=c[e], static_tyre_load=static[e],
+        tyre_lift_off=veh.tyre_lift_off, gravity=veh.gravity, offsets=offsets, sides=sides,
+        dof_names=dof_names,
+        bar_map=None if bar_map is None else _shared(bar_map),
+        bar_stiffness=None if bar_k is None else bar_k[:, None, :])
+
+
+def _anti_roll_bars(pv: ParamView, corners, body_dofs):
+    """Twist map (P, B, n) and stiffness (P, B) of the axles' bars, or (None, None).
+
+    A bar is a torsional spring between the body roll φ and the axle roll (z_R - z_L)/w,
+    w = b_1 + b_2: twist = φ - (z_R - z_L)/w (ERRATA for Eq 2.11-2.12 and 2.25).
+    """
+    if "roll" not in body_dofs:
+        return None, None
+    nb, n = len(body_dofs), len(body_dofs) + len(corners)
+    track = pv.get("vehicle.body.b_right") + pv.get("vehicle.body.b_left")
+    maps, stiffness = [], []
+    for axle, key in (("F", "front"), ("R", "rear")):
+        k = pv.get(f"vehicle.anti_roll_bars.{key}")
+        if f"{axle}1" not in corners or not np.any(k):
+            continue
+        a = np.zeros((pv.P, n))
+        a[:, body_dofs.index("roll")] = 1.0
+        a[:, nb + corners.index(f"{axle}1")] = -1.0 / track
+        a[:, nb + corners.index(f"{axle}2")] = 1.0 / track
+        maps.append(a)
+        stiffness.append(k)
+    if not maps:
+        return None, None
+    return np.stack(maps, axis=1), np.stack(stiffness, axis=1)
+
+
+def _static_tyre_load(mass, K, nb, N, kt, body_dofs, g) -> np.ndarray:
+    """Tyre loads at rest [N] from the linear statics K q0 = -M g (translations only)."""
+    load = np.zeros(mass.shape)
+    if "heave" in body_dofs:
+        load[:, body_dofs.index("heave")] = -mass[:, body_dofs.index("heave")] * g
+    load[:, nb:] = -mass[:, nb:] * g
+    q0 = np.linalg.solve(K, load[..., None])[..., 0]
+    return -kt * q0[:, nb:]
+
+
+@dataclass
+class ModalResult:
+    """Undamped modes: ``frequency (P, n)`` [Hz] ascending, ``shape (P, n, n)`` (columns,
+    normalised to unit max |entry|), ``dominant (P, n)`` DOF name with most kinetic energy."""
+
+    frequency: np.ndarray
+    shape: np.ndarray
+    dominant: np.ndarray
+    dof_names: tuple[str, ...]
+
+
+def modal_analysis(model: VehicleModel) -> ModalResult:
+    """Undamped natural frequencies and mode shapes of the linearised model (K φ = ω² M φ).
+
+    Solved as the symmetric problem M^-1/2 K M^-1/2 (M diagonal), batched over designs. The
+    Duffing term has zero stiffness at equilibrium and does not enter.
+    """
+    m = np.broadcast_to(model.mass[:, 0, :], (model.P, model.n_dof))
+    K = np.broadcast_to(model.stiffness, (model.P, model.n_dof, model.n_dof))
+    s = 1.0 / np.sqrt(m)
+    lam, vec = np.linalg.eigh(s[:, :, None] * K * s[:, None, :])
+    shape = s[:, :, None] * vec
+    shape = shape / np.max(np.abs(shape), axis=1, keepdims=True)
+    energy = m[:, :, None] * shape ** 2
+    names = np.array(model.dof_names)
+    return ModalResult(frequency=np.sqrt(np.clip(lam, 0, None)) / (2 * np.pi), shape=shape,
+                       dominant=names[np.argmax(energy, axis=1)], dof_names=model.dof_names)
+
+
+def frequency_response(model: VehicleModel, f: np.ndarray, speed: float | None = None,
+                       corners: tuple[str, ...] | None = None) -> np.ndarray:
+    """Analytic response of the linear(ised) model to a road input, (P, F, n) [m per m].
+
+    The same unit-amplitude road height ``exp(jωt)`` enters under each wheel in ``corners``
+    (default all), the rear ones delayed by ``offset/speed`` when a speed is given: the
+    complex DOF amplitudes solve ``(K - ω² M + jω C) Q = (k_T + jω c_T) R``. Body
+    accelerations are ``-ω² Q``. Duffing and lift-off are not in the linear model.
+    """
+    f = np.atleast_1d(np.asarray(f, dtype=float))
+    omega = 2 * np.pi * f
+    use = np.array([c in (corners or model.corners) for c in model.corners], dtype=float)
+    delay = model.offsets / speed if speed else np.zeros(len(model.corners))
+    road = use[None, :] * np.exp(-1j * omega[:, None] * delay[None, :])  # (F, N)
+    n = model.n_dof
+    m = np.broadcast_to(model.mass[:, 0, :], (model.P, n))
+    K = np.broadcast_to(model.stiffness, (model.P, n, n))
+    C = np.broadcast_to(model.damping, (model.P, n, n))
+    dyn = K[:, None] - omega[None, :, None, None] ** 2 * (m[:, None, :, None] * np.eye(n)) \
+        + 1j * omega[None, :, None, None] * C[:, None]
+    rhs = np.zeros((model.P, f.size, n), dtype=complex)
+    rhs[..., model.wheels] = (model.tyre_stiffness + 1j * omega[None, :, None]
+                              * model.tyre_damping) * road[None]
+    return np.linalg.solve(dyn, rhs[..., None])[..., 0]

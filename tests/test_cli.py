@@ -1,0 +1,101 @@
+"""The command line: exit codes, one-line errors naming key and line, atomic HDF5 output."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import CONFIGS
+
+GOOD = (CONFIGS / "quickstart.yaml").read_text()
+
+
+def run(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "suspopt", *map(str, args)],
+                          capture_output=True, text=True, cwd=cwd, timeout=120)
+
+
+def write(tmp_path: Path, text: str, name="case.yaml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+BAD_INPUTS = {
+    "malformed_yaml": (GOOD.replace("  preset: half_pitch", "  preset: [half_pitch"),
+                       "malformed YAML", None),
+    "unknown_key": (GOOD.replace("unsprung_mass: 50", "unsprung_mas: 50"),
+                    "vehicle.corners.F1.unsprung_mas: unknown key; did you mean unsprung_mass",
+                    9),
+    "negative_mass": (GOOD.replace("mass: 2210", "mass: -2210"), "vehicle.body.mass", 6),
+    "zero_mass": (GOOD.replace("unsprung_mass: 100", "unsprung_mass: 0"),
+                  "vehicle.corners.R1.unsprung_mass", 14),
+    "missing_section": (GOOD.split("simulation:")[0], "simulation: required key is missing",
+                        None),
+    "wrong_type": (GOOD.replace("height: 0.05", "height: high"), "road.height", 20),
+    "no_road_file": (GOOD.split("road:")[0] + "road: {kind: file, path: nowhere.csv, "
+                     "speed: 10}\nsimulation: {duration: 1.0}\n", "road.path", 18),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_INPUTS))
+def test_bad_input_exits_2_with_one_line(tmp_path, case):
+    text, needle, line = BAD_INPUTS[case]
+    cfg = write(tmp_path, text)
+    out = tmp_path / "out.h5"
+    proc = run("simulate", cfg, "-o", out)
+    assert proc.returncode == 2, proc.stderr
+    message = proc.stderr.strip()
+    assert len(message.splitlines()) == 1, message
+    assert "Traceback" not in proc.stderr + proc.stdout
+    assert needle in message
+    if line is not None:
+        assert f"case.yaml:{line}:" in message
+    assert not out.exists()
+    assert list(tmp_path.glob("*.tmp")) == [] and list(tmp_path.glob(".*tmp")) == []
+
+
+def test_missing_config_file_exits_2(tmp_path):
+    proc = run("validate", tmp_path / "absent.yaml")
+    assert proc.returncode == 2 and "no such config file" in proc.stderr
+
+
+def test_validate_and_schema():
+    proc = run("validate", CONFIGS / "quickstart.yaml")
+    assert proc.returncode == 0 and "valid" in proc.stdout
+    proc = run("schema")
+    schema = json.loads(proc.stdout)
+    assert {"vehicle", "road", "simulation"} <= set(schema["properties"])
+
+
+def test_simulate_writes_the_design_md_layout(tmp_path):
+    out = tmp_path / "run.h5"
+    proc = run("simulate", CONFIGS / "quickstart.yaml", "-o", out)
+    assert proc.returncode == 0, proc.stderr
+    assert "peak |body heave acc|" in proc.stdout
+    with h5py.File(out) as h5:
+        for key in ("suspopt_version", "created", "command", "config", "seed"):
+            assert key in h5.attrs
+        assert h5.attrs["config"] == GOOD
+        T = h5["time"].shape[0]
+        assert T == 3001 and h5["time"].attrs["units"] == "s"
+        acc = h5["signals/body.heave_acc"]
+        assert acc.shape == (1, T) and acc.attrs["units"] == "m/s^2"
+        assert h5["signals/travel.F1"].attrs["units"] == "m"
+        assert h5["signals/tyre_force.R1"].attrs["units"] == "N"
+        assert np.isnan(h5["diverged_at"][()]).all()
+        assert h5["modal/frequency"].attrs["units"] == "Hz"
+
+
+def test_every_bundled_config_validates():
+    configs = sorted(CONFIGS.rglob("*.yaml"))
+    assert len(configs) >= 17
+    for cfg in configs:
+        proc = run("validate", cfg)
+        assert proc.returncode == 0, f"{cfg}: {proc.stderr}"

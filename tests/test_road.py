@@ -1,0 +1,267 @@
+"""Road inputs: bump shapes and delays, ISO 8608 spectra, tracks, CSV profiles, config errors."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from pydantic import BaseModel, TypeAdapter, ValidationError
+from scipy.integrate import trapezoid
+from scipy.signal import welch
+
+from suspopt.config.road import RoadConfig
+from suspopt.road import iso8608_harmonics, iso8608_level, profile, road_inputs
+
+ROAD = TypeAdapter(RoadConfig)
+# dyadic numbers keep the bump edges exactly on grid points
+DT = 1.0 / 1024
+T = np.arange(0, 2048) * DT
+SPEED = 8.0
+WHEELBASE = 2.0           # delay 0.25 s
+START = 0.5
+LENGTH = 2.0              # 0.25 s on the bump
+HEIGHT = 0.05
+FOUR_WHEELS = (np.array([0.0, 0.0, WHEELBASE, WHEELBASE]), ["right", "left", "right", "left"])
+
+
+def bump(kind: str, **changes) -> RoadConfig:
+    return ROAD.validate_python(dict(kind=kind, height=HEIGHT, length=LENGTH, speed=SPEED,
+                                     start=START) | changes)
+
+
+def iso(**changes) -> RoadConfig:
+    return ROAD.validate_python(dict(kind="iso8608", road_class="B", convention="iso8608",
+                                     speed=20.0) | changes)
+
+
+def window(delay: float) -> np.ndarray:
+    """Times (of T) a wheel delayed by ``delay`` spends on the bump."""
+    return (T >= START + delay) & (T < START + delay + LENGTH / SPEED)
+
+
+# --- bumps -----------------------------------------------------------------------------------
+
+def test_step_bump_height_start_duration_and_rear_delay():
+    z, _ = road_inputs(bump("bump_step"), *FOUR_WHEELS, T)
+    delay = WHEELBASE / SPEED
+    for row, d in zip(z, [0.0, 0.0, delay, delay]):
+        np.testing.assert_array_equal(row, np.where(window(d), HEIGHT, 0.0))
+    # ERRATA Eq 2.104: the rear plateau lasts as long as the front one
+    assert np.count_nonzero(z[2]) == np.count_nonzero(z[0]) == round(LENGTH / SPEED / DT)
+
+
+def test_step_bump_can_be_a_pothole():
+    z, _ = road_inputs(bump("bump_step", height=-0.03), np.zeros(1), ["right"], T)
+    assert z.min() == -0.03 and z.max() == 0.0
+
+
+def test_step_derivative_integrates_to_the_step():
+    z, zdot = road_inputs(bump("bump_step"), *FOUR_WHEELS, T)
+    integral = np.concatenate([np.zeros((4, 1)), np.cumsum(zdot[:, 1:] * np.diff(T), axis=1)],
+                              axis=1)
+    np.testing.assert_allclose(integral, z, atol=1e-12)
+    mid_plateau = np.searchsorted(T, START + 0.1)
+    assert trapezoid(zdot[0, :mid_plateau], T[:mid_plateau]) == pytest.approx(HEIGHT)
+
+
+def test_step_derivative_on_unsorted_stage_times_matches_the_sorted_grid():
+    stages = np.concatenate([T, T + DT / 2, T + DT / 2, T + DT])    # RK4 stage times
+    _, zdot = road_inputs(bump("bump_step"), np.zeros(1), ["right"], stages)
+    grid = np.unique(stages)
+    _, zdot_grid = road_inputs(bump("bump_step"), np.zeros(1), ["right"], grid)
+    np.testing.assert_array_equal(zdot[0], zdot_grid[0, np.searchsorted(grid, stages)])
+    assert zdot_grid.max() == pytest.approx(HEIGHT / (DT / 2))
+
+
+def test_half_sine_shape_and_rear_delay():
+    z, _ = road_inputs(bump("bump_half_sine"), *FOUR_WHEELS, T)
+    for row, d in zip(z, [0.0, 0.0, 0.25, 0.25]):
+        expected = HEIGHT * np.sin(math.pi * (T - START - d) * SPEED / LENGTH)
+        np.testing.assert_allclose(row, np.where(window(d), expected, 0.0), atol=1e-15)
+    crest = np.argmax(z[0])
+    assert T[crest] == pytest.approx(START + LENGTH / SPEED / 2)
+    assert z[0, crest] == pytest.approx(HEIGHT)
+
+
+def test_half_sine_derivative_matches_finite_differences():
+    fine = np.linspace(0, 1.5, 150001)
+    z, zdot = road_inputs(bump("bump_half_sine"), np.array([0.0, WHEELBASE]), ["right"] * 2,
+                          fine)
+    numeric = np.gradient(z, fine, axis=1)
+    inside = np.abs(np.gradient(zdot, fine, axis=1)) < 1e3     # away from the kinks at the ends
+    np.testing.assert_allclose(zdot[inside], numeric[inside], atol=1e-6)
+    assert np.abs(zdot).max() == pytest.approx(HEIGHT * math.pi * SPEED / LENGTH, rel=1e-6)
+
+
+@pytest.mark.parametrize("kind", ["bump_step", "bump_half_sine"])
+def test_bump_tracks(kind):
+    offsets, sides = FOUR_WHEELS
+    z, zdot = road_inputs(bump(kind), offsets, sides, T)
+    np.testing.assert_array_equal(z[0], z[1])
+    np.testing.assert_array_equal(z[2], z[3])
+    z, zdot = road_inputs(bump(kind, tracks="right_only"), offsets, sides, T)
+    assert not z[1::2].any() and not zdot[1::2].any()
+    assert z[0].max() == pytest.approx(HEIGHT) and z[2].max() == pytest.approx(HEIGHT)
+    z, _ = road_inputs(bump(kind, tracks="left_only"), offsets, sides, T)
+    assert not z[0::2].any() and z[1].max() == pytest.approx(HEIGHT)
+
+
+# --- ISO 8608 --------------------------------------------------------------------------------
+
+def welch_level_and_slope(road, length=6000.0, spacing=0.05):
+    """Fitted G(n0) [m^3] and slope of the Welch PSD of a generated profile."""
+    s = np.arange(0.0, length, spacing)
+    f, psd = welch(profile(road, s), fs=1.0 / spacing, nperseg=8192)
+    band = (f >= 5 * road.n_min) & (f <= 0.9 * road.n_max)     # clear of the band edges
+    slope, intercept = np.polyfit(np.log(f[band]), np.log(psd[band]), 1)
+    return math.exp(intercept + slope * math.log(0.1)), slope
+
+
+@pytest.mark.parametrize("convention", ["iso8608", "thesis"])
+@pytest.mark.parametrize("road_class", list("ABCDE"))
+def test_iso8608_psd_level_and_slope(road_class, convention):
+    road = iso(road_class=road_class, convention=convention, seed="ABCDE".index(road_class))
+    level, slope = welch_level_and_slope(road)
+    assert level == pytest.approx(iso8608_level(road), rel=0.10)
+    assert slope == pytest.approx(-2.0, abs=0.1)
+
+
+def test_convention_levels_and_amplitudes():
+    level = 64e-6
+    assert iso8608_level(iso(convention="iso8608")) == level
+    assert iso8608_level(iso(convention="thesis")) == pytest.approx(level / (2 * math.pi))
+    assert iso8608_level(iso(level=1e-5, road_class="E")) == 1e-5
+    thesis = iso8608_harmonics(iso(convention="thesis"), 500.0)
+    standard = iso8608_harmonics(iso(convention="iso8608"), 500.0)
+    np.testing.assert_allclose(thesis.amplitude / standard.amplitude, 1 / math.sqrt(2 * math.pi))
+    np.testing.assert_array_equal(thesis.phase, standard.phase)
+
+
+def test_iso8608_variance_is_the_integral_of_the_psd():
+    road = iso(road_class="C")
+    harmonics = iso8608_harmonics(road, 2000.0)
+    half_step = (harmonics.omega[1] - harmonics.omega[0]) / (4 * math.pi)
+    # each harmonic carries G_d dn around it (midpoint rule): integrate G0 (n/n0)^-2 over the
+    # band widened by dn/2 at either end
+    expected = 256e-6 * 0.1 ** 2 * (1 / (road.n_min - half_step) - 1 / (road.n_max + half_step))
+    assert np.sum(harmonics.amplitude ** 2 / 2) == pytest.approx(expected, rel=1e-3)
+
+
+def test_default_number_of_waves_spacing_and_band():
+    road = iso()
+    harmonics = iso8608_harmonics(road, 1000.0)
+    n = harmonics.omega / (2 * math.pi)
+    assert n[0] == pytest.approx(road.n_min) and n[-1] == pytest.approx(road.n_max)
+    spacing = np.diff(n)
+    np.testing.assert_allclose(spacing, spacing[0])
+    assert spacing[0] <= 1 / 1000.0 * (1 + 1e-12) < (road.n_max - road.n_min) / (n.size - 2)
+    assert iso8608_harmonics(iso(n_waves=50), 1000.0).omega.size == 50
+
+
+def test_harmonic_sum_matches_the_direct_sum():
+    road = iso(road_class="D", speed=24.0)
+    s = np.linspace(-3.0, 1440.0, 200001)
+    z = profile(road, s)
+    harmonics = iso8608_harmonics(road, np.ptp(s))
+    pick = np.random.default_rng(3).choice(s.size, 500, replace=False)
+    direct = (harmonics.amplitude * np.sin(np.outer(s[pick], harmonics.omega)
+                                           - harmonics.phase)).sum(axis=1)
+    np.testing.assert_allclose(z[pick], direct, atol=1e-6 * z.std())
+
+
+def test_iso8608_wheels_see_the_profile_delayed_and_zdot_is_its_derivative():
+    road = iso(n_waves=400)
+    t = np.linspace(0.0, 5.0, 50001)
+    z, zdot = road_inputs(road, np.array([0.0, 2.7]), ["right", "right"], t)
+    np.testing.assert_allclose(z[1], profile(road, road.speed * t - 2.7), atol=1e-12)
+    np.testing.assert_allclose(z[0], profile(road, road.speed * t), atol=1e-12)
+    numeric = np.gradient(z, t, axis=1)[:, 1:-1]
+    np.testing.assert_allclose(zdot[:, 1:-1], numeric, atol=2e-3 * np.abs(zdot).max())
+
+
+def test_same_seed_same_bits_other_seed_differs():
+    offsets, sides = FOUR_WHEELS
+    t = np.linspace(0, 10, 2001)
+    first, _ = road_inputs(iso(seed=11), offsets, sides, t)
+    again, _ = road_inputs(iso(seed=11), offsets, sides, t)
+    other, _ = road_inputs(iso(seed=12), offsets, sides, t)
+    assert np.array_equal(first, again)
+    assert np.abs(first - other).max() > 0.1 * first.std()
+
+
+def test_tracks_identical_independent_and_one_sided():
+    s = np.arange(0.0, 4000.0, 0.1)
+    right, left = (profile(iso(tracks="independent"), s, side) for side in ("right", "left"))
+    assert abs(np.corrcoef(right, left)[0, 1]) < 0.1
+    # the right track of an independent road is the identical road's single track
+    np.testing.assert_array_equal(right, profile(iso(), s, "left"))
+    np.testing.assert_array_equal(profile(iso(), s, "right"), profile(iso(), s, "left"))
+    assert not profile(iso(tracks="right_only"), s, "left").any()
+    np.testing.assert_array_equal(profile(iso(tracks="right_only"), s, "right"), right)
+    z, zdot = road_inputs(iso(tracks="left_only"), *FOUR_WHEELS, np.linspace(0, 2, 101))
+    assert not z[0::2].any() and not zdot[0::2].any() and z[1::2].all()
+
+
+# --- CSV profiles ----------------------------------------------------------------------------
+
+def write_profile(path, header=True):
+    rows = "0,0\n1,0.02\n3,-0.02\n4,0.01\n"
+    path.write_text(("distance_m,height_m\n" if header else "") + rows)
+
+
+@pytest.mark.parametrize("header", [True, False])
+def test_file_profile_interpolation_scale_and_outside_range(tmp_path, header):
+    write_profile(tmp_path / "bumps.csv", header)
+    road = ROAD.validate_python(dict(kind="file", path="bumps.csv", speed=2.0, scale=0.5))
+    s = np.array([-1.0, 0.5, 1.0, 2.0, 2.5, 4.0, 5.0])
+    np.testing.assert_allclose(profile(road, s, base_dir=tmp_path),
+                               0.5 * np.array([0, 0.01, 0.02, 0.0, -0.01, 0.01, 0]), atol=1e-15)
+    t = np.array([0.25, 1.0, 2.5])                  # road positions 0.5, 2, 5 m
+    z, zdot = road_inputs(road, np.zeros(1), ["right"], t, base_dir=tmp_path)
+    np.testing.assert_allclose(z[0], 0.5 * np.array([0.01, 0.0, 0.0]), atol=1e-15)
+    # V dz/ds: 2 m/s x 0.5 x slopes 0.02/1 and -0.04/2, flat beyond the last point
+    np.testing.assert_allclose(zdot[0], [0.02, -0.02, 0.0], atol=1e-15)
+
+
+def test_missing_file_is_named(tmp_path):
+    road = ROAD.validate_python(dict(kind="file", path="nowhere.csv", speed=2.0))
+    with pytest.raises(FileNotFoundError, match="nowhere.csv"):
+        road_inputs(road, np.zeros(1), ["right"], np.zeros(3), base_dir=tmp_path)
+
+    class Config(BaseModel):
+        road: RoadConfig
+
+    with pytest.raises(ValidationError) as error:
+        Config.model_validate({"road": dict(kind="file", path="nowhere.csv", speed=2.0)},
+                              context={"base_dir": tmp_path})
+    (detail,) = error.value.errors()
+    assert detail["loc"][0] == "road" and detail["loc"][-1] == "path"
+    assert str(tmp_path / "nowhere.csv") in detail["msg"]
+
+
+# --- config errors ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("data, key", [
+    (dict(kind="bump_step", height=0.05, length=1, speed=0.0, start=0), "speed"),
+    (dict(kind="bump_step", height=0.05, length=1, speed=-3, start=0), "speed"),
+    (dict(kind="bump_half_sine", height=0.05, length=0, speed=1, start=0), "length"),
+    (dict(kind="bump_half_sine", height=0.05, length=1, speed=1, start=-1), "start"),
+    (dict(kind="speed_bump", height=0.05, length=1, speed=1, start=0), None),
+    (dict(kind="bump_step", height=0.05, length=1, speed=1, start=0, lenght=2), "lenght"),
+    (dict(kind="iso8608", road_class="B", convention="iso8608", speed=10, n_min=3.0), "n_max"),
+    (dict(kind="iso8608", road_class="B", convention="iso8608", speed=10, n_max=0.011),
+     "n_max"),
+    (dict(kind="iso8608", road_class="B", speed=10), "convention"),
+    (dict(kind="iso8608", convention="thesis", speed=10), None),
+    (dict(kind="iso8608", road_class="F", convention="thesis", speed=10), "road_class"),
+    (dict(kind="bump_step", height=0.05, length=1, speed=1, start=0, tracks="independent"),
+     "tracks"),
+    (dict(kind="file", path="a.csv", speed=1, tracks="independent"), "tracks"),
+])
+def test_bad_road_values_are_rejected_on_their_key(data, key):
+    with pytest.raises(ValidationError) as error:
+        ROAD.validate_python(data)
+    (detail,) = error.value.errors()
+    if key is not None:
+        assert detail["loc"][-1] == key

@@ -1,0 +1,115 @@
+"""Vehicle assembly and modal analysis against Table 3.5 and closed forms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import suspopt
+from suspopt.vehicle import build_vehicle, modal_analysis
+
+from conftest import corner, make_config
+
+
+def quarter_car_frequencies(m_s, m_u, k, k_t):
+    """Closed form of the 2-DOF quarter car (Eq 2.1-2.2, undamped): roots of
+    ω⁴ - ω² (k/m_s + (k + k_t)/m_u) + k k_t/(m_s m_u) = 0, in Hz, ascending."""
+    b = k / m_s + (k + k_t) / m_u
+    c = k * k_t / (m_s * m_u)
+    disc = np.sqrt(b * b - 4 * c)
+    return np.sqrt([(b - disc) / 2, (b + disc) / 2]) / (2 * np.pi)
+
+
+def modes(load, rel):
+    return modal_analysis(build_vehicle(load(rel)))
+
+
+def freq_of(result, dof):
+    """Frequency of the lowest mode dominated by ``dof`` (design 0)."""
+    idx = np.flatnonzero(result.dominant[0] == dof)
+    return result.frequency[0, idx[0]]
+
+
+# Table 3.5 prints two decimals; one unit in the last place is the tolerance.
+TABLE_TOL = 0.01
+
+
+def test_quarter_car_matches_table_3_5_and_closed_form(load):
+    res = modes(load, "ch3/part1a_qc_bump.yaml")
+    assert np.allclose(res.frequency[0], quarter_car_frequencies(1085 / 4, 40, 1e4, 1.5e5),
+                       rtol=1e-10)
+    assert abs(freq_of(res, "body.heave") - 0.93) <= TABLE_TOL
+    assert abs(freq_of(res, "wheel.F1") - 10.07) <= TABLE_TOL
+
+
+def test_half_roll_and_half_pitch_match_table_3_5(load):
+    hc1 = modes(load, "ch3/part1a_hc1_bump.yaml")
+    assert abs(freq_of(hc1, "body.roll") - 0.78) <= TABLE_TOL
+    assert abs(freq_of(hc1, "body.heave") - 0.94) <= TABLE_TOL
+    hc2 = modes(load, "ch3/part1a_hc2_bump.yaml")
+    assert abs(freq_of(hc2, "body.pitch") - 1.33) <= TABLE_TOL
+    assert abs(freq_of(hc2, "body.heave") - 0.93) <= TABLE_TOL
+    fc = modes(load, "ch3/part1a_fc_bump.yaml")
+    for dof, table in (("body.heave", 0.93), ("body.roll", 0.78), ("body.pitch", 1.33)):
+        assert abs(freq_of(fc, dof) - table) <= TABLE_TOL
+
+
+@pytest.mark.parametrize("preset,inertia,geom", [
+    ("half_pitch", "pitch_inertia", {"a_front": 1.2, "a_rear": 1.2}),
+    ("half_roll", "roll_inertia", {"b_right": 0.8, "b_left": 0.8}),
+])
+def test_symmetric_half_car_rotation_closed_form(preset, inertia, geom):
+    """With equal lever arms a, the rotation mode is a quarter car of mass I/(2 a²)."""
+    m, I, a = 600.0, 700.0, 1.2 if preset == "half_pitch" else 0.8
+    cfg = make_config({
+        "vehicle": {"preset": preset, "body": {"mass": m, inertia: I, **geom},
+                    "corner_defaults": corner(m_u=45, k_t=2e5, k=2.5e4)},
+        "road": {"kind": "bump_step", "height": 0.01, "length": 1, "speed": 10, "start": 0},
+        "simulation": {"duration": 1.0}})
+    f = modal_analysis(build_vehicle(cfg)).frequency[0]
+    heave = quarter_car_frequencies(m / 2, 45, 2.5e4, 2e5)
+    rotation = quarter_car_frequencies(I / (2 * a * a), 45, 2.5e4, 2e5)
+    assert np.allclose(np.sort(f), np.sort(np.r_[heave, rotation]), rtol=1e-10)
+
+
+def test_anti_roll_bar_raises_only_the_roll_frequency(load):
+    plain = modes(load, "ch3/part2a_fc_no_arb_bump.yaml")
+    bars = modes(load, "ch3/part2a_fc_arb_bump.yaml")
+    assert freq_of(bars, "body.roll") > freq_of(plain, "body.roll") + 0.1
+    for dof in ("body.heave", "body.pitch"):
+        # b1 != b2 couples heave and roll a little; Table 3.15 prints both as equal
+        assert freq_of(bars, dof) == pytest.approx(freq_of(plain, dof), abs=0.005)
+
+
+def test_static_tyre_loads_carry_the_weight(load):
+    for rel in ("ch3/part1a_fc_bump.yaml", "quickstart.yaml"):
+        cfg = load(rel)
+        model = build_vehicle(cfg)
+        weight = cfg.vehicle.gravity * (cfg.vehicle.body.mass + model.unsprung_mass.sum())
+        assert model.static_tyre_load.sum() == pytest.approx(weight, rel=1e-12)
+    hc2 = build_vehicle(load("quickstart.yaml"))
+    # moments about the CG: front load a_F = rear load a_R for the sprung part
+    body = hc2.static_tyre_load[0, 0] - hc2.unsprung_mass[0, 0] * 9.81
+    assert body[0] * 1.61 == pytest.approx(body[1] * 1.67, rel=1e-9)
+
+
+def test_travel_sign_convention(load):
+    """ST_i = z_s + y_i φ - x_i θ - z_ui (DESIGN.md; Eq 2.26 with ERRATA)."""
+    model = build_vehicle(load("ch3/part1a_fc_bump.yaml"))
+    q = np.zeros((1, 1, model.n_dof))
+    q[..., 1] = 0.01  # roll
+    q[..., 2] = 0.02  # pitch
+    st = model.travel(q)[0, 0]
+    b1, b2, aF, aR = 0.7, 0.75, 1.4, 1.47
+    expect = [b1 * .01 - aF * .02, -b2 * .01 - aF * .02, b1 * .01 + aR * .02,
+              -b2 * .01 + aR * .02]
+    assert np.allclose(st, expect, rtol=1e-14)
+
+
+def test_frequency_response_peaks_at_body_mode(load):
+    cfg = load("ch3/part1a_qc_bump.yaml")
+    model = build_vehicle(cfg)
+    f = np.linspace(0.2, 3, 2000)
+    H = suspopt.frequency_response(model, f)[0, :, 0]
+    assert f[np.argmax(np.abs(H))] == pytest.approx(0.93, abs=0.05)
+    assert abs(H[0]) == pytest.approx(1.0, rel=0.05)   # body follows the road at low frequency
