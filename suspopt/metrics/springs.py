@@ -1,0 +1,26 @@
+"""Usage of the non-linear part of a Duffing suspension spring (thesis Eq 5.3, spring Eq 2.31)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["nonlinear_spring_usage"]
+
+
+def nonlinear_spring_usage(travel: np.ndarray, k_linear: np.ndarray | float,
+                           k_nonlinear: np.ndarray | float) -> np.ndarray:
+    """``Ratio = max_t k_nl x³ / (k_l x + k_nl x³)``, dimensionless (thesis Eq 5.3).
+
+    The share of the spring force ``k_l x + k_nl x³`` (Eq 2.31) carried by the cubic term, at its
+    largest over the record. ``travel`` ``x`` in m, ``(T,)`` or ``(P, T)``; ``k_linear`` in N/m
+    and ``k_nonlinear`` in N/m³, scalars or one per design ``(P,)``. The ratio is evaluated as
+    ``k_nl x² / (k_l + k_nl x²)``, equal for ``x ≠ 0``; where the cubic force is zero (``x = 0``,
+    the 0/0 of Eq 5.3, or ``k_nl = 0``) it is defined as 0. Chapter 5 constrains it to 10-30 %.
+    """
+    x2 = np.square(np.asarray(travel, dtype=float))
+    k_l = np.asarray(k_linear, dtype=float)[..., None]
+    k_nl = np.asarray(k_nonlinear, dtype=float)[..., None]
+    cubic = k_nl * x2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where(cubic != 0.0, cubic / (k_l + cubic), 0.0)
+    return np.max(ratio, axis=-1)

@@ -1,0 +1,160 @@
+"""Statistics of signals along time, and the handling / road-holding metrics (thesis Sec 2.4.4).
+
+Every function reduces the last (time) axis of ``(T,)`` or ``(P, T)`` samples to a scalar or
+``(P,)``, in the unit of the signal (squared for variances). Sample statistics weight the samples
+equally, as the thesis's sums over ``j = 1..n`` do; the simulator's fixed step makes that a time
+average.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+__all__ = [
+    "STATISTICS",
+    "var",
+    "std",
+    "rms",
+    "maximum",
+    "minimum",
+    "max_abs",
+    "mean",
+    "peak_to_peak",
+    "suspension_travel_variance",
+    "suspension_travel_max",
+    "suspension_travel_max_abs",
+    "tyre_deflection_variance",
+    "tyre_deflection_max",
+    "tyre_deflection_max_abs",
+    "pitch_variance",
+    "dynamic_tyre_load_ratio",
+    "peak_dynamic_tyre_load_ratio",
+    "peak_tyre_force",
+]
+
+
+def var(x: np.ndarray) -> np.ndarray:
+    """Population variance ``(1/n) Σ (x_j - x̄)²`` along time (thesis Eq 2.87, 2.89, 2.91)."""
+    return np.var(x, axis=-1)
+
+
+def std(x: np.ndarray) -> np.ndarray:
+    """Population standard deviation along time, the square root of :func:`var`."""
+    return np.std(x, axis=-1)
+
+
+def rms(x: np.ndarray) -> np.ndarray:
+    """Root mean square ``[(1/n) Σ x_j²]^½`` along time (mean not removed)."""
+    return np.sqrt(np.mean(np.square(x), axis=-1))
+
+
+def maximum(x: np.ndarray) -> np.ndarray:
+    """Largest (signed) sample along time (thesis Eq 2.88, 2.90: ``MAX``)."""
+    return np.max(x, axis=-1)
+
+
+def minimum(x: np.ndarray) -> np.ndarray:
+    """Smallest (signed) sample along time."""
+    return np.min(x, axis=-1)
+
+
+def max_abs(x: np.ndarray) -> np.ndarray:
+    """Largest magnitude ``max_j |x_j|`` along time."""
+    return np.max(np.abs(x), axis=-1)
+
+
+def mean(x: np.ndarray) -> np.ndarray:
+    """Arithmetic mean along time."""
+    return np.mean(x, axis=-1)
+
+
+def peak_to_peak(x: np.ndarray) -> np.ndarray:
+    """Range ``max - min`` along time."""
+    return np.ptp(x, axis=-1)
+
+
+STATISTICS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
+    "var": var,
+    "std": std,
+    "rms": rms,
+    "max": maximum,
+    "min": minimum,
+    "max_abs": max_abs,
+    "mean": mean,
+    "peak_to_peak": peak_to_peak,
+}
+"""Statistic name -> function of a signal ``(..., T)`` returning ``(...)``; objectives use these
+names (ERRATA: objectives must be configurable as var / std / rms / max of a signal). The
+functions are named ``maximum`` / ``minimum`` so that they do not shadow the builtins."""
+
+
+def suspension_travel_variance(travel: np.ndarray) -> np.ndarray:
+    """VST: variance of the suspension travel in m² (thesis Eq 2.87)."""
+    return var(travel)
+
+
+def suspension_travel_max(travel: np.ndarray) -> np.ndarray:
+    """MST: maximum (signed, as printed) of the suspension travel in m (thesis Eq 2.88).
+
+    Eq 2.88 reads ``MAX(ST_i)``; the largest excursion either way is
+    :func:`suspension_travel_max_abs`.
+    """
+    return maximum(travel)
+
+
+def suspension_travel_max_abs(travel: np.ndarray) -> np.ndarray:
+    """Largest suspension travel magnitude in m, the two-sided reading of Eq 2.88."""
+    return max_abs(travel)
+
+
+def tyre_deflection_variance(deflection: np.ndarray) -> np.ndarray:
+    """VTD: variance of the tyre deflection in m² (thesis Eq 2.89)."""
+    return var(deflection)
+
+
+def tyre_deflection_max(deflection: np.ndarray) -> np.ndarray:
+    """MTD: maximum (signed, as printed) of the tyre deflection in m (thesis Eq 2.90)."""
+    return maximum(deflection)
+
+
+def tyre_deflection_max_abs(deflection: np.ndarray) -> np.ndarray:
+    """Largest tyre deflection magnitude in m, the two-sided reading of Eq 2.90."""
+    return max_abs(deflection)
+
+
+def pitch_variance(pitch: np.ndarray) -> np.ndarray:
+    """PTC: variance of the body pitch angle in rad² (thesis Eq 2.91)."""
+    return var(pitch)
+
+
+def dynamic_tyre_load_ratio(tyre_force: np.ndarray, static_load: np.ndarray | float) -> np.ndarray:
+    """Standard deviation of the tyre force over the static wheel load, dimensionless.
+
+    ``tyre_force`` in N, ``(..., T)``; ``static_load`` in N, scalar or ``(...)`` (one per design).
+    The standard deviation ignores the mean, so the force may be the dynamic part (the thesis's
+    ``k_T·TD`` about equilibrium, Eq 2.28) or the total load. The thesis scores road holding by
+    tyre deflection (Eq 2.89); this is the same quantity normalised by the load it rides on.
+    """
+    return std(tyre_force) / np.asarray(static_load, dtype=float)
+
+
+def peak_dynamic_tyre_load_ratio(tyre_force: np.ndarray, static_load: np.ndarray | float,
+                                 includes_static: bool = False) -> np.ndarray:
+    """Largest dynamic tyre force magnitude over the static wheel load, dimensionless.
+
+    ``tyre_force`` in N is the dynamic force about static equilibrium (Eq 2.28) unless
+    ``includes_static`` is true, in which case ``static_load`` (N) is subtracted first. A ratio
+    of 1 means the wheel momentarily carries no load (or twice its static load).
+    """
+    load = np.asarray(static_load, dtype=float)
+    dynamic = np.asarray(tyre_force, dtype=float)
+    if includes_static:
+        dynamic = dynamic - load[..., None]
+    return max_abs(dynamic) / load
+
+
+def peak_tyre_force(tyre_force: np.ndarray) -> np.ndarray:
+    """Largest tyre force magnitude in N along time."""
+    return max_abs(tyre_force)
