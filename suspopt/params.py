@@ -6,6 +6,7 @@ one batch; every field not in ``params`` keeps its config value for all designs.
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Mapping
 from typing import Any
 
@@ -44,7 +45,6 @@ class ParamView:
         sizes = set()
         for path, value in (params or {}).items():
             if path not in self.values:
-                import difflib
                 close = difflib.get_close_matches(path, list(self.values), n=3)
                 hint = f"; did you mean {', '.join(close)}?" if close else ""
                 raise ConfigError(f"params: {path}: not a numeric field of this config{hint}")

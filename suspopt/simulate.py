@@ -12,9 +12,11 @@ so a diverged design can never pass for a valid one.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
+
+import difflib
 
 import numpy as np
 
@@ -30,38 +32,143 @@ DIVERGENCE_LIMIT = 1.0e6
 _CHECK_EVERY = 25
 
 
+class Controller(Protocol):
+    """A semi-active damper controller (built by :mod:`suspopt.control`).
+
+    The integrator calls ``start`` once, then ``step`` at the start of every integration step
+    with the vehicle states ``q, v (P, 1, n)``; ``step`` returns the damping coefficients
+    ``(P, 1, N)`` [N s/m] held over that step, so a digital controller changes them only at
+    its own sample instants (zero-order hold). ``acceleration()`` gives the vehicle
+    accelerations ``(P, 1, n)`` at the current instant, computed only when called.
+    ``record`` returns the controller's quantities ``{name: (P, N)}`` at output instants;
+    they become the signals ``<name>.<corner>`` with units ``units[name]``.
+    """
+
+    units: dict[str, str]
+
+    def start(self, P: int) -> np.ndarray: ...
+
+    def step(self, k: int, t: float, q: np.ndarray, v: np.ndarray,
+             acceleration: Callable[[], np.ndarray]) -> np.ndarray: ...
+
+    def record(self) -> dict[str, np.ndarray]: ...
+
+
+class Attachment(Protocol):
+    """Extra bodies mounted at a point of the vehicle body (a seat, a seated passenger).
+
+    ``dof_names`` name its vertical DOFs (appended after the vehicle's), ``mass (1|P, 1, m)``
+    their masses. ``point = (x, y)`` is where it sits on the body [m] (x + forward, y + right);
+    the base motion is the body's vertical motion there. ``force`` returns the forces on its
+    own DOFs ``(P, S, m)`` and the vertical force it exerts on the body at the point
+    ``(P, S)`` (upward +), which acts on the body only when ``coupled`` (two-way); the thesis
+    drives seats one way. ``signal(name, ...)`` computes its named signals ``(P, S)``.
+    """
+
+    dof_names: tuple[str, ...]
+    mass: np.ndarray
+    point: tuple[float, float]
+    coupled: bool
+
+    def force(self, q: np.ndarray, v: np.ndarray, base: np.ndarray,
+              base_vel: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def signal_names(self) -> list[str]: ...
+
+    def signal(self, name: str, q: np.ndarray, v: np.ndarray, acc: np.ndarray,
+               base: np.ndarray, base_vel: np.ndarray, base_acc: np.ndarray) -> np.ndarray: ...
+
+
 class _Dynamics:
-    """Right-hand side y' = [q', M^-1 f(q, q', road)] of the first-order system y = [q, q']."""
+    """Right-hand side y' = [q', M^-1 f(q, q', road)] of the first-order system y = [q, q'],
+    q = [vehicle DOFs, attachment DOFs]."""
 
-    def __init__(self, model: VehicleModel):
+    def __init__(self, model: VehicleModel, attachments: Sequence[Attachment] = ()):
         self.model = model
-        self.n = model.n_dof
-        self.inverse_mass = 1.0 / model.mass
+        self.attachments = tuple(attachments)
+        self.n_vehicle = model.n_dof
+        self.slices, start = [], model.n_dof
+        for att in self.attachments:
+            self.slices.append(slice(start, start + len(att.dof_names)))
+            start += len(att.dof_names)
+        self.n = start
+        self.point_rows = [model.point_map(*att.point) for att in self.attachments]
+        masses = [model.mass] + [att.mass for att in self.attachments]
+        P = max(m.shape[0] for m in masses)
+        self.inverse_mass = 1.0 / np.concatenate(
+            [np.broadcast_to(m, (P, 1, m.shape[-1])) for m in masses], axis=-1)
 
-    def __call__(self, y: np.ndarray, road: np.ndarray, road_vel: np.ndarray) -> np.ndarray:
-        q, v = y[..., :self.n], y[..., self.n:]
-        force = self.model.generalised_force(q, v, road, road_vel)
-        return np.concatenate([v, force * self.inverse_mass], axis=-1)
+    def base(self, j: int, x: np.ndarray) -> np.ndarray:
+        """Body displacement (or velocity, acceleration) at attachment j's point, (P, S)."""
+        return x[..., :self.n_vehicle] @ self.point_rows[j]
+
+    def __call__(self, y: np.ndarray, road: np.ndarray, road_vel: np.ndarray,
+                 damping: np.ndarray | None = None) -> np.ndarray:
+        n, nv = self.n, self.n_vehicle
+        q, v = y[..., :n], y[..., n:]
+        force = self.model.generalised_force(q[..., :nv], v[..., :nv], road, road_vel, damping)
+        parts = [force]
+        for j, att in enumerate(self.attachments):
+            sl = self.slices[j]
+            own, reaction = att.force(q[..., sl], v[..., sl], self.base(j, q), self.base(j, v))
+            if att.coupled:
+                force = force + reaction[..., None] * self.point_rows[j]
+                parts[0] = force
+            parts.append(own)
+        acc = (np.concatenate(parts, axis=-1) if len(parts) > 1 else parts[0]) \
+            * self.inverse_mass
+        return np.concatenate([v, acc], axis=-1)
+
+
+@dataclass
+class _Trajectory:
+    """What one integration produced: states (P, T, 2n), damping (P, T, N) or None,
+    controller records {name: (P, T, N)} and the divergence times (P,)."""
+
+    states: np.ndarray
+    damping: np.ndarray | None
+    records: dict[str, np.ndarray]
+    diverged_at: np.ndarray
 
 
 def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt: float,
-               n_steps: int, every: int):
+               n_steps: int, every: int, controller: Controller | None = None) -> _Trajectory:
     """RK4 over ``n_steps``; ``road``/``road_vel`` are (2 n_steps + 1, 1, 1, N) on the
-    half-step grid. Returns states (P, T, 2n) at every ``every``-th step, diverged, time."""
-    n2 = 2 * f.n
+    half-step grid. Samples are kept at every ``every``-th step."""
+    n, n2 = f.n, 2 * f.n
     y = np.zeros((P, 1, n2))
     n_out = n_steps // every + 1
     states = np.empty((n_out, P, n2))      # time-major: each sample is one contiguous write
-    states[0] = y[:, 0]
+    damping_out = records = None
+    damping = None
+    if controller is not None:
+        damping = controller.start(P)
+        damping_out = np.empty((n_out, P, len(f.model.corners)))
+        records = {}
     diverged_at = np.full(P, np.nan)
     half = 0.5 * dt
+    nv = f.n_vehicle
+
+    def keep(j: int) -> None:
+        states[j] = y[:, 0]
+        if controller is not None:
+            damping_out[j] = damping[:, 0]
+            for name, value in controller.record().items():
+                records.setdefault(name, np.empty((n_out,) + value.shape))[j] = value
+
     with np.errstate(over="ignore", invalid="ignore"):
         for k in range(n_steps):
             i = 2 * k
-            k1 = f(y, road[i], road_vel[i])
-            k2 = f(y + half * k1, road[i + 1], road_vel[i + 1])
-            k3 = f(y + half * k2, road[i + 1], road_vel[i + 1])
-            k4 = f(y + dt * k3, road[i + 2], road_vel[i + 2])
+            if controller is not None:
+                def acceleration(y=y, i=i, damping=damping):
+                    return f(y, road[i], road_vel[i], damping)[..., n:n + nv]
+                damping = controller.step(k, k * dt, y[..., :nv], y[..., n:n + nv], acceleration)
+            if k == 0:
+                keep(0)
+            k1 = f(y, road[i], road_vel[i], damping)
+            k2 = f(y + half * k1, road[i + 1], road_vel[i + 1], damping)
+            k3 = f(y + half * k2, road[i + 1], road_vel[i + 1], damping)
+            k4 = f(y + dt * k3, road[i + 2], road_vel[i + 2], damping)
             y = y + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
             if (k + 1) % _CHECK_EVERY == 0 or k + 1 == n_steps:
                 bad = ~(np.abs(y) < DIVERGENCE_LIMIT).all(axis=(1, 2))
@@ -70,8 +177,13 @@ def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt:
                     diverged_at[new] = (k + 1) * dt
                     y[bad] = np.nan
             if (k + 1) % every == 0:
-                states[(k + 1) // every] = y[:, 0]
-    return np.ascontiguousarray(states.transpose(1, 0, 2)), diverged_at
+                keep((k + 1) // every)
+
+    def time_second(a):
+        return None if a is None else np.ascontiguousarray(np.moveaxis(a, 0, 1))
+    return _Trajectory(states=time_second(states), damping=time_second(damping_out),
+                       records={k: time_second(v) for k, v in (records or {}).items()},
+                       diverged_at=diverged_at)
 
 
 def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> "Result":
@@ -82,18 +194,27 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> "Result":
     """
     pv = ParamView(cfg, params)
     model = build_vehicle(cfg, pv)
+    controller: Controller | None = None
+    attachments: list[Attachment] = []
+    return _run(cfg, pv, model, controller, attachments)
+
+
+def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller | None,
+         attachments: Sequence[Attachment]) -> "Result":
     sim = cfg.simulation
     n_steps, every = sim.n_steps, sim.output_every
     t_grid = np.arange(2 * n_steps + 1) * (0.5 * sim.dt)
     z, zd = road_inputs(cfg.road, model.offsets, model.sides, t_grid, base_dir=cfg.base_dir)
     road = np.ascontiguousarray(z.T)[:, None, None, :]
     road_vel = np.ascontiguousarray(zd.T)[:, None, None, :]
-    f = _Dynamics(model)
-    states, diverged_at = _integrate(f, pv.P, road, road_vel, sim.dt, n_steps, every)
+    f = _Dynamics(model, attachments)
+    traj = _integrate(f, pv.P, road, road_vel, sim.dt, n_steps, every, controller)
     out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
-    return Result(config=cfg, model=model, time=t_grid[out_idx], states=states,
+    return Result(config=cfg, model=model, time=t_grid[out_idx], states=traj.states,
                   road=z[:, out_idx].T[None], road_vel=zd[:, out_idx].T[None],
-                  diverged_at=diverged_at, designs=dict(pv.params), _dynamics=f)
+                  diverged_at=traj.diverged_at, designs=dict(pv.params), _dynamics=f,
+                  damping_history=traj.damping, controller_records=traj.records,
+                  controller_units=dict(getattr(controller, "units", {})))
 
 
 _BODY_UNITS = {"heave": "m", "roll": "rad", "pitch": "rad"}
@@ -128,6 +249,13 @@ class SignalMap(Mapping):
         for head in ("travel", "travel_vel", "tyre_deflection", "tyre_force", "spring_force",
                      "damper_force", "damping", "road", "road_vel"):
             names += [f"{head}.{c}" for c in m.corners]
+        for head in result.controller_records:
+            names += [f"{head}.{c}" for c in m.corners]
+        self._attachment_of: dict[str, int] = {}
+        for j, att in enumerate(result._dynamics.attachments):
+            for name in att.signal_names():
+                self._attachment_of[name] = j
+                names.append(name)
         self._names = names
 
     def __iter__(self) -> Iterator[str]:
@@ -139,7 +267,6 @@ class SignalMap(Mapping):
     def __getitem__(self, name: str) -> np.ndarray:
         if name not in self._cache:
             if name not in self._names:
-                import difflib
                 close = difflib.get_close_matches(name, self._names, n=3)
                 raise KeyError(f"unknown signal {name!r}" +
                                (f"; did you mean {', '.join(close)}?" if close else ""))
@@ -148,31 +275,34 @@ class SignalMap(Mapping):
 
     def _compute(self, name: str) -> np.ndarray:
         r, m = self._r, self._r.model
+        if name in self._attachment_of:
+            return r.attachment_signal(self._attachment_of[name], name)
         parts = name.split(".")
         head = parts[0]
         if head == "body":
             dof, _, deriv = parts[1].partition("_")
-            j = m.body_dofs.index(dof)
-            return r.channel(deriv, j)
+            return r.channel(deriv, m.body_dofs.index(dof))
         c = m.corners.index(parts[1])
+        if head in r.controller_records:
+            return r.controller_records[head][..., c]
         if head == "wheel":
-            deriv = parts[2].partition("_")[2]
-            return r.channel(deriv, m.n_body + c)
+            return r.channel(parts[2].partition("_")[2], m.n_body + c)
         if head in ("road", "road_vel"):
             src = r.road if head == "road" else r.road_vel
             return np.broadcast_to(src[..., c], (m.P, r.time.size)).copy()
         if head in ("travel", "spring_force"):
             st = r.per_corner("travel")
             return (st if head == "travel" else m.spring_force(st))[..., c]
-        if head in ("travel_vel", "damper_force"):
-            std = r.per_corner("travel_vel")
-            return (std if head == "travel_vel" else m.damper * std)[..., c]
+        if head == "travel_vel":
+            return r.per_corner("travel_vel")[..., c]
+        if head == "damper_force":
+            return (r.damping_coefficient() * r.per_corner("travel_vel"))[..., c]
+        if head == "damping":
+            return np.broadcast_to(r.damping_coefficient()[..., c], (m.P, r.time.size)).copy()
         if head == "tyre_deflection":
             return r.q[..., m.n_body + c] - r.road[..., c]
         if head == "tyre_force":
-            return m.tyre_force(r.q, r.v, r.road, r.road_vel)[..., c]
-        if head == "damping":
-            return np.broadcast_to(m.damper[..., c], (m.P, r.time.size)).copy()
+            return m.tyre_force(r.vehicle_q, r.vehicle_v, r.road, r.road_vel)[..., c]
         raise KeyError(name)
 
 
@@ -194,6 +324,9 @@ class Result:
     diverged_at: np.ndarray
     designs: dict[str, np.ndarray]
     _dynamics: _Dynamics
+    damping_history: np.ndarray | None = None
+    controller_records: dict[str, np.ndarray] = field(default_factory=dict)
+    controller_units: dict[str, str] = field(default_factory=dict)
     metrics: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self):
@@ -212,27 +345,53 @@ class Result:
 
     @property
     def q(self) -> np.ndarray:
-        return self.states[..., : self.model.n_dof]
+        """Displacements of every DOF (vehicle, then attachments), (P, T, n)."""
+        return self.states[..., : self._dynamics.n]
 
     @property
     def v(self) -> np.ndarray:
-        return self.states[..., self.model.n_dof:]
+        """Velocities of every DOF, (P, T, n)."""
+        return self.states[..., self._dynamics.n:]
+
+    @property
+    def vehicle_q(self) -> np.ndarray:
+        return self.q[..., : self.model.n_dof]
+
+    @property
+    def vehicle_v(self) -> np.ndarray:
+        return self.v[..., : self.model.n_dof]
+
+    def damping_coefficient(self) -> np.ndarray:
+        """Damper coefficient of every corner, (P, T, N) or (P, 1, N) when passive [N s/m]."""
+        return self.model.damper if self.damping_history is None else self.damping_history
+
+    def acceleration(self) -> np.ndarray:
+        """Accelerations of every DOF, (P, T, n), from the equations of motion."""
+        if self._derivative is None:
+            with np.errstate(invalid="ignore", over="ignore"):
+                damping = self.damping_history
+                self._derivative = self._dynamics(self.states, self.road, self.road_vel,
+                                                  damping)
+        return self._derivative[..., self._dynamics.n:]
+
+    def attachment_signal(self, j: int, name: str) -> np.ndarray:
+        f = self._dynamics
+        sl = f.slices[j]
+        acc = self.acceleration()
+        return f.attachments[j].signal(name, self.q[..., sl], self.v[..., sl], acc[..., sl],
+                                       f.base(j, self.q), f.base(j, self.v), f.base(j, acc))
 
     def channel(self, deriv: str, j: int) -> np.ndarray:
         """DOF ``j`` displacement (''), velocity ('vel') or acceleration ('acc'), (P, T)."""
-        n = self.model.n_dof
         if deriv == "":
-            return self.states[..., j]
+            return self.q[..., j]
         if deriv == "vel":
-            return self.states[..., n + j]
-        if self._derivative is None:
-            with np.errstate(invalid="ignore", over="ignore"):
-                self._derivative = self._dynamics(self.states, self.road, self.road_vel)
-        return self._derivative[..., n + j]
+            return self.v[..., j]
+        return self.acceleration()[..., j]
 
     def per_corner(self, kind: str) -> np.ndarray:
         """(P, T, N) suspension travel ('travel') or its rate ('travel_vel')."""
         if kind not in self._corner_cache:
-            src = self.q if kind == "travel" else self.v
+            src = self.vehicle_q if kind == "travel" else self.vehicle_v
             self._corner_cache[kind] = self.model.travel(src)
         return self._corner_cache[kind]

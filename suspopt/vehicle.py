@@ -119,19 +119,30 @@ class VehicleModel:
         return self.static_tyre_load + self.dynamic_tyre_force(q, v, road, road_vel)
 
     def generalised_force(self, q: np.ndarray, v: np.ndarray, road: np.ndarray,
-                          road_vel: np.ndarray) -> np.ndarray:
+                          road_vel: np.ndarray, damping: np.ndarray | None = None) -> np.ndarray:
         """Right-hand side of M q'' = f: suspension, tyre and anti-roll-bar forces, (P, S, n).
 
         Each suspension force ``F_K + F_C`` acts along the travel map (``-J^T F``), each tyre
-        force on its wheel, each anti-roll bar along its twist map (Eq 2.1-2.25).
+        force on its wheel, each anti-roll bar along its twist map (Eq 2.1-2.25). ``damping``
+        (P, 1|S, N) [N s/m] replaces the passive coefficients (a semi-active damper's current
+        value, Eq 2.32-2.33).
         """
-        force = self.spring_force(self.travel(q)) + self.damper * self.travel(v)
+        c = self.damper if damping is None else damping
+        force = self.spring_force(self.travel(q)) + c * self.travel(v)
         gen = -matvec(self.travel_map, force)
         gen[..., self.wheels] += self.dynamic_tyre_force(q, v, road, road_vel)
         if self.bar_map is not None:
             twist = matvec(np.swapaxes(self.bar_map, 1, 2), q)
             gen -= matvec(self.bar_map, self.bar_stiffness * twist)
         return gen
+
+    def point_map(self, x: float, y: float) -> np.ndarray:
+        """Row (n,) giving the body's vertical displacement at the body point (x, y) [m]
+        (x + forward, y + right) from q: z_s + y φ - x θ."""
+        row = np.zeros(self.n_dof)
+        for j, dof in enumerate(self.body_dofs):
+            row[j] = {"heave": 1.0, "roll": y, "pitch": -x}[dof]
+        return row
 
     def __post_init__(self):
         self._travel_map_t = np.swapaxes(self.travel_map, 1, 2)
