@@ -111,3 +111,38 @@ def simulate(config: Path = typer.Argument(..., help="YAML config file"),
         except KeyError as exc:
             _fail(f"output.signals: {exc.args[0]}")
         out.print(f"wrote {output}")
+
+
+@app.command()
+def analyse(kind: str = typer.Argument(..., help="analysis kind"),
+            source: Path = typer.Argument(..., help="YAML config or result HDF5 file"),
+            output: Optional[Path] = typer.Option(None, "-o", "--output",
+                                                  help="HDF5 file for the numbers"),
+            plot: Optional[Path] = typer.Option(None, "--plot",
+                                                help="figure file (.png or .svg)")) -> None:
+    """Run an analysis (see the README for the kinds) and print its table."""
+    from .analyse import analysis_kinds
+
+    kinds = analysis_kinds()
+    if kind not in kinds:
+        _fail(f"analyse: unknown kind {kind!r}; available: {', '.join(sorted(kinds))}")
+    if not source.exists():
+        _fail(f"{source}: no such file")
+    for path in (output, plot):
+        if path is not None and not path.parent.exists():
+            _fail(f"{path}: folder {path.parent} does not exist")
+    try:
+        report = kinds[kind](source, output, plot)
+    except (ConfigError, FileNotFoundError, ValueError) as exc:
+        _fail(str(exc))
+    table = Table(title=report.title)
+    for col in report.columns:
+        table.add_column(col)
+    for row in report.rows:
+        table.add_row(*row)
+    out.print(table)
+    for note in report.notes:
+        out.print(note)
+    for path in (output, plot):
+        if path is not None:
+            out.print(f"wrote {path}")
