@@ -9,6 +9,7 @@ __version__ = "0.1.0"
 from .config import Config, ConfigError, config_schema, load_config  # noqa: E402
 from .simulate import Result, simulate  # noqa: E402
 from .vehicle import build_vehicle, frequency_response, modal_analysis  # noqa: E402
+from .optimise import Problem  # noqa: E402
 
 __all__ = ["__version__", "Config", "ConfigError", "config_schema", "load_config", "Result",
-           "simulate", "build_vehicle", "modal_analysis", "frequency_response"]
+           "simulate", "build_vehicle", "modal_analysis", "frequency_response", "Problem"]

@@ -45,7 +45,18 @@ def _command() -> str:
 @app.command()
 def validate(config: Path = typer.Argument(..., help="YAML config file")) -> None:
     """Check a config file and report the first problem with its line."""
+    from .simulate import check
+
     cfg = _load(config)
+    try:
+        check(cfg)
+        if cfg.design_variables or cfg.objectives or cfg.optimiser:
+            from .optimise import Problem, build_optimiser
+            problem = Problem.from_config(cfg)
+            if cfg.optimiser is not None:
+                build_optimiser(cfg, problem)
+    except ConfigError as exc:
+        _fail(str(exc))
     out.print(f"{config}: valid ({cfg.vehicle.preset}, road {cfg.road.kind})")
 
 
@@ -83,6 +94,19 @@ def _summary_table(result) -> Table:
     return table
 
 
+def _metrics_table(result) -> Table:
+    """The config's metrics (``metrics:`` section), one row each."""
+    P = min(result.P, 5)
+    table = Table(title="metrics")
+    table.add_column("metric")
+    table.add_column("unit")
+    for p in range(P):
+        table.add_column(f"design {p}" if result.P > 1 else "value", justify="right")
+    for name, values in result.metrics.items():
+        table.add_row(name, result.metric_units[name], *(f"{v:.4g}" for v in values[:P]))
+    return table
+
+
 @app.command()
 def simulate(config: Path = typer.Argument(..., help="YAML config file"),
              output: Optional[Path] = typer.Option(None, "-o", "--output",
@@ -96,13 +120,15 @@ def simulate(config: Path = typer.Argument(..., help="YAML config file"),
         _fail(f"-o {output}: folder {output.parent} does not exist")
     try:
         result = run(cfg)
-    except (ConfigError, FileNotFoundError, ValueError) as exc:
+    except (ConfigError, FileNotFoundError) as exc:
         _fail(str(exc))
     if result.diverged.any():
         err.print(f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
                   f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
                   f"try a smaller simulation.dt", markup=False)
     out.print(_summary_table(result))
+    if result.metrics:
+        out.print(_metrics_table(result))
     if output is not None:
         signals = None if cfg.output.signals == "all" else cfg.output.signals
         try:
@@ -146,3 +172,91 @@ def analyse(kind: str = typer.Argument(..., help="analysis kind"),
     for path in (output, plot):
         if path is not None:
             out.print(f"wrote {path}")
+
+
+def _progress_line(p) -> str:
+    """One generation's report: budget, evaluations, best or hypervolume, feasible share."""
+    gen = f"gen {p.generation}" + (f"/{p.max_generations}" if p.max_generations else "")
+    if not np.isfinite(p.best).any():
+        score = "none feasible yet"
+    else:
+        score = f"HV {p.hypervolume:.4g}" if p.best.size > 1 else f"best {p.best[0]:.4g}"
+    left = f", {p.time_left:.0f} s left" if p.time_left is not None else ""
+    return (f"{p.phase} {gen}, {p.evaluations} evaluations, {score}, "
+            f"{100 * p.feasible:.0f} % feasible{left}")
+
+
+def _optimum_table(result, rows: int = 12) -> Table:
+    """The best design (one column), or up to ``rows`` designs spread along the Pareto front
+    (one row each)."""
+    from rich.markup import escape
+
+    N = len(result.X)
+    names = result.obj_names + result.var_names
+    units = result.obj_units + result.var_units
+    values = np.hstack([result.F, result.X])
+    feasible = ["yes" if ok else "no" for ok in (result.G <= 0).all(axis=1)]
+    suffix = "" if result.status == "finished" else " (interrupted)"
+    if N == 1:
+        table = Table(title="best design" + suffix)
+        for col in ("quantity", "unit", "value"):
+            table.add_column(col, justify="right" if col == "value" else "left")
+        for name, unit, value in zip(names, units, values[0]):
+            table.add_row(name, unit, f"{value:.5g}")
+        table.add_row("feasible", "", feasible[0])
+        return table
+    pick = np.unique(np.linspace(0, N - 1, min(rows, N)).round().astype(int))
+    table = Table(title=f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
+    table.add_column("#", justify="right")
+    for name, unit in zip(names, units):
+        table.add_column(escape(f"{name} [{unit}]"), justify="right")
+    table.add_column("feasible")
+    for i in pick:
+        table.add_row(str(i), *(f"{v:.4g}" for v in values[i]), feasible[i])
+    return table
+
+
+@app.command()
+def optimise(config: Path = typer.Argument(..., help="YAML config file"),
+             output: Optional[Path] = typer.Option(
+                 None, "-o", "--output", help="HDF5 file (default CONFIG's name with .h5 in "
+                 "the current folder), rewritten every generation"),
+             resume: bool = typer.Option(False, "--resume",
+                                         help="continue from the checkpoint in OUT.h5")) -> None:
+    """Optimise the config's design variables; write the optimum or Pareto set to HDF5."""
+    from rich.progress import BarColumn, Progress, TextColumn
+
+    from .optimise import optimise as run
+
+    cfg = _load(config)
+    output = output if output is not None else Path(config.stem + ".h5")
+    if not output.parent.exists():
+        _fail(f"-o {output}: folder {output.parent} does not exist")
+    total = cfg.optimiser.generations if cfg.optimiser is not None else None
+    bar = Progress(TextColumn("{task.description}"), BarColumn(), console=err,
+                   disable=not err.is_terminal)
+    task = bar.add_task("starting", total=total)
+
+    def report(p) -> None:
+        bar.update(task, completed=p.generation, description=_progress_line(p))
+        if not err.is_terminal:
+            err.print(_progress_line(p), markup=False, highlight=False)
+
+    try:
+        with bar:
+            result = run(cfg, output, resume=resume, callback=report, command=_command())
+    except ConfigError as exc:
+        _fail(str(exc))
+    except KeyboardInterrupt:
+        err.print("interrupted before the first generation completed; nothing written")
+        raise typer.Exit(code=130)
+    out.print(_optimum_table(result))
+    if result.weights is not None:
+        out.print("weighted sum (Eq 5.7): " + " + ".join(
+            f"{w:.4g} {name}" for w, name in zip(result.weights, result.obj_names)))
+    if result.status == "interrupted":
+        err.print(f"interrupted: wrote the designs found so far to {output}; continue with "
+                  f"suspopt optimise {config} -o {output} --resume", markup=False,
+                  soft_wrap=True)
+        raise typer.Exit(code=130)
+    out.print(f"wrote {output}")

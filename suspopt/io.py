@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
@@ -59,29 +59,26 @@ def _dataset(group: h5py.Group, name: str, data, units: str, **attrs) -> h5py.Da
 
 
 def write_simulation(path: str | Path, result, signals: Iterable[str] | None = None,
-                     units_of: Callable[[str], str] | None = None, float32: bool = False,
-                     metric_units: dict[str, str] | None = None,
-                     command: str | None = None) -> Path:
+                     float32: bool = False, command: str | None = None) -> Path:
     """Write a simulation ``Result`` with the layout of DESIGN.md.
 
     ``/time (T,)``, ``/signals/<name> (P, T)``, ``/metrics/<name> (P,)``, ``/diverged_at (P,)``
     (NaN where the design did not diverge), ``/designs/X (P, n)`` with attr ``names`` when
     design parameters were given, and ``/modal/frequency (P, n)`` with attr ``dominant``.
     """
-    from .simulate import signal_units
     from .vehicle import modal_analysis
 
-    units_of = units_of or signal_units
     names = list(result.signals) if signals is None else list(signals)
     dtype = np.float32 if float32 else np.float64
     with atomic_h5(path, result.config, command) as h5:
         _dataset(h5, "time", result.time, "s")
         grp = h5.create_group("signals")
         for name in names:
-            _dataset(grp, name, np.asarray(result.signals[name], dtype=dtype), units_of(name))
+            _dataset(grp, name, np.asarray(result.signals[name], dtype=dtype),
+                     result.signal_unit(name))
         met = h5.create_group("metrics")
         for name, value in result.metrics.items():
-            _dataset(met, name, np.asarray(value), (metric_units or {}).get(name, ""))
+            _dataset(met, name, np.asarray(value), result.metric_units[name])
         _dataset(h5, "diverged_at", result.diverged_at, "s")
         if result.designs:
             X = np.column_stack([result.designs[k] for k in result.designs])

@@ -21,11 +21,16 @@ import difflib
 import numpy as np
 
 from .config import Config
+from .control import build_controller
 from .params import ParamView
+from .specs import evaluate_spec, spec_signals
 from .road import road_inputs
+from .seat import SIGNAL_HEADS as _SEAT_HEADS, build_attachments
+from .seat import signal_units as _seat_signal_units
 from .vehicle import VehicleModel, build_vehicle
 
-__all__ = ["simulate", "Result", "SignalMap", "DIVERGENCE_LIMIT", "signal_units"]
+__all__ = ["simulate", "check", "signal_names", "signal_units", "Result", "SignalMap",
+           "Controller", "Attachment", "DIVERGENCE_LIMIT"]
 
 #: |state| above this (m, rad, m/s, rad/s) counts as divergence.
 DIVERGENCE_LIMIT = 1.0e6
@@ -154,7 +159,9 @@ def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt:
         if controller is not None:
             damping_out[j] = damping[:, 0]
             for name, value in controller.record().items():
-                records.setdefault(name, np.empty((n_out,) + value.shape))[j] = value
+                if name not in records:     # allocated once (setdefault would every call)
+                    records[name] = np.empty((n_out,) + value.shape)
+                records[name][j] = value
 
     with np.errstate(over="ignore", invalid="ignore"):
         for k in range(n_steps):
@@ -186,17 +193,41 @@ def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt:
                        diverged_at=diverged_at)
 
 
+def _prepare(cfg: Config, params: Mapping[str, Any] | None):
+    """Designs, model, controller and attachments of a run; metric specs checked against the
+    signals the run will have (so bad specs fail before any integration)."""
+    pv = ParamView(cfg, params)
+    model = build_vehicle(cfg, pv)
+    controller: Controller | None = build_controller(cfg, pv, model)
+    attachments: list[Attachment] = build_attachments(cfg, pv)
+    available = signal_names(model, getattr(controller, "units", {}), attachments)
+    for i, spec in enumerate(cfg.metrics):
+        try:
+            spec_signals(spec, available, model.corners)
+        except ValueError as exc:
+            raise cfg.error(("metrics", i, "signal"), str(exc)) from None
+    return pv, model, controller, attachments
+
+
+def check(cfg: Config) -> None:
+    """Raise ConfigError for problems only the assembled model reveals (metric signals)."""
+    _prepare(cfg, None)
+
+
 def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> "Result":
     """Simulate ``cfg`` for one design, or for P designs given as dotted-path arrays.
 
     ``params`` maps dotted config paths (e.g. ``"vehicle.corners.F1.damper.c"``) to arrays of
-    shape (P,). Returns a :class:`Result` whose signals are (P, T).
+    shape (P,). Returns a :class:`Result` whose signals are (P, T) and whose ``metrics`` hold
+    the config's ``metrics:`` specs as (P,) arrays.
     """
-    pv = ParamView(cfg, params)
-    model = build_vehicle(cfg, pv)
-    controller: Controller | None = None
-    attachments: list[Attachment] = []
-    return _run(cfg, pv, model, controller, attachments)
+    pv, model, controller, attachments = _prepare(cfg, params)
+    result = _run(cfg, pv, model, controller, attachments)
+    for spec in cfg.metrics:
+        for name, values, unit in evaluate_spec(spec, result, result.signal_unit):
+            result.metrics[name] = values
+            result.metric_units[name] = unit
+    return result
 
 
 def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller | None,
@@ -223,6 +254,8 @@ _BODY_UNITS = {"heave": "m", "roll": "rad", "pitch": "rad"}
 def signal_units(name: str) -> str:
     """SI unit of a signal name."""
     head = name.split(".")[0]
+    if head in _SEAT_HEADS:
+        return _seat_signal_units(name)
     if head == "body":
         dof, _, deriv = name.split(".")[1].partition("_")
         base = _BODY_UNITS[dof]
@@ -234,35 +267,41 @@ def signal_units(name: str) -> str:
             "road_vel": "m/s"}[head]
 
 
+def signal_names(model: VehicleModel, controller_units: Mapping[str, str] = {},
+                 attachments: Sequence[Attachment] = ()) -> list[str]:
+    """Every signal a simulation of this model (controller, attachments) provides."""
+    names = []
+    for dof in model.body_dofs:
+        names += [f"body.{dof}", f"body.{dof}_vel", f"body.{dof}_acc"]
+    for c in model.corners:
+        names += [f"wheel.{c}.heave", f"wheel.{c}.heave_vel", f"wheel.{c}.heave_acc"]
+    for head in ("travel", "travel_vel", "tyre_deflection", "tyre_force", "spring_force",
+                 "damper_force", "damping", "road", "road_vel", *controller_units):
+        names += [f"{head}.{c}" for c in model.corners]
+    for att in attachments:
+        names += att.signal_names()
+    return names
+
+
 class SignalMap(Mapping):
     """Lazy, cached mapping of signal name -> (P, T) array, computed from the states."""
 
     def __init__(self, result: "Result"):
         self._r = result
         self._cache: dict[str, np.ndarray] = {}
-        m = result.model
-        names = []
-        for dof in m.body_dofs:
-            names += [f"body.{dof}", f"body.{dof}_vel", f"body.{dof}_acc"]
-        for c in m.corners:
-            names += [f"wheel.{c}.heave", f"wheel.{c}.heave_vel", f"wheel.{c}.heave_acc"]
-        for head in ("travel", "travel_vel", "tyre_deflection", "tyre_force", "spring_force",
-                     "damper_force", "damping", "road", "road_vel"):
-            names += [f"{head}.{c}" for c in m.corners]
-        for head in result.controller_records:
-            names += [f"{head}.{c}" for c in m.corners]
-        self._attachment_of: dict[str, int] = {}
-        for j, att in enumerate(result._dynamics.attachments):
-            for name in att.signal_names():
-                self._attachment_of[name] = j
-                names.append(name)
-        self._names = names
+        self._names = signal_names(result.model, result.controller_units,
+                                   result._dynamics.attachments)
+        self._attachment_of = {name: j for j, att in enumerate(result._dynamics.attachments)
+                               for name in att.signal_names()}
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._names)
 
     def __len__(self) -> int:
         return len(self._names)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._names
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name not in self._cache:
@@ -328,11 +367,19 @@ class Result:
     controller_records: dict[str, np.ndarray] = field(default_factory=dict)
     controller_units: dict[str, str] = field(default_factory=dict)
     metrics: dict[str, np.ndarray] = field(default_factory=dict)
+    metric_units: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self):
         self.signals = SignalMap(self)
         self._corner_cache: dict[str, np.ndarray] = {}
         self._derivative: np.ndarray | None = None
+
+    def signal_unit(self, name: str) -> str:
+        """SI unit of a signal of this result."""
+        head = name.split(".")[0]
+        if head in self.controller_units:
+            return self.controller_units[head]
+        return signal_units(name)
 
     @property
     def P(self) -> int:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .config import Config
+from .config import Config, ConfigError
 from .config.vehicle import PRESET_BODY_DOFS, PRESET_CORNERS
 from .params import ParamView
 
@@ -67,7 +67,7 @@ class VehicleModel:
     tyre_damping: np.ndarray    # (P, 1, N) [N s/m]
     spring_linear: np.ndarray   # (P, 1, N) [N/m]
     spring_cubic: np.ndarray    # (P, 1, N) [N/m^3]
-    damper: np.ndarray          # (P, 1, N) passive damping coefficient [N s/m]
+    damper: np.ndarray          # (P, 1, N) passive coefficient, C_min if semi-active [N s/m]
     static_tyre_load: np.ndarray  # (P, 1, N) tyre load at rest, compression positive [N]
     tyre_lift_off: bool
     gravity: float
@@ -183,10 +183,13 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     mu = corner_param("unsprung_mass", True)
     kt, ct = corner_param("tyre.stiffness", True), corner_param("tyre.damping")
     kl, knl = corner_param("spring.linear", True), corner_param("spring.cubic")
-    c = corner_param("damper.c")
+    # a semi-active damper enters the linear model (modes, frequency response) at its soft
+    # state C_min; the controller (suspopt.control) sets its coefficient while integrating
+    c = np.stack([pv.get(f"vehicle.corners.{cn}.damper.{veh.corners[cn].damper.soft_field}")
+                  for cn in corners], axis=1)
     for name, arr in (("tyre.damping", ct), ("damper.c", c)):
         if np.any(arr < 0):
-            raise ValueError(f"vehicle.corners.*.{name}: must be >= 0")
+            raise ConfigError(f"params: vehicle.corners.*.{name}: must be >= 0")
 
     mass = np.empty((P, n))
     for j, dof in enumerate(body_dofs):
@@ -215,7 +218,7 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     offsets = np.where(rear, wheelbase, 0.0) if cfg.road.wheelbase_delay else np.zeros(N)
     if pv.varies("vehicle.body.a_front") or pv.varies("vehicle.body.a_rear"):
         if any(cn[0] == "R" for cn in corners):
-            raise ValueError("vehicle.body.a_front/a_rear cannot be design parameters of a model "
+            raise ConfigError("params: vehicle.body.a_front/a_rear cannot be design parameters of a model "
                              "with a rear axle: the road's wheelbase delay is one per run")
     sides = tuple("right" if cn[1] == "1" else "left" for cn in corners)
     dof_names = tuple(f"body.{d}" for d in body_dofs) + tuple(f"wheel.{cn}" for cn in corners)

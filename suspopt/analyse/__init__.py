@@ -31,4 +31,6 @@ KINDS: dict[str, Callable[[Path, Path | None, Path | None], Report]] = {}
 
 def analysis_kinds() -> dict[str, Callable[[Path, Path | None, Path | None], Report]]:
     """Every available analysis kind, importing the modules that provide them."""
+    from . import cdf  # noqa: F401  (registers cdf-sensitivity)
+    from . import transmissibility  # noqa: F401  (registers transmissibility)
     return dict(KINDS)

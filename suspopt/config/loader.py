@@ -15,7 +15,11 @@ import yaml
 from pydantic import Field, PrivateAttr, ValidationError
 
 from .base import Section
+from .control import Control
+from .metrics import MetricSpec
+from .optimise import Constraint, DesignVariable, Objectives, Optimiser
 from .road import RoadConfig
+from .seat import SeatConfig
 from .simulation import Output, Simulation
 from .vehicle import Vehicle
 
@@ -33,9 +37,30 @@ class Config(Section):
     road: RoadConfig
     simulation: Simulation
     output: Output = Field(default_factory=Output)
+    metrics: list[MetricSpec] = Field(default_factory=list,
+                                      description="metrics computed and stored by simulate")
+    control: Control | None = Field(None, description="digital controller of the semi-active "
+                                    "dampers (sample time, actuator lag, CDF threshold)")
+    seat: SeatConfig | None = Field(None, description="seat isolator (PS, NSS1-NSS4) on the "
+                                    "body, with its optional passenger (Sec 2.2-2.3)")
+    design_variables: list[DesignVariable] = Field(
+        default_factory=list, description="config fields the optimiser varies, with bounds")
+    objectives: Objectives | None = Field(None, description="main and supplementary "
+                                          "objectives of suspopt optimise (minimised)")
+    constraints: list[Constraint] = Field(default_factory=list,
+                                          description="constraints g <= 0 of suspopt optimise")
+    optimiser: Optimiser | None = Field(None, description="algorithm, budget and seed of "
+                                        "suspopt optimise")
 
     _source: Path | None = PrivateAttr(None)
     _text: str = PrivateAttr("")
+    _lines: dict = PrivateAttr(default_factory=dict)
+
+    def error(self, loc: tuple, message: str) -> "ConfigError":
+        """A ConfigError for a problem found after validation, located like a load error."""
+        name = str(self._source) if self._source is not None else "<config>"
+        line = _line_of(loc, self._lines) if self._lines else None
+        return ConfigError(f"{name}:{line if line else '?'}: {_dotted(loc)}: {message}")
 
     @property
     def source(self) -> Path | None:
@@ -86,30 +111,44 @@ def _line_of(loc: tuple, lines: dict) -> int | None:
     return None
 
 
+_DAMPER_TAGS = ("passive", "semi_active")
+
+
 def _clean_loc(loc: tuple) -> tuple:
-    """Drop pydantic's union-tag entries (e.g. the ``bump_step`` in road.bump_step.height)."""
+    """Drop pydantic's union-tag entries (e.g. the ``bump_step`` in road.bump_step.height, the
+    ``semi_active`` in vehicle.corners.F1.damper.semi_active.c_max)."""
     out = []
     for i, part in enumerate(loc):
-        if i == 1 and loc[0] == "road" and isinstance(part, str) and len(loc) > 2:
+        if i == 1 and isinstance(part, str) and (loc[0] == "seat" or loc[0] == "road"
+                                                 and len(loc) > 2):
+            continue
+        if i >= 1 and loc[i - 1] == "damper" and part in _DAMPER_TAGS:
             continue
         out.append(part)
     return tuple(out)
 
 
+def _dotted(loc: tuple) -> str:
+    """``("metrics", 0, "signal")`` -> ``metrics[0].signal``."""
+    return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p))
+                   for i, p in enumerate(loc))
+
+
 def _format(err: dict, lines: dict, data: Any) -> tuple[str, int | None]:
     loc = _clean_loc(tuple(err["loc"]))
-    dotted = ".".join(str(p) for p in loc) or "(top level)"
+    dotted = _dotted(loc) or "(top level)"
     msg = err["msg"]
-    if msg.startswith("Value error, "):
+    custom = msg.startswith("Value error, ")
+    if custom:
         msg = msg[len("Value error, "):]
     if err["type"] == "extra_forbidden":
-        allowed = _allowed_keys(loc[:-1])
+        allowed = _allowed_keys(tuple(err["loc"])[:-1])
         close = difflib.get_close_matches(str(loc[-1]), allowed, n=3)
         msg = "unknown key" + (f"; did you mean {', '.join(close)}?" if close else
                                f"; allowed: {', '.join(allowed)}" if allowed else "")
     elif err["type"] == "missing":
         msg = "required key is missing"
-    elif "input" in err and not isinstance(err["input"], (dict, list)):
+    elif not custom and "input" in err and not isinstance(err["input"], (dict, list)):
         msg = f"{msg} (got {err['input']!r})"
     return f"{dotted}: {msg}", _line_of(loc, lines)
 
@@ -125,9 +164,23 @@ def _section_type(annotation: Any) -> Any:
     return None
 
 
+def _union_member(annotation: Any, tag: Any) -> Any:
+    """The section of a discriminated union whose ``kind`` is ``tag`` (None if there is none)."""
+    for arg in get_args(annotation):
+        kind = getattr(arg, "model_fields", {}).get("kind")
+        if kind is not None and tag in get_args(kind.annotation):
+            return arg
+        found = None if hasattr(arg, "model_fields") else _union_member(arg, tag)
+        if found is not None:
+            return found
+    return None
+
+
 def _allowed_keys(loc: tuple) -> list[str]:
-    """Field names of the section at ``loc`` (for 'did you mean' hints)."""
+    """Field names of the section at ``loc``, a pydantic error location with its union tags
+    (for 'did you mean' hints)."""
     model: Any = Config
+    annotation: Any = None
     for part in loc:
         fields = getattr(model, "model_fields", {})
         if part in fields:
@@ -135,8 +188,12 @@ def _allowed_keys(loc: tuple) -> list[str]:
             model = _section_type(annotation)
             if get_origin(annotation) is dict:
                 model = ("dict", model)
+        elif isinstance(part, int):         # an item of a list of sections
+            continue
         elif isinstance(model, tuple):      # a key of a dict of sections
             model = model[1]
+        elif _union_member(annotation, part) is not None:   # a union's tag: its member
+            model = _union_member(annotation, part)
         else:
             return []
     return sorted(getattr(model, "model_fields", {}))
@@ -171,6 +228,7 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
         raise ConfigError(f"{name}:{line if line else '?'}: {msg}{tail}") from None
     cfg._source = source
     cfg._text = text
+    cfg._lines = lines
     return cfg
 
 

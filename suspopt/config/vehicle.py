@@ -3,18 +3,24 @@
 All quantities SI. The body mass and inertias are those *of the model* (the thesis's QC uses
 ``m_s/4``, HC1/HC2 ``m_s/2`` and ``I_x/2`` or ``I_y/2``; Sec 2.1.1-2.1.3), so a preset never
 rescales what the user wrote.
+
+A corner's damper is passive (``c``) or semi-active (``kind: semi_active``: ``c_min``, ``c_max``
+and a control ``law``, Sec 2.1.6); the controller's sampling and the CDF threshold are set in
+the ``control:`` section (:mod:`suspopt.config.control`).
 """
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Annotated, Any, ClassVar, Literal, Union
 
-from pydantic import Field, PositiveFloat, NonNegativeFloat, model_validator
+from pydantic import (Discriminator, Field, NonNegativeFloat, PositiveFloat, Tag,
+                      model_validator)
 
 from .base import Section
 
 __all__ = [
-    "PRESET_CORNERS", "PRESET_BODY_DOFS", "Spring", "Tyre", "Damper", "Corner", "Body",
+    "PRESET_CORNERS", "PRESET_BODY_DOFS", "DAMPER_LAWS", "LAW_PARAMETERS", "Spring", "Tyre",
+    "PassiveDamper", "SemiActiveDamper", "Damper", "Corner", "Body",
     "AntiRollBars", "Vehicle",
 ]
 
@@ -57,11 +63,83 @@ class Tyre(Section):
                                       "the thesis mostly takes 0)")
 
 
-class Damper(Section):
-    """Suspension damper, Eq 2.32: F_C = c dST/dt."""
+class PassiveDamper(Section):
+    """Passive suspension damper, Eq 2.32: F_C = c dST/dt."""
 
-    kind: Literal["passive"] = Field("passive", description="damper type")
+    kind: Literal["passive"] = Field("passive", description="damper type (default passive)")
     c: NonNegativeFloat = Field(description="viscous damping coefficient [N s/m]")
+
+    #: field holding the coefficient of the linear analyses (modes, frequency response)
+    soft_field: ClassVar[str] = "c"
+
+
+#: Control laws of a semi-active damper (suspopt.control has their exact definitions).
+DAMPER_LAWS = ("sh_2", "sh_l", "add", "sh_add_1", "sh_add_2", "groundhook", "hybrid")
+#: Law parameters of SemiActiveDamper and the laws that use them.
+LAW_PARAMETERS: dict[str, tuple[str, ...]] = {
+    "linear_weight": ("sh_l",),
+    "crossover_frequency": ("sh_add_1", "sh_add_2"),
+    "skyhook_weight": ("hybrid",),
+}
+
+
+class SemiActiveDamper(Section):
+    """Controllable damper switched or varied between ``c_min`` and ``c_max`` (Sec 2.1.6).
+
+    ``law`` picks the control law: ``sh_2`` (Eq 2.34), ``sh_l`` (Eq 2.35), ``add`` (Eq 2.36),
+    ``sh_add_1`` (Eq 2.37), ``sh_add_2`` (Eq 2.39), ``groundhook`` and ``hybrid``
+    (skyhook-groundhook, named in Sec 4.4); :mod:`suspopt.control` defines each one with the
+    project's signs (``ST = z_s - z_u``, extension positive). The linear analyses (modal,
+    frequency response) see the soft state ``c_min``.
+    """
+
+    kind: Literal["semi_active"] = Field(description="damper type")
+    c_min: NonNegativeFloat = Field(description="soft damping coefficient C_min [N s/m]")
+    c_max: NonNegativeFloat = Field(description="stiff damping coefficient C_max [N s/m], "
+                                    "at least c_min")
+    law: Literal[DAMPER_LAWS] = Field(description="control law: " + " | ".join(DAMPER_LAWS))
+    linear_weight: float | None = Field(
+        None, ge=0, le=1, allow_inf_nan=False,
+        description="SH-L tuning parameter alpha of Eq 2.35 in [0, 1] [-]; 1 gives SH-2 "
+        "(law sh_l only)")
+    crossover_frequency: PositiveFloat | None = Field(
+        None, allow_inf_nan=False,
+        description="frequency-range selector alpha of Eq 2.37-2.39 [rad/s] (the thesis uses "
+        "39 rad/s, about 6 Hz; laws sh_add_1 and sh_add_2 only)")
+    skyhook_weight: float | None = Field(
+        None, ge=0, le=1, allow_inf_nan=False,
+        description="share beta of the skyhook term in the hybrid law in [0, 1] [-]; 1 is pure "
+        "skyhook, 0 pure groundhook (law hybrid only)")
+
+    soft_field: ClassVar[str] = "c_min"
+
+    @model_validator(mode="after")
+    def _check(self) -> "SemiActiveDamper":
+        if self.c_max < self.c_min:
+            raise ValueError(f"c_max ({self.c_max}) must be at least c_min ({self.c_min})")
+        for name, laws in LAW_PARAMETERS.items():
+            given = getattr(self, name) is not None
+            if self.law in laws and not given:
+                raise ValueError(f"law {self.law!r} needs {name}")
+            if given and self.law not in laws:
+                raise ValueError(f"{name} is a parameter of law {' / '.join(laws)}, not of "
+                                 f"{self.law!r}; remove it")
+        return self
+
+
+def _damper_kind(value: Any) -> str:
+    """Tag of a damper: its ``kind`` (``passive`` when omitted, as in every passive config)."""
+    if isinstance(value, dict):
+        return value.get("kind", "passive")
+    return getattr(value, "kind", "passive")
+
+
+Damper = Annotated[
+    Union[Annotated[PassiveDamper, Tag("passive")],
+          Annotated[SemiActiveDamper, Tag("semi_active")]],
+    Discriminator(_damper_kind, custom_error_type="damper_kind",
+                  custom_error_message="unknown damper kind; use 'passive' (default) or "
+                  "'semi_active'")]
 
 
 class Corner(Section):
@@ -101,9 +179,12 @@ class AntiRollBars(Section):
 
 
 def _deep_merge(base: dict, over: dict) -> dict:
+    """``over`` on top of ``base``; a sub-section of another ``kind`` (a semi-active damper over
+    a passive default) replaces the default's instead of mixing keys of both kinds."""
     out = dict(base)
     for key, value in over.items():
-        if isinstance(value, dict) and isinstance(out.get(key), dict):
+        if isinstance(value, dict) and isinstance(out.get(key), dict) and \
+                _damper_kind(value) == _damper_kind(out[key]):
             out[key] = _deep_merge(out[key], value)
         else:
             out[key] = value

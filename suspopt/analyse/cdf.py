@@ -1,0 +1,164 @@
+"""``suspopt analyse cdf-sensitivity CONFIG``: the CDF strategy's threshold sweep (Figs. 4.7, 4.10).
+
+The config's semi-active dampers run with an adaptive threshold (``control.threshold.mode:
+adaptive``). The sweep asks for C_max shares of 20 to 70 % in steps of 5 % and compares each
+with the base law (threshold 0), in ONE batched simulation: the share is the design parameter
+``control.threshold.c_max_share``, and design 0 runs the base law because its
+``control.threshold.learn_time`` lies beyond the end of the run, so its threshold never leaves 0.
+
+Metrics (Sec 2.4, as Tables 4.2-4.3): SW the damper state changes (Sec 2.4.6, summed over the
+semi-active corners), RC the ISO 2631-1 Wk-weighted r.m.s. of the body heave acceleration
+(Eq 2.78), ST and TD the r.m.s. suspension travel and tyre deflection (mean over corners), DE
+the mean power the dampers dissipate (Eq 2.92, summed over corners). Each is reported as the
+thesis's reduction ``(X_base - X_CDF) / X_base * 100 %`` (Sec 4.3): positive means smaller
+with the CDF strategy. The share achieved is counted after the first fit (``t >= learn_time``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..config import load_config
+from ..io import atomic_h5
+from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
+from ..simulate import simulate
+from . import KINDS, Report
+
+__all__ = ["SHARES", "METRIC_UNITS", "semi_active_metrics", "run"]
+
+#: C_max shares of the sweep (the thesis's 20-70 %, Sec 4.3 item 4).
+SHARES = np.round(np.arange(0.20, 0.7001, 0.05), 2)
+#: Units of :func:`semi_active_metrics`.
+METRIC_UNITS = {"SW": "1", "RC": "m/s^2", "ST": "m", "TD": "m", "DE": "W"}
+
+
+def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarray]:
+    """Ch. 4 metrics of a result with semi-active dampers, (P,) each (units METRIC_UNITS),
+    plus ``share``: the mean damper state (the C_max share of the on-off laws) over the samples
+    at ``t >= share_after``, averaged over the semi-active corners.
+
+    SW counts state changes between output samples, so ``simulation.output_dt`` must not exceed
+    ``control.sample_time`` (every sample seen)."""
+    cfg, sig, t = result.config, result.signals, result.time
+    corners = result.model.corners
+    active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]
+    late = t >= share_after - 0.5 * cfg.simulation.dt
+    return {
+        "SW": np.sum([damper_switches(sig[f"damper_state.{c}"]) for c in active], axis=0),
+        "RC": weighted_rms(sig["body.heave_acc"], cfg.simulation.output_rate, "Wk"),
+        "ST": np.mean([np.sqrt(np.mean(sig[f"travel.{c}"] ** 2, axis=-1)) for c in corners],
+                      axis=0),
+        "TD": np.mean([np.sqrt(np.mean(sig[f"tyre_deflection.{c}"] ** 2, axis=-1))
+                       for c in corners], axis=0),
+        "DE": np.sum([mean_dissipated_power(sig[f"damper_force.{c}"], sig[f"travel_vel.{c}"], t)
+                      for c in corners], axis=0),
+        "share": np.mean([np.mean(sig[f"damper_state.{c}"][:, late], axis=-1) for c in active],
+                         axis=0),
+    }
+
+
+def _check(cfg) -> None:
+    spec = cfg.control.threshold if cfg.control is not None else None
+    if spec is None or spec.mode != "adaptive":
+        raise cfg.error(("control", "threshold"), "cdf-sensitivity needs an adaptive threshold "
+                        "(control.threshold.mode: adaptive, with c_max_share)")
+    if not any(cfg.vehicle.corners[c].damper.kind == "semi_active" for c in cfg.vehicle.corners):
+        raise cfg.error(("vehicle", "corners"), "cdf-sensitivity needs a semi-active damper")
+    sim = cfg.simulation
+    if sim.dt * sim.output_every > cfg.control.sample_time * (1 + 1e-9):
+        raise cfg.error(("simulation", "output_dt"), "must not exceed control.sample_time, or "
+                        "the switch count SW misses switches")
+    if spec.learn_time >= sim.duration:
+        raise cfg.error(("control", "threshold", "learn_time"), "must be shorter than "
+                        "simulation.duration: the threshold is never fitted")
+
+
+def _dataset(group, name: str, data, units: str) -> None:
+    group.create_dataset(name, data=data).attrs["units"] = units
+
+
+def _plot(path: Path, shares, base_share, reduction, title: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(7, 6))
+    top.plot(100 * shares, reduction["SW"], "o-", color="k", label="SW")
+    for name in ("RC", "ST", "TD", "DE"):
+        bottom.plot(100 * shares, reduction[name], "o-", label=name)
+    for ax in (top, bottom):
+        ax.axhline(0, color="0.6", lw=0.8)
+        ax.axvline(100 * base_share, color="0.4", ls="--", lw=0.8)
+        ax.set_ylabel("reduction vs base law [%]")
+        ax.legend(loc="best")
+        ax.grid(alpha=0.3)
+    bottom.set_xlabel("C_max share requested (1 - N) [%]; dashed: base law's share")
+    top.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
+    """Sweep the C_max share 20-70 % against the base law (module docstring)."""
+    cfg = load_config(source)
+    _check(cfg)
+    spec = cfg.control.threshold
+    base_learn = 2.0 * cfg.simulation.duration + spec.learn_time
+    path = "control.threshold."
+    learn = np.concatenate(([base_learn], np.full(SHARES.size, spec.learn_time)))
+    shares = np.concatenate(([SHARES[0]], SHARES))
+    result = simulate(cfg, params={path + "c_max_share": shares, path + "learn_time": learn})
+    values = semi_active_metrics(result, share_after=spec.learn_time)
+    base = {k: v[0] for k, v in values.items()}
+    with np.errstate(divide="ignore", invalid="ignore"):
+        reduction = {k: 100.0 * (base[k] - values[k][1:]) / base[k] for k in METRIC_UNITS}
+    corners = result.model.corners
+    active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]
+    laws = sorted({cfg.vehicle.corners[c].damper.law for c in active})
+    threshold = np.stack([result.signals[f"control_threshold.{c}"][1:, -1] for c in active],
+                         axis=1)
+    unit = result.signal_unit(f"control_threshold.{active[0]}")
+    title = (f"CDF sensitivity: {' / '.join(laws)} on {source.name} "
+             f"({spec.distribution} fit, T_learn {spec.learn_time:g} s)")
+
+    if output is not None:
+        with atomic_h5(output, cfg) as h5:
+            grp = h5.create_group("cdf_sensitivity")
+            grp.attrs["laws"] = ",".join(laws)
+            grp.attrs["distribution"] = spec.distribution
+            grp.attrs["corners"] = ",".join(active)
+
+            _dataset(grp, "c_max_share", SHARES, "1")
+            _dataset(grp, "achieved_share", values["share"][1:], "1")
+            _dataset(grp, "base_share", values["share"][0], "1")
+            _dataset(grp, "final_threshold", threshold, unit)
+            for key, group in (("base", grp.create_group("base")),
+                               ("cdf", grp.create_group("cdf")),
+                               ("reduction", grp.create_group("reduction"))):
+                for name, m_unit in METRIC_UNITS.items():
+                    data = {"base": base[name], "cdf": values[name][1:],
+                            "reduction": reduction[name]}[key]
+                    _dataset(group, name, data, "%" if key == "reduction" else m_unit)
+    if plot is not None:
+        _plot(plot, SHARES, base["share"], reduction, title)
+
+    rows = [[f"{100 * s:.0f}", f"{100 * a:.1f}", " ".join(f"{x:.3g}" for x in thr),
+             *(f"{reduction[k][i]:+.1f}" for k in METRIC_UNITS)]
+            for i, (s, a, thr) in enumerate(zip(SHARES, values["share"][1:], threshold))]
+    notes = [
+        f"base law ({' / '.join(laws)}): C_max share {100 * base['share']:.1f} %, "
+        f"SW {base['SW']:.0f}, RC {base['RC']:.4g} m/s^2, ST {1e3 * base['ST']:.4g} mm, "
+        f"TD {1e3 * base['TD']:.4g} mm, DE {base['DE']:.4g} W",
+        "reduction = (X_base - X_CDF) / X_base * 100 % (thesis Sec 4.3): positive = smaller "
+        "with the CDF threshold; shares counted after the first fit",
+    ]
+    return Report(title=title,
+                  columns=["C_max share [%]", "achieved [%]", f"final T [{unit}]",
+                           *(f"{k} [%]" for k in METRIC_UNITS)],
+                  rows=rows, notes=notes)
+
+
+KINDS["cdf-sensitivity"] = run

@@ -1,0 +1,40 @@
+"""Metric specs in YAML (the ``metrics:`` list; later objectives and constraints reuse them)."""
+
+from __future__ import annotations
+
+import difflib
+from typing import Literal
+
+from pydantic import Field, PositiveFloat, field_validator
+
+from ..specs import METRICS
+from .base import Section
+
+__all__ = ["MetricSpec"]
+
+
+class MetricSpec(Section):
+    """One metric of one signal (or of a per-corner signal family), see suspopt.metrics.specs."""
+
+    name: str | None = Field(None, description="name under /metrics (default metric.signal)")
+    metric: str = Field(description="one of: " + ", ".join(METRICS))
+    signal: str | None = Field(None, description="signal name (body.heave_acc) or per-corner "
+                               "family (travel, tyre_deflection, ...)")
+    corners: list[str] | None = Field(None, description="corners of a family (default all)")
+    reduce: Literal["none", "mean", "max", "min", "sum"] = Field(
+        "none", description="combine the corners' values into one (none: one per corner)")
+    weighting: Literal["Wk", "Wd", "Wf", "Wc", "We", "Wj"] | None = Field(
+        None, description="ISO 2631-1 frequency weighting for rms_weighted, vdv, mtvv, "
+        "crest_factor (none: unweighted)")
+    tau: PositiveFloat = Field(1.0, description="running r.m.s. integration time for mtvv [s]")
+    band: PositiveFloat = Field(0.02, description="settling band for transient metrics [-]")
+
+    @field_validator("metric")
+    @classmethod
+    def _known_metric(cls, metric: str) -> str:
+        if metric not in METRICS:
+            close = difflib.get_close_matches(metric, list(METRICS), n=3)
+            raise ValueError(f"unknown metric {metric!r}" + (
+                f"; did you mean {', '.join(close)}?" if close else
+                f"; known: {', '.join(METRICS)}"))
+        return metric

@@ -1,0 +1,289 @@
+"""``suspopt.Problem``: the YAML optimisation problem as a vectorised pymoo ``Problem``.
+
+``Problem.from_config(cfg)`` reads ``design_variables``, ``objectives`` and ``constraints``
+(:mod:`suspopt.config.optimise`); ``evaluate(X)`` runs ONE :func:`suspopt.simulate` for the
+whole population ``X (N, n_var)`` and returns ``F (N, n_obj)`` and ``G (N, n_ieq_constr)``
+(``G <= 0`` feasible, Eq 6.3).
+
+Search coordinates. ``X`` holds each variable's value in its SI unit, except that a variable
+with ``scale: log`` is its ``log10``; :meth:`Problem.to_physical` gives the values (integer
+variables rounded). ``xl``/``xu`` are in the same coordinates.
+
+Failed designs never stop a run. A design whose simulation diverges, or whose objectives or
+constraints come out NaN or infinite (an undefined seat geometry, Sec 8.2.2), gets every
+objective set to :data:`PENALTY` and the last constraint, ``simulation_failed``, set to
+:data:`PENALTY` (it is -1 for a sound design); its other non-finite constraints are
+:data:`PENALTY` too. Constrained algorithms therefore rank it below every sound design.
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from pymoo.core.problem import Problem as _PymooProblem
+
+from ..config import Config, ConfigError
+from ..config.optimise import DesignVariable, Objective
+from ..control import build_controller
+from ..params import ParamView, numeric_paths
+from ..seat import CONSTRAINT_UNITS, build_attachments, seat_constraints, seat_static_deflection
+from ..simulate import signal_names, signal_units, simulate
+from ..specs import evaluate_spec, metric_unit, spec_signals
+from ..vehicle import build_vehicle
+
+__all__ = ["Problem", "PENALTY"]
+
+#: Objective and constraint value given to a failed (diverged, NaN) design.
+PENALTY = 1.0e10
+
+#: Config sections and fields that are one per run: the simulator never reads them per design.
+_ONE_PER_RUN = {
+    "simulation": "the simulation settings are one per run",
+    "road": "the road is one per run",
+    "output": "the output settings are one per run",
+    "optimiser": "the optimiser settings are one per run",
+    "vehicle.gravity": "gravity is one per run",
+    "vehicle.corner_defaults": "corner_defaults are merged into the corners when the config "
+                               "loads; vary vehicle.corners.<corner>... instead",
+}
+_FAILED = "simulation_failed"
+
+
+@dataclass(frozen=True)
+class _Term:
+    """A compiled objective or constraint spec: its value names and units, one per column."""
+
+    spec: Objective
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    keys: tuple[str, ...] = ()      # seat.geometry: the seat_constraints keys, in order
+
+
+class Problem(_PymooProblem):
+    """The optimisation problem of a config (see the module docstring).
+
+    Names and units, in column order: ``var_names``/``var_units`` (X, physical values),
+    ``obj_names``/``obj_units`` (F), ``constraint_names``/``constraint_units`` (G),
+    ``supplementary_names``/``supplementary_units`` (``S``, computed when asked for with
+    ``evaluate(X, return_values_of=["S"])``). ``constraint_scale (n_ieq_constr,)`` is each
+    constraint's bound magnitude (1 where the bound is 0), for algorithms that scale ``G``.
+    """
+
+    def __init__(self, cfg: Config, objectives: Sequence[_Term], constraints: Sequence[_Term],
+                 supplementary: Sequence[_Term] = ()):
+        self.cfg = cfg
+        self.variables: list[DesignVariable] = list(cfg.design_variables)
+        self._objectives, self._constraints = list(objectives), list(constraints)
+        self._supplementary = list(supplementary)
+        self._sim_cfg = cfg.model_copy(update={"metrics": []})
+        self._simulates = any(t.spec.metric for t in self._all_terms())
+        self._log = np.array([v.scale == "log" for v in self.variables])
+        self._integer = np.array([v.integer for v in self.variables])
+        lower = np.array([v.lower for v in self.variables], dtype=float)
+        upper = np.array([v.upper for v in self.variables], dtype=float)
+        self.var_names = [v.label for v in self.variables]
+        self.var_units = [_field_unit(cfg, v.path) for v in self.variables]
+        self.obj_names = [n for t in self._objectives for n in t.names]
+        self.obj_units = [u for t in self._objectives for u in t.units]
+        self.supplementary_names = [n for t in self._supplementary for n in t.names]
+        self.supplementary_units = [u for t in self._supplementary for u in t.units]
+        self.constraint_names, self.constraint_units, scale = [], [], []
+        for term in self._constraints:
+            for name, unit in zip(term.names, term.units):
+                for op, bound in ((">=", term.spec.min), ("<=", term.spec.max)):
+                    if bound is not None:
+                        self.constraint_names.append(f"{name} {op} {bound:g}")
+                        self.constraint_units.append(unit)
+                        scale.append(abs(bound) or 1.0)
+        self.constraint_names.append(_FAILED)
+        self.constraint_units.append("1")
+        self.constraint_scale = np.array(scale + [1.0])
+        lower[self._log], upper[self._log] = np.log10(lower[self._log]), \
+            np.log10(upper[self._log])
+        super().__init__(n_var=len(self.variables), n_obj=len(self.obj_names),
+                         n_ieq_constr=len(self.constraint_names), xl=lower, xu=upper)
+
+    @classmethod
+    def from_config(cls, cfg: Config) -> "Problem":
+        """Build the problem of ``cfg``; raise ConfigError (with the YAML line) for a bad path,
+        a bound the model rejects, an unknown signal or an objective with several values."""
+        if not cfg.design_variables:
+            raise cfg.error(("design_variables",), "required key is missing: list the config "
+                            "fields to optimise, with their bounds")
+        if cfg.objectives is None:
+            raise cfg.error(("objectives",), "required key is missing: give the main "
+                            "objectives")
+        _check_paths(cfg)
+        available, unit_of, corners = _signals_at_bounds(cfg)
+
+        def compile_all(specs, loc, objective):
+            return [_compile(cfg, spec, loc + (i,), available, unit_of, corners, objective)
+                    for i, spec in enumerate(specs)]
+
+        return cls(cfg, compile_all(cfg.objectives.main, ("objectives", "main"), True),
+                   compile_all(cfg.constraints, ("constraints",), False),
+                   compile_all(cfg.objectives.supplementary, ("objectives", "supplementary"),
+                               True))
+
+    def to_physical(self, X) -> np.ndarray:
+        """Values of the design variables (N, n_var) in SI units: ``10**X`` on a log scale,
+        rounded for integer variables."""
+        values = np.array(np.atleast_2d(X), dtype=float)
+        values[:, self._log] = 10.0 ** values[:, self._log]
+        values[:, self._integer] = np.round(values[:, self._integer])
+        return values
+
+    def params(self, X) -> dict[str, np.ndarray]:
+        """``simulate``'s ``params``: each variable's dotted path -> its (N,) values."""
+        values = self.to_physical(X)
+        return {v.path: values[:, j] for j, v in enumerate(self.variables)}
+
+    def _all_terms(self) -> list[_Term]:
+        return self._objectives + self._constraints + self._supplementary
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        params = self.params(X)
+        with np.errstate(all="ignore"):      # failed designs are flagged below, not warned about
+            result = simulate(self._sim_cfg, params) if self._simulates else None
+            F = _stack(self._objectives, self.cfg, result, params, len(X))
+            G = self._constraint_values(result, params, len(X))
+            failed = ~(np.isfinite(F).all(axis=1) & np.isfinite(G).all(axis=1))
+            if result is not None:
+                failed |= result.diverged
+            out["F"] = np.where(failed[:, None], PENALTY, F)
+            out["G"] = np.column_stack([np.where(np.isfinite(G), G, PENALTY),
+                                        np.where(failed, PENALTY, -1.0)])
+            if "S" in out:
+                out["S"] = _stack(self._supplementary, self.cfg, result, params, len(X))
+
+    def _constraint_values(self, result, params, P: int) -> np.ndarray:
+        """``g = min - value`` and ``g = value - max`` of every constraint column, (P, k)."""
+        columns = []
+        for term in self._constraints:
+            values = _values(term, self.cfg, result, params)
+            for j in range(values.shape[1]):
+                if term.spec.min is not None:
+                    columns.append(term.spec.min - values[:, j])
+                if term.spec.max is not None:
+                    columns.append(values[:, j] - term.spec.max)
+        return np.column_stack(columns) if columns else np.empty((P, 0))
+
+
+def _stack(terms: Sequence[_Term], cfg: Config, result, params, P: int) -> np.ndarray:
+    """Values of terms side by side, (P, columns)."""
+    if not terms:
+        return np.empty((P, 0))
+    return np.column_stack([_values(t, cfg, result, params) for t in terms])
+
+
+def _values(term: _Term, cfg: Config, result, params) -> np.ndarray:
+    """The (P, len(term.names)) values of one term."""
+    spec = term.spec
+    if spec.quantity == "seat.static_deflection":
+        return seat_static_deflection(cfg, params)[:, None]
+    if spec.quantity == "seat.geometry":
+        values = seat_constraints(cfg, params, mu=spec.mu or 0.8)
+        return np.column_stack([values[k] for k in term.keys])
+    return np.column_stack([v for _, v, _ in evaluate_spec(spec, result, result.signal_unit)])
+
+
+# --- construction checks ----------------------------------------------------------------------
+
+def _check_paths(cfg: Config) -> None:
+    """Every design variable is a numeric config field that the simulator reads per design."""
+    numeric = numeric_paths(cfg)
+    seen: dict[str, int] = {}
+    for i, var in enumerate(cfg.design_variables):
+        loc = ("design_variables", i, "path")
+        if var.path not in numeric:
+            close = difflib.get_close_matches(var.path, list(numeric), n=3, cutoff=0.5)
+            raise cfg.error(loc, f"{var.path!r} is not a numeric field of this config" + (
+                f"; did you mean {', '.join(close)}?" if close else
+                " (derived quantities such as a seat's K_v stay derived)"))
+        for prefix, why in _ONE_PER_RUN.items():
+            if var.path == prefix or var.path.startswith(prefix + "."):
+                raise cfg.error(loc, f"{var.path} cannot vary between designs: {why}")
+        if var.path in seen:
+            raise cfg.error(loc, f"{var.path} is already design_variables[{seen[var.path]}]")
+        seen[var.path] = i
+
+
+def _signals_at_bounds(cfg: Config):
+    """Build the model with every variable at its lower bound (design 0) and at its upper
+    bound (design 1), so that a bound the model rejects fails now; return the signal names
+    of the model, a signal-unit function and the corners."""
+    bounds = {v.path: np.array([v.lower, v.upper]) for v in cfg.design_variables}
+    try:
+        pv = ParamView(cfg, bounds)
+        model = build_vehicle(cfg, pv)
+        controller = build_controller(cfg, pv, model)
+        attachments = build_attachments(cfg, pv)
+    except ConfigError as exc:
+        raise _at_variable(cfg, str(exc)) from None
+    units = dict(getattr(controller, "units", {}))
+
+    def unit_of(name: str) -> str:
+        return units.get(name.split(".")[0]) or signal_units(name)
+
+    return signal_names(model, units, attachments), unit_of, model.corners
+
+
+def _at_variable(cfg: Config, message: str) -> ConfigError:
+    """Locate a model error about a design parameter at the design variable it names."""
+    message = message.removeprefix("params: ")
+    for i, var in sorted(enumerate(cfg.design_variables), key=lambda iv: -len(iv[1].path)):
+        if var.path in message:
+            return cfg.error(("design_variables", i), f"with every variable at its lower "
+                             f"(design 0) or upper (design 1) bound: {message}")
+    return cfg.error(("design_variables",), message)
+
+
+def _compile(cfg: Config, spec: Objective, loc: tuple, available: list[str], unit_of,
+             corners: tuple[str, ...], objective: bool) -> _Term:
+    """Check one spec against the model and name its value columns."""
+    if spec.quantity is not None:
+        if cfg.seat is None:
+            raise cfg.error(loc + ("quantity",), f"{spec.quantity} needs a seat: section")
+        if spec.quantity == "seat.static_deflection":
+            return _Term(spec, (spec.label,), ("m",))
+        known = list(seat_constraints(cfg))
+        keys = tuple(spec.conditions or known)
+        for j, key in enumerate(keys):
+            if key not in known:
+                close = difflib.get_close_matches(key, known, n=3)
+                raise cfg.error(loc + ("conditions", j), f"{cfg.seat.kind} has no condition "
+                                f"{key!r}; it has {', '.join(close or known)}")
+        return _Term(spec, tuple(f"{spec.label}.{k}" for k in keys),
+                     tuple(CONSTRAINT_UNITS[k] for k in keys), keys)
+    try:
+        signals = spec_signals(spec, available, corners)
+    except ValueError as exc:
+        raise cfg.error(loc + ("signal",), str(exc)) from None
+    unit = metric_unit(spec, unit_of(signals[0]))
+    if (len(signals) == 1 and spec.signal in available) or spec.reduce != "none":
+        return _Term(spec, (spec.label,), (unit,))
+    if objective:
+        corner_list = ", ".join(s.rsplit(".", 1)[1] for s in signals)
+        raise cfg.error(loc + ("reduce",), f"{spec.label} gives one value per corner "
+                        f"({corner_list}); an objective is one number per design: add "
+                        f"reduce: mean (or max, min, sum)")
+    return _Term(spec, tuple(f"{spec.label}.{s.rsplit('.', 1)[1]}" for s in signals),
+                 (unit,) * len(signals))
+
+
+_UNIT = re.compile(r"\[([^\],]+)\]")
+
+
+def _field_unit(cfg: Config, path: str) -> str:
+    """SI unit of a config field, read from its description (``[N/m]``); "SI" if none."""
+    node = cfg
+    parts = path.split(".")
+    for part in parts[:-1]:
+        node = node[part] if isinstance(node, dict) else getattr(node, part)
+    info = type(node).model_fields.get(parts[-1])
+    found = _UNIT.findall(info.description or "") if info is not None else []
+    return found[-1] if found else "SI"

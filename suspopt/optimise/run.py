@@ -1,0 +1,386 @@
+"""``optimise(cfg, output)``: the run behind ``suspopt optimise``, checkpointed to HDF5.
+
+The run builds :class:`~suspopt.optimise.problem.Problem` and the optimiser of the config,
+then advances one generation at a time. After every generation it rewrites ``output``
+(atomically, :func:`suspopt.io.atomic_h5`) with the optimum so far, the history and a
+checkpoint; ``resume=True`` continues from that checkpoint to the same result as an
+uninterrupted run. Ctrl-C (KeyboardInterrupt) stops the run and rewrites the file from the
+last completed generation with ``status = "interrupted"``. Nothing here prints: progress goes
+to ``callback(Progress)``.
+
+HDF5 layout (DESIGN.md), every dataset with a ``units`` attribute (one per column for X, F, G
+and best):
+
+- ``/pareto/X (N, n)`` physical values, ``/pareto/F (N, m)``, ``/pareto/G (N, k)`` (G <= 0
+  feasible), each with ``names``: the best design (one objective) or the non-dominated set,
+  sorted by the first objective. With a weighted sum, F holds the main objectives (not the
+  sum) and ``/pareto`` has the attribute ``weights``.
+- ``/history/<name> (generations,)``: ``generation``, ``best`` (generations, m: the lowest
+  feasible value of each objective, NaN while none is feasible; the weighted sum with
+  weights), ``hypervolume`` (of the feasible optimum, objectives normalised by the first
+  feasible generation's ideal and nadir points, reference point 1.1; NaN for one objective),
+  ``evaluations``, ``time`` [s], ``feasible`` (share of the generation's designs).
+- ``/checkpoint/state``: the pickled run (optimiser with its random Generator, history);
+  ``--resume`` unpickles it, so resume only files you wrote.
+- root attributes: those of ``atomic_h5`` plus ``status`` (running, finished, interrupted),
+  ``algorithm``, ``optimiser_seed``, ``generations``, ``evaluations``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import io
+import pickle
+import sys
+import time
+import types
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import h5py
+import numpy as np
+from pymoo.indicators.hv import HV
+
+from ..config import Config, ConfigError
+from ..config.optimise import ALGORITHMS, Hybrid as HybridSettings
+from ..io import atomic_h5
+from .algorithms import (Gradient, Hybrid, Optimiser, PymooOptimiser, Solutions, WeightedSum,
+                         balanced_weights, pymoo_algorithm, termination)
+from .problem import Problem
+
+__all__ = ["optimise", "build_optimiser", "Progress", "OptimisationResult"]
+
+_HV_REFERENCE = 1.1
+
+
+@dataclass
+class Progress:
+    """What the run reports after each generation."""
+
+    generation: int
+    max_generations: int | None
+    evaluations: int
+    max_evaluations: int | None
+    best: np.ndarray                 # (m,) lowest feasible objective values, NaN if none
+    hypervolume: float               # NaN for one objective
+    feasible: float                  # share of the generation's designs that are feasible
+    elapsed: float                   # [s], including time before a resume
+    time_left: float | None          # [s], from the budget; None without one
+    phase: str                       # the algorithm running now
+
+
+@dataclass
+class OptimisationResult:
+    """The optimum (or Pareto set) of a run: ``X`` physical values (N, n), ``F (N, m)``,
+    ``G (N, k)``, their names and units; ``history`` as written to ``/history``; ``status``
+    finished or interrupted."""
+
+    X: np.ndarray
+    F: np.ndarray
+    G: np.ndarray
+    var_names: list[str]
+    var_units: list[str]
+    obj_names: list[str]
+    obj_units: list[str]
+    constraint_names: list[str]
+    history: dict[str, np.ndarray]
+    status: str
+    path: Path
+    weights: np.ndarray | None = None
+
+
+@dataclass
+class _Run:
+    """Everything a checkpoint holds."""
+
+    optimiser: Optimiser
+    weights: np.ndarray | None
+    history: dict[str, list] = field(default_factory=lambda: {
+        k: [] for k in ("generation", "best", "hypervolume", "evaluations", "time",
+                        "feasible")})
+    elapsed: float = 0.0
+    normalisation: tuple[np.ndarray, np.ndarray] | None = None
+    weighted_optimum: tuple[bytes, np.ndarray, np.ndarray] | None = None   # X key, F, G
+
+
+@dataclass
+class _Snapshot:
+    """The run after a completed generation, ready to write."""
+
+    state: bytes
+    optimum: Solutions              # X physical, F main objectives
+    history: dict[str, np.ndarray]
+    generation: int
+    evaluations: int
+
+
+def optimise(cfg: Config, output: str | Path, resume: bool = False,
+             callback: Callable[[Progress], None] | None = None,
+             command: str | None = None) -> OptimisationResult:
+    """Optimise ``cfg`` and write ``output`` (HDF5, layout in the module docstring).
+
+    ``resume`` continues from the checkpoint in ``output``, which must have been written for
+    the same config text. Raises ConfigError for bad input before any simulation, and
+    KeyboardInterrupt only when interrupted before the first generation completed.
+    """
+    output = Path(output)
+    problem = Problem.from_config(cfg)
+    optimiser = build_optimiser(cfg, problem)
+    run = _load(output, cfg, problem) if resume else _start(cfg, problem, optimiser)
+    snapshot = None
+    status = "finished"
+    try:
+        start = time.perf_counter() - run.elapsed
+        while run.optimiser.has_next():
+            run.optimiser.next()
+            run.elapsed = time.perf_counter() - start
+            progress = _record(run, cfg)
+            snapshot = _snapshot(run, problem)
+            _write(output, cfg, problem, snapshot, run.weights, "running", command)
+            if callback is not None:
+                callback(progress)
+    except KeyboardInterrupt:
+        if snapshot is None:
+            raise
+        status = "interrupted"
+    if snapshot is None:                 # resumed a finished run, or nothing to do
+        snapshot = _snapshot(run, problem)
+    return _write(output, cfg, problem, snapshot, run.weights, status, command)
+
+
+def build_optimiser(cfg: Config, problem: Problem) -> Optimiser:
+    """The optimiser of ``cfg.optimiser`` for ``problem`` (not yet set up); ConfigError for a
+    combination that cannot work (e.g. GA on three objectives without a weighted sum)."""
+    opt = cfg.optimiser
+    if opt is None:
+        raise cfg.error(("optimiser",), "required key is missing: give at least algorithm, "
+                        "seed and a budget")
+    _check_objectives(cfg, problem)
+    if opt.algorithm == "gradient":
+        return _gradient(cfg, problem, opt.generations, opt.max_evaluations)
+    n_obj = 1 if opt.weighted_sum else problem.n_obj
+    try:
+        algorithm = pymoo_algorithm(ALGORITHMS[opt.algorithm], opt.options, opt.population,
+                                    n_obj)
+    except ValueError as exc:
+        raise cfg.error(("optimiser", "options"), str(exc)) from None
+    if opt.algorithm == "hybrid":
+        settings = opt.hybrid or HybridSettings()
+        ga_generations = min(settings.ga_generations, opt.generations or float("inf"))
+        ga = PymooOptimiser(algorithm, termination(1, ga_generations, opt.max_evaluations,
+                                                   opt.tolerance, opt.stall_generations))
+        return Hybrid(ga, _gradient(cfg, problem, None, None), settings.shrink,
+                      opt.generations, opt.max_evaluations)
+    return PymooOptimiser(algorithm, termination(n_obj, opt.generations, opt.max_evaluations,
+                                                 opt.tolerance, opt.stall_generations))
+
+
+def _gradient(cfg: Config, problem: Problem, iterations, evaluations) -> Gradient:
+    opt = cfg.optimiser
+    return Gradient(max_iterations=iterations, max_evaluations=evaluations,
+                    tolerance=opt.tolerance, step=opt.gradient.step,
+                    constraint_scale=problem.constraint_scale)
+
+
+def _check_objectives(cfg: Config, problem: Problem) -> None:
+    """The algorithm suits the number of objectives; weights match the objectives."""
+    opt = cfg.optimiser
+    single = opt.algorithm in ("gradient", "hybrid") or ".soo." in ALGORITHMS[opt.algorithm]
+    if opt.weighted_sum is None:
+        if single and problem.n_obj > 1:
+            raise cfg.error(("optimiser", "algorithm"), f"{opt.algorithm} minimises one "
+                            f"objective and objectives.main has {problem.n_obj}: add "
+                            f"optimiser.weighted_sum (Eq 5.7) or use nsga2")
+        return
+    if not single:
+        raise cfg.error(("optimiser", "weighted_sum"), f"a weighted sum leaves one objective; "
+                        f"{opt.algorithm} is for several: use ga, gradient or hybrid")
+    weights, balance = opt.weighted_sum.weights, opt.weighted_sum.balance
+    if weights is not None and len(weights) != problem.n_obj:
+        raise cfg.error(("optimiser", "weighted_sum", "weights"), f"{len(weights)} weights for "
+                        f"{problem.n_obj} main objectives ({', '.join(problem.obj_names)})")
+    if balance is not None and balance.dominant is not None and \
+            balance.dominant not in problem.obj_names:
+        raise cfg.error(("optimiser", "weighted_sum", "balance", "dominant"),
+                        f"{balance.dominant!r} is not a main objective; they are "
+                        f"{', '.join(problem.obj_names)}")
+
+
+def _start(cfg: Config, problem: Problem, optimiser: Optimiser) -> _Run:
+    """A new run: the Generator of the seed balances the weights (if asked), then drives the
+    optimiser."""
+    opt = cfg.optimiser
+    rng = np.random.default_rng(opt.seed)
+    weights, working = None, problem
+    if opt.weighted_sum is not None:
+        ws = opt.weighted_sum
+        if ws.weights is not None:
+            weights = np.array(ws.weights, dtype=float)
+        else:
+            dominant = None if ws.balance.dominant is None else \
+                problem.obj_names.index(ws.balance.dominant)
+            try:
+                weights = balanced_weights(problem, ws.balance.samples, rng, dominant,
+                                           ws.balance.factor)
+            except ValueError as exc:
+                raise cfg.error(("optimiser", "weighted_sum", "balance"), str(exc)) from None
+        working = WeightedSum(problem, weights)
+    optimiser.setup(working, rng)
+    return _Run(optimiser=optimiser, weights=weights)
+
+
+def _record(run: _Run, cfg: Config) -> Progress:
+    """Append this generation to the history; return the progress report."""
+    opt, optimiser = cfg.optimiser, run.optimiser
+    optimum, population = optimiser.optimum(), optimiser.population()
+    feasible_f = optimum.F[optimum.feasible]
+    best = feasible_f.min(axis=0) if len(feasible_f) else np.full(optimum.F.shape[1], np.nan)
+    hv = np.nan
+    if optimum.F.shape[1] > 1 and len(feasible_f):
+        if run.normalisation is None:
+            ideal, nadir = feasible_f.min(axis=0), feasible_f.max(axis=0)
+            run.normalisation = (ideal, np.where(nadir > ideal, nadir, ideal + 1.0))
+        ideal, nadir = run.normalisation
+        hv = float(HV(ref_point=np.full(len(ideal), _HV_REFERENCE))(
+            (feasible_f - ideal) / (nadir - ideal)))
+    h = run.history
+    h["generation"].append(optimiser.n_gen)
+    h["best"].append(best)
+    h["hypervolume"].append(hv)
+    h["evaluations"].append(optimiser.n_eval)
+    h["time"].append(run.elapsed)
+    h["feasible"].append(float(population.feasible.mean()) if len(population.X) else 0.0)
+    return Progress(generation=optimiser.n_gen, max_generations=opt.generations,
+                    evaluations=optimiser.n_eval, max_evaluations=opt.max_evaluations,
+                    best=best, hypervolume=hv, feasible=h["feasible"][-1],
+                    elapsed=run.elapsed, time_left=_time_left(run, opt), phase=optimiser.phase)
+
+
+def _time_left(run: _Run, opt) -> float | None:
+    """Seconds left at the pace so far, from whichever budget ends first."""
+    optimiser, left = run.optimiser, []
+    if opt.generations is not None and optimiser.n_gen:
+        left.append(run.elapsed / optimiser.n_gen * max(opt.generations - optimiser.n_gen, 0))
+    if opt.max_evaluations is not None and optimiser.n_eval:
+        left.append(run.elapsed / optimiser.n_eval
+                    * max(opt.max_evaluations - optimiser.n_eval, 0))
+    return min(left) if left else None
+
+
+def _snapshot(run: _Run, problem: Problem) -> _Snapshot:
+    """Pickle the run and take its optimum (re-evaluating the main objectives of a weighted
+    sum's best design: F is the sum there)."""
+    optimum = run.optimiser.optimum()
+    order = np.argsort(optimum.F[:, 0], kind="stable")
+    X, F, G = optimum.X[order], optimum.F[order], optimum.G[order]
+    if run.weights is not None:
+        key = X.tobytes()
+        if run.weighted_optimum is None or run.weighted_optimum[0] != key:
+            run.weighted_optimum = (key, *problem.evaluate(X, return_values_of=["F", "G"]))
+        F, G = run.weighted_optimum[1:]
+    buffer = io.BytesIO()
+    _Pickler(buffer, problem).dump(run)
+    return _Snapshot(state=buffer.getvalue(), optimum=Solutions(problem.to_physical(X), F, G),
+                     history={k: np.array(v, dtype=float) for k, v in run.history.items()},
+                     generation=run.optimiser.n_gen, evaluations=run.optimiser.n_eval)
+
+
+class _Pickler(pickle.Pickler):
+    """Pickles a run without its Problem (rebuilt from the config on resume)."""
+
+    def __init__(self, file, problem: Problem):
+        super().__init__(file, protocol=pickle.HIGHEST_PROTOCOL)
+        self._problem = problem
+
+    def persistent_id(self, obj):
+        return "problem" if obj is self._problem else None
+
+    def reducer_override(self, obj):
+        """pymoo's ``@default_random_state`` wraps module-level functions (GA's tournament
+        comparison) without ``functools.wraps``, so pickle cannot find them by name: store
+        them as the module attribute they are."""
+        if not isinstance(obj, types.FunctionType) or "<locals>" not in obj.__qualname__:
+            return NotImplemented
+        for cell in obj.__closure__ or ():
+            inner = cell.cell_contents
+            if isinstance(inner, types.FunctionType) and \
+                    getattr(sys.modules.get(inner.__module__), inner.__name__, None) is obj:
+                return _module_attribute, (inner.__module__, inner.__name__)
+        return NotImplemented
+
+
+def _module_attribute(module: str, name: str):
+    return getattr(importlib.import_module(module), name)
+
+
+class _Unpickler(pickle.Unpickler):
+    def __init__(self, file, problem: Problem):
+        super().__init__(file)
+        self._problem = problem
+
+    def persistent_load(self, pid):
+        return self._problem
+
+
+def _load(output: Path, cfg: Config, problem: Problem) -> _Run:
+    """The run checkpointed in ``output``; ConfigError if there is none or the config
+    differs."""
+    if not output.exists():
+        raise ConfigError(f"--resume: {output} does not exist (run without --resume to start)")
+    try:
+        with h5py.File(output, "r") as h5:
+            text, state = h5.attrs["config"], h5["checkpoint/state"][()]
+    except (OSError, KeyError):
+        raise ConfigError(f"--resume: {output} is not a suspopt optimise file with a "
+                          f"checkpoint") from None
+    if text != cfg.text:
+        raise ConfigError(f"--resume: {output} was written for another config (its YAML "
+                          f"text differs); use the same config or run without --resume")
+    return _Unpickler(io.BytesIO(state.tobytes()), problem).load()
+
+
+def _dataset(group, name: str, data, units, **attrs) -> None:
+    ds = group.create_dataset(name, data=data)
+    ds.attrs["units"] = np.array(units, dtype="S") if isinstance(units, list) else units
+    for key, value in attrs.items():
+        ds.attrs[key] = value
+
+
+def _names(names: list[str]) -> np.ndarray:
+    return np.array(names, dtype="S")
+
+
+def _write(output: Path, cfg: Config, problem: Problem, snap: _Snapshot,
+           weights: np.ndarray | None, status: str, command: str | None
+           ) -> OptimisationResult:
+    opt = cfg.optimiser
+    best_names = problem.obj_names if weights is None else ["weighted_sum"]
+    best_units = problem.obj_units if weights is None else ["1"]
+    with atomic_h5(output, cfg, command) as h5:
+        h5.attrs.update(status=status, algorithm=opt.algorithm, optimiser_seed=opt.seed,
+                        generations=snap.generation, evaluations=snap.evaluations)
+        pareto = h5.create_group("pareto")
+        if weights is not None:
+            pareto.attrs["weights"] = weights
+        o = snap.optimum
+        _dataset(pareto, "X", o.X, problem.var_units, names=_names(problem.var_names))
+        _dataset(pareto, "F", o.F, problem.obj_units, names=_names(problem.obj_names))
+        _dataset(pareto, "G", o.G, problem.constraint_units,
+                 names=_names(problem.constraint_names))
+        hist = h5.create_group("history")
+        units = {"generation": "1", "hypervolume": "1", "evaluations": "1", "time": "s",
+                 "feasible": "1"}
+        for key, values in snap.history.items():
+            if key == "best":
+                _dataset(hist, key, values.reshape(len(values), -1), best_units,
+                         names=_names(best_names))
+            else:
+                _dataset(hist, key, values, units[key])
+        _dataset(h5.create_group("checkpoint"), "state", np.void(snap.state), "pickle")
+    return OptimisationResult(X=o.X, F=o.F, G=o.G, var_names=problem.var_names,
+                              var_units=problem.var_units, obj_names=problem.obj_names,
+                              obj_units=problem.obj_units,
+                              constraint_names=problem.constraint_names,
+                              history=snap.history, status=status, path=output,
+                              weights=weights)

@@ -1,0 +1,386 @@
+"""Optimisation: algorithms on analytic problems, the YAML problem, checkpoints and the CLI."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from pymoo.algorithms.moo.nsga2 import NSGA2
+from pymoo.algorithms.soo.nonconvex.ga import GA
+from pymoo.core.problem import Problem as PymooProblem
+from pymoo.indicators.igd import IGD
+from pymoo.problems import get_problem
+
+import suspopt
+from suspopt.config import ConfigError
+from suspopt.config.loader import load_config_text
+from suspopt.config.optimise import ALGORITHMS
+from suspopt.optimise import (PENALTY, Gradient, Hybrid, PymooOptimiser, WeightedSum,
+                              balanced_weights, build_optimiser, minimize, optimise)
+from suspopt.optimise.algorithms import pymoo_algorithm, termination
+
+
+# --- analytic problems: the algorithm layer needs no vehicle -----------------------------------
+
+class Quadratic(PymooProblem):
+    """f = |x - (1, -2, 0.5)|^2 on [-5, 5]^3; records the batch sizes it is asked for."""
+
+    optimum = np.array([1.0, -2.0, 0.5])
+
+    def __init__(self):
+        super().__init__(n_var=3, n_obj=1, xl=-5.0, xu=5.0)
+        self.batches: list[int] = []
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        self.batches.append(len(X))
+        out["F"] = ((X - self.optimum) ** 2).sum(axis=1)
+
+
+class Disc(PymooProblem):
+    """min x0^2 + x1^2 subject to x0 + x1 >= 1: optimum (0.5, 0.5), f = 0.5."""
+
+    def __init__(self):
+        super().__init__(n_var=2, n_obj=1, n_ieq_constr=1, xl=-2.0, xu=2.0)
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        out["F"] = (X ** 2).sum(axis=1)
+        out["G"] = 1.0 - X.sum(axis=1)
+
+
+class TwoObjectives(PymooProblem):
+    """f1 = the quadratic, f2 = |x|^2 (with the same constraint as Disc, x0 + x1 >= 1)."""
+
+    def __init__(self, n_obj=2):
+        super().__init__(n_var=3, n_obj=n_obj, n_ieq_constr=1, xl=-5.0, xu=5.0)
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        f1 = ((X - Quadratic.optimum) ** 2).sum(axis=1)
+        out["F"] = np.column_stack([f1, (X ** 2).sum(axis=1)])[:, :self.n_obj]
+        out["G"] = 1.0 - X[:, 0] - X[:, 1]
+
+
+def ga(pop=40, generations=60, n_obj=1):
+    return PymooOptimiser(GA(pop_size=pop), termination(n_obj, generations, None, 1e-10, 30))
+
+
+def test_ga_finds_the_minimum_of_a_quadratic():
+    best = minimize(Quadratic(), ga(), seed=1)
+    np.testing.assert_allclose(best.X[0], Quadratic.optimum, atol=0.05)
+    assert best.F[0, 0] < 2e-3
+
+
+def test_gradient_uses_one_batch_of_n_plus_1_designs_per_gradient():
+    problem = Quadratic()
+    gradient = Gradient(max_iterations=100)
+    best = minimize(problem, gradient, seed=1)
+    np.testing.assert_allclose(best.X[0], Quadratic.optimum, atol=2e-3)
+    assert set(problem.batches) == {problem.n_var + 1}
+    assert gradient.n_eval == sum(problem.batches)
+    assert gradient.n_gen < 20
+
+
+def test_gradient_and_hybrid_hold_a_constraint():
+    best = minimize(Disc(), Gradient(max_iterations=100), seed=1)
+    np.testing.assert_allclose(best.X[0], [0.5, 0.5], atol=1e-5)
+    hybrid = Hybrid(ga(pop=20, generations=5), Gradient(), shrink=0.2, max_iterations=60)
+    best = minimize(Disc(), hybrid, seed=3)
+    assert hybrid.ga.n_gen == 5 and hybrid.gradient.n_gen >= 1
+    np.testing.assert_allclose(best.X[0], [0.5, 0.5], atol=1e-4)
+    assert best.G[0, 0] <= 1e-8
+    lo, hi = hybrid.gradient.box                 # the GA best +- 0.2/2 of the range, cut by bounds
+    assert np.all(hi - lo <= 0.2 * 4.0 + 1e-12)
+
+
+def test_nsga2_approaches_the_zdt1_front():
+    zdt1 = get_problem("zdt1")
+    front = minimize(zdt1, PymooOptimiser(NSGA2(pop_size=100),
+                                          termination(2, 150, None, 1e-9, 50)), seed=1)
+    assert len(front.F) > 50
+    assert IGD(zdt1.pareto_front())(front.F) < 0.01
+
+
+def test_same_seed_same_run_and_no_global_random_state():
+    np.random.seed(123)
+    before = np.random.get_state()[1].copy()
+    runs = [minimize(TwoObjectives(), PymooOptimiser(NSGA2(pop_size=20),
+                                                     termination(2, 10, None, 1e-9, 50)),
+                     seed=seed) for seed in (7, 7, 8)]
+    np.testing.assert_array_equal(runs[0].X, runs[1].X)
+    np.testing.assert_array_equal(runs[0].F, runs[1].F)
+    assert not np.array_equal(runs[0].F, runs[2].F)
+    np.testing.assert_array_equal(np.random.get_state()[1], before)   # global RNG untouched
+
+
+def test_weighted_sum_with_one_unit_weight_is_the_single_objective():
+    single = minimize(TwoObjectives(n_obj=1), ga(generations=15), seed=5)
+    weighted = minimize(WeightedSum(TwoObjectives(), [1.0, 0.0]), ga(generations=15), seed=5)
+    np.testing.assert_array_equal(single.X, weighted.X)
+    np.testing.assert_array_equal(single.F, weighted.F)
+    with pytest.raises(ValueError, match="2 weights for 1"):
+        WeightedSum(TwoObjectives(n_obj=1), [1.0, 1.0])
+
+
+def test_balanced_weights_are_inverse_medians():
+    class Scaled(PymooProblem):
+        def __init__(self):
+            super().__init__(n_var=1, n_obj=3, xl=0.0, xu=1.0)
+
+        def _evaluate(self, X, out, *args, **kwargs):
+            out["F"] = X[:, :1] * np.array([1.0, 1e-3, 1e4])
+
+    w = balanced_weights(Scaled(), 2001, np.random.default_rng(0))
+    np.testing.assert_allclose(w * np.array([1.0, 1e-3, 1e4]), 2.0, rtol=0.1)  # median x ~ 0.5
+    w5 = balanced_weights(Scaled(), 2001, np.random.default_rng(0), dominant=0, factor=10.0)
+    np.testing.assert_allclose(w5, w * [10.0, 1.0, 1.0])
+
+
+def test_pymoo_algorithms_by_name_with_checked_options():
+    gde3 = pymoo_algorithm(ALGORITHMS["gde3"], {"CR": 0.5}, 20, 2)     # a DE variant option
+    front = minimize(TwoObjectives(), PymooOptimiser(gde3, termination(2, 10, None, 1e-9, 50)),
+                     seed=1)
+    assert front.feasible.all()
+    with pytest.raises(ValueError, match="did you mean eliminate_duplicates"):
+        pymoo_algorithm(ALGORITHMS["ga"], {"eliminate_duplicate": True}, 10, 1)
+    with pytest.raises(ValueError, match="set by suspopt"):
+        pymoo_algorithm(ALGORITHMS["nsga2"], {"seed": 3}, 10, 2)
+
+
+class Mixed(PymooProblem):
+    """One to three objectives with a constraint, for the algorithm registry."""
+
+    def __init__(self, n_obj):
+        super().__init__(n_var=3, n_obj=n_obj, n_ieq_constr=1, xl=0.0, xu=1.0)
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        out["F"] = np.column_stack([((X - 0.3) ** 2).sum(axis=1), ((X - 0.7) ** 2).sum(axis=1),
+                                    (X ** 2).sum(axis=1)])[:, :self.n_obj]
+        out["G"] = 0.2 - X[:, 0]
+
+
+@pytest.mark.parametrize("name", [k for k in ALGORITHMS if k not in ("gradient", "hybrid")])
+def test_every_registered_pymoo_algorithm_is_seeded_and_resumes_from_its_pickle(name,
+                                                                                 monkeypatch):
+    import io
+
+    from suspopt.optimise.run import _Pickler, _Unpickler
+
+    n_obj = 3 if ".moo." in ALGORITHMS[name] else 1
+    problem = Mixed(n_obj)
+    optimiser = PymooOptimiser(pymoo_algorithm(ALGORITHMS[name], {}, 12, n_obj),
+                               termination(n_obj, 8, None, 1e-12, 30))
+    optimiser.setup(problem, np.random.default_rng(1))
+    default_rng = np.random.default_rng
+
+    def seeded_only(seed=None, *args):            # pymoo's fallback for a missing random_state
+        assert seed is not None, f"{name} draws from an unseeded Generator"
+        return default_rng(seed, *args)
+
+    monkeypatch.setattr(np.random, "default_rng", seeded_only)
+    for _ in range(3):
+        optimiser.next()
+    buffer = io.BytesIO()
+    _Pickler(buffer, problem).dump(optimiser)
+    resumed = _Unpickler(io.BytesIO(buffer.getvalue()), problem).load()
+    while optimiser.has_next():
+        optimiser.next()
+        resumed.next()
+    assert not resumed.has_next()
+    np.testing.assert_array_equal(optimiser.optimum().F, resumed.optimum().F)
+
+
+# --- the YAML problem on a tiny Chapter 5 half car -----------------------------------------------
+
+TINY = """\
+vehicle:
+  preset: half_pitch
+  body: {mass: 2210, pitch_inertia: 1142, a_front: 1.61, a_rear: 1.67}
+  corners:
+    F1:
+      unsprung_mass: 50
+      tyre: {stiffness: 4.0e5}
+      spring: {linear: 5.0e4, cubic: 1.0e7}
+      damper: {c: 3000}
+    R1:
+      unsprung_mass: 100
+      tyre: {stiffness: 8.0e5}
+      spring: {linear: 6.0e4, cubic: 1.0e7}
+      damper: {c: 3500}
+road: {kind: bump_half_sine, height: 0.05, length: 1.0, speed: 11.111, start: 0.1}
+simulation: {duration: 0.5, dt: 1.0e-3}
+design_variables:
+  - {name: k_F1, path: vehicle.corners.F1.spring.linear, lower: 3.2e4, upper: 1.5e5}
+  - {name: c_F1, path: vehicle.corners.F1.damper.c, lower: 2.0e3, upper: 1.0e4}
+  - {name: knl_F1, path: vehicle.corners.F1.spring.cubic, lower: 5.0e5, upper: 3.0e7, scale: log}
+objectives:
+  main:
+    - {name: f1, metric: var, signal: body.heave_acc}
+    - {name: f3, metric: var, signal: tyre_deflection, reduce: mean}
+  supplementary:
+    - {name: f2, metric: var, signal: travel, reduce: mean}
+constraints:
+  - {name: RC, metric: rms_weighted, signal: body.heave_acc, weighting: Wk, max: 1.4}
+  - {name: ratio, metric: spring_usage, min: 0.1, max: 0.3}
+optimiser: {algorithm: nsga2, population: 8, generations: 4, seed: 1}
+"""
+
+
+def tiny(text: str = TINY, **replace) -> suspopt.Config:
+    for old, new in replace.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    return load_config_text(text, Path("case.yaml"))
+
+
+def test_problem_names_units_and_one_batch_equal_to_single_designs():
+    problem = suspopt.Problem.from_config(tiny())
+    assert problem.var_names == ["k_F1", "c_F1", "knl_F1"]
+    assert problem.var_units == ["N/m", "N s/m", "N/m^3"]
+    assert problem.obj_names == ["f1", "f3"] and problem.obj_units == ["(m/s^2)^2", "m^2"]
+    assert problem.constraint_names == ["RC <= 1.4", "ratio.F1 >= 0.1", "ratio.F1 <= 0.3",
+                                        "ratio.R1 >= 0.1", "ratio.R1 <= 0.3",
+                                        "simulation_failed"]
+    assert problem.supplementary_names == ["f2"]
+    np.testing.assert_allclose(problem.xu[2], np.log10(3.0e7))
+    X = problem.xl + np.random.default_rng(0).random((4, 3)) * (problem.xu - problem.xl)
+    F, G, S = problem.evaluate(X, return_values_of=["F", "G", "S"])
+    assert F.shape == (4, 2) and G.shape == (4, 6) and S.shape == (4, 1)
+    single = np.vstack([np.hstack(problem.evaluate(x[None], return_values_of=["F", "G"]))
+                        for x in X])
+    np.testing.assert_allclose(np.hstack([F, G]), single, rtol=1e-12)
+    assert (G[:, -1] == -1).all()
+    np.testing.assert_allclose(problem.to_physical(X)[:, 2], 10 ** X[:, 2])
+
+
+def test_a_diverging_design_is_penalised_and_the_batch_survives():
+    cfg = tiny(**{"dt: 1.0e-3": "dt: 5.0e-3",
+                  "path: vehicle.corners.F1.damper.c, lower: 2.0e3, upper: 1.0e4":
+                  "path: vehicle.corners.F1.tyre.stiffness, lower: 2.0e5, upper: 2.0e7"})
+    problem = suspopt.Problem.from_config(cfg)
+    X = np.array([[5e4, 4e5, 7.0], [5e4, 2e7, 7.0]])     # the stiff tyre blows up RK4 at 5 ms
+    F, G = problem.evaluate(X, return_values_of=["F", "G"])
+    assert np.isfinite(F).all() and np.isfinite(G).all()
+    assert (F[1] == PENALTY).all() and G[1, -1] == PENALTY
+    assert (F[0] < PENALTY).all() and G[0, -1] == -1
+
+
+BAD = {
+    "path": ({"path: vehicle.corners.F1.spring.linear": "path: vehicle.corners.F1.spring.linaer"},
+             "did you mean vehicle.corners.F1.spring.linear", 18),
+    "swapped": ({"lower: 3.2e4, upper: 1.5e5": "lower: 1.5e5, upper: 3.2e4"},
+                "did you swap the bounds", 18),
+    "per_corner_objective": ({"signal: tyre_deflection, reduce: mean}": "signal: tyre_deflection}"},
+                             "objectives.main[1].reduce: f3 gives one value per corner", 24),
+    "one_per_run": ({"path: vehicle.corners.F1.damper.c,": "path: road.speed,"},
+                    "road is one per run", 19),
+    "bound_rejected": ({"path: vehicle.corners.F1.damper.c, lower: 2.0e3":
+                        "path: vehicle.corners.F1.unsprung_mass, lower: 0"},
+                       "vehicle.corners.F1.unsprung_mass: must be > 0", 19),
+    "signal": ({"signal: body.heave_acc}": "signal: body.heave_ac}"},
+               "did you mean body.heave_acc", 23),
+    "ga_two_objectives": ({"algorithm: nsga2": "algorithm: ga"}, "add optimiser.weighted_sum", 30),
+    "weights": ({"algorithm: nsga2,": "algorithm: ga, weighted_sum: {weights: [1, 2, 3]},"},
+                "3 weights for 2 main objectives", 30),
+    "option": ({"seed: 1}": "seed: 1, options: {n_offspring: 4}}"},
+               "did you mean n_offsprings", 30),
+    "algorithm": ({"algorithm: nsga2": "algorithm: nsga"}, "nsga2", 30),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_optimisation_input_names_key_and_line(case):
+    replace, needle, line = BAD[case]
+    with pytest.raises(ConfigError) as exc:
+        cfg = tiny(**replace)
+        build_optimiser(cfg, suspopt.Problem.from_config(cfg))
+    message = str(exc.value)
+    assert needle in message and message.startswith(f"case.yaml:{line}:"), message
+
+
+# --- runs: reproducible, resumable, written as DESIGN.md says -----------------------------------
+
+@pytest.mark.parametrize("variant", ["nsga2", "hybrid_weighted"])
+def test_resume_equals_an_uninterrupted_run(tmp_path, variant):
+    cfg = tiny() if variant == "nsga2" else tiny(**{
+        "{algorithm: nsga2, population: 8, generations: 4, seed: 1}":
+        "{algorithm: hybrid, population: 8, generations: 5, seed: 1, hybrid: {ga_generations: "
+        "2}, weighted_sum: {balance: {samples: 8, dominant: f1}}}"})
+    whole = optimise(cfg, tmp_path / "whole.h5")
+    again = optimise(cfg, tmp_path / "again.h5")
+
+    def stop_at_3(progress):
+        if progress.generation == 3:
+            raise KeyboardInterrupt
+
+    part = optimise(cfg, tmp_path / "part.h5", callback=stop_at_3)
+    assert part.status == "interrupted" and len(part.history["generation"]) == 3
+    with h5py.File(tmp_path / "part.h5") as h5:
+        assert h5.attrs["status"] == "interrupted"
+    resumed = optimise(cfg, tmp_path / "part.h5", resume=True)
+    assert resumed.status == "finished"
+    for other in (again, resumed):
+        for key in ("X", "F", "G"):
+            np.testing.assert_array_equal(getattr(whole, key), getattr(other, key))
+        np.testing.assert_array_equal(whole.history["evaluations"],
+                                      other.history["evaluations"])
+    if variant == "hybrid_weighted":
+        assert whole.F.shape == (1, 2) and whole.weights.shape == (2,)
+    with pytest.raises(ConfigError, match="another config"):
+        optimise(tiny(**{"seed: 1}": "seed: 2}"}), tmp_path / "part.h5", resume=True)
+
+
+def run_cli(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "suspopt", *map(str, args)],
+                          capture_output=True, text=True, cwd=cwd, timeout=120)
+
+
+def test_cli_optimise_writes_the_design_md_layout(tmp_path):
+    config = tmp_path / "case.yaml"
+    config.write_text(TINY.replace("generations: 4", "generations: 2"))
+    out = tmp_path / "front.h5"
+    proc = run_cli("optimise", config, "-o", out)
+    assert proc.returncode == 0, proc.stderr
+    assert "Pareto set" in proc.stdout or "best design" in proc.stdout
+    assert "NSGA2 gen 2/2" in proc.stderr
+    with h5py.File(out) as h5:
+        assert h5.attrs["status"] == "finished" and h5.attrs["optimiser_seed"] == 1
+        assert h5.attrs["config"] == config.read_text()
+        X, F, G = (h5[f"pareto/{k}"] for k in "XFG")
+        N = X.shape[0]
+        assert X.shape == (N, 3) and F.shape == (N, 2) and G.shape == (N, 6) and N >= 1
+        assert [n.decode() for n in X.attrs["names"]] == ["k_F1", "c_F1", "knl_F1"]
+        assert [u.decode() for u in F.attrs["units"]] == ["(m/s^2)^2", "m^2"]
+        assert G.attrs["names"][-1] == b"simulation_failed"
+        for key in ("best", "hypervolume", "evaluations", "time", "generation", "feasible"):
+            assert h5[f"history/{key}"].shape[0] == 2 and "units" in h5[f"history/{key}"].attrs
+        assert h5["history/evaluations"][-1] == 16
+        assert "units" in h5["checkpoint/state"].attrs
+
+
+@pytest.mark.parametrize("change, needle", [
+    ({"upper: 1.5e5}": "upper: 1.5e4}"},
+     "case.yaml:18: design_variables[0]: lower (32000) > upper (15000): did you swap"),
+    ({"name: f1, metric: var, signal": "name: f1, metric: vra, signal"},
+     "case.yaml:23: objectives.main[0].metric: unknown metric 'vra'; did you mean var"),
+    ({"seed: 1}": "seed: 1, max_evals: 10}"},
+     "case.yaml:30: optimiser.max_evals: unknown key; did you mean max_evaluations"),
+])
+def test_cli_optimise_bad_input_exits_2_with_one_line(tmp_path, change, needle):
+    from typer.testing import CliRunner
+
+    from suspopt.cli import app
+
+    config = tmp_path / "case.yaml"
+    text = TINY
+    for old, new in change.items():
+        text = text.replace(old, new)
+    config.write_text(text)
+    result = CliRunner().invoke(app, ["optimise", str(config), "-o", str(tmp_path / "o.h5")])
+    assert result.exit_code == 2
+    message = result.stderr.strip()
+    assert len(message.splitlines()) == 1 and "Traceback" not in message
+    assert needle in message, message
+    assert not (tmp_path / "o.h5").exists()
