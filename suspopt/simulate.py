@@ -187,8 +187,10 @@ def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt:
                 keep((k + 1) // every)
 
     def time_second(a):
-        return None if a is None else np.ascontiguousarray(np.moveaxis(a, 0, 1))
-    return _Trajectory(states=time_second(states), damping=time_second(damping_out),
+        # a view: controller records are read a corner at a time, copying them all is waste
+        return None if a is None else np.moveaxis(a, 0, 1)
+    return _Trajectory(states=np.ascontiguousarray(time_second(states)),
+                       damping=time_second(damping_out),
                        records={k: time_second(v) for k, v in (records or {}).items()},
                        diverged_at=diverged_at)
 

@@ -187,7 +187,7 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     # state C_min; the controller (suspopt.control) sets its coefficient while integrating
     c = np.stack([pv.get(f"vehicle.corners.{cn}.damper.{veh.corners[cn].damper.soft_field}")
                   for cn in corners], axis=1)
-    for name, arr in (("tyre.damping", ct), ("damper.c", c)):
+    for name, arr in (("tyre.damping", ct), ("damper.c (c_min if semi-active)", c)):
         if np.any(arr < 0):
             raise ConfigError(f"params: vehicle.corners.*.{name}: must be >= 0")
 

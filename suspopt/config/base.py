@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
+
 from pydantic import BaseModel, ConfigDict
 
-__all__ = ["Section"]
+__all__ = ["Section", "check_known"]
 
 
 class Section(BaseModel):
@@ -15,3 +18,13 @@ class Section(BaseModel):
     """
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False)
+
+
+def check_known(what: str, name: str, known: Iterable[str]) -> str:
+    """Return ``name`` if it is in ``known``, else raise ValueError with the closest matches."""
+    known = list(known)
+    if name not in known:
+        close = difflib.get_close_matches(name, known, n=3)
+        raise ValueError(f"unknown {what} {name!r}" + (
+            f"; did you mean {', '.join(close)}?" if close else f"; known: {', '.join(known)}"))
+    return name

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import difflib
 from typing import Literal
 
 from pydantic import Field, PositiveFloat, field_validator
 
 from ..specs import METRICS
-from .base import Section
+from .base import Section, check_known
 
 __all__ = ["MetricSpec"]
 
@@ -32,9 +31,4 @@ class MetricSpec(Section):
     @field_validator("metric")
     @classmethod
     def _known_metric(cls, metric: str) -> str:
-        if metric not in METRICS:
-            close = difflib.get_close_matches(metric, list(METRICS), n=3)
-            raise ValueError(f"unknown metric {metric!r}" + (
-                f"; did you mean {', '.join(close)}?" if close else
-                f"; known: {', '.join(METRICS)}"))
-        return metric
+        return check_known("metric", metric, METRICS)

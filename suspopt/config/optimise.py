@@ -24,7 +24,7 @@ from typing import Annotated, Any, Literal
 from pydantic import (Field, NonNegativeFloat, PositiveFloat, PositiveInt, field_validator,
                       model_validator)
 
-from .base import Section
+from .base import Section, check_known
 from .metrics import MetricSpec
 
 __all__ = ["QUANTITIES", "ALGORITHMS", "DesignVariable", "Objective", "Constraint",
@@ -246,13 +246,7 @@ class Optimiser(Section):
     @field_validator("algorithm")
     @classmethod
     def _known(cls, name: str) -> str:
-        if name not in ALGORITHMS:
-            import difflib
-            close = difflib.get_close_matches(name, list(ALGORITHMS), n=3)
-            raise ValueError(f"unknown algorithm {name!r}" + (
-                f"; did you mean {', '.join(close)}?" if close else
-                f"; known: {', '.join(ALGORITHMS)}"))
-        return name
+        return check_known("algorithm", name, ALGORITHMS)
 
     @model_validator(mode="after")
     def _check(self) -> "Optimiser":
