@@ -13,8 +13,8 @@ call's (best of several interleaved rounds; CPU time because the development mac
 and wall time swings by tens of per cent), and ``own``, the time spent inside the controller
 (start, step, record: the laws, the sampling, the refits) over the passive call's. ``total``
 also contains the simulator storing the controller's records (three per-corner signals and the
-coefficient, time-major, transposed at the end), which at P = 1000 with every step kept weighs
-more than the control itself; the last row keeps every 4th step instead. Run: ``python benchmarks/bench_control.py``.
+coefficient), which are stored once per change (every ΔT) and expanded only when read; the
+last row keeps every 4th step instead of every step. Run: ``python benchmarks/bench_control.py``.
 Prints a table; asserts nothing.
 """
 

@@ -126,13 +126,31 @@ class _Dynamics:
 
 
 @dataclass
+class _Held:
+    """A controller quantity held between changes: the distinct values ``(S, P, N)`` and, for
+    each output sample, which of them held ``(T,)``. Expanded to ``(P, T, N)`` on demand, so a
+    coefficient that changes only every ΔT is stored once per change, not per sample."""
+
+    values: np.ndarray
+    index: np.ndarray
+
+    def corner(self, c: int) -> np.ndarray:
+        """(P, T) series of corner ``c``."""
+        return self.values[self.index, :, c].T
+
+    def full(self) -> np.ndarray:
+        """(P, T, N) series of every corner."""
+        return np.moveaxis(self.values[self.index], 0, 1)
+
+
+@dataclass
 class _Trajectory:
-    """What one integration produced: states (P, T, 2n), damping (P, T, N) or None,
-    controller records {name: (P, T, N)} and the divergence times (P,)."""
+    """What one integration produced: states (P, T, 2n), the held damping coefficients and
+    controller records (or None / empty without a controller) and the divergence times (P,)."""
 
     states: np.ndarray
-    damping: np.ndarray | None
-    records: dict[str, np.ndarray]
+    damping: _Held | None
+    records: dict[str, _Held]
     diverged_at: np.ndarray
 
 
@@ -144,12 +162,12 @@ def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt:
     y = np.zeros((P, 1, n2))
     n_out = n_steps // every + 1
     states = np.empty((n_out, P, n2))      # time-major: each sample is one contiguous write
-    damping_out = records = None
     damping = None
+    held: list[tuple[np.ndarray, dict[str, np.ndarray]]] = []
+    held_index = np.empty(n_out, dtype=np.intp)
+    last: list = [None, None]
     if controller is not None:
         damping = controller.start(P)
-        damping_out = np.empty((n_out, P, len(f.model.corners)))
-        records = {}
     diverged_at = np.full(P, np.nan)
     half = 0.5 * dt
     nv = f.n_vehicle
@@ -157,11 +175,13 @@ def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt:
     def keep(j: int) -> None:
         states[j] = y[:, 0]
         if controller is not None:
-            damping_out[j] = damping[:, 0]
-            for name, value in controller.record().items():
-                if name not in records:     # allocated once (setdefault would every call)
-                    records[name] = np.empty((n_out,) + value.shape)
-                records[name][j] = value
+            records = controller.record()
+            # controllers hand out new arrays when a value changes: store only the changes
+            if damping is not last[0] or records is not last[1]:
+                held.append((damping[:, 0].copy(),
+                             {name: np.array(value) for name, value in records.items()}))
+                last[:] = [damping, records]
+            held_index[j] = len(held) - 1
 
     with np.errstate(over="ignore", invalid="ignore"):
         for k in range(n_steps):
@@ -186,13 +206,13 @@ def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt:
             if (k + 1) % every == 0:
                 keep((k + 1) // every)
 
-    def time_second(a):
-        # a view: controller records are read a corner at a time, copying them all is waste
-        return None if a is None else np.moveaxis(a, 0, 1)
-    return _Trajectory(states=np.ascontiguousarray(time_second(states)),
-                       damping=time_second(damping_out),
-                       records={k: time_second(v) for k, v in (records or {}).items()},
-                       diverged_at=diverged_at)
+    damping_held, records_held = None, {}
+    if controller is not None:
+        damping_held = _Held(np.stack([h[0] for h in held]), held_index)
+        records_held = {name: _Held(np.stack([h[1][name] for h in held]), held_index)
+                        for name in held[0][1]}
+    return _Trajectory(states=np.ascontiguousarray(np.moveaxis(states, 0, 1)),
+                       damping=damping_held, records=records_held, diverged_at=diverged_at)
 
 
 def _prepare(cfg: Config, params: Mapping[str, Any] | None):
@@ -246,7 +266,7 @@ def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller
     return Result(config=cfg, model=model, time=t_grid[out_idx], states=traj.states,
                   road=z[:, out_idx].T[None], road_vel=zd[:, out_idx].T[None],
                   diverged_at=traj.diverged_at, designs=dict(pv.params), _dynamics=f,
-                  damping_history=traj.damping, controller_records=traj.records,
+                  held_damping=traj.damping, controller_records=traj.records,
                   controller_units=dict(getattr(controller, "units", {})))
 
 
@@ -325,7 +345,7 @@ class SignalMap(Mapping):
             return r.channel(deriv, m.body_dofs.index(dof))
         c = m.corners.index(parts[1])
         if head in r.controller_records:
-            return r.controller_records[head][..., c]
+            return r.controller_records[head].corner(c)
         if head == "wheel":
             return r.channel(parts[2].partition("_")[2], m.n_body + c)
         if head in ("road", "road_vel"):
@@ -365,8 +385,8 @@ class Result:
     diverged_at: np.ndarray
     designs: dict[str, np.ndarray]
     _dynamics: _Dynamics
-    damping_history: np.ndarray | None = None
-    controller_records: dict[str, np.ndarray] = field(default_factory=dict)
+    held_damping: _Held | None = None
+    controller_records: dict[str, _Held] = field(default_factory=dict)
     controller_units: dict[str, str] = field(default_factory=dict)
     metrics: dict[str, np.ndarray] = field(default_factory=dict)
     metric_units: dict[str, str] = field(default_factory=dict)
@@ -375,6 +395,7 @@ class Result:
         self.signals = SignalMap(self)
         self._corner_cache: dict[str, np.ndarray] = {}
         self._derivative: np.ndarray | None = None
+        self._damping_full: np.ndarray | None = None
 
     def signal_unit(self, name: str) -> str:
         """SI unit of a signal of this result."""
@@ -413,6 +434,15 @@ class Result:
     def damping_coefficient(self) -> np.ndarray:
         """Damper coefficient of every corner, (P, T, N) or (P, 1, N) when passive [N s/m]."""
         return self.model.damper if self.damping_history is None else self.damping_history
+
+    @property
+    def damping_history(self) -> np.ndarray | None:
+        """(P, T, N) damping coefficients of a controlled run [N s/m], None when passive."""
+        if self.held_damping is None:
+            return None
+        if self._damping_full is None:
+            self._damping_full = self.held_damping.full()
+        return self._damping_full
 
     def acceleration(self) -> np.ndarray:
         """Accelerations of every DOF, (P, T, n), from the equations of motion."""
