@@ -218,8 +218,9 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     offsets = np.where(rear, wheelbase, 0.0) if cfg.road.wheelbase_delay else np.zeros(N)
     if pv.varies("vehicle.body.a_front") or pv.varies("vehicle.body.a_rear"):
         if any(cn[0] == "R" for cn in corners):
-            raise ConfigError("params: vehicle.body.a_front/a_rear cannot be design parameters of a model "
-                             "with a rear axle: the road's wheelbase delay is one per run")
+            raise ConfigError("params: vehicle.body.a_front/a_rear cannot be design parameters "
+                              "of a model with a rear axle: the road's wheelbase delay is one "
+                              "per run")
     sides = tuple("right" if cn[1] == "1" else "left" for cn in corners)
     dof_names = tuple(f"body.{d}" for d in body_dofs) + tuple(f"wheel.{cn}" for cn in corners)
     e = (slice(None), None, slice(None))

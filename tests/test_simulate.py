@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 import suspopt
-from suspopt.vehicle import build_vehicle
 
 from conftest import corner, make_config
 

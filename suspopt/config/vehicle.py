@@ -24,7 +24,8 @@ __all__ = [
     "AntiRollBars", "Vehicle",
 ]
 
-#: Corners of each preset (thesis names: F1 front right, F2 front left, R1 rear right, R2 rear left).
+#: Corners of each preset (thesis names: F1 front right, F2 front left, R1 rear right,
+#: R2 rear left).
 PRESET_CORNERS: dict[str, tuple[str, ...]] = {
     "quarter": ("F1",),
     "half_roll": ("F1", "F2"),
