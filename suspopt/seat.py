@@ -27,12 +27,13 @@ Equations of motion (``u = x - z_s``; the passenger's pelvis link acts on the se
   a negative stiffness) and Eq 2.76 lacks the head's reaction ``-c_1 (ż_1 - ż_2) -
   k_1 (z_1 - z_2)`` on the back; the links here are equal and opposite on both parts.
 
-The seat and its passenger form one :class:`SeatModel`, an attachment of the simulator
-(:class:`suspopt.simulate.Attachment`): linear springs and dampers are links of a network over
-the nodes [floor, seat, (inner mass), passenger parts]; the mechanism of NSS1-NSS4 is one
-non-linear element between the floor and the mass it carries. The linearised model (for
-transmissibility and modes) is taken from that same force function by complex-step
-differentiation, never from a second copy of the equations.
+The seat and its passenger form one :class:`SeatModel`, mounted on the vehicle by the
+simulator: a :class:`suspopt.network.Network` (:func:`seat_network`) whose linear springs and
+dampers are links over the nodes [floor, seat, (inner mass), passenger parts] and whose
+mechanism (NSS1-NSS4) is one non-linear element between the floor and the mass it carries.
+The linearised model (for transmissibility and modes) comes from that same network, with the
+mechanism's slope at rest by complex-step differentiation, never from a second copy of the
+equations.
 """
 
 from __future__ import annotations
@@ -44,8 +45,9 @@ from typing import Any
 import numpy as np
 
 from .config import Config, ConfigError
+from .network import Elements, Network, apply, widen
 from .params import ParamView
-from .vehicle import _shared, matvec
+from .vehicle import _shared
 
 __all__ = [
     "PASSENGER_PARTS", "SIGNAL_HEADS", "SeatModel", "Mechanism", "LinearSeat",
@@ -128,15 +130,25 @@ def nss4_static_deflection(load_mass, inner_mass, support_stiffness, preload, gr
 # --------------------------------------------------------------------------------------------
 # Mechanism forces (exact geometry) and their Taylor series
 
-def _link_force(w, stiffness, offset, length):
-    """``2 k (1 + c / sqrt(ℓ² - w²)) w``: two symmetric horizontal springs acting through a
-    link whose vertical position is ``w`` and horizontal reach ``sqrt(ℓ² - w²)``, with
-    ``c`` the spring's free length offset (NSS2, NSS3, NSS4 share this form)."""
-    return 2.0 * stiffness * (1.0 + offset / np.sqrt(length * length - w * w)) * w
+def _link_law(stiffness, offset, length) -> Callable[[np.ndarray], np.ndarray]:
+    """``w -> 2 k (1 + c / sqrt(ℓ² - w²)) w``: two symmetric horizontal springs acting through
+    a link whose vertical position is ``w`` and horizontal reach ``sqrt(ℓ² - w²)``, with
+    ``c`` the spring's free length offset (NSS2, NSS3, NSS4 share this form). The constants are
+    folded once, so the simulator evaluates it in six array operations."""
+    a = 2.0 * stiffness
+    b, square = a * offset, length * length
+    return lambda w: (a + b / np.sqrt(square - w * w)) * w
+
+
+def _carrella_law(stiffness, wall_distance, spring_free_length):
+    """``u -> 2 K_h (L_o / sqrt(u² + a_o²) - 1) u`` (:func:`nss1_force`), constants folded."""
+    a, b = -2.0 * stiffness, 2.0 * stiffness * spring_free_length
+    square = wall_distance * wall_distance
+    return lambda u: (b / np.sqrt(u * u + square) + a) * u
 
 
 def _link_series(rest, stiffness, offset, length):
-    """Coefficients ``(k1, k2, k3)`` of :func:`_link_force` about ``w = rest``:
+    """Coefficients ``(k1, k2, k3)`` of :func:`_link_law` about ``w = rest``:
     ``F(rest + δ) - F(rest) = k1 δ + k2 δ² + k3 δ³ + O(δ⁴)``.
 
     With ``h(w) = w (ℓ² - w²)^(-1/2)``: ``h' = ℓ² D^(-3/2)``, ``h'' = 3 ℓ² w D^(-5/2)``,
@@ -159,8 +171,7 @@ def nss1_force(u, horizontal_stiffness, wall_distance, spring_free_length):
     its force ``u / sqrt(u² + a_o²)``. Zero at ``u = 0`` (springs horizontal) and at
     ``u = X_ST`` (springs free).
     """
-    return 2.0 * horizontal_stiffness * (
-        spring_free_length / np.sqrt(u * u + wall_distance * wall_distance) - 1.0) * u
+    return _carrella_law(horizontal_stiffness, wall_distance, spring_free_length)(u)
 
 
 def nss1_taylor(horizontal_stiffness, wall_distance, spring_free_length):
@@ -185,7 +196,12 @@ def nss2_force(u, horizontal_stiffness, wall_distance, spring_free_length, bar_l
     fraction by ``L_o`` gives ``f_N = 2 K_h (1 + (1 - γ2) / sqrt(γ1² - (u/L_o)²)) u`` — the
     printed ``sqrt(γ1² - x²)`` lacks the ``1/L_o`` on ``x``.
     """
-    return _link_force(u, horizontal_stiffness, spring_free_length - wall_distance, bar_length)
+    return _nss2_law(horizontal_stiffness, wall_distance, spring_free_length, bar_length)(u)
+
+
+def _nss2_law(horizontal_stiffness, wall_distance, spring_free_length, bar_length):
+    """:func:`nss2_force` as a function of the travel (constants folded)."""
+    return _link_law(horizontal_stiffness, spring_free_length - wall_distance, bar_length)
 
 
 def nss2_taylor(horizontal_stiffness, wall_distance, spring_free_length, bar_length):
@@ -205,8 +221,14 @@ def nss3_force(u, horizontal_stiffness, cam_radius, roller_radius, cam_offset, p
     distance less ``d + r``, and the contact normal gives the vertical share
     ``u / sqrt((R + r)² - u²)``.
     """
-    return _link_force(u, horizontal_stiffness, precompression - cam_offset - roller_radius,
-                       cam_radius + roller_radius)
+    return _nss3_law(horizontal_stiffness, cam_radius, roller_radius, cam_offset,
+                     precompression)(u)
+
+
+def _nss3_law(horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression):
+    """:func:`nss3_force` as a function of the travel (constants folded)."""
+    return _link_law(horizontal_stiffness, precompression - cam_offset - roller_radius,
+                     cam_radius + roller_radius)
 
 
 def nss3_taylor(horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression):
@@ -232,7 +254,11 @@ def nss4_force(u, horizontal_stiffness, wall_distance, spring_free_length, bar_l
     on ``m_d`` is ``-f_N``; its positive slope ``2 K_h (1 + c_I)`` at ``u = 0`` is the negative
     stiffness ``K_N = -2 K_h`` of Sec 2.2.5 for ``c_I = 0``. The same geometry as NSS2.
     """
-    return _link_force(u, horizontal_stiffness, spring_free_length - wall_distance, bar_length)
+    return _nss4_law(horizontal_stiffness, wall_distance, spring_free_length, bar_length)(u)
+
+
+#: :func:`nss4_force` as a function of the travel: the geometry of NSS2.
+_nss4_law = _nss2_law
 
 
 def nss4_taylor(hinge_offset, horizontal_stiffness, wall_distance, spring_free_length,
@@ -246,25 +272,30 @@ def nss4_taylor(hinge_offset, horizontal_stiffness, wall_distance, spring_free_l
 # --------------------------------------------------------------------------------------------
 # The attachment
 
+_COMPLEX_STEP = 1.0e-20
+
 @dataclass
 class Mechanism:
     """The geometric element of NSS1-NSS4 between the floor and the mass it carries.
 
-    ``node``: index of that mass among the seat's DOFs; ``exact(w)``: force on it [N] at the
-    mechanism coordinate ``w``, the travel from where the geometry is symmetric (the springs
-    horizontal); ``rest``: ``w`` at static equilibrium, (P, 1), or None for 0 (NSS1-NSS3; NSS4
+    ``node``: index of that mass among the seat's DOFs; ``law(s, width=None)``: the function
+    ``w -> s F(w)``, F the force on that mass [N] at the mechanism coordinate ``w`` (the travel
+    from where the geometry is symmetric, the springs horizontal), its constants folded for the
+    scale ``s`` (and widened to ``width`` design columns); ``rest``: ``w`` at static equilibrium, (P, 1), or None for 0 (NSS1-NSS3; NSS4
     rests at ``u_0``); ``series``: ``(k1, k2, k3)`` about ``rest`` when the Taylor form is used,
     else None; ``limit``: the largest ``|w|`` the geometry allows [m], (P, 1), or None.
     """
 
     node: int
-    exact: Callable[[np.ndarray], np.ndarray]
+    law: Callable[..., Callable[[np.ndarray], np.ndarray]]
     rest: np.ndarray | None
     series: tuple[np.ndarray, np.ndarray, np.ndarray] | None
     limit: np.ndarray | None
+    exact: Callable[[np.ndarray], np.ndarray] = field(init=False, repr=False)
     _preload: np.ndarray | None = field(init=False, repr=False)
 
     def __post_init__(self):
+        self.exact = self.law(1.0)
         self._preload = None if self.rest is None else self.exact(self.rest)
 
     def force(self, delta: np.ndarray) -> np.ndarray:
@@ -277,6 +308,28 @@ class Mechanism:
             return self.exact(delta)
         return self.exact(self.rest + delta) - self._preload
 
+    def element_force(self, width: int
+                      ) -> Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+        """``-force(δ)`` as the non-linear part of a network element along ``δ`` (the element
+        force resists the deformation; :mod:`suspopt.network`) for ``width`` design columns,
+        with the sign folded into the constants: the same arithmetic as :meth:`force`,
+        negated exactly."""
+        if self.series is not None:
+            c1, c2, c3 = (widen(-k[None], width) for k in self.series)
+            return lambda d, r, f: ((c3 * d + c2) * d + c1) * d
+        negated = self.law(-1.0, width)
+        if self.rest is None:
+            return lambda d, r, f: negated(d)
+        rest, preload = widen(self.rest[None], width), widen(self._preload[None], width)
+        return lambda d, r, f: negated(rest + d) + preload
+
+    def slope(self) -> np.ndarray:
+        """``dF/dδ`` at rest, (P,) [N/m] (a positive slope is a negative stiffness), by
+        complex-step differentiation: ``Im F(i h) / h`` is exact to rounding for these
+        analytic forces, the same for the exact and the Taylor form."""
+        return np.atleast_2d(self.force(np.full((1, 1), 1j * _COMPLEX_STEP))).imag[:, 0] \
+            / _COMPLEX_STEP
+
     def coordinate(self, delta: np.ndarray) -> np.ndarray:
         """The mechanism coordinate ``w`` for the travel ``delta`` from rest [m]."""
         return delta if self.rest is None else self.rest + delta
@@ -286,12 +339,15 @@ class Mechanism:
 class SeatModel:
     """A seat isolator and its optional passenger, mounted at ``point`` on the body.
 
-    Implements :class:`suspopt.simulate.Attachment`. ``dof_names``: ``seat``, ``seat.inner``
-    (NSS4), then the passenger's parts; ``mass (1|P, 1, m)`` [kg]; ``network (1|P, 2(m+1), m+1)``
-    the stacked stiffness and damping matrices ``[K; C]`` of the linear links over the nodes
-    [floor, DOFs...]; ``mechanism`` the geometric element (None for PS); ``isolator`` the
-    derived and given isolator quantities by name, (P,) each (``static_deflection`` [m],
-    ``vertical_stiffness`` [N/m], ...).
+    ``dof_names``: ``seat``, ``seat.inner`` (NSS4), then the passenger's parts; ``mass (1|P, 1,
+    m)`` [kg]; ``network`` its :class:`~suspopt.network.Network` over those DOFs with the floor
+    under the seat as the one input (groups ``links``: the linear springs and dampers; and, for
+    NSS1-NSS4, ``mechanism``: the geometric element between the floor and the mass it carries,
+    whose force is the group's non-linear part); ``point = (x, y)`` [m] the mount on the body
+    (x + forward, y + right), ``coupled`` whether the seat pushes back on the body (two-way) or
+    is driven one way (the thesis's way); ``mechanism`` the geometric element (None for PS);
+    ``isolator`` the derived and given isolator quantities by name, (P,) each
+    (``static_deflection`` [m], ``vertical_stiffness`` [N/m], ...).
     """
 
     kind: str
@@ -299,12 +355,11 @@ class SeatModel:
     mass: np.ndarray
     point: tuple[float, float]
     coupled: bool
-    network: np.ndarray
+    network: Network
     mechanism: Mechanism | None
     isolator: dict[str, np.ndarray]
 
     def __post_init__(self):
-        self._minus_network = -self.network
         self._signals = self._signal_table()
 
     @property
@@ -318,23 +373,22 @@ class SeatModel:
 
     def force(self, q: np.ndarray, v: np.ndarray, base: np.ndarray,
               base_vel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Forces on the seat's DOFs (P, S, m) and on the floor (P, S), upward +, from the
-        states ``q, v (P, S, m)`` and the floor's motion ``base, base_vel (P, S)``."""
-        y = np.concatenate((base[..., None], q, base_vel[..., None], v), axis=-1)
-        f = matvec(self._minus_network, y)
-        mech = self.mechanism
-        if mech is not None:
-            fm = mech.force(q[..., mech.node] - base)
-            f[..., mech.node + 1] += fm
-            f[..., 0] -= fm
-        return f[..., 1:], f[..., 0]
+        """Forces on the seat's DOFs (m, P, S) and on the floor (P, S), upward +, from the
+        states ``q, v (m, P, S)`` and the floor's motion ``base, base_vel (P, S)``."""
+        u, u_dot = base[None], base_vel[None]
+        own = self.network.generalised_force(q, v, u, u_dot)
+        floor = 0.0
+        for g, (elastic, viscous) in zip(self.network.groups,
+                                          self.network.forces(q, v, u, u_dot).values()):
+            floor = floor - apply(g.input_map.T, elastic + viscous)[0]
+        return own, floor
 
     def signal_names(self) -> list[str]:
         return list(self._signals)
 
     def signal(self, name: str, q: np.ndarray, v: np.ndarray, acc: np.ndarray,
                base: np.ndarray, base_vel: np.ndarray, base_acc: np.ndarray) -> np.ndarray:
-        """Signal ``name`` (P, T) from the seat's states (P, T, m) and the floor's (P, T)."""
+        """Signal ``name`` (P, T) from the seat's states (m, P, T) and the floor's (P, T)."""
         return self._signals[name](q, v, acc, base, base_vel, base_acc)
 
     def _signal_table(self) -> dict[str, Callable[..., np.ndarray]]:
@@ -342,24 +396,24 @@ class SeatModel:
             "seat.base": lambda q, v, a, b, bv, ba: b,
             "seat.base_vel": lambda q, v, a, b, bv, ba: bv,
             "seat.base_acc": lambda q, v, a, b, bv, ba: ba,
-            "seat.x": lambda q, v, a, b, bv, ba: q[..., 0],
-            "seat.vel": lambda q, v, a, b, bv, ba: v[..., 0],
-            "seat.acc": lambda q, v, a, b, bv, ba: a[..., 0],
-            "seat.travel": lambda q, v, a, b, bv, ba: q[..., 0] - b,
-            "seat.travel_vel": lambda q, v, a, b, bv, ba: v[..., 0] - bv,
+            "seat.x": lambda q, v, a, b, bv, ba: q[0],
+            "seat.vel": lambda q, v, a, b, bv, ba: v[0],
+            "seat.acc": lambda q, v, a, b, bv, ba: a[0],
+            "seat.travel": lambda q, v, a, b, bv, ba: q[0] - b,
+            "seat.travel_vel": lambda q, v, a, b, bv, ba: v[0] - bv,
         }
         if "seat.inner" in self.dof_names:
-            table["seat.inner_x"] = lambda q, v, a, b, bv, ba: q[..., 1]
-            table["seat.inner_acc"] = lambda q, v, a, b, bv, ba: a[..., 1]
+            table["seat.inner_x"] = lambda q, v, a, b, bv, ba: q[1]
+            table["seat.inner_acc"] = lambda q, v, a, b, bv, ba: a[1]
         mech = self.mechanism
         if mech is not None and mech.limit is not None:
             table["seat.travel_margin"] = lambda q, v, a, b, bv, ba: \
-                mech.limit - np.abs(mech.coordinate(q[..., mech.node] - b))
+                mech.limit - np.abs(mech.coordinate(q[mech.node] - b))
         for j, name in enumerate(self.dof_names):
             if name in PASSENGER_PARTS:
-                table[f"{name}.x"] = lambda q, v, a, b, bv, ba, j=j: q[..., j]
-                table[f"{name}.vel"] = lambda q, v, a, b, bv, ba, j=j: v[..., j]
-                table[f"{name}.acc"] = lambda q, v, a, b, bv, ba, j=j: a[..., j]
+                table[f"{name}.x"] = lambda q, v, a, b, bv, ba, j=j: q[j]
+                table[f"{name}.vel"] = lambda q, v, a, b, bv, ba, j=j: v[j]
+                table[f"{name}.acc"] = lambda q, v, a, b, bv, ba, j=j: a[j]
         return table
 
 
@@ -368,6 +422,16 @@ def _passive(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form:
     k_v = get("stiffness")
     return [(0, 1, k_v, get("damping"))], None, {
         "static_deflection": ps_static_deflection(load, k_v, g), "vertical_stiffness": k_v}
+
+
+def _scaled(law: Callable, params: tuple[np.ndarray, ...]):
+    """``(s, width) -> law(s K_h, *geometry)`` for a mechanism's ``params = (K_h, *geometry)``,
+    (P, 1) each, widened to ``width`` design columns when given."""
+    def make(scale: float, width: int | None = None):
+        # shaped like the mechanism's row (1, width, 1): numpy is slow to broadcast
+        p = params if width is None else tuple(widen(a[None], width) for a in params)
+        return law(scale * p[0], *p[1:])
+    return make
 
 
 def _negative_stiffness(kind: str):
@@ -390,8 +454,8 @@ def _negative_stiffness(kind: str):
         k_v = vertical_stiffness(load, x_st, g)
         k_h = get("stiffness_ratio") * k_v
         params = tuple(p[:, None] for p in (k_h,) + geometry)
-        force, series = _FORMS[kind]
-        mech = Mechanism(node=0, exact=lambda w: force(w, *params), rest=None,
+        law, series = _FORMS[kind]
+        mech = Mechanism(node=0, law=_scaled(law, params), rest=None,
                          series=series(*params) if form == "taylor" else None,
                          limit=None if limit is None else limit[:, None])
         return [(0, 1, k_v, get("damping"))], mech, {
@@ -408,7 +472,7 @@ def _kdamper(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form:
     u_0 = get("hinge_offset")
     params = tuple(p[:, None] for p in (k_h, a_o, l_o, b))
     preload = nss4_force(u_0, k_h, a_o, l_o, b)
-    mech = Mechanism(node=1, exact=lambda w: nss4_force(w, *params), rest=u_0[:, None],
+    mech = Mechanism(node=1, law=_scaled(_nss4_law, params), rest=u_0[:, None],
                      series=nss4_taylor(u_0[:, None], *params) if form == "taylor" else None,
                      limit=b[:, None])
     return [(0, 1, k_s, 0.0), (1, 2, k_v, get("damping"))], mech, {
@@ -417,9 +481,10 @@ def _kdamper(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form:
         "mechanism_preload": preload, "c_I": (l_o - a_o) / b}
 
 
-#: Exact force and Taylor coefficients of NSS1-NSS3, same parameters after the travel.
-_FORMS = {"nss1": (nss1_force, nss1_taylor), "nss2": (nss2_force, nss2_taylor),
-          "nss3": (nss3_force, nss3_taylor)}
+#: Exact force law (the parameters of the ``*_force`` function after the travel, giving the
+#: function of the travel) and Taylor coefficients of NSS1-NSS3.
+_FORMS = {"nss1": (_carrella_law, nss1_taylor), "nss2": (_nss2_law, nss2_taylor),
+          "nss3": (_nss3_law, nss3_taylor)}
 #: Isolator builders: (get, load [kg], g, form) -> (links, mechanism, quantities). Links are
 #: (node_a, node_b, stiffness, damping) over the nodes 0 floor, 1 seat, 2 inner mass.
 _ISOLATORS = {"ps": _passive, "nss1": _negative_stiffness("nss1"),
@@ -462,20 +527,42 @@ def build_seat(cfg: Config, pv: ParamView | None = None) -> SeatModel:
     with np.errstate(divide="ignore", invalid="ignore"):     # undefined geometry -> NaN
         iso_links, mechanism, isolator = _ISOLATORS[seat.kind](get, load, cfg.vehicle.gravity,
                                                                form)
-    n = len(node)
-    network = np.zeros((P, 2 * n, n))
-    for a, b, k, c in iso_links + links:
-        for offset, value in ((0, k), (n, c)):
-            value = np.broadcast_to(value, (P,))
-            network[:, offset + a, a] += value
-            network[:, offset + b, b] += value
-            network[:, offset + a, b] -= value
-            network[:, offset + b, a] -= value
-    mass = np.stack(masses, axis=1)[:, None, :]
+        mass = np.stack(masses, axis=1)[:, None, :]
+        network = seat_network(names, mass[:, 0, :], iso_links + links, mechanism)
     return SeatModel(kind=seat.kind, dof_names=names, mass=_shared(mass),
                      point=(seat.position.x, seat.position.y),
-                     coupled=seat.coupling == "two_way", network=_shared(network),
+                     coupled=seat.coupling == "two_way", network=network,
                      mechanism=mechanism, isolator={**isolator, "load_mass": load})
+
+
+def seat_network(dof_names: tuple[str, ...], mass: np.ndarray, links: list,
+                 mechanism: Mechanism | None) -> Network:
+    """The seat's :class:`~suspopt.network.Network`: DOFs ``dof_names`` with ``mass (P, m)``
+    [kg], the floor as input; ``links`` ``(node_a, node_b, k, c)`` over the nodes 0 floor,
+    1.. the DOFs, each a spring and damper along ``x_a - x_b`` (group ``links``); the
+    ``mechanism`` between the floor and its node (group ``mechanism``, linear part zero: its
+    element force is minus the mechanism's upward force on the node, so the node feels that
+    force and the floor its reaction)."""
+    P, m = mass.shape
+    dof_map, floor = np.zeros((len(links), m)), np.zeros((len(links), 1))
+    for i, (a, b, _, _) in enumerate(links):
+        for node, sign in ((a, 1.0), (b, -1.0)):
+            if node == 0:
+                floor[i, 0] += sign
+            else:
+                dof_map[i, node - 1] += sign
+    k = np.stack([np.broadcast_to(link[2], (P,)) for link in links])[:, :, None]
+    c = np.stack([np.broadcast_to(link[3], (P,)) for link in links])[:, :, None]
+    groups = [Elements("links", dof_map, floor, k, c)]
+    if mechanism is not None:
+        carried = np.zeros((1, m))
+        carried[0, mechanism.node] = 1.0
+        zero = np.zeros((1, P, 1))
+        groups.append(Elements("mechanism", carried, -np.ones((1, 1)), zero, zero,
+                               extra=mechanism.element_force,
+                               extra_slope=-mechanism.slope()[None, :, None]))
+    return Network(dof_names, ("floor",), np.ascontiguousarray(mass.T)[:, :, None],
+                   tuple(groups))
 
 
 def build_attachments(cfg: Config, pv: ParamView) -> list[SeatModel]:
@@ -503,35 +590,14 @@ class LinearSeat:
     input_damping: np.ndarray
 
 
-_COMPLEX_STEP = 1.0e-20
-
-
 def linearise(seat: SeatModel) -> LinearSeat:
-    """Linearise ``seat.force`` at rest by complex-step differentiation.
-
-    ``∂F/∂p = Im F(p + i h) / h`` is exact to rounding for the analytic forces here (no
-    subtraction error, unlike finite differences); all ``2m + 2`` inputs (q, v, z_s, z_s') are
-    perturbed at once along the sample axis of one ``force`` call. The mechanism enters with
-    its slope at rest, the same for the exact and the Taylor form.
-    """
-    m, P = len(seat.dof_names), seat.P
-    n = 2 * m + 2
-    q = np.zeros((P, n, m), dtype=complex)
-    v = np.zeros((P, n, m), dtype=complex)
-    base = np.zeros((P, n), dtype=complex)
-    base_vel = np.zeros((P, n), dtype=complex)
-    step = 1j * _COMPLEX_STEP * np.eye(m)
-    q[:, :m] = step
-    v[:, m:2 * m] = step
-    base[:, 2 * m] = 1j * _COMPLEX_STEP
-    base_vel[:, 2 * m + 1] = 1j * _COMPLEX_STEP
-    own, _ = seat.force(q, v, base, base_vel)
-    d = own.imag / _COMPLEX_STEP           # d[p, j, i] = ∂F_i / ∂input_j
-    return LinearSeat(dof_names=seat.dof_names,
-                      mass=np.broadcast_to(seat.mass[:, 0, :], (P, m)).copy(),
-                      stiffness=-np.swapaxes(d[:, :m], 1, 2),
-                      damping=-np.swapaxes(d[:, m:2 * m], 1, 2),
-                      input_stiffness=d[:, 2 * m], input_damping=d[:, 2 * m + 1])
+    """The seat linearised about static equilibrium (:meth:`Network.linear_model` of its
+    network): the links as they are, the mechanism with its slope at rest
+    (:meth:`Mechanism.slope`), the floor motion as the input."""
+    lin = seat.network.linear_model()
+    return LinearSeat(dof_names=seat.dof_names, mass=lin.mass, stiffness=lin.stiffness,
+                      damping=lin.damping, input_stiffness=lin.input_stiffness[..., 0],
+                      input_damping=lin.input_damping[..., 0])
 
 
 def base_transmissibility(lin: LinearSeat, f: np.ndarray) -> np.ndarray:

@@ -1,9 +1,12 @@
 """Batched fixed-step simulation of P designs at once and the ``Result`` it returns.
 
-The integrator is the classical 4th-order Runge-Kutta method with a fixed step ``dt``; the road
-is sampled on the half-step grid the stages need, so a bump edge that falls on a step boundary
-is seen exactly. All P designs advance together: each stage is a handful of array operations on
-states of shape (P, 1, 2n) - there is no Python loop over designs.
+The equations of motion are the vehicle's :class:`~suspopt.network.Network` with the seat (if
+any) mounted on it, packed by :class:`_Assembled`. The integrator is the classical 4th-order
+Runge-Kutta method with a fixed step ``dt``; the road is sampled on the half-step grid the
+stages need, so a bump edge that falls on a step boundary is seen exactly. All P designs
+advance together: states are ``(2n, P, 1)`` - DOF by DOF, each a contiguous row over the
+designs - and each stage is two small matrix products and the element forces on whole rows,
+in preallocated buffers. There is no Python loop over designs.
 
 A design whose state becomes non-finite or exceeds ``DIVERGENCE_LIMIT`` is marked in
 ``Result.diverged`` (with the time in ``Result.diverged_at``); its samples from then on are NaN,
@@ -22,6 +25,7 @@ import numpy as np
 
 from .config import Config
 from .control import build_controller
+from .network import Network, widen
 from .params import ParamView
 from .specs import evaluate_spec, spec_signals
 from .road import road_inputs
@@ -35,6 +39,10 @@ __all__ = ["simulate", "check", "signal_names", "signal_units", "Result", "Signa
 #: |state| above this (m, rad, m/s, rad/s) counts as divergence.
 DIVERGENCE_LIMIT = 1.0e6
 _CHECK_EVERY = 25
+#: Input offsets are stored per design column when that takes at most this many floats.
+_WIDE_OFFSETS = 4_000_000
+#: Output samples moved to the (2n, P, T) states at a time.
+_BLOCK = 64
 
 
 class Controller(Protocol):
@@ -62,21 +70,18 @@ class Controller(Protocol):
 class Attachment(Protocol):
     """Extra bodies mounted at a point of the vehicle body (a seat, a seated passenger).
 
-    ``dof_names`` name its vertical DOFs (appended after the vehicle's), ``mass (1|P, 1, m)``
-    their masses. ``point = (x, y)`` is where it sits on the body [m] (x + forward, y + right);
-    the base motion is the body's vertical motion there. ``force`` returns the forces on its
-    own DOFs ``(P, S, m)`` and the vertical force it exerts on the body at the point
-    ``(P, S)`` (upward +), which acts on the body only when ``coupled`` (two-way); the thesis
-    drives seats one way. ``signal(name, ...)`` computes its named signals ``(P, S)``.
+    ``dof_names`` name its vertical DOFs (appended after the vehicle's); ``network`` its
+    :class:`~suspopt.network.Network` with the floor under it as the one input;
+    ``point = (x, y)`` is where it sits on the body [m] (x + forward, y + right), the floor's
+    motion being the body's vertical motion there; ``coupled`` puts the floor's reaction on
+    the body (two-way); the thesis drives seats one way. ``signal(name, ...)`` computes its
+    named signals ``(P, T)`` from its states ``(m, P, T)`` and the floor's ``(P, T)``.
     """
 
     dof_names: tuple[str, ...]
-    mass: np.ndarray
+    network: Network
     point: tuple[float, float]
     coupled: bool
-
-    def force(self, q: np.ndarray, v: np.ndarray, base: np.ndarray,
-              base_vel: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
 
     def signal_names(self) -> list[str]: ...
 
@@ -84,51 +89,102 @@ class Attachment(Protocol):
                base: np.ndarray, base_vel: np.ndarray, base_acc: np.ndarray) -> np.ndarray: ...
 
 
-class _Dynamics:
-    """Right-hand side y' = [q', M^-1 f(q, q', road)] of the first-order system y = [q, q'],
-    q = [vehicle DOFs, attachment DOFs]."""
+def _product(matrix: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
+    """``out = matrix @ x`` for a (P, r, c) matrix per design and columns ``x (c, P*S)``
+    ordered design-major."""
+    P = matrix.shape[0]
+    np.einsum("prc,cps->rps", matrix, x.reshape(x.shape[0], P, -1),
+              out=out.reshape(out.shape[0], P, -1))
 
-    def __init__(self, model: VehicleModel, attachments: Sequence[Attachment] = ()):
-        self.model = model
-        self.attachments = tuple(attachments)
-        self.n_vehicle = model.n_dof
-        self.slices, start = [], model.n_dof
-        for att in self.attachments:
-            self.slices.append(slice(start, start + len(att.dof_names)))
-            start += len(att.dof_names)
-        self.n = start
-        self.point_rows = [model.point_map(*att.point) for att in self.attachments]
-        masses = [model.mass] + [att.mass for att in self.attachments]
-        P = max(m.shape[0] for m in masses)
-        self.inverse_mass = 1.0 / np.concatenate(
-            [np.broadcast_to(m, (P, 1, m.shape[-1])) for m in masses], axis=-1)
 
-    def base(self, j: int, x: np.ndarray) -> np.ndarray:
-        """Body displacement (or velocity, acceleration) at attachment j's point, (P, S)."""
-        return x[..., :self.n_vehicle] @ self.point_rows[j]
+class _Assembled:
+    """A network packed for fast evaluation of ``q'' = M^-1 Σ -D_qᵀ F`` (suspopt.network).
 
-    def __call__(self, y: np.ndarray, road: np.ndarray, road_vel: np.ndarray,
-                 damping: np.ndarray | None = None) -> np.ndarray:
-        n, nv = self.n, self.n_vehicle
-        q, v = y[..., :n], y[..., n:]
-        force = self.model.generalised_force(q[..., :nv], v[..., :nv], road, road_vel, damping)
-        parts = [force]
-        for j, att in enumerate(self.attachments):
-            sl = self.slices[j]
-            own, reaction = att.force(q[..., sl], v[..., sl], self.base(j, q), self.base(j, v))
-            if att.coupled:
-                force = force + reaction[..., None] * self.point_rows[j]
-                parts[0] = force
-            parts.append(own)
-        acc = (np.concatenate(parts, axis=-1) if len(parts) > 1 else parts[0]) \
-            * self.inverse_mass
-        return np.concatenate([v, acc], axis=-1)
+    All groups' deformation rows are stacked: ``e = D2 @ [q; v] + offset`` gives the
+    displacements (rows ``:R``) and rates (rows ``R:``) of every element, ``F = coef * e`` their
+    elastic and viscous forces (``coef = [k; c]``), the groups' non-linear parts are added to
+    the elastic rows, and ``q'' = M^-1 G2 @ F`` with ``G2 = [G, G]`` (``G = -D_qᵀ``, masked
+    where a one-way seat does not push the body). ``offset`` holds the inputs' part
+    ``[D_u u; D_u u']``. A semi-active damper's coefficients are the rows ``damper_rows`` of
+    ``coef``. The integrator and the signals computed afterwards use this one evaluation.
+    """
+
+    def __init__(self, network: Network, P: int, controlled: str | None = None):
+        self.network = network
+        n, groups = network.n, network.groups
+        R = sum(g.size for g in groups)
+        self.n, self.R, self.P = n, R, P
+        per_design = any(g.dof_map.ndim == 3 for g in groups)
+        dq = [np.broadcast_to(g.dof_map, (P, g.size, n)) if per_design else g.dof_map
+              for g in groups]
+        Dq = np.concatenate(dq, axis=-2)
+        D2 = np.zeros(Dq.shape[:-2] + (2 * R, 2 * n))
+        D2[..., :R, :n] = Dq
+        D2[..., R:, n:] = Dq
+        self.input_map = np.concatenate([g.input_map for g in groups])       # (R, n_u)
+        G = np.concatenate([np.broadcast_to(g.force_map, (P, n, g.size)) if per_design
+                            else g.force_map for g in groups], axis=-1)
+        G2 = np.concatenate([G, G], axis=-1)
+        # M^-1 multiplies the accelerations even where it could be folded into G2: folding
+        # rounds differently, and a design must give the same bits whatever else varies in
+        # its batch
+        self.inverse_mass = np.ascontiguousarray(1.0 / np.broadcast_to(network.mass,
+                                                                       (n, P, 1)))
+        self.D2, self.G2 = np.ascontiguousarray(D2), np.ascontiguousarray(G2)
+        self.coef = np.ascontiguousarray(np.concatenate(
+            [np.broadcast_to(g.stiffness, (g.size, P, 1)) for g in groups]
+            + [np.broadcast_to(g.damping, (g.size, P, 1)) for g in groups]))
+        self.extras, self.damper_rows, start = [], None, 0
+        for g in groups:
+            rows = slice(start, start + g.size)
+            rates = slice(R + start, R + start + g.size)
+            if g.extra is not None:
+                self.extras.append((rows, rates, g.extra, g.extra_uses_force))
+            if g.name == controlled:
+                self.damper_rows = rates
+            start += g.size
+
+    def offsets(self, u: np.ndarray, u_dot: np.ndarray) -> np.ndarray:
+        """``[D_u u; D_u u']`` at each sample of the inputs ``u, u_dot (n_u, T)``: (T, 2R,
+        1, 1), contiguous per sample."""
+        off = np.concatenate([self.input_map @ u, self.input_map @ u_dot])
+        return np.ascontiguousarray(off.T)[:, :, None, None]
+
+    def evaluator(self, S: int = 1, width: int | None = None
+                  ) -> Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                 np.ndarray], None]:
+        """A function ``(y2, offset, coef, inverse_mass, acc2, acc) -> None`` that writes
+        ``q''`` of S samples of ``width`` designs (default P) into ``acc``.
+
+        ``y2 = [q; v]`` (2n, width*S); ``offset`` (2R, 1|width, 1|S); ``coef`` (2R, width,
+        1|S); ``inverse_mass`` (n, width, 1), scaled when the caller wants a multiple of q'';
+        ``acc2``/``acc`` the (n, width*S) and (n, width, S) views of the output. Its buffers
+        for the deformations and forces are allocated once, with the non-linear parts' views
+        into them, so that the integrator's stages allocate nothing.
+        """
+        R, width = self.R, width or self.P
+        e, F = np.empty((2 * R, width, S)), np.empty((2 * R, width, S))
+        e2, F2 = e.reshape(2 * R, -1), F.reshape(2 * R, -1)
+        extras = [(F[rows], F[rates], e[rows], e[rates], make(width), uses)
+                  for rows, rates, make, uses in self.extras]
+        product = np.matmul if self.D2.ndim == 2 else _product
+        D2, G2, multiply = self.D2, self.G2, np.multiply
+
+        def evaluate(y2, offset, coef, inverse_mass, acc2, acc) -> None:
+            product(D2, y2, out=e2)
+            e.__iadd__(offset)
+            multiply(coef, e, out=F)
+            for elastic, viscous, disp, rate, fn, uses_force in extras:
+                elastic += fn(disp, rate, elastic + viscous if uses_force else None)
+            product(G2, F2, out=acc2)
+            acc.__imul__(inverse_mass)
+        return evaluate
 
 
 @dataclass
 class _Held:
     """A controller quantity held between changes: the distinct values ``(S, P, N)`` and, for
-    each output sample, which of them held ``(T,)``. Expanded to ``(P, T, N)`` on demand, so a
+    each output sample, which of them held ``(T,)``. Expanded to ``(N, P, T)`` on demand, so a
     coefficient that changes only every ΔT is stored once per change, not per sample."""
 
     values: np.ndarray
@@ -139,13 +195,13 @@ class _Held:
         return self.values[self.index, :, c].T
 
     def full(self) -> np.ndarray:
-        """(P, T, N) series of every corner."""
-        return np.moveaxis(self.values[self.index], 0, 1)
+        """(N, P, T) series of every corner."""
+        return np.transpose(self.values[self.index], (2, 1, 0))
 
 
 @dataclass
 class _Trajectory:
-    """What one integration produced: states (P, T, 2n), the held damping coefficients and
+    """What one integration produced: states (2n, P, T), the held damping coefficients and
     controller records (or None / empty without a controller) and the divergence times (P,)."""
 
     states: np.ndarray
@@ -154,26 +210,69 @@ class _Trajectory:
     diverged_at: np.ndarray
 
 
-def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt: float,
-               n_steps: int, every: int, controller: Controller | None = None) -> _Trajectory:
-    """RK4 over ``n_steps``; ``road``/``road_vel`` are (2 n_steps + 1, 1, 1, N) on the
-    half-step grid. Samples are kept at every ``every``-th step."""
-    n, n2 = f.n, 2 * f.n
-    y = np.zeros((P, 1, n2))
+def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, n_steps: int,
+               every: int, controller: Controller | None = None) -> _Trajectory:
+    """Classical RK4 over ``n_steps``; ``offsets`` (2 n_steps + 1, 2R, 1, 1) are the inputs'
+    part of the deformations on the half-step grid. Samples are kept every ``every``-th step.
+
+    Every array lives in preallocated buffers (states ``(2n, P, 1)``) and each stage is a few
+    whole-population operations: two small matrix products and the element forces.
+
+    A single design is integrated as two identical columns: BLAS multiplies one column by a
+    matrix-vector kernel whose rounding differs from the matrix-matrix kernel's, and a design
+    must give the same bits alone as in any batch.
+    """
+    n, P = asm.n, asm.P
+    n2, width = 2 * n, max(P, 2)
+    evaluate = asm.evaluator(width=width)
+    y, ys, scratch = (np.zeros((n2, width, 1)) for _ in range(3))
+    s1, s2, s3, s4 = (np.empty((n2, width, 1)) for _ in range(4))
+    coef = np.broadcast_to(asm.coef, asm.coef.shape[:1] + (width, 1)).copy()
+    half = 0.5 * dt
+    if offsets.size * width <= _WIDE_OFFSETS:          # small batches: no broadcasting
+        offsets = widen(offsets, width)
+    # each stage returns its slope already scaled by the step it is used with, so that a stage
+    # state is one addition: s1 = dt/2 k1, s2 = dt/2 k2, s3 = dt k3, s4 = dt/6 k4, and
+    # y += dt/6 (k1 + 2 k2 + 2 k3 + k4) = (s1 + 2 s2 + s3)/3 + s4.
+    # A stage: (state, half-steps after t_k, M^-1 scaled, slope, its views, scale, next state)
+    flat = {id(a): a.reshape(n2, width) for a in (y, ys)}
+
+    def plan(state, shift, slope, h, target):
+        return (flat[id(state)], shift, widen(asm.inverse_mass * h, width),
+                slope[n:].reshape(n, width), slope[n:], slope[:n], state[n:], h, slope, target)
+    stages = (plan(y, 0, s1, half, ys), plan(ys, 1, s2, half, ys), plan(ys, 1, s3, dt, ys),
+              plan(ys, 2, s4, dt / 6.0, None))
+    unscaled = plan(y, 0, scratch, 1.0, None)
     n_out = n_steps // every + 1
-    states = np.empty((n_out, P, n2))      # time-major: each sample is one contiguous write
-    damping = None
+    # samples go to a time-major block (one contiguous write each), and each full block is
+    # moved to the states (2n, P, T) as a transposed copy: cache-friendly, unlike moving the
+    # whole time-major record at the end (ten times slower for 1000 designs)
+    states = np.empty((n2, P, n_out))
+    by_time = states.reshape(n2 * P, n_out)
+    block = np.empty((_BLOCK, n2, P))
+    by_sample = block.reshape(_BLOCK, n2 * P)
     held: list[tuple[np.ndarray, dict[str, np.ndarray]]] = []
     held_index = np.empty(n_out, dtype=np.intp)
     last: list = [None, None]
-    if controller is not None:
-        damping = controller.start(P)
+    damping = controller.start(P) if controller is not None else None
     diverged_at = np.full(P, np.nan)
-    half = 0.5 * dt
-    nv = f.n_vehicle
+    vel = y[n:]
+
+    def set_damping(value: np.ndarray) -> None:
+        coef[asm.damper_rows] = np.transpose(value, (2, 0, 1))
+
+    def acceleration(i: int):
+        def vehicle_acceleration() -> np.ndarray:
+            y2, _, inverse_mass, acc2, acc = unscaled[:5]
+            evaluate(y2, offsets[i], coef, inverse_mass, acc2, acc)
+            return np.transpose(acc[:n_vehicle, :P], (1, 2, 0)).copy()
+        return vehicle_acceleration
 
     def keep(j: int) -> None:
-        states[j] = y[:, 0]
+        block[j % _BLOCK] = y[:, :P, 0]
+        if j % _BLOCK == _BLOCK - 1 or j == n_out - 1:
+            j0 = j - j % _BLOCK
+            by_time[:, j0:j + 1] = by_sample[:j + 1 - j0].T
         if controller is not None:
             records = controller.record()
             # controllers hand out new arrays when a value changes: store only the changes
@@ -183,26 +282,38 @@ def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt:
                 last[:] = [damping, records]
             held_index[j] = len(held) - 1
 
+    if controller is not None:
+        set_damping(damping)
+    third, multiply, add = 1.0 / 3.0, np.multiply, np.add
     with np.errstate(over="ignore", invalid="ignore"):
         for k in range(n_steps):
             i = 2 * k
             if controller is not None:
-                def acceleration(y=y, i=i, damping=damping):
-                    return f(y, road[i], road_vel[i], damping)[..., n:n + nv]
-                damping = controller.step(k, k * dt, y[..., :nv], y[..., n:n + nv], acceleration)
+                new = controller.step(k, k * dt, np.transpose(y[:n_vehicle, :P], (1, 2, 0)),
+                                      np.transpose(vel[:n_vehicle, :P], (1, 2, 0)),
+                                      acceleration(i))
+                if new is not damping:
+                    damping = new
+                    set_damping(damping)
             if k == 0:
                 keep(0)
-            k1 = f(y, road[i], road_vel[i], damping)
-            k2 = f(y + half * k1, road[i + 1], road_vel[i + 1], damping)
-            k3 = f(y + half * k2, road[i + 1], road_vel[i + 1], damping)
-            k4 = f(y + dt * k3, road[i + 2], road_vel[i + 2], damping)
-            y = y + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
+            for y2, shift, inverse_mass, acc2, acc, q_rate, v, h, slope, target in stages:
+                evaluate(y2, offsets[i + shift], coef, inverse_mass, acc2, acc)
+                multiply(v, h, out=q_rate)
+                if target is not None:
+                    add(y, slope, out=target)
+            s1 += s3
+            s2 *= 2.0
+            s1 += s2
+            s1 *= third
+            s1 += s4
+            y += s1
             if (k + 1) % _CHECK_EVERY == 0 or k + 1 == n_steps:
-                bad = ~(np.abs(y) < DIVERGENCE_LIMIT).all(axis=(1, 2))
-                new = bad & np.isnan(diverged_at)
-                if new.any():
-                    diverged_at[new] = (k + 1) * dt
-                    y[bad] = np.nan
+                bad = ~(np.abs(flat[id(y)][:, :P]) < DIVERGENCE_LIMIT).all(axis=0)
+                new_bad = bad & np.isnan(diverged_at)
+                if new_bad.any():
+                    diverged_at[new_bad] = (k + 1) * dt
+                    y[:, :P][:, bad] = np.nan
             if (k + 1) % every == 0:
                 keep((k + 1) // every)
 
@@ -211,8 +322,8 @@ def _integrate(f: _Dynamics, P: int, road: np.ndarray, road_vel: np.ndarray, dt:
         damping_held = _Held(np.stack([h[0] for h in held]), held_index)
         records_held = {name: _Held(np.stack([h[1][name] for h in held]), held_index)
                         for name in held[0][1]}
-    return _Trajectory(states=np.ascontiguousarray(np.moveaxis(states, 0, 1)),
-                       damping=damping_held, records=records_held, diverged_at=diverged_at)
+    return _Trajectory(states=states, damping=damping_held, records=records_held,
+                       diverged_at=diverged_at)
 
 
 def _prepare(cfg: Config, params: Mapping[str, Any] | None):
@@ -258,15 +369,17 @@ def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller
     n_steps, every = sim.n_steps, sim.output_every
     t_grid = np.arange(2 * n_steps + 1) * (0.5 * sim.dt)
     z, zd = road_inputs(cfg.road, model.offsets, model.sides, t_grid, base_dir=cfg.base_dir)
-    road = np.ascontiguousarray(z.T)[:, None, None, :]
-    road_vel = np.ascontiguousarray(zd.T)[:, None, None, :]
-    f = _Dynamics(model, attachments)
-    traj = _integrate(f, pv.P, road, road_vel, sim.dt, n_steps, every, controller)
+    network = model.network
+    for att in attachments:
+        network = network.attach(att.network, model.point_map(*att.point), att.coupled)
+    asm = _Assembled(network, pv.P, controlled="suspension" if controller else None)
+    traj = _integrate(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller)
     out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
     return Result(config=cfg, model=model, time=t_grid[out_idx], states=traj.states,
-                  road=z[:, out_idx].T[None], road_vel=zd[:, out_idx].T[None],
-                  diverged_at=traj.diverged_at, designs=dict(pv.params), _dynamics=f,
-                  held_damping=traj.damping, controller_records=traj.records,
+                  road=z[:, None, out_idx], road_vel=zd[:, None, out_idx],
+                  diverged_at=traj.diverged_at, designs=dict(pv.params), _assembled=asm,
+                  attachments=tuple(attachments), held_damping=traj.damping,
+                  controller_records=traj.records,
                   controller_units=dict(getattr(controller, "units", {})))
 
 
@@ -309,11 +422,12 @@ class SignalMap(Mapping):
     """Lazy, cached mapping of signal name -> (P, T) array, computed from the states."""
 
     def __init__(self, result: "Result"):
-        self._r = result
-        self._cache: dict[str, np.ndarray] = {}
-        self._names = signal_names(result.model, result.controller_units,
-                                   result._dynamics.attachments)
-        self._attachment_of = {name: j for j, att in enumerate(result._dynamics.attachments)
+        # the result keeps the cache, not this map: a cycle result <-> map would keep the
+        # (large) arrays alive until the cyclic garbage collector happens to run
+        self._result = result
+        self._cache = result._signal_cache
+        self._names = result._signal_names
+        self._attachment_of = {name: j for j, att in enumerate(result.attachments)
                                for name in att.signal_names()}
 
     def __iter__(self) -> Iterator[str]:
@@ -335,7 +449,8 @@ class SignalMap(Mapping):
         return self._cache[name]
 
     def _compute(self, name: str) -> np.ndarray:
-        r, m = self._r, self._r.model
+        r = self._result
+        m = r.model
         if name in self._attachment_of:
             return r.attachment_signal(self._attachment_of[name], name)
         parts = name.split(".")
@@ -350,20 +465,23 @@ class SignalMap(Mapping):
             return r.channel(parts[2].partition("_")[2], m.n_body + c)
         if head in ("road", "road_vel"):
             src = r.road if head == "road" else r.road_vel
-            return np.broadcast_to(src[..., c], (m.P, r.time.size)).copy()
-        if head in ("travel", "spring_force"):
-            st = r.per_corner("travel")
-            return (st if head == "travel" else m.spring_force(st))[..., c]
+            return np.broadcast_to(src[c], (m.P, r.time.size)).copy()
+        if head == "travel":
+            return r.deformation("suspension")[c]
         if head == "travel_vel":
-            return r.per_corner("travel_vel")[..., c]
-        if head == "damper_force":
-            return (r.damping_coefficient() * r.per_corner("travel_vel"))[..., c]
-        if head == "damping":
-            return np.broadcast_to(r.damping_coefficient()[..., c], (m.P, r.time.size)).copy()
+            return r.deformation("suspension", rate=True)[c]
         if head == "tyre_deflection":
-            return r.q[..., m.n_body + c] - r.road[..., c]
+            return r.deformation("tyre")[c]
+        if head == "spring_force":
+            return r.element_forces("suspension")[0][c]
+        if head == "damper_force":
+            return r.element_forces("suspension")[1][c]
+        if head == "damping":
+            return np.broadcast_to(r.damping_coefficient()[c], (m.P, r.time.size)).copy()
         if head == "tyre_force":
-            return m.tyre_force(r.vehicle_q, r.vehicle_v, r.road, r.road_vel)[..., c]
+            # the normal load, compression +: static load less the tyre element's force
+            elastic, viscous = r.element_forces("tyre")
+            return m.static_tyre_load[:, 0, c, None] - (elastic[c] + viscous[c])
         raise KeyError(name)
 
 
@@ -373,18 +491,20 @@ class Result:
 
     ``time (T,)`` [s]; ``signals[name] (P, T)`` (lazy); ``metrics[name] (P,)``;
     ``diverged (P,)`` and ``diverged_at (P,)`` [s, NaN when fine]; ``designs`` the (P,) arrays of
-    the design parameters by dotted path; ``states (P, T, 2n)`` the raw [q, q'] samples.
+    the design parameters by dotted path; ``states (2n, P, T)`` the raw [q, q'] samples, DOF
+    by DOF (vehicle, then attachments).
     """
 
     config: Config
     model: VehicleModel
     time: np.ndarray
     states: np.ndarray
-    road: np.ndarray
-    road_vel: np.ndarray
+    road: np.ndarray            # (N, 1, T) road height under each wheel [m]
+    road_vel: np.ndarray        # (N, 1, T) [m/s]
     diverged_at: np.ndarray
     designs: dict[str, np.ndarray]
-    _dynamics: _Dynamics
+    _assembled: _Assembled
+    attachments: tuple[Attachment, ...] = ()
     held_damping: _Held | None = None
     controller_records: dict[str, _Held] = field(default_factory=dict)
     controller_units: dict[str, str] = field(default_factory=dict)
@@ -392,10 +512,17 @@ class Result:
     metric_units: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self):
-        self.signals = SignalMap(self)
-        self._corner_cache: dict[str, np.ndarray] = {}
-        self._derivative: np.ndarray | None = None
+        self._signal_cache: dict[str, np.ndarray] = {}
+        self._signal_names = signal_names(self.model, self.controller_units, self.attachments)
+        self._deformation: dict[tuple[str, bool], np.ndarray] = {}
+        self._forces: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self._acceleration: np.ndarray | None = None
         self._damping_full: np.ndarray | None = None
+
+    @property
+    def signals(self) -> SignalMap:
+        """Signal name -> (P, T) array, computed on first use and cached."""
+        return SignalMap(self)
 
     def signal_unit(self, name: str) -> str:
         """SI unit of a signal of this result."""
@@ -406,7 +533,12 @@ class Result:
 
     @property
     def P(self) -> int:
-        return self.states.shape[0]
+        return self.states.shape[1]
+
+    @property
+    def n(self) -> int:
+        """Number of DOFs (vehicle and attachments)."""
+        return self._assembled.n
 
     @property
     def diverged(self) -> np.ndarray:
@@ -415,62 +547,99 @@ class Result:
 
     @property
     def q(self) -> np.ndarray:
-        """Displacements of every DOF (vehicle, then attachments), (P, T, n)."""
-        return self.states[..., : self._dynamics.n]
+        """Displacements of every DOF (vehicle, then attachments), (P, T, n) (a view)."""
+        return np.moveaxis(self.states[:self.n], 0, -1)
 
     @property
     def v(self) -> np.ndarray:
-        """Velocities of every DOF, (P, T, n)."""
-        return self.states[..., self._dynamics.n:]
-
-    @property
-    def vehicle_q(self) -> np.ndarray:
-        return self.q[..., : self.model.n_dof]
-
-    @property
-    def vehicle_v(self) -> np.ndarray:
-        return self.v[..., : self.model.n_dof]
+        """Velocities of every DOF, (P, T, n) (a view)."""
+        return np.moveaxis(self.states[self.n:], 0, -1)
 
     def damping_coefficient(self) -> np.ndarray:
-        """Damper coefficient of every corner, (P, T, N) or (P, 1, N) when passive [N s/m]."""
-        return self.model.damper if self.damping_history is None else self.damping_history
+        """Damper coefficient of every corner, (N, P, T) or (N, P, 1) when passive [N s/m]."""
+        if self.damping_history is None:
+            return self.model.network.group("suspension").damping
+        return self.damping_history
 
     @property
     def damping_history(self) -> np.ndarray | None:
-        """(P, T, N) damping coefficients of a controlled run [N s/m], None when passive."""
+        """(N, P, T) damping coefficients of a controlled run [N s/m], None when passive."""
         if self.held_damping is None:
             return None
         if self._damping_full is None:
             self._damping_full = self.held_damping.full()
         return self._damping_full
 
+    def deformation(self, group: str, rate: bool = False) -> np.ndarray:
+        """Deformations (or their rates) of a vehicle element group, (m, P, T): ``suspension``
+        the travel ST [m], ``tyre`` the tyre deflection TD [m], ``anti_roll_bar`` the twist."""
+        key = (group, rate)
+        if key not in self._deformation:
+            g = self.model.network.group(group)
+            nv = self.model.n_dof
+            x = self.states[self.n:self.n + nv] if rate else self.states[:nv]
+            self._deformation[key] = g.deformation(x, self.road_vel if rate else self.road)
+        return self._deformation[key]
+
+    def element_forces(self, group: str) -> tuple[np.ndarray, np.ndarray]:
+        """The elastic and viscous forces (m, P, T) [N] of a vehicle element group (the
+        suspension's spring force F_K and damper force F_C, Eq 2.30-2.32; the tyre's
+        F_T parts, Eq 2.28-2.29), with the controller's damping where it has one."""
+        if group not in self._forces:
+            g = self.model.network.group(group)
+            nv, n = self.model.n_dof, self.n
+            damping = self.damping_history if group == "suspension" else None
+            self._forces[group] = g.parts(self.states[:nv], self.states[n:n + nv], self.road,
+                                          self.road_vel, damping)
+        return self._forces[group]
+
     def acceleration(self) -> np.ndarray:
-        """Accelerations of every DOF, (P, T, n), from the equations of motion."""
-        if self._derivative is None:
+        """Accelerations of every DOF, (n, P, T), from the assembled equations of motion that
+        were integrated (evaluated in blocks of samples to bound the memory)."""
+        if self._acceleration is None:
+            asm = self._assembled
+            T = self.time.size
+            acc = np.empty((asm.n, self.P, T))
+            offsets = asm.offsets(self.road[:, 0], self.road_vel[:, 0])   # (T, 2R, 1, 1)
+            block = max(1, int(4.0e6 // (2 * asm.R * self.P)))
+            damping = self.damping_history
             with np.errstate(invalid="ignore", over="ignore"):
-                damping = self.damping_history
-                self._derivative = self._dynamics(self.states, self.road, self.road_vel,
-                                                  damping)
-        return self._derivative[..., self._dynamics.n:]
+                for t0 in range(0, T, block):
+                    t1 = min(T, t0 + block)
+                    evaluate = asm.evaluator(t1 - t0)
+                    y = np.ascontiguousarray(self.states[:, :, t0:t1])
+                    coef = asm.coef
+                    if damping is not None:
+                        coef = np.broadcast_to(coef, coef.shape[:2] + (t1 - t0,)).copy()
+                        coef[asm.damper_rows] = damping[:, :, t0:t1]
+                    out = acc if t1 - t0 == T else np.empty((asm.n, self.P, t1 - t0))
+                    evaluate(y.reshape(2 * asm.n, -1),
+                             np.transpose(offsets[t0:t1, :, :, 0], (1, 2, 0)), coef,
+                             asm.inverse_mass, out.reshape(asm.n, -1), out)
+                    if out is not acc:
+                        acc[:, :, t0:t1] = out
+            self._acceleration = acc
+        return self._acceleration
+
+    def base(self, j: int, x: np.ndarray) -> np.ndarray:
+        """Body displacement (velocity, acceleration) at attachment ``j``'s point, (P, T),
+        from the vehicle rows of ``x (n_vehicle, P, T)``."""
+        row = self.model.point_map(*self.attachments[j].point)
+        return np.tensordot(row, x[:self.model.n_dof], axes=1)
 
     def attachment_signal(self, j: int, name: str) -> np.ndarray:
-        f = self._dynamics
-        sl = f.slices[j]
-        acc = self.acceleration()
-        return f.attachments[j].signal(name, self.q[..., sl], self.v[..., sl], acc[..., sl],
-                                       f.base(j, self.q), f.base(j, self.v), f.base(j, acc))
+        nv = self.model.n_dof
+        start = nv + sum(len(a.dof_names) for a in self.attachments[:j])
+        sl = slice(start, start + len(self.attachments[j].dof_names))
+        n = self.n
+        q, v, acc = self.states[:n], self.states[n:], self.acceleration()
+        return self.attachments[j].signal(name, q[sl], v[sl], acc[sl], self.base(j, q),
+                                          self.base(j, v), self.base(j, acc))
 
     def channel(self, deriv: str, j: int) -> np.ndarray:
         """DOF ``j`` displacement (''), velocity ('vel') or acceleration ('acc'), (P, T)."""
         if deriv == "":
-            return self.q[..., j]
+            return self.states[j]
         if deriv == "vel":
-            return self.v[..., j]
-        return self.acceleration()[..., j]
-
-    def per_corner(self, kind: str) -> np.ndarray:
-        """(P, T, N) suspension travel ('travel') or its rate ('travel_vel')."""
-        if kind not in self._corner_cache:
-            src = self.vehicle_q if kind == "travel" else self.vehicle_v
-            self._corner_cache[kind] = self.model.travel(src)
-        return self._corner_cache[kind]
+            return self.states[self.n + j]
+        return self.acceleration()[j]

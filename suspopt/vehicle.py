@@ -5,19 +5,25 @@ The body has a subset of the degrees of freedom {heave, roll, pitch}; corner ``i
 an unsprung mass on a tyre, joined to the body by a spring and a damper. The suspension travel
 is ``ST_i = z_s + y_i φ - x_i θ - z_ui`` (Eq 2.3, 2.9, 2.17 and Eq 2.26 with the rear roll sign
 mended per ERRATA) and the tyre deflection ``TD_i = z_ui - z_road,i`` (Eq 2.4, 2.10, 2.18, 2.27).
-With forces ``F_K = k_l ST + k_nl ST^3`` (Eq 2.30-2.31), ``F_C = c dST/dt`` (Eq 2.32) and
-``F_T = k_T TD + c_T dTD/dt`` (Eq 2.28-2.29) the equations of motion of every preset
-(Eq 2.1-2.2, 2.5-2.8, 2.13-2.16, 2.19-2.25) are
+The vehicle is a :class:`suspopt.network.Network` over ``q = [body DOFs, wheel heaves]``
+(measured from static equilibrium) with the road heights under the wheels as inputs, and three
+element groups (:func:`vehicle_network`):
 
-    M q'' = -K q - C q' + B_k r + B_c r' - J^T (k_nl ST^3) + (tyre lift-off correction)
+- ``suspension``: along ``ST = J q`` (``J`` the travel map), the spring
+  ``F_K = k_l ST + k_nl ST^3`` (Eq 2.30-2.31; the cubic term is the group's non-linear part) and
+  the damper ``F_C = c dST/dt`` (Eq 2.32; a semi-active damper's controller replaces ``c``);
+- ``tyre``: along ``TD = z_u - z_road``, ``F_T = k_T TD + c_T dTD/dt`` (Eq 2.28-2.29); with
+  ``tyre_lift_off`` the tyre cannot pull, so ``F_T`` never exceeds the static load;
+- ``anti_roll_bar``: torsional springs between the body roll and the axle roll
+  ``(z_right - z_left)/(b_1 + b_2)`` (ERRATA for Eq 2.11-2.12 and 2.25).
 
-with ``q = [body DOFs, wheel heaves]`` measured from static equilibrium, ``J`` the travel map
-(``ST = J q``) and ``M`` diagonal. Anti-roll bars are torsional springs between the body roll
-and the axle roll ``(z_right - z_left)/(b_1 + b_2)`` (ERRATA for Eq 2.11-2.12 and 2.25).
+By virtual work these give the equations of motion of every preset (Eq 2.1-2.2, 2.5-2.8,
+2.13-2.16, 2.19-2.25) as ``M q'' = -J^T (F_K + F_C) - F_T - ...``; the linear matrices ``K``,
+``C`` used for statics, modes and frequency responses come from the same network.
 
-All parameter arrays are batched over P designs: shapes are ``(P, 1, N)`` so that they
-broadcast against states of shape ``(P, S, n)`` (``S = 1`` while integrating, ``S = T`` when
-signals are computed afterwards). Matrices identical for all designs are stored once.
+The parameter fields of :class:`VehicleModel` are batched over P designs with shapes
+``(P, 1, N)``, broadcasting against states ``(P, S, n)``; matrices identical for all designs
+are stored once.
 """
 
 from __future__ import annotations
@@ -28,9 +34,10 @@ import numpy as np
 
 from .config import Config, ConfigError
 from .config.vehicle import PRESET_BODY_DOFS, PRESET_CORNERS
+from .network import Elements, Network, widen
 from .params import ParamView
 
-__all__ = ["VehicleModel", "build_vehicle", "modal_analysis", "ModalResult",
+__all__ = ["VehicleModel", "build_vehicle", "vehicle_network", "modal_analysis", "ModalResult",
            "frequency_response"]
 
 _INERTIA_FIELD = {"heave": "mass", "roll": "roll_inertia", "pitch": "pitch_inertia"}
@@ -76,6 +83,7 @@ class VehicleModel:
     dof_names: tuple[str, ...]
     bar_map: np.ndarray | None  # (1|P, B, n) anti-roll bar twist = bar_map q [rad]
     bar_stiffness: np.ndarray | None  # (P, 1, B) [N m/rad]
+    network: Network            # the equations of motion (module docstring)
 
     @property
     def n_dof(self) -> int:
@@ -95,47 +103,6 @@ class VehicleModel:
         Applied to velocities it gives the travel rate."""
         return matvec(self._travel_map_t, q)
 
-    def spring_force(self, travel: np.ndarray) -> np.ndarray:
-        """Dynamic spring force F_K = k_l ST + k_nl ST^3 (Eq 2.30-2.31) [N]."""
-        if self.has_cubic:
-            return (self.spring_linear + self.spring_cubic * travel * travel) * travel
-        return self.spring_linear * travel
-
-    def dynamic_tyre_force(self, q: np.ndarray, v: np.ndarray, road: np.ndarray,
-                           road_vel: np.ndarray) -> np.ndarray:
-        """Change of the normal tyre load from rest, compression positive [N]:
-        ``-(k_T TD + c_T TD')`` (Eq 2.28-2.29); never below minus the static load when tyres
-        may lift off (a tyre cannot pull)."""
-        w = self.wheels
-        force = self.tyre_stiffness * (road - q[..., w])
-        if self.has_tyre_damping:
-            force = force + self.tyre_damping * (road_vel - v[..., w])
-        if self.tyre_lift_off:
-            force = np.maximum(force, -self.static_tyre_load)
-        return force
-
-    def tyre_force(self, q, v, road, road_vel) -> np.ndarray:
-        """Total normal tyre load, compression positive [N] (static + dynamic)."""
-        return self.static_tyre_load + self.dynamic_tyre_force(q, v, road, road_vel)
-
-    def generalised_force(self, q: np.ndarray, v: np.ndarray, road: np.ndarray,
-                          road_vel: np.ndarray, damping: np.ndarray | None = None) -> np.ndarray:
-        """Right-hand side of M q'' = f: suspension, tyre and anti-roll-bar forces, (P, S, n).
-
-        Each suspension force ``F_K + F_C`` acts along the travel map (``-J^T F``), each tyre
-        force on its wheel, each anti-roll bar along its twist map (Eq 2.1-2.25). ``damping``
-        (P, 1|S, N) [N s/m] replaces the passive coefficients (a semi-active damper's current
-        value, Eq 2.32-2.33).
-        """
-        c = self.damper if damping is None else damping
-        force = self.spring_force(self.travel(q)) + c * self.travel(v)
-        gen = -matvec(self.travel_map, force)
-        gen[..., self.wheels] += self.dynamic_tyre_force(q, v, road, road_vel)
-        if self.bar_map is not None:
-            twist = matvec(np.swapaxes(self.bar_map, 1, 2), q)
-            gen -= matvec(self.bar_map, self.bar_stiffness * twist)
-        return gen
-
     def point_map(self, x: float, y: float) -> np.ndarray:
         """Row (n,) giving the body's vertical displacement at the body point (x, y) [m]
         (x + forward, y + right) from q: z_s + y φ - x θ."""
@@ -146,8 +113,6 @@ class VehicleModel:
 
     def __post_init__(self):
         self._travel_map_t = np.swapaxes(self.travel_map, 1, 2)
-        self.has_cubic = bool(np.any(self.spring_cubic))
-        self.has_tyre_damping = bool(np.any(self.tyre_damping))
 
 
 def _corner_geometry(pv: ParamView, preset: str, corners: tuple[str, ...]):
@@ -202,17 +167,17 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
         J[:, :, j] = {"heave": 1.0, "roll": y, "pitch": -x}[dof]
     J[:, np.arange(N), nb + np.arange(N)] = -1.0
 
-    # linear matrices of the same elements, for statics, modes and frequency response
     bar_map, bar_k = _anti_roll_bars(pv, corners, body_dofs)
-    K = np.einsum("pi,pik,pil->pkl", kl, J, J)
-    C = np.einsum("pi,pik,pil->pkl", c, J, J)
-    w = nb + np.arange(N)
-    K[:, w, w] += kt
-    C[:, w, w] += ct
-    if bar_map is not None:
-        K += np.einsum("pb,pbk,pbl->pkl", bar_k, bar_map, bar_map)
-
+    dof_names = tuple(f"body.{d}" for d in body_dofs) + tuple(f"wheel.{cn}" for cn in corners)
+    shared_J = _shared(J)
+    network = vehicle_network(dof_names, mass, shared_J, kl, knl, c, kt, ct,
+                              None if bar_map is None else _shared(bar_map), bar_k)
+    linear = network.linear_model()
+    K, C = linear.stiffness, linear.damping
     static = _static_tyre_load(mass, K, nb, N, kt, body_dofs, veh.gravity)
+    if veh.tyre_lift_off:
+        tyre = network.group("tyre")
+        tyre.extra, tyre.extra_uses_force = tyre_lift_off(static), True
     rear = np.array([cn[0] == "R" for cn in corners])
     wheelbase = (veh.body.a_front or 0.0) + (veh.body.a_rear or 0.0)
     offsets = np.where(rear, wheelbase, 0.0) if cfg.road.wheelbase_delay else np.zeros(N)
@@ -222,18 +187,67 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
                               "of a model with a rear axle: the road's wheelbase delay is one "
                               "per run")
     sides = tuple("right" if cn[1] == "1" else "left" for cn in corners)
-    dof_names = tuple(f"body.{d}" for d in body_dofs) + tuple(f"wheel.{cn}" for cn in corners)
     e = (slice(None), None, slice(None))
     return VehicleModel(
         preset=veh.preset, body_dofs=body_dofs, corners=corners, P=P,
         mass=_shared(mass[:, None, :]), stiffness=_shared(K), damping=_shared(C),
-        travel_map=_shared(J), corner_x=x, corner_y=y,
+        travel_map=shared_J, corner_x=x, corner_y=y,
         unsprung_mass=mu[e], tyre_stiffness=kt[e], tyre_damping=ct[e], spring_linear=kl[e],
         spring_cubic=knl[e], damper=c[e], static_tyre_load=static[e],
         tyre_lift_off=veh.tyre_lift_off, gravity=veh.gravity, offsets=offsets, sides=sides,
         dof_names=dof_names,
         bar_map=None if bar_map is None else _shared(bar_map),
-        bar_stiffness=None if bar_k is None else bar_k[:, None, :])
+        bar_stiffness=None if bar_k is None else bar_k[:, None, :], network=network)
+
+
+def _rows(a: np.ndarray) -> np.ndarray:
+    """(P, m) per-design element values as (m, P, 1) network parameters."""
+    return np.ascontiguousarray(a.T)[:, :, None]
+
+
+def vehicle_network(dof_names: tuple[str, ...], mass: np.ndarray, travel_map: np.ndarray,
+                    spring_linear: np.ndarray, spring_cubic: np.ndarray, damper: np.ndarray,
+                    tyre_stiffness: np.ndarray, tyre_damping: np.ndarray,
+                    bar_map: np.ndarray | None, bar_stiffness: np.ndarray | None) -> Network:
+    """The vehicle's :class:`~suspopt.network.Network` (module docstring).
+
+    ``mass (P, n)``; ``travel_map`` J (1|P, N, n); per-corner ``(P, N)`` arrays: k_l [N/m],
+    k_nl [N/m^3], c [N s/m], k_T [N/m], c_T [N s/m]; ``bar_map`` (1|P, B, n) and
+    ``bar_stiffness (P, B)`` [N m/rad] or None. Inputs: the road height under each wheel.
+    Tyres that may lift off get :func:`tyre_lift_off` once the static loads are known.
+    """
+    P, N = spring_linear.shape
+    n = mass.shape[1]
+    nb = n - N
+    squeeze = (lambda a: a[0]) if travel_map.shape[0] == 1 else (lambda a: a)
+    cubic = _rows(spring_cubic)
+
+    def duffing(width: int):
+        k_nl = widen(cubic, width)
+        return lambda disp, rate, force: k_nl * (disp * disp * disp)     # k_nl ST^3 (Eq 2.31)
+    groups = [Elements("suspension", squeeze(travel_map), np.zeros((N, N)), _rows(spring_linear),
+                       _rows(damper), extra=duffing if np.any(spring_cubic) else None)]
+    wheels = np.zeros((N, n))
+    wheels[np.arange(N), nb + np.arange(N)] = 1.0
+    groups.append(Elements("tyre", wheels, -np.eye(N), _rows(tyre_stiffness),
+                           _rows(tyre_damping)))
+    if bar_map is not None:
+        groups.append(Elements("anti_roll_bar", squeeze(bar_map),
+                               np.zeros((bar_map.shape[1], N)), _rows(bar_stiffness),
+                               np.zeros((bar_map.shape[1], P, 1))))
+    return Network(dof_names, tuple(f"road.{i}" for i in range(N)),
+                   np.ascontiguousarray(mass.T)[:, :, None], tuple(groups))
+
+
+def tyre_lift_off(static_load: np.ndarray):
+    """Non-linear part of a tyre that cannot pull: ``F_T`` is capped at the static load
+    ``(P, N)`` [N], so the total normal load ``static - F_T`` never falls below 0."""
+    rows = _rows(static_load)
+
+    def make(width: int):
+        load = widen(rows, width)
+        return lambda disp, rate, force: np.minimum(force, load) - force
+    return make
 
 
 def _anti_roll_bars(pv: ParamView, corners, body_dofs):

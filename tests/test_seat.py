@@ -62,7 +62,7 @@ def test_each_isolator_rests_at_zero_with_its_static_deflection(kind, form):
     x_st = seat.static_deflection[0]
     assert x_st == pytest.approx(X_ST[kind], rel=1e-12)
     m = len(seat.dof_names)
-    own, reaction = seat.force(np.zeros((1, 1, m)), np.zeros((1, 1, m)), np.zeros((1, 1)),
+    own, reaction = seat.force(np.zeros((m, 1, 1)), np.zeros((m, 1, 1)), np.zeros((1, 1)),
                                np.zeros((1, 1)))
     assert np.all(own == 0) and np.all(reaction == 0)
     # the absolute statics the dynamic equations leave out
@@ -152,13 +152,13 @@ def test_nss4_without_horizontal_springs_is_the_linear_two_mass_system():
     seat = build_seat(config({**SEATS["nss4"], "horizontal_stiffness": 0.0}))
     assert seat.static_deflection[0] == pytest.approx((m + m_d) * G / k_s, rel=1e-12)
     rng = np.random.default_rng(5)
-    q, v = rng.normal(size=(1, 7, 2)) * 0.01, rng.normal(size=(1, 7, 2)) * 0.1
+    q, v = rng.normal(size=(2, 1, 7)) * 0.01, rng.normal(size=(2, 1, 7)) * 0.1
     z, zd = rng.normal(size=(1, 7)) * 0.01, rng.normal(size=(1, 7)) * 0.1
     own, reaction = seat.force(q, v, z, zd)
-    x, y, xd, yd = q[..., 0], q[..., 1], v[..., 0], v[..., 1]
-    assert np.allclose(own[..., 0], -k_s * (x - z) - k_v * (x - y) - c_v * (xd - yd),
+    x, y, xd, yd = q[0], q[1], v[0], v[1]
+    assert np.allclose(own[0], -k_s * (x - z) - k_v * (x - y) - c_v * (xd - yd),
                        rtol=1e-12, atol=1e-12)
-    assert np.allclose(own[..., 1], k_v * (x - y) + c_v * (xd - yd), rtol=1e-12, atol=1e-12)
+    assert np.allclose(own[1], k_v * (x - y) + c_v * (xd - yd), rtol=1e-12, atol=1e-12)
     assert np.allclose(reaction, k_s * (x - z), rtol=1e-12, atol=1e-12)
     assert np.array_equal(seat.mass[0, 0], [m, m_d])
 

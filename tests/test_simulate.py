@@ -29,7 +29,7 @@ def test_energy_is_conserved_in_undamped_free_vibration():
     q, v = res.q[0], res.v[0]
     M = m.mass[0, 0]
     K = m.stiffness[0]
-    st = res.per_corner("travel")[0]
+    st = res.deformation("suspension")[:, 0].T
     energy = 0.5 * np.einsum("ti,i,ti->t", v, M, v) + 0.5 * np.einsum("ti,ij,tj->t", q, K, q) \
         + 0.25 * np.sum(m.spring_cubic[0] * st ** 4, axis=-1)
     after = res.time > 0.05 + (1.0 + 2.6) / 10.0 + 0.01   # rear wheel off the bump
