@@ -381,21 +381,21 @@ class SemiActiveController:
         self._records: dict[str, np.ndarray] | None = None
         return self._c
 
-    def step(self, k: int, t: float, q: np.ndarray, v: np.ndarray,
-             acceleration: Callable[[], np.ndarray]) -> np.ndarray:
+    def step(self, k: int, t: float, state) -> np.ndarray:
         """Coefficients held over integration step ``k`` (see the protocol in simulate.py)."""
         if k % self._every == 0:
-            self._sample(t, v, acceleration)
+            self._sample(t, state)
         if self._lagged:
             self._c = self._cmd - (self._cmd - self._c) * self._decay
             return self._c
         return self._cmd
 
-    def _sample(self, t: float, v: np.ndarray, acceleration: Callable[[], np.ndarray]) -> None:
+    def _sample(self, t: float, state) -> None:
+        v = state.velocity()
         travel_vel = self._travel(v)
         body_vel = matvec(self._body_t, v[..., :self._nb])
         wheel_vel = v[..., self._wheels]
-        body_acc = matvec(self._body_t, acceleration()[..., :self._nb]) \
+        body_acc = matvec(self._body_t, state.acceleration()[..., :self._nb]) \
             if self._needs_acc else None
         condition = None
         for law, mask in self._groups:

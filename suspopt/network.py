@@ -60,8 +60,8 @@ class Elements:
     ``dof_map`` D_q (m, n), or (P, m, n) when it differs between designs; ``input_map`` D_u
     (m, n_u); ``stiffness`` k and ``damping`` c (m, P, 1) [N/m, N s/m; N m/rad for a torsional
     element]; ``extra`` the non-linear part or None: ``extra(width)`` returns the function
-    ``(δ, δ̇, k δ + c δ̇) -> F_x`` (m, width, S) [N] for ``width`` design columns (its
-    parameters widened to them, :func:`widen`), with ``extra_slope`` its derivative dF_x/dδ at
+    ``(δ, δ̇, k δ + c δ̇, out)`` that writes F_x (m, width, S) [N] into ``out`` for ``width``
+    design columns (its parameters widened to them, :func:`widen`), with ``extra_slope`` its derivative dF_x/dδ at
     rest (m, P, 1) [N/m] for the linearised model (None for 0) and ``extra_uses_force``
     whether F_x reads its third argument; ``reacts`` (n,) bool marks the DOFs that feel the
     group's force (None: all - a one-way seat's links do not push the body).
@@ -72,8 +72,7 @@ class Elements:
     input_map: np.ndarray
     stiffness: np.ndarray
     damping: np.ndarray
-    extra: Callable[[int], Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]] | None \
-        = None
+    extra: Callable[[int], Callable[..., object]] | None = None
     extra_slope: np.ndarray | None = None
     extra_uses_force: bool = False
     reacts: np.ndarray | None = None
@@ -105,7 +104,9 @@ class Elements:
         elastic = self.stiffness * disp
         viscous = (self.damping if damping is None else damping) * rate
         if self.extra is not None:
-            elastic = elastic + self.extra(disp.shape[1])(disp, rate, elastic + viscous)
+            extra = np.empty(np.broadcast_shapes(elastic.shape, viscous.shape))
+            self.extra(disp.shape[1])(disp, rate, elastic + viscous, extra)
+            elastic = elastic + extra
         return elastic, viscous
 
 

@@ -137,14 +137,14 @@ def _link_law(stiffness, offset, length) -> Callable[[np.ndarray], np.ndarray]:
     folded once, so the simulator evaluates it in six array operations."""
     a = 2.0 * stiffness
     b, square = a * offset, length * length
-    return lambda w: (a + b / np.sqrt(square - w * w)) * w
+    return lambda w, out=None: np.multiply(a + b / np.sqrt(square - w * w), w, out=out)
 
 
 def _carrella_law(stiffness, wall_distance, spring_free_length):
     """``u -> 2 K_h (L_o / sqrt(u² + a_o²) - 1) u`` (:func:`nss1_force`), constants folded."""
     a, b = -2.0 * stiffness, 2.0 * stiffness * spring_free_length
     square = wall_distance * wall_distance
-    return lambda u: (b / np.sqrt(u * u + square) + a) * u
+    return lambda u, out=None: np.multiply(b / np.sqrt(u * u + square) + a, u, out=out)
 
 
 def _link_series(rest, stiffness, offset, length):
@@ -308,20 +308,19 @@ class Mechanism:
             return self.exact(delta)
         return self.exact(self.rest + delta) - self._preload
 
-    def element_force(self, width: int
-                      ) -> Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
-        """``-force(δ)`` as the non-linear part of a network element along ``δ`` (the element
-        force resists the deformation; :mod:`suspopt.network`) for ``width`` design columns,
-        with the sign folded into the constants: the same arithmetic as :meth:`force`,
-        negated exactly."""
+    def element_force(self, width: int) -> Callable[..., object]:
+        """``(δ, δ̇, F, out) -> out = -force(δ)``: the mechanism as the non-linear part of a
+        network element along ``δ`` (the element force resists the deformation;
+        :mod:`suspopt.network`) for ``width`` design columns, with the sign folded into the
+        constants: the same arithmetic as :meth:`force`, negated exactly."""
         if self.series is not None:
             c1, c2, c3 = (widen(-k[None], width) for k in self.series)
-            return lambda d, r, f: ((c3 * d + c2) * d + c1) * d
+            return lambda d, r, f, out: np.multiply((c3 * d + c2) * d + c1, d, out=out)
         negated = self.law(-1.0, width)
         if self.rest is None:
-            return lambda d, r, f: negated(d)
+            return lambda d, r, f, out: negated(d, out)
         rest, preload = widen(self.rest[None], width), widen(self._preload[None], width)
-        return lambda d, r, f: negated(rest + d) + preload
+        return lambda d, r, f, out: np.add(negated(rest + d), preload, out=out)
 
     def slope(self) -> np.ndarray:
         """``dF/dδ`` at rest, (P,) [N/m] (a positive slope is a negative stiffness), by

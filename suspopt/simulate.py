@@ -48,23 +48,41 @@ _BLOCK = 64
 class Controller(Protocol):
     """A semi-active damper controller (built by :mod:`suspopt.control`).
 
-    The integrator calls ``start`` once, then ``step`` at the start of every integration step
-    with the vehicle states ``q, v (P, 1, n)``; ``step`` returns the damping coefficients
-    ``(P, 1, N)`` [N s/m] held over that step, so a digital controller changes them only at
-    its own sample instants (zero-order hold). ``acceleration()`` gives the vehicle
-    accelerations ``(P, 1, n)`` at the current instant, computed only when called.
-    ``record`` returns the controller's quantities ``{name: (P, N)}`` at output instants;
-    they become the signals ``<name>.<corner>`` with units ``units[name]``.
+    The integrator calls ``start`` once, then ``step(k, t, state)`` at the start of every
+    integration step; ``step`` returns the damping coefficients ``(P, 1, N)`` [N s/m] held
+    over that step, so a digital controller changes them only at its own sample instants
+    (zero-order hold), and hands out a new array whenever they change. ``state.velocity()``
+    gives the vehicle velocities ``(P, 1, n)`` at the current instant, ``state.acceleration()``
+    the accelerations (computed only when called, with the coefficients in force before this
+    step). ``record`` returns the controller's quantities ``{name: (P, N)}`` at output
+    instants, a new dict whenever they change; they become the signals ``<name>.<corner>``
+    with units ``units[name]``.
     """
 
     units: dict[str, str]
 
     def start(self, P: int) -> np.ndarray: ...
 
-    def step(self, k: int, t: float, q: np.ndarray, v: np.ndarray,
-             acceleration: Callable[[], np.ndarray]) -> np.ndarray: ...
+    def step(self, k: int, t: float, state: "_VehicleState") -> np.ndarray: ...
 
     def record(self) -> dict[str, np.ndarray]: ...
+
+
+class _VehicleState:
+    """The vehicle's motion at the current step, as the controller reads it (AoS views)."""
+
+    __slots__ = ("_velocity", "_acceleration")
+
+    def __init__(self, velocity: np.ndarray, acceleration: Callable[[], np.ndarray]):
+        self._velocity, self._acceleration = velocity, acceleration
+
+    def velocity(self) -> np.ndarray:
+        """(P, 1, n_vehicle) [m/s, rad/s]."""
+        return self._velocity
+
+    def acceleration(self) -> np.ndarray:
+        """(P, 1, n_vehicle) [m/s^2, rad/s^2]."""
+        return self._acceleration()
 
 
 class Attachment(Protocol):
@@ -124,7 +142,11 @@ class _Assembled:
         self.input_map = np.concatenate([g.input_map for g in groups])       # (R, n_u)
         G = np.concatenate([np.broadcast_to(g.force_map, (P, n, g.size)) if per_design
                             else g.force_map for g in groups], axis=-1)
-        G2 = np.concatenate([G, G], axis=-1)
+        # the non-linear parts are forces of their own rows of F, acting like their elements
+        extra_rows = np.concatenate([np.arange(start, start + g.size) for start, g
+                                     in zip(np.cumsum([0] + [g.size for g in groups]), groups)
+                                     if g.extra is not None] or [np.arange(0)])
+        G2 = np.concatenate([G, G, G[..., extra_rows]], axis=-1)
         # M^-1 multiplies the accelerations even where it could be folded into G2: folding
         # rounds differently, and a design must give the same bits whatever else varies in
         # its batch
@@ -134,15 +156,18 @@ class _Assembled:
         self.coef = np.ascontiguousarray(np.concatenate(
             [np.broadcast_to(g.stiffness, (g.size, P, 1)) for g in groups]
             + [np.broadcast_to(g.damping, (g.size, P, 1)) for g in groups]))
-        self.extras, self.damper_rows, start = [], None, 0
+        self.extras, self.damper_rows, start, out = [], None, 0, 2 * R
         for g in groups:
             rows = slice(start, start + g.size)
             rates = slice(R + start, R + start + g.size)
             if g.extra is not None:
-                self.extras.append((rows, rates, g.extra, g.extra_uses_force))
+                self.extras.append((rows, rates, slice(out, out + g.size), g.extra,
+                                    g.extra_uses_force))
+                out += g.size
             if g.name == controlled:
                 self.damper_rows = rates
             start += g.size
+        self.F_rows = out
 
     def offsets(self, u: np.ndarray, u_dot: np.ndarray) -> np.ndarray:
         """``[D_u u; D_u u']`` at each sample of the inputs ``u, u_dot (n_u, T)``: (T, 2R,
@@ -163,19 +188,19 @@ class _Assembled:
         into them, so that the integrator's stages allocate nothing.
         """
         R, width = self.R, width or self.P
-        e, F = np.empty((2 * R, width, S)), np.empty((2 * R, width, S))
-        e2, F2 = e.reshape(2 * R, -1), F.reshape(2 * R, -1)
-        extras = [(F[rows], F[rates], e[rows], e[rates], make(width), uses)
-                  for rows, rates, make, uses in self.extras]
+        e, F = np.empty((2 * R, width, S)), np.empty((self.F_rows, width, S))
+        e2, F2, linear = e.reshape(2 * R, -1), F.reshape(self.F_rows, -1), F[:2 * R]
+        extras = [(F[rows], F[rates], e[rows], e[rates], F[out], make(width), uses)
+                  for rows, rates, out, make, uses in self.extras]
         product = np.matmul if self.D2.ndim == 2 else _product
-        D2, G2, multiply = self.D2, self.G2, np.multiply
+        D2, G2, multiply, add = self.D2, self.G2, np.multiply, np.add
 
         def evaluate(y2, offset, coef, inverse_mass, acc2, acc) -> None:
             product(D2, y2, out=e2)
             e.__iadd__(offset)
-            multiply(coef, e, out=F)
-            for elastic, viscous, disp, rate, fn, uses_force in extras:
-                elastic += fn(disp, rate, elastic + viscous if uses_force else None)
+            multiply(coef, e, out=linear)
+            for elastic, viscous, disp, rate, out, fn, uses_force in extras:
+                fn(disp, rate, add(elastic, viscous) if uses_force else None, out)
             product(G2, F2, out=acc2)
             acc.__imul__(inverse_mass)
         return evaluate
@@ -201,10 +226,12 @@ class _Held:
 
 @dataclass
 class _Trajectory:
-    """What one integration produced: states (2n, P, T), the held damping coefficients and
-    controller records (or None / empty without a controller) and the divergence times (P,)."""
+    """What one integration produced: states (2n, P, T), accelerations (n, P, T), the held
+    damping coefficients and controller records (or None / empty without a controller) and
+    the divergence times (P,)."""
 
     states: np.ndarray
+    accelerations: np.ndarray
     damping: _Held | None
     records: dict[str, _Held]
     diverged_at: np.ndarray
@@ -216,7 +243,11 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     part of the deformations on the half-step grid. Samples are kept every ``every``-th step.
 
     Every array lives in preallocated buffers (states ``(2n, P, 1)``) and each stage is a few
-    whole-population operations: two small matrix products and the element forces.
+    whole-population operations: two small matrix products and the element forces. A sample
+    at ``t_k`` holds the state, the accelerations ``f(y_k)`` - the first stage of step k, so
+    they cost nothing more - and the controller's coefficients and records in force over
+    step k (from ``t_k`` on); the last sample, where no step begins, asks the controller once
+    more and evaluates the accelerations.
 
     A single design is integrated as two identical columns: BLAS multiplies one column by a
     matrix-vector kernel whose rounding differs from the matrix-matrix kernel's, and a design
@@ -225,80 +256,93 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     n, P = asm.n, asm.P
     n2, width = 2 * n, max(P, 2)
     evaluate = asm.evaluator(width=width)
-    y, ys, scratch = (np.zeros((n2, width, 1)) for _ in range(3))
+    y, ys = np.zeros((n2, width, 1)), np.empty((n2, width, 1))
     s1, s2, s3, s4 = (np.empty((n2, width, 1)) for _ in range(4))
     coef = np.broadcast_to(asm.coef, asm.coef.shape[:1] + (width, 1)).copy()
     half = 0.5 * dt
     if offsets.size * width <= _WIDE_OFFSETS:          # small batches: no broadcasting
         offsets = widen(offsets, width)
-    # each stage returns its slope already scaled by the step it is used with, so that a stage
-    # state is one addition: s1 = dt/2 k1, s2 = dt/2 k2, s3 = dt k3, s4 = dt/6 k4, and
-    # y += dt/6 (k1 + 2 k2 + 2 k3 + k4) = (s1 + 2 s2 + s3)/3 + s4.
-    # A stage: (state, half-steps after t_k, M^-1 scaled, slope, its views, scale, next state)
+    # Each stage's slope is scaled by the step it is used with, so that a stage state is one
+    # addition: s1 = dt/2 k1, s2 = dt/2 k2, s3 = dt k3, s4 = dt/6 k4, and
+    # y += dt/6 (k1 + 2 k2 + 2 k3 + k4) = (s1 + 2 s2 + s3)/3 + s4. The first stage is
+    # evaluated unscaled (it is the sample's acceleration) and scaled after.
+    # A stage: (state, half-steps after t_k, M^-1 scaled, slope and its views, scale, target)
     flat = {id(a): a.reshape(n2, width) for a in (y, ys)}
 
     def plan(state, shift, slope, h, target):
         return (flat[id(state)], shift, widen(asm.inverse_mass * h, width),
                 slope[n:].reshape(n, width), slope[n:], slope[:n], state[n:], h, slope, target)
-    stages = (plan(y, 0, s1, half, ys), plan(ys, 1, s2, half, ys), plan(ys, 1, s3, dt, ys),
-              plan(ys, 2, s4, dt / 6.0, None))
-    unscaled = plan(y, 0, scratch, 1.0, None)
+    first = plan(y, 0, s1, 1.0, ys)
+    stages = (plan(ys, 1, s2, half, ys), plan(ys, 1, s3, dt, ys), plan(ys, 2, s4, dt / 6.0, None))
     n_out = n_steps // every + 1
     # samples go to a time-major block (one contiguous write each), and each full block is
-    # moved to the states (2n, P, T) as a transposed copy: cache-friendly, unlike moving the
-    # whole time-major record at the end (ten times slower for 1000 designs)
-    states = np.empty((n2, P, n_out))
-    by_time = states.reshape(n2 * P, n_out)
-    block = np.empty((_BLOCK, n2, P))
-    by_sample = block.reshape(_BLOCK, n2 * P)
-    held: list[tuple[np.ndarray, dict[str, np.ndarray]]] = []
-    held_index = np.empty(n_out, dtype=np.intp)
+    # moved to the (rows, P, T) records as a transposed copy: cache-friendly, unlike moving
+    # the whole time-major record at the end (ten times slower for 1000 designs)
+    states, accelerations = np.empty((n2, P, n_out)), np.empty((n, P, n_out))
+    by_time = [a.reshape(-1, n_out) for a in (states, accelerations)]
+    blocks = [np.empty((_BLOCK, n2, P)), np.empty((_BLOCK, n, P))]
+    by_sample = [b.reshape(_BLOCK, -1) for b in blocks]
+    # controller quantities are stored when they change (damping and records apart: a lagged
+    # damper changes every step, the records only at sample instants)
+    held_damping: list[np.ndarray] = []
+    held_records: list[dict[str, np.ndarray]] = []
+    damping_index = np.empty(n_out, dtype=np.intp)
+    records_index = np.empty(n_out, dtype=np.intp)
     last: list = [None, None]
     damping = controller.start(P) if controller is not None else None
     diverged_at = np.full(P, np.nan)
-    vel = y[n:]
+    step_index = [0]
+    y2, _, unscaled_mass, acc2, acc = first[:5]
 
-    def set_damping(value: np.ndarray) -> None:
-        coef[asm.damper_rows] = np.transpose(value, (2, 0, 1))
+    def vehicle_acceleration() -> np.ndarray:
+        evaluate(y2, offsets[step_index[0]], coef, unscaled_mass, acc2, acc)
+        return np.transpose(acc[:n_vehicle, :P], (1, 2, 0)).copy()
+    vehicle = _VehicleState(np.transpose(y[n:n + n_vehicle, :P], (1, 2, 0)),
+                            vehicle_acceleration)
 
-    def acceleration(i: int):
-        def vehicle_acceleration() -> np.ndarray:
-            y2, _, inverse_mass, acc2, acc = unscaled[:5]
-            evaluate(y2, offsets[i], coef, inverse_mass, acc2, acc)
-            return np.transpose(acc[:n_vehicle, :P], (1, 2, 0)).copy()
-        return vehicle_acceleration
+    def control(k: int) -> None:
+        nonlocal damping
+        step_index[0] = 2 * k
+        new = controller.step(k, k * dt, vehicle)
+        if new is not damping:
+            damping = new
+            coef[asm.damper_rows] = np.transpose(damping, (2, 0, 1))
 
     def keep(j: int) -> None:
-        block[j % _BLOCK] = y[:, :P, 0]
-        if j % _BLOCK == _BLOCK - 1 or j == n_out - 1:
-            j0 = j - j % _BLOCK
-            by_time[:, j0:j + 1] = by_sample[:j + 1 - j0].T
+        """Sample j: the state and the accelerations just evaluated into s1."""
+        row = j % _BLOCK
+        blocks[0][row] = y[:, :P, 0]
+        blocks[1][row] = acc[:, :P, 0]
+        if row == _BLOCK - 1 or j == n_out - 1:
+            for target, source in zip(by_time, by_sample):
+                target[:, j - row:j + 1] = source[:row + 1].T
         if controller is not None:
+            if damping is not last[0]:
+                held_damping.append(damping[:, 0].copy())
+                last[0] = damping
             records = controller.record()
-            # controllers hand out new arrays when a value changes: store only the changes
-            if damping is not last[0] or records is not last[1]:
-                held.append((damping[:, 0].copy(),
-                             {name: np.array(value) for name, value in records.items()}))
-                last[:] = [damping, records]
-            held_index[j] = len(held) - 1
+            if records is not last[1]:
+                held_records.append({name: np.array(value) for name, value in records.items()})
+                last[1] = records
+            damping_index[j], records_index[j] = len(held_damping) - 1, len(held_records) - 1
 
     if controller is not None:
-        set_damping(damping)
+        coef[asm.damper_rows] = np.transpose(damping, (2, 0, 1))
     third, multiply, add = 1.0 / 3.0, np.multiply, np.add
+    q_rate1, v1 = first[5], first[6]
     with np.errstate(over="ignore", invalid="ignore"):
         for k in range(n_steps):
             i = 2 * k
             if controller is not None:
-                new = controller.step(k, k * dt, np.transpose(y[:n_vehicle, :P], (1, 2, 0)),
-                                      np.transpose(vel[:n_vehicle, :P], (1, 2, 0)),
-                                      acceleration(i))
-                if new is not damping:
-                    damping = new
-                    set_damping(damping)
-            if k == 0:
-                keep(0)
-            for y2, shift, inverse_mass, acc2, acc, q_rate, v, h, slope, target in stages:
-                evaluate(y2, offsets[i + shift], coef, inverse_mass, acc2, acc)
+                control(k)
+            evaluate(y2, offsets[i], coef, unscaled_mass, acc2, acc)
+            if k % every == 0:
+                keep(k // every)
+            acc *= half
+            multiply(v1, half, out=q_rate1)
+            add(y, s1, out=ys)
+            for state2, shift, inverse_mass, out2, out, q_rate, v, h, slope, target in stages:
+                evaluate(state2, offsets[i + shift], coef, inverse_mass, out2, out)
                 multiply(v, h, out=q_rate)
                 if target is not None:
                     add(y, slope, out=target)
@@ -314,16 +358,19 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
                 if new_bad.any():
                     diverged_at[new_bad] = (k + 1) * dt
                     y[:, :P][:, bad] = np.nan
-            if (k + 1) % every == 0:
-                keep((k + 1) // every)
+        if n_steps % every == 0:                         # the final instant is a sample
+            if controller is not None:
+                control(n_steps)
+            evaluate(y2, offsets[2 * n_steps], coef, unscaled_mass, acc2, acc)
+            keep(n_out - 1)
 
     damping_held, records_held = None, {}
     if controller is not None:
-        damping_held = _Held(np.stack([h[0] for h in held]), held_index)
-        records_held = {name: _Held(np.stack([h[1][name] for h in held]), held_index)
-                        for name in held[0][1]}
-    return _Trajectory(states=states, damping=damping_held, records=records_held,
-                       diverged_at=diverged_at)
+        damping_held = _Held(np.stack(held_damping), damping_index)
+        records_held = {name: _Held(np.stack([h[name] for h in held_records]), records_index)
+                        for name in held_records[0]}
+    return _Trajectory(states=states, accelerations=accelerations, damping=damping_held,
+                       records=records_held, diverged_at=diverged_at)
 
 
 def _prepare(cfg: Config, params: Mapping[str, Any] | None):
@@ -376,7 +423,7 @@ def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller
     traj = _integrate(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller)
     out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
     return Result(config=cfg, model=model, time=t_grid[out_idx], states=traj.states,
-                  road=z[:, None, out_idx], road_vel=zd[:, None, out_idx],
+                  accelerations=traj.accelerations, road=z[:, None, out_idx], road_vel=zd[:, None, out_idx],
                   diverged_at=traj.diverged_at, designs=dict(pv.params), _assembled=asm,
                   attachments=tuple(attachments), held_damping=traj.damping,
                   controller_records=traj.records,
@@ -492,13 +539,17 @@ class Result:
     ``time (T,)`` [s]; ``signals[name] (P, T)`` (lazy); ``metrics[name] (P,)``;
     ``diverged (P,)`` and ``diverged_at (P,)`` [s, NaN when fine]; ``designs`` the (P,) arrays of
     the design parameters by dotted path; ``states (2n, P, T)`` the raw [q, q'] samples, DOF
-    by DOF (vehicle, then attachments).
+    by DOF (vehicle, then attachments), and ``accelerations (n, P, T)`` their q''. A sample
+    at ``t`` holds what is in force from ``t`` on: a semi-active damper's coefficient (and so
+    its force and the accelerations) is the one set at ``t`` when ``t`` is a sample instant
+    of its controller.
     """
 
     config: Config
     model: VehicleModel
     time: np.ndarray
     states: np.ndarray
+    accelerations: np.ndarray
     road: np.ndarray            # (N, 1, T) road height under each wheel [m]
     road_vel: np.ndarray        # (N, 1, T) [m/s]
     diverged_at: np.ndarray
@@ -516,7 +567,6 @@ class Result:
         self._signal_names = signal_names(self.model, self.controller_units, self.attachments)
         self._deformation: dict[tuple[str, bool], np.ndarray] = {}
         self._forces: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-        self._acceleration: np.ndarray | None = None
         self._damping_full: np.ndarray | None = None
 
     @property
@@ -594,32 +644,9 @@ class Result:
         return self._forces[group]
 
     def acceleration(self) -> np.ndarray:
-        """Accelerations of every DOF, (n, P, T), from the assembled equations of motion that
-        were integrated (evaluated in blocks of samples to bound the memory)."""
-        if self._acceleration is None:
-            asm = self._assembled
-            T = self.time.size
-            acc = np.empty((asm.n, self.P, T))
-            offsets = asm.offsets(self.road[:, 0], self.road_vel[:, 0])   # (T, 2R, 1, 1)
-            block = max(1, int(4.0e6 // (2 * asm.R * self.P)))
-            damping = self.damping_history
-            with np.errstate(invalid="ignore", over="ignore"):
-                for t0 in range(0, T, block):
-                    t1 = min(T, t0 + block)
-                    evaluate = asm.evaluator(t1 - t0)
-                    y = np.ascontiguousarray(self.states[:, :, t0:t1])
-                    coef = asm.coef
-                    if damping is not None:
-                        coef = np.broadcast_to(coef, coef.shape[:2] + (t1 - t0,)).copy()
-                        coef[asm.damper_rows] = damping[:, :, t0:t1]
-                    out = acc if t1 - t0 == T else np.empty((asm.n, self.P, t1 - t0))
-                    evaluate(y.reshape(2 * asm.n, -1),
-                             np.transpose(offsets[t0:t1, :, :, 0], (1, 2, 0)), coef,
-                             asm.inverse_mass, out.reshape(asm.n, -1), out)
-                    if out is not acc:
-                        acc[:, :, t0:t1] = out
-            self._acceleration = acc
-        return self._acceleration
+        """Accelerations of every DOF, (n, P, T): the equations of motion at each sample, as
+        the integrator evaluated them."""
+        return self.accelerations
 
     def base(self, j: int, x: np.ndarray) -> np.ndarray:
         """Body displacement (velocity, acceleration) at attachment ``j``'s point, (P, T),

@@ -224,7 +224,8 @@ def vehicle_network(dof_names: tuple[str, ...], mass: np.ndarray, travel_map: np
 
     def duffing(width: int):
         k_nl = widen(cubic, width)
-        return lambda disp, rate, force: k_nl * (disp * disp * disp)     # k_nl ST^3 (Eq 2.31)
+        return lambda disp, rate, force, out: np.multiply(k_nl, disp * disp * disp,
+                                                          out=out)     # k_nl ST^3 (Eq 2.31)
     groups = [Elements("suspension", squeeze(travel_map), np.zeros((N, N)), _rows(spring_linear),
                        _rows(damper), extra=duffing if np.any(spring_cubic) else None)]
     wheels = np.zeros((N, n))
@@ -246,7 +247,10 @@ def tyre_lift_off(static_load: np.ndarray):
 
     def make(width: int):
         load = widen(rows, width)
-        return lambda disp, rate, force: np.minimum(force, load) - force
+        def lift_off(disp, rate, force, out):
+            np.minimum(force, load, out=out)
+            out -= force
+        return lift_off
     return make
 
 
