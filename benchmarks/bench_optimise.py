@@ -10,7 +10,8 @@ The per-design path writes the HC2 right-hand side here from the model's paramet
 and tyre coefficients) and the bump from the road section, integrates it with RK45
 (``rtol = 1e-4``, ``max_step`` a quarter of the bump's duration), samples it on the same 1 ms
 grid and computes the same objectives and constraints with the public metric functions. It runs
-on the first ``--per-design`` designs (default 40) and its rate is per design.
+on the first ``--per-design`` designs (default 40) and its rate is per design. The batched
+path is timed as the best of ``REPEATS`` calls on the whole population.
 
 Run: ``python benchmarks/bench_optimise.py``. Prints a table; asserts nothing.
 """
@@ -34,6 +35,10 @@ CONFIG = Path(__file__).resolve().parents[1] / "configs" / "ch5" / "case4_s1.yam
 #: at most 0.47 % at rtol = 1e-3, 0.12 % at 1e-4 and 0.016 % at 1e-5; max_step bounds the
 #: step, so 1e-3 and 1e-4 run equally fast: 1e-4 keeps a margin to the 0.5 % target.
 RTOL, ATOL = 1.0e-4, 1.0e-7
+#: Batched calls timed per population size (the best counts): an optimiser evaluates one
+#: population after another, and the first call of a size also pays the operating system for
+#: memory the process has not touched before.
+REPEATS = 3
 
 
 def bump(road, offsets: np.ndarray, t) -> tuple[np.ndarray, np.ndarray]:
@@ -101,9 +106,11 @@ def main() -> None:
           f"{'speed-up':>9} {'max rel. diff f1-f3':>20}")
     for P in (200, 1000):
         X = problem.xl + rng.random((P, problem.n_var)) * (problem.xu - problem.xl)
-        start = time.perf_counter()
-        F, G = problem.evaluate(X, return_values_of=["F", "G"])
-        batched = time.perf_counter() - start
+        batched = np.inf
+        for _ in range(REPEATS):             # the optimiser's steady state, one generation
+            start = time.perf_counter()
+            F, G = problem.evaluate(X, return_values_of=["F", "G"])
+            batched = min(batched, time.perf_counter() - start)
         designs = problem.to_physical(X[:args.per_design])
         start = time.perf_counter()
         reference = np.array([per_design(cfg, dict(zip((v.path for v in problem.variables),

@@ -192,7 +192,7 @@ class _Assembled:
         e2, F2, linear = e.reshape(2 * R, -1), F.reshape(self.F_rows, -1), F[:2 * R]
         extras = [(F[rows], F[rates], e[rows], e[rates], F[out], make(width), uses)
                   for rows, rates, out, make, uses in self.extras]
-        product = np.matmul if self.D2.ndim == 2 else _product
+        product = np.dot if self.D2.ndim == 2 else _product
         D2, G2, multiply, add = self.D2, self.G2, np.multiply, np.add
 
         def evaluate(y2, offset, coef, inverse_mass, acc2, acc) -> None:
