@@ -21,10 +21,11 @@ from pathlib import Path
 import numpy as np
 
 from ..config import load_config
+from .. import plots
 from ..io import atomic_h5
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..simulate import simulate
-from . import KINDS, Report
+from . import KINDS, Kind, Report
 
 __all__ = ["SHARES", "METRIC_UNITS", "semi_active_metrics", "run"]
 
@@ -79,30 +80,10 @@ def _dataset(group, name: str, data, units: str) -> None:
     group.create_dataset(name, data=data).attrs["units"] = units
 
 
-def _plot(path: Path, shares, base_share, reduction, title: str) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(7, 6))
-    top.plot(100 * shares, reduction["SW"], "o-", color="k", label="SW")
-    for name in ("RC", "ST", "TD", "DE"):
-        bottom.plot(100 * shares, reduction[name], "o-", label=name)
-    for ax in (top, bottom):
-        ax.axhline(0, color="0.6", lw=0.8)
-        ax.axvline(100 * base_share, color="0.4", ls="--", lw=0.8)
-        ax.set_ylabel("reduction vs base law [%]")
-        ax.legend(loc="best")
-        ax.grid(alpha=0.3)
-    bottom.set_xlabel("C_max share requested (1 - N) [%]; dashed: base law's share")
-    top.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-
-
 def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
     """Sweep the C_max share 20-70 % against the base law (module docstring)."""
+    if plot is not None:
+        plots.check_path(plot)
     cfg = load_config(source)
     _check(cfg)
     spec = cfg.control.threshold
@@ -143,7 +124,11 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
                             "reduction": reduction[name]}[key]
                     _dataset(group, name, data, "%" if key == "reduction" else m_unit)
     if plot is not None:
-        _plot(plot, SHARES, base["share"], reduction, title)
+        plots.sensitivity(plot, title, 100 * SHARES, "C_max share requested (1 - N) [%]",
+                          [{"SW": reduction["SW"]},
+                           {k: reduction[k] for k in ("RC", "ST", "TD", "DE")}],
+                          "reduction vs base law [%]", marker=100 * base["share"],
+                          marker_label="base law's share")
 
     rows = [[f"{100 * s:.0f}", f"{100 * a:.1f}", " ".join(f"{x:.3g}" for x in thr),
              *(f"{reduction[k][i]:+.1f}" for k in METRIC_UNITS)]
@@ -161,4 +146,4 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
                   rows=rows, notes=notes)
 
 
-KINDS["cdf-sensitivity"] = run
+KINDS["cdf-sensitivity"] = Kind(run)

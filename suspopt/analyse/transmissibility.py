@@ -32,13 +32,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import plots
 from ..config import Config, ConfigError, load_config
 from ..io import atomic_h5
 from ..metrics import transmissibility, coherence, weighted_rms
 from ..seat import (CONSTRAINT_UNITS, base_transmissibility, build_seat, linearise,
                     natural_frequencies, seat_constraints)
 from ..simulate import simulate
-from . import KINDS, Report
+from . import KINDS, Kind, Report
 
 __all__ = ["SeatTransmissibility", "seat_transmissibility", "write_transmissibility",
            "plot_transmissibility", "run", "LINEAR_FREQUENCIES", "SEGMENT"]
@@ -140,34 +141,21 @@ def plot_transmissibility(data: SeatTransmissibility, path: str | Path,
                           design: int = 0) -> Path:
     """Figure of the seat transmissibility and (with a passenger) STHT of one design: linear
     model as lines, simulation (H1) as dots where the coherence is at least 0.8."""
-    try:
-        from matplotlib.figure import Figure
-    except ImportError:
-        raise ValueError("--plot needs matplotlib: pip install 'suspopt[plot]'") from None
-    fig = Figure(figsize=(7.0, 4.5), layout="constrained")
-    ax = fig.subplots()
     f_sim = data.simulated_frequency
     band = (f_sim >= data.linear_frequency[0]) & (f_sim <= 30.0)
-    for name, label, colour in (("seat", "seat  z̈_seat/z̈_s", "C0"),
-                                ("head", "STHT  z̈_head/z̈_s", "C3")):
+    lines, points = [], []
+    for name, label in (("seat", "seat  z̈_seat/z̈_s"), ("head", "STHT  z̈_head/z̈_s")):
         if name not in data.dof_names:
             continue
         j = data.dof_names.index(name)
-        ax.plot(data.linear_frequency, data.linear[design, :, j], color=colour,
-                label=f"{label} (linearised)")
+        lines.append((f"{label} (linearised)", data.linear_frequency,
+                      data.linear[design, :, j]))
         good = band & (data.coherence[design, :, j] >= _MIN_COHERENCE)
-        ax.plot(f_sim[good], data.simulated[design, good, j], ".", color=colour, ms=3,
-                label=f"{label} (simulated, H1)")
-    ax.set_xscale("log")
-    ax.set_xlim(data.linear_frequency[0], 30.0)
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("acceleration transmissibility [-]")
-    ax.set_title(f"{data.kind.upper()} seat, X_ST = {1e3 * data.static_deflection[design]:.1f}"
-                 f" mm (Eq 2.86)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.savefig(path, dpi=120)
-    return Path(path)
+        points.append((f"{label} (simulated, H1)", f_sim[good], data.simulated[design, good, j]))
+    title = (f"{data.kind.upper()} seat, X_ST = {1e3 * data.static_deflection[design]:.1f} mm "
+             f"(Eq 2.86)")
+    return plots.transmissibilities(path, title, lines, points,
+                                    f_range=(data.linear_frequency[0], 30.0))
 
 
 def _peak(f: np.ndarray, values: np.ndarray, valid: np.ndarray | None = None):
@@ -183,6 +171,8 @@ def _peak(f: np.ndarray, values: np.ndarray, valid: np.ndarray | None = None):
 
 def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
     """The ``transmissibility`` analysis of ``source`` (a YAML config with a seat)."""
+    if plot is not None:
+        plots.check_path(plot)
     cfg = load_config(source)
     data = seat_transmissibility(cfg)
     if output is not None:
@@ -213,4 +203,4 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
                   columns=["quantity", "unit", "value"], rows=rows, notes=notes)
 
 
-KINDS["transmissibility"] = run
+KINDS["transmissibility"] = Kind(run)
