@@ -53,5 +53,6 @@ KINDS: dict[str, Kind] = {}
 def analysis_kinds() -> dict[str, Kind]:
     """Every available analysis kind, importing the modules that provide them."""
     from . import cdf  # noqa: F401  (registers cdf-sensitivity)
+    from . import models  # noqa: F401  (registers models)
     from . import transmissibility  # noqa: F401  (registers transmissibility)
     return dict(KINDS)
