@@ -54,5 +54,6 @@ def analysis_kinds() -> dict[str, Kind]:
     """Every available analysis kind, importing the modules that provide them."""
     from . import cdf  # noqa: F401  (registers cdf-sensitivity)
     from . import models  # noqa: F401  (registers models)
+    from . import pseudo  # noqa: F401  (registers roads, masses, controllers)
     from . import transmissibility  # noqa: F401  (registers transmissibility)
     return dict(KINDS)

@@ -1,0 +1,371 @@
+"""Pseudo Pareto fronts: the designs of a stored front re-simulated under a change.
+
+The thesis re-simulates the optimal designs of a Pareto front under conditions other than the
+ones they were optimised for and compares the objectives ("pseudo" Pareto fronts):
+
+- ``roads`` (Sec 8.4.2, Fig. 8.23, Table 8.12): other road profiles. ``--road B`` keeps the
+  stored road and changes its ISO 8608 class only (same seed, speed and length: the same
+  realisation scaled); ``--road CONFIG.yaml`` takes that config's ``road`` and ``simulation``
+  sections (e.g. ``configs/ch8/ps_class_b.yaml``: class B at 85 km/h over 1000 m, as the thesis
+  drives each class at its own speed).
+- ``masses`` (Sec 8.4.3, Fig. 8.24, Table 8.13): another passenger, the whole load on the
+  isolator ``m ± 20 kg``, seated by :func:`suspopt.seat.passenger_mass_change` (NSS1-NSS3 keep
+  ``X_ST``, their ``K_v`` follows the load and ``K_h`` stays as built; PS and NSS4 keep their
+  stiffnesses and their ``X_ST`` follows the load). Where the stiffness ratio ``α`` is itself a
+  design variable, each design's ``α`` takes the same factor ``m_old/m_new``.
+- ``controllers`` (Sec 7.3, Fig. 7.4b): another controller. ``--with FILE.yaml`` (a config or
+  a fragment) supplies a ``control:`` section and/or dampers (``vehicle.corner_defaults.damper``,
+  ``vehicle.corners.<c>.damper``), which replace the stored config's; the designs' own values
+  (e.g. ``c_min``, ``c_max``) are then applied on top. ``configs/ch7/controllers/cdf.yaml``
+  gives SH-2-CDF and SH-ADD-2-CDF from the SH-2 and SH-ADD-2 fronts.
+
+Each change is ONE batched simulation of all N designs (:func:`evaluate_front`). The change of
+each objective is ``100 (f_changed - f_stored) / f_stored`` in % (Tables 8.12-8.13: positive
+when the objective grows). A design whose simulation fails under the change gets NaN
+objectives and ``failed = 1`` (the optimiser's penalty values are not reported).
+
+HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text, plus
+``analysis`` (the kind) and ``source`` (the Pareto file)); every dataset has ``units`` (one per
+column for X, F, G, S, as ``suspopt optimise`` writes them) and ``names``:
+
+- ``/pareto/X (N, n)``, ``/pareto/F (N, m)``, ``/pareto/G (N, k)``: the stored front;
+- ``/pseudo`` with attribute ``labels``; per change ``/pseudo/<label>/``: ``F (N, m)``,
+  ``G (N, k)``, ``S (N, s)`` (the config's supplementary objectives, if any), ``change (N, m)``
+  [%], ``failed (N,)`` [1]; attributes ``label``, ``config`` (the changed config's YAML text) and
+  the change (``road_class`` or ``road_source``; ``load_mass`` [kg] and ``mass_change`` [kg];
+  ``controller_source``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+
+from .. import plots
+from ..config import Config, ConfigError
+from ..io import atomic_h5
+from ..seat import build_seat, passenger_mass_change
+from . import KINDS, Kind, Report
+from .pareto import FrontValues, ParetoSet, config_with, evaluate_front, read_pareto
+
+__all__ = ["Variant", "PseudoFronts", "road_variants", "mass_variants",
+           "controller_variants", "pseudo_fronts", "write_pseudo_fronts", "plot_pseudo_fronts",
+           "MASS_CHANGES", "run_roads", "run_masses", "run_controllers"]
+
+#: Passenger changes of Sec 8.4.3 [kg]: 20 kg lighter and heavier.
+MASS_CHANGES = (-20.0, 20.0)
+#: Rows of the printed table: designs spread along the front.
+_TABLE_ROWS = 12
+_ROAD_CLASSES = ("A", "B", "C", "D", "E")
+
+
+@dataclass
+class Variant:
+    """One change of a stored front: ``config`` to simulate with, ``extra`` design
+    parameters computed from the designs' own (or None), ``attrs`` that describe it."""
+
+    label: str
+    config: Config
+    extra: Callable[[Mapping[str, np.ndarray]], dict[str, np.ndarray]] | None = None
+    attrs: dict = field(default_factory=dict)
+
+
+@dataclass
+class PseudoFronts:
+    """A stored front and its pseudo-fronts: ``values[i]`` under ``variants[i]``."""
+
+    kind: str
+    pareto: ParetoSet
+    variants: list[Variant]
+    values: list[FrontValues]
+
+    def change(self, i: int) -> np.ndarray:
+        """(N, m) change of each objective under variant ``i`` [%] (NaN where it failed)."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return 100.0 * (self.values[i].F - self.pareto.F) / self.pareto.F
+
+
+def _yaml_mapping(path: Path, option: str) -> dict:
+    import yaml
+
+    try:
+        data = yaml.safe_load(path.read_text())
+    except FileNotFoundError:
+        raise ConfigError(f"{option} {path}: no such file") from None
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise ConfigError(f"{option} {path}: cannot read it as YAML "
+                          f"({exc.__class__.__name__})") from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{option} {path}: must be a YAML mapping of config sections")
+    return data
+
+
+# --- changes -------------------------------------------------------------------------------
+
+def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
+    """One variant per road: an ISO 8608 class letter (A-E: the stored road with that class)
+    or a config file whose ``road`` and ``simulation`` sections replace the stored ones."""
+    if not roads:
+        raise ConfigError("analyse roads: give at least one --road CLASS (A-E) or "
+                          "--road CONFIG.yaml")
+    variants = []
+    for road in roads:
+        if road.upper() in _ROAD_CLASSES:
+            letter = road.upper()
+            if pareto.config.road.kind != "iso8608":
+                raise ConfigError(f"--road {road}: a road class needs an ISO 8608 road; the "
+                                  f"road of {pareto.path.name} is {pareto.config.road.kind} "
+                                  f"(give a config file instead)")
+
+            def set_class(data, letter=letter):
+                data["road"]["road_class"] = letter
+                data["road"].pop("level", None)     # a level would override the class
+
+            cfg = config_with(pareto, set_class, f"road class {letter}")
+            variants.append(Variant(f"class {letter}", cfg, attrs={"road_class": letter}))
+            continue
+        path = Path(road)
+        if not path.exists():
+            raise ConfigError(f"--road {road}: neither a road class (A-E) nor a file")
+        other = _yaml_mapping(path, "--road")
+        if not isinstance(other.get("road"), dict):
+            raise ConfigError(f"--road {road}: the file has no road: section")
+        section = dict(other["road"])
+        if section.get("kind") == "file" and not Path(section.get("path", "")).is_absolute():
+            section["path"] = str((path.parent / section["path"]).resolve())
+
+        def set_road(data, section=section, simulation=other.get("simulation")):
+            data["road"] = section
+            if simulation is not None:
+                data["simulation"] = simulation
+
+        cfg = config_with(pareto, set_road, f"the road of {path}")
+        variants.append(Variant(path.stem, cfg, attrs={"road_source": str(path)}))
+    return variants
+
+
+def _mass_change(cfg: Config, load_mass: float, params: Mapping[str, np.ndarray]
+                 ) -> dict[str, np.ndarray]:
+    """The passenger change's parameters for every design (Sec 8.4.3). The rule is
+    :func:`passenger_mass_change`'s; it scales ``seat.stiffness_ratio`` from the config's
+    value, so a design's own ratio takes the factor the rule gives a ratio of 1."""
+    P = len(next(iter(params.values())))
+    changed = passenger_mass_change(cfg, np.full(P, load_mass))
+    path = "seat.stiffness_ratio"
+    if path in changed and path in params:
+        unit = cfg.model_copy(update={"seat": cfg.seat.model_copy(update={"stiffness_ratio": 1.0})})
+        changed[path] = params[path] * passenger_mass_change(unit, np.full(P, load_mass))[path]
+    return changed
+
+
+def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) -> list[Variant]:
+    """One variant per change of the whole load on the isolator [kg] (Sec 8.4.3: ±20 kg)."""
+    cfg = pareto.config
+    if cfg.seat is None:
+        raise ConfigError(f"{pareto.path}: analyse masses needs a seat, and the optimised "
+                          f"config has no seat: section")
+    for var in cfg.design_variables:
+        if var.path == "seat.mass" or var.path.startswith("seat.passenger."):
+            raise ConfigError(f"{pareto.path}: analyse masses changes the passenger, and "
+                              f"{var.path} is a design variable")
+    if not changes:
+        raise ConfigError("analyse masses: give at least one --mass-change KG")
+    load = float(build_seat(cfg).isolator["load_mass"][0])
+    lowest = cfg.seat.mass if cfg.seat.passenger is not None else 0.0
+    variants = []
+    for delta in changes:
+        new = load + float(delta)
+        if not new > lowest:
+            raise ConfigError(f"--mass-change {delta:g}: the load would be {new:g} kg, not "
+                              f"above the {'seat mass' if lowest else 'zero'} ({lowest:g} kg)")
+        variants.append(Variant(f"{new:g} kg", cfg, partial(_mass_change, cfg, new),
+                                attrs={"load_mass": new, "mass_change": float(delta)}))
+    return variants
+
+
+def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Variant]:
+    """One variant per file whose ``control:`` section and dampers replace the stored ones
+    (a damper in ``vehicle.corner_defaults`` replaces every corner's, one under
+    ``vehicle.corners.<c>`` that corner's)."""
+    if not sources:
+        raise ConfigError("analyse controllers: give at least one --with FILE.yaml")
+    corners = set(pareto.config.vehicle.corners)
+    variants = []
+    for source in sources:
+        source = Path(source)
+        other = _yaml_mapping(source, "--with")
+        vehicle = other.get("vehicle") or {}
+        control = other.get("control")
+        default = (vehicle.get("corner_defaults") or {}).get("damper")
+        own = {c: v["damper"] for c, v in (vehicle.get("corners") or {}).items()
+               if isinstance(v, dict) and "damper" in v}
+        if control is None and default is None and not own:
+            raise ConfigError(f"--with {source}: the file has no control: section and no "
+                              f"damper (vehicle.corner_defaults.damper or "
+                              f"vehicle.corners.<corner>.damper)")
+        unknown = sorted(set(own) - corners)
+        if unknown:
+            raise ConfigError(f"--with {source}: corner(s) {', '.join(unknown)} are not in "
+                              f"{pareto.path.name} (it has {', '.join(sorted(corners))})")
+
+        def replace(data, control=control, default=default, own=own):
+            if control is not None:
+                data["control"] = control
+            veh = data["vehicle"]
+            if default is not None:
+                veh.setdefault("corner_defaults", {})["damper"] = default
+                for corner in (veh.get("corners") or {}).values():
+                    if isinstance(corner, dict):
+                        corner.pop("damper", None)
+            for name, damper in own.items():
+                veh.setdefault("corners", {})
+                if not isinstance(veh["corners"].get(name), dict):
+                    veh["corners"][name] = {}
+                veh["corners"][name]["damper"] = damper
+
+        cfg = config_with(pareto, replace, f"the controller of {source}")
+        variants.append(Variant(source.stem, cfg, attrs={"controller_source": str(source)}))
+    return variants
+
+
+# --- evaluation, output ----------------------------------------------------------------------
+
+def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> PseudoFronts:
+    """Evaluate the stored designs under every variant, one batch each."""
+    labels = [v.label for v in variants]
+    if len(set(labels)) != len(labels):
+        raise ConfigError(f"analyse {kind}: the changes must differ (got {', '.join(labels)})")
+    values = [evaluate_front(pareto, v.config, v.extra) for v in variants]
+    for v in values:      # the optimiser's penalty values stand for "failed": report NaN
+        failed = v.failed
+        v.F[failed] = np.nan
+        v.S[failed] = np.nan
+    return PseudoFronts(kind=kind, pareto=pareto, variants=list(variants), values=values)
+
+
+def _columns(group, name: str, data, names, units) -> None:
+    ds = group.create_dataset(name, data=data)
+    ds.attrs["names"] = np.array(names, dtype="S")
+    ds.attrs["units"] = np.array(units, dtype="S")
+
+
+def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
+                        command: str | None = None) -> Path:
+    """Write ``fronts`` with the layout of the module docstring (atomically)."""
+    p = fronts.pareto
+    with atomic_h5(path, p.config, command) as h5:
+        h5.attrs["analysis"] = fronts.kind
+        h5.attrs["source"] = str(p.path)
+        grp = h5.create_group("pareto")
+        _columns(grp, "X", p.X, p.var_names, p.var_units)
+        _columns(grp, "F", p.F, p.obj_names, p.obj_units)
+        _columns(grp, "G", p.G, p.constraint_names, p.constraint_units)
+        pseudo = h5.create_group("pseudo")
+        pseudo.attrs["labels"] = np.array([v.label for v in fronts.variants], dtype="S")
+        for i, (variant, values) in enumerate(zip(fronts.variants, fronts.values)):
+            g = pseudo.create_group(variant.label.replace("/", "_"))
+            g.attrs.update(label=variant.label, config=variant.config.text, **variant.attrs)
+            _columns(g, "F", values.F, values.obj_names, values.obj_units)
+            _columns(g, "G", values.G, values.constraint_names, values.constraint_units)
+            if values.S.shape[1]:
+                _columns(g, "S", values.S, values.supplementary_names,
+                         values.supplementary_units)
+            _columns(g, "change", fronts.change(i), values.obj_names, ["%"] * len(p.obj_names))
+            ds = g.create_dataset("failed", data=values.failed.astype(np.int8))
+            ds.attrs["units"] = "1"
+    return Path(path)
+
+
+def _is_comfort(cfg: Config) -> list[bool]:
+    """Which main objectives are ISO 2631-1 weighted r.m.s. accelerations (their comfort
+    levels are drawn)."""
+    return [spec.metric == "rms_weighted" for spec in cfg.objectives.main]
+
+
+def plot_pseudo_fronts(fronts: PseudoFronts, path: str | Path, title: str,
+                       marks: Mapping[str, int] | None = None) -> Path:
+    """The stored front and its pseudo-fronts, and the design variables along the stored
+    front (:func:`suspopt.plots.pareto_fronts`)."""
+    p = fronts.pareto
+    curves = [(f"optimised ({p.path.name})", p.F)]
+    curves += [(v.label, values.F) for v, values in zip(fronts.variants, fronts.values)]
+    variables = [(name, unit, p.X[:, j]) for j, (name, unit)
+                 in enumerate(zip(p.var_names, p.var_units))]
+    return plots.pareto_fronts(path, title, list(zip(p.obj_names, p.obj_units)), curves,
+                               variables, marks=marks, comfort=_is_comfort(p.config))
+
+
+def _spread(N: int, rows: int = _TABLE_ROWS) -> np.ndarray:
+    return np.unique(np.linspace(0, N - 1, min(rows, N)).round().astype(int))
+
+
+def _report(fronts: PseudoFronts, title: str) -> Report:
+    p = fronts.pareto
+    columns = ["#"] + [f"{n} [{u}]" for n, u in zip(p.obj_names, p.obj_units)]
+    for v in fronts.variants:
+        columns += [f"{v.label}: {n} (change)" for n in p.obj_names]
+    changes = [fronts.change(i) for i in range(len(fronts.variants))]
+    rows = []
+    for k in _spread(p.N):
+        row = [str(k)] + [f"{f:.4g}" for f in p.F[k]]
+        for values, change in zip(fronts.values, changes):
+            row += ["failed" if values.failed[k] else f"{f:.4g} ({c:+.0f} %)"
+                    for f, c in zip(values.F[k], change[k])]
+        rows.append(row)
+    notes = [f"{len(rows)} of {p.N} designs of {p.path.name}, sorted by {p.obj_names[0]}; "
+             f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)"]
+    for v, values, change in zip(fronts.variants, fronts.values, changes):
+        spans = []
+        for j, name in enumerate(p.obj_names):
+            c = change[~values.failed, j]
+            if c.size:
+                spans.append(f"{name} {np.min(c):+.1f} to {np.max(c):+.1f} % "
+                             f"(median {np.median(c):+.1f} %)")
+        notes.append(f"{v.label}: {int(values.feasible.sum())} of {p.N} designs feasible, "
+                     f"{int(values.failed.sum())} failed; " + "; ".join(spans))
+    return Report(title=title, columns=columns, rows=rows, notes=notes)
+
+
+def _run(kind: str, source: Path, output: Path | None, plot: Path | None,
+         variants: Callable[[ParetoSet], list[Variant]], what: str) -> Report:
+    if plot is not None:
+        plots.check_path(plot)
+    pareto = read_pareto(source)
+    fronts = pseudo_fronts(kind, pareto, variants(pareto))
+    title = f"{kind}: {pareto.path.name} {what}"
+    if output is not None:
+        write_pseudo_fronts(output, fronts)
+    if plot is not None:
+        plot_pseudo_fronts(fronts, plot, title)
+    return _report(fronts, title)
+
+
+def run_roads(source: Path, output: Path | None = None, plot: Path | None = None,
+              road: Sequence[str] = ()) -> Report:
+    """``suspopt analyse roads PARETO.h5 --road B --road C`` (Sec 8.4.2, Table 8.12)."""
+    return _run("roads", source, output, plot, lambda p: road_variants(p, road),
+                "on other roads (Sec 8.4.2)")
+
+
+def run_masses(source: Path, output: Path | None = None, plot: Path | None = None,
+               mass_change: Sequence[float] = MASS_CHANGES) -> Report:
+    """``suspopt analyse masses PARETO.h5 [--mass-change -20 --mass-change 20]`` (Sec 8.4.3,
+    Table 8.13)."""
+    return _run("masses", source, output, plot, lambda p: mass_variants(p, mass_change),
+                "with other passengers (Sec 8.4.3)")
+
+
+def run_controllers(source: Path, output: Path | None = None, plot: Path | None = None,
+                    with_: Sequence[Path] = ()) -> Report:
+    """``suspopt analyse controllers PARETO.h5 --with OTHER.yaml`` (Sec 7.3, Fig. 7.4b)."""
+    return _run("controllers", source, output, plot,
+                lambda p: controller_variants(p, with_), "with other controllers (Fig. 7.4b)")
+
+
+KINDS["roads"] = Kind(run_roads, options=("road",))
+KINDS["masses"] = Kind(run_masses, options=("mass_change",))
+KINDS["controllers"] = Kind(run_controllers, options=("with_",))
