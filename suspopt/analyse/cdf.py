@@ -22,7 +22,7 @@ import numpy as np
 
 from ..config import load_config
 from .. import plots
-from ..io import atomic_h5
+from ..io import atomic_h5, dataset
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..simulate import simulate
 from . import KINDS, Kind, Report
@@ -76,10 +76,6 @@ def _check(cfg) -> None:
                         "simulation.duration: the threshold is never fitted")
 
 
-def _dataset(group, name: str, data, units: str) -> None:
-    group.create_dataset(name, data=data).attrs["units"] = units
-
-
 def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
     """Sweep the C_max share 20-70 % against the base law (module docstring)."""
     if plot is not None:
@@ -112,17 +108,17 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
             grp.attrs["distribution"] = spec.distribution
             grp.attrs["corners"] = ",".join(active)
 
-            _dataset(grp, "c_max_share", SHARES, "1")
-            _dataset(grp, "achieved_share", values["share"][1:], "1")
-            _dataset(grp, "base_share", values["share"][0], "1")
-            _dataset(grp, "final_threshold", threshold, unit)
+            dataset(grp, "c_max_share", SHARES, "1")
+            dataset(grp, "achieved_share", values["share"][1:], "1")
+            dataset(grp, "base_share", values["share"][0], "1")
+            dataset(grp, "final_threshold", threshold, unit)
             for key, group in (("base", grp.create_group("base")),
                                ("cdf", grp.create_group("cdf")),
                                ("reduction", grp.create_group("reduction"))):
                 for name, m_unit in METRIC_UNITS.items():
                     data = {"base": base[name], "cdf": values[name][1:],
                             "reduction": reduction[name]}[key]
-                    _dataset(group, name, data, "%" if key == "reduction" else m_unit)
+                    dataset(group, name, data, "%" if key == "reduction" else m_unit)
     if plot is not None:
         plots.sensitivity(plot, title, 100 * SHARES, "C_max share requested (1 - N) [%]",
                           [{"SW": reduction["SW"]},

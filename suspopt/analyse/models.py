@@ -48,7 +48,7 @@ import numpy as np
 from .. import plots
 from ..config import Config, ConfigError, load_config
 from ..config.metrics import MetricSpec
-from ..io import atomic_h5
+from ..io import atomic_h5, dataset
 from ..metrics import psd
 from ..simulate import Result, simulate
 from ..specs import METRICS, evaluate_spec
@@ -234,12 +234,6 @@ def compare_models(sources: Sequence[str | Path], reference: str | Path | None =
 def write_models(path: str | Path, comparison: ModelComparison,
                  command: str | None = None) -> Path:
     """Write ``comparison`` with the layout of the module docstring (atomically)."""
-    def put(group, name, data, units, **attrs):
-        ds = group.create_dataset(name, data=data)
-        ds.attrs["units"] = units
-        for key, value in attrs.items():
-            ds.attrs[key] = value
-
     models = comparison.models
     ref = models[comparison.reference]
     labels = np.array([m.label for m in models], dtype="S")
@@ -250,22 +244,22 @@ def write_models(path: str | Path, comparison: ModelComparison,
             g = top.create_group(m.label.replace("/", "_"))
             g.attrs.update(source=str(m.source), config=m.config.text,
                            preset=m.config.vehicle.preset, road=m.config.road.kind)
-            put(g, "time", m.time, "s")
+            dataset(g, "time", m.time, "s")
             sig = g.create_group("signals")
             for name, values in m.signals.items():
-                put(sig, name, values, m.units[name])
+                dataset(sig, name, values, m.units[name])
             spectra = g.create_group("psd")
-            put(spectra, "frequency", m.psd_frequency, "Hz")
+            dataset(spectra, "frequency", m.psd_frequency, "Hz")
             for name, values in m.psd.items():
-                put(spectra, name, values, m.units[f"PSD of {name}"])
-            put(g.create_group("modal"), "frequency", m.natural_frequency, "Hz",
+                dataset(spectra, name, values, m.units[f"PSD of {name}"])
+            dataset(g.create_group("modal"), "frequency", m.natural_frequency, "Hz",
                 dominant=np.array(m.dominant, dtype="S"))
         value = h5.create_group("comparison/value")
         difference = h5.create_group("comparison/difference")
         for name in comparison.metric_names:
-            put(value, name, comparison.value[name], comparison.metric_units[name],
+            dataset(value, name, comparison.value[name], comparison.metric_units[name],
                 models=labels)
-            put(difference, name, comparison.difference[name], "%", models=labels)
+            dataset(difference, name, comparison.difference[name], "%", models=labels)
     return Path(path)
 
 

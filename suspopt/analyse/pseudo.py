@@ -47,7 +47,7 @@ import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError
-from ..io import atomic_h5
+from ..io import atomic_h5, dataset
 from ..seat import build_seat, passenger_mass_change
 from . import KINDS, Kind, Report
 from .pareto import FrontValues, ParetoSet, config_with, evaluate_front, read_pareto
@@ -248,9 +248,7 @@ def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> 
 
 
 def _columns(group, name: str, data, names, units) -> None:
-    ds = group.create_dataset(name, data=data)
-    ds.attrs["names"] = np.array(names, dtype="S")
-    ds.attrs["units"] = np.array(units, dtype="S")
+    dataset(group, name, data, units, names=np.array(names, dtype="S"))
 
 
 def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
@@ -275,8 +273,7 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
                 _columns(g, "S", values.S, values.supplementary_names,
                          values.supplementary_units)
             _columns(g, "change", fronts.change(i), values.obj_names, ["%"] * len(p.obj_names))
-            ds = g.create_dataset("failed", data=values.failed.astype(np.int8))
-            ds.attrs["units"] = "1"
+            dataset(g, "failed", values.failed.astype(np.int8), "1")
     return Path(path)
 
 

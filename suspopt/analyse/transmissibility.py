@@ -34,7 +34,7 @@ import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError, load_config
-from ..io import atomic_h5
+from ..io import atomic_h5, dataset
 from ..metrics import transmissibility, coherence, weighted_rms
 from ..seat import (CONSTRAINT_UNITS, base_transmissibility, build_seat, linearise,
                     natural_frequencies, seat_constraints)
@@ -112,28 +112,22 @@ def _acc_signal(dof: str) -> str:
 def write_transmissibility(path: str | Path, data: SeatTransmissibility, cfg: Config,
                            command: str | None = None) -> Path:
     """Write ``data`` with the layout of the module docstring (atomically)."""
-    def put(group, name, values, units, **attrs):
-        ds = group.create_dataset(name, data=values)
-        ds.attrs["units"] = units
-        for key, value in attrs.items():
-            ds.attrs[key] = value
-
     with atomic_h5(path, cfg, command) as h5:
         h5.attrs["seat_kind"] = data.kind
         lin, sim = h5.create_group("linear"), h5.create_group("simulated")
-        put(lin, "frequency", data.linear_frequency, "Hz")
-        put(sim, "frequency", data.simulated_frequency, "Hz")
+        dataset(lin, "frequency", data.linear_frequency, "Hz")
+        dataset(sim, "frequency", data.simulated_frequency, "Hz")
         coh = sim.create_group("coherence")
         for j, name in enumerate(data.dof_names):
-            put(lin, name, data.linear[..., j], "-")
-            put(sim, name, data.simulated[..., j], "-")
-            put(coh, name, data.coherence[..., j], "-")
-        put(h5.create_group("statics"), "static_deflection", data.static_deflection, "m")
-        put(h5.create_group("modal"), "frequency", data.natural_frequency, "Hz",
+            dataset(lin, name, data.linear[..., j], "-")
+            dataset(sim, name, data.simulated[..., j], "-")
+            dataset(coh, name, data.coherence[..., j], "-")
+        dataset(h5.create_group("statics"), "static_deflection", data.static_deflection, "m")
+        dataset(h5.create_group("modal"), "frequency", data.natural_frequency, "Hz",
             dof_names=np.array(data.dof_names, dtype="S"))
         con = h5.create_group("constraints")
         for name, values in data.constraints.items():
-            put(con, name, values, CONSTRAINT_UNITS[name])
+            dataset(con, name, values, CONSTRAINT_UNITS[name])
     return Path(path)
 
 
