@@ -78,7 +78,7 @@ def write_simulation(path: str | Path, result, signals: Iterable[str] | None = N
         grp = h5.create_group("signals")
         for name in names:
             dataset(grp, name, np.asarray(result.signals[name], dtype=dtype),
-                     result.signal_unit(name))
+                    result.signal_unit(name))
         met = h5.create_group("metrics")
         for name, value in result.metrics.items():
             dataset(met, name, np.asarray(value), result.metric_units[name])
@@ -86,10 +86,10 @@ def write_simulation(path: str | Path, result, signals: Iterable[str] | None = N
         if result.designs:
             X = np.column_stack([result.designs[k] for k in result.designs])
             dataset(h5.create_group("designs"), "X", X, "SI",
-                     names=np.array(list(result.designs), dtype="S"))
+                    names=np.array(list(result.designs), dtype="S"))
         modes = modal_analysis(result.model)
         dataset(h5.create_group("modal"), "frequency", modes.frequency, "Hz",
-                 dominant=np.array(modes.dominant[0], dtype="S"))
+                dominant=np.array(modes.dominant[0], dtype="S"))
     return Path(path)
 
 

@@ -11,7 +11,7 @@ them and which keyword options it accepts (the CLI passes only those).
 |---|---|---|
 | ``models`` | several configs (Ch. 3) | :mod:`.models` |
 | ``cdf-sensitivity`` | a config with an adaptive threshold (Figs. 4.7, 4.10) | :mod:`.cdf` |
-| ``roads``, ``masses``, ``controllers`` | a Pareto file (Sec 8.4.2-8.4.3, Fig. 7.4b) | :mod:`.pseudo` |
+| ``roads``, ``masses``, ``controllers`` | a Pareto file (Sec 8.4.2-8.4.3, Ch. 7) | :mod:`.pseudo` |
 | ``transmissibility`` | a config with a seat (Eq 2.86, Fig. 8.26) | :mod:`.transmissibility` |
 """
 

@@ -80,7 +80,8 @@ _RIDE = (
     {"name": "VTD", "metric": "var", "signal": "tyre_deflection"},
     {"name": "MTD", "metric": "max", "signal": "tyre_deflection"},
 )
-_RIDE_ROLL = ({"metric": "var", "signal": "body.roll"}, {"metric": "max_abs", "signal": "body.roll"})
+_RIDE_ROLL = ({"metric": "var", "signal": "body.roll"},
+              {"metric": "max_abs", "signal": "body.roll"})
 
 
 @dataclass
@@ -253,12 +254,12 @@ def write_models(path: str | Path, comparison: ModelComparison,
             for name, values in m.psd.items():
                 dataset(spectra, name, values, m.units[f"PSD of {name}"])
             dataset(g.create_group("modal"), "frequency", m.natural_frequency, "Hz",
-                dominant=np.array(m.dominant, dtype="S"))
+                    dominant=np.array(m.dominant, dtype="S"))
         value = h5.create_group("comparison/value")
         difference = h5.create_group("comparison/difference")
         for name in comparison.metric_names:
             dataset(value, name, comparison.value[name], comparison.metric_units[name],
-                models=labels)
+                    models=labels)
             dataset(difference, name, comparison.difference[name], "%", models=labels)
     return Path(path)
 

@@ -124,7 +124,7 @@ def write_transmissibility(path: str | Path, data: SeatTransmissibility, cfg: Co
             dataset(coh, name, data.coherence[..., j], "-")
         dataset(h5.create_group("statics"), "static_deflection", data.static_deflection, "m")
         dataset(h5.create_group("modal"), "frequency", data.natural_frequency, "Hz",
-            dof_names=np.array(data.dof_names, dtype="S"))
+                dof_names=np.array(data.dof_names, dtype="S"))
         con = h5.create_group("constraints")
         for name, values in data.constraints.items():
             dataset(con, name, values, CONSTRAINT_UNITS[name])
