@@ -183,6 +183,9 @@ def test_controllers_with_the_stored_control_reproduce_the_front(tmp_path, sh2_f
         assert list(g["S"].attrs["names"].astype(str)) == ["f3", "f4", "f5", "f6"]
         assert list(g["S"].attrs["units"].astype(str)) == ["m^2", "rad^2", "W", "1"]
         assert g["S"].shape == (len(ref["X"]), 4)
+        # the file has no supplementary objectives: the stored designs are re-simulated for them
+        assert np.array_equal(h5["pareto/S"][()], g["S"][()]) and np.all(g["S_change"][()] == 0)
+        assert list(h5["pseudo/cdf/S_change"].attrs["units"].astype(str)) == ["%"] * 4
         c = load_config_text(h5["pseudo/cdf"].attrs["config"])
         assert c.control.threshold.c_max_share == 0.27 and c.control.threshold.learn_time == 1.0
         assert not np.array_equal(h5["pseudo/cdf/F"][()], ref["F"])

@@ -22,16 +22,19 @@ ones they were optimised for and compares the objectives ("pseudo" Pareto fronts
 Each change is ONE batched simulation of all N designs (:func:`evaluate_front`). The change of
 each objective is ``100 (f_changed - f_stored) / f_stored`` in % (Tables 8.12-8.13: positive
 when the objective grows). A design whose simulation fails under the change gets NaN
-objectives and ``failed = 1`` (the optimiser's penalty values are not reported).
+objectives and ``failed = 1`` (the optimiser's penalty values are not reported). The file holds
+no supplementary objectives (Eq 7.7-7.10 in Ch. 7), so when the config has some, the stored
+designs are simulated once more with the stored config for theirs, to compare them too.
 
 HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text, plus
 ``analysis`` (the kind) and ``source`` (the Pareto file)); every dataset has ``units`` (one per
 column for X, F, G, S, as ``suspopt optimise`` writes them) and ``names``:
 
-- ``/pareto/X (N, n)``, ``/pareto/F (N, m)``, ``/pareto/G (N, k)``: the stored front;
+- ``/pareto/X (N, n)``, ``/pareto/F (N, m)``, ``/pareto/G (N, k)``: the stored front, and
+  ``/pareto/S (N, s)``, its supplementary objectives re-simulated (if the config has any);
 - ``/pseudo`` with attribute ``labels``; per change ``/pseudo/<label>/``: ``F (N, m)``,
   ``G (N, k)``, ``S (N, s)`` (the config's supplementary objectives, if any), ``change (N, m)``
-  [%], ``failed (N,)`` [1]; attributes ``label``, ``config`` (the changed config's YAML text) and
+  and ``S_change (N, s)`` [%], ``failed (N,)`` [1]; attributes ``label``, ``config`` (the changed config's YAML text) and
   the change (``road_class`` or ``road_source``; ``load_mass`` [kg] and ``mass_change`` [kg];
   ``controller_source``).
 """
@@ -76,17 +79,27 @@ class Variant:
 
 @dataclass
 class PseudoFronts:
-    """A stored front and its pseudo-fronts: ``values[i]`` under ``variants[i]``."""
+    """A stored front and its pseudo-fronts: ``values[i]`` under ``variants[i]``;
+    ``stored_S (N, s)`` the supplementary objectives of the stored designs."""
 
     kind: str
     pareto: ParetoSet
     variants: list[Variant]
     values: list[FrontValues]
+    stored_S: np.ndarray
 
     def change(self, i: int) -> np.ndarray:
         """(N, m) change of each objective under variant ``i`` [%] (NaN where it failed)."""
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return 100.0 * (self.values[i].F - self.pareto.F) / self.pareto.F
+        return _change(self.values[i].F, self.pareto.F)
+
+    def supplementary_change(self, i: int) -> np.ndarray:
+        """(N, s) change of each supplementary objective under variant ``i`` [%]."""
+        return _change(self.values[i].S, self.stored_S)
+
+
+def _change(new: np.ndarray, old: np.ndarray) -> np.ndarray:
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return 100.0 * (new - old) / old
 
 
 def _yaml_mapping(path: Path, option: str) -> dict:
@@ -240,11 +253,13 @@ def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> 
     if len(set(labels)) != len(labels):
         raise ConfigError(f"analyse {kind}: the changes must differ (got {', '.join(labels)})")
     values = [evaluate_front(pareto, v.config, v.extra) for v in variants]
+    stored_S = evaluate_front(pareto).S if values[0].S.shape[1] else values[0].S
     for v in values:      # the optimiser's penalty values stand for "failed": report NaN
         failed = v.failed
         v.F[failed] = np.nan
         v.S[failed] = np.nan
-    return PseudoFronts(kind=kind, pareto=pareto, variants=list(variants), values=values)
+    return PseudoFronts(kind=kind, pareto=pareto, variants=list(variants), values=values,
+                        stored_S=stored_S)
 
 
 def _columns(group, name: str, data, names, units) -> None:
@@ -262,6 +277,10 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
         _columns(grp, "X", p.X, p.var_names, p.var_units)
         _columns(grp, "F", p.F, p.obj_names, p.obj_units)
         _columns(grp, "G", p.G, p.constraint_names, p.constraint_units)
+        first = fronts.values[0]
+        if fronts.stored_S.shape[1]:
+            _columns(grp, "S", fronts.stored_S, first.supplementary_names,
+                     first.supplementary_units)
         pseudo = h5.create_group("pseudo")
         pseudo.attrs["labels"] = np.array([v.label for v in fronts.variants], dtype="S")
         for i, (variant, values) in enumerate(zip(fronts.variants, fronts.values)):
@@ -272,6 +291,8 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
             if values.S.shape[1]:
                 _columns(g, "S", values.S, values.supplementary_names,
                          values.supplementary_units)
+                _columns(g, "S_change", fronts.supplementary_change(i),
+                         values.supplementary_names, ["%"] * values.S.shape[1])
             _columns(g, "change", fronts.change(i), values.obj_names, ["%"] * len(p.obj_names))
             dataset(g, "failed", values.failed.astype(np.int8), "1")
     return Path(path)
@@ -315,9 +336,10 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
         rows.append(row)
     notes = [f"{len(rows)} of {p.N} designs of {p.path.name}, sorted by {p.obj_names[0]}; "
              f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)"]
-    for v, values, change in zip(fronts.variants, fronts.values, changes):
+    for i, (v, values) in enumerate(zip(fronts.variants, fronts.values)):
+        change = np.hstack([changes[i], fronts.supplementary_change(i)])
         spans = []
-        for j, name in enumerate(p.obj_names):
+        for j, name in enumerate(p.obj_names + values.supplementary_names):
             c = change[~values.failed, j]
             if c.size:
                 spans.append(f"{name} {np.min(c):+.1f} to {np.max(c):+.1f} % "
