@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
@@ -20,7 +20,7 @@ import numpy as np
 from . import __version__
 from .config import Config
 
-__all__ = ["atomic_h5", "dataset", "write_simulation", "read_simulation_signals"]
+__all__ = ["atomic_h5", "write_dataset", "write_simulation", "read_simulation_signals"]
 
 
 def _seed_of(cfg: Config) -> int:
@@ -50,12 +50,12 @@ def atomic_h5(path: str | Path, cfg: Config, command: str | None = None):
         raise
 
 
-def dataset(group: h5py.Group, name: str, data, units: str | Sequence[str],
-            **attrs) -> h5py.Dataset:
-    """Create ``group[name]`` with its ``units`` attribute (one string, or one per column as
-    an array of strings) and further attributes."""
+def write_dataset(group: h5py.Group, name: str, data, units: str | list[str],
+                  **attrs) -> h5py.Dataset:
+    """Create ``group[name]`` with its ``units`` attribute (one string, or one per column) and
+    any other attributes."""
     ds = group.create_dataset(name, data=data)
-    ds.attrs["units"] = units if isinstance(units, str) else np.array(list(units), dtype="S")
+    ds.attrs["units"] = np.array(units, dtype="S") if isinstance(units, list) else units
     for key, value in attrs.items():
         ds.attrs[key] = value
     return ds
@@ -74,22 +74,22 @@ def write_simulation(path: str | Path, result, signals: Iterable[str] | None = N
     names = list(result.signals) if signals is None else list(signals)
     dtype = np.float32 if float32 else np.float64
     with atomic_h5(path, result.config, command) as h5:
-        dataset(h5, "time", result.time, "s")
+        write_dataset(h5, "time", result.time, "s")
         grp = h5.create_group("signals")
         for name in names:
-            dataset(grp, name, np.asarray(result.signals[name], dtype=dtype),
-                    result.signal_unit(name))
+            write_dataset(grp, name, np.asarray(result.signals[name], dtype=dtype),
+                     result.signal_unit(name))
         met = h5.create_group("metrics")
         for name, value in result.metrics.items():
-            dataset(met, name, np.asarray(value), result.metric_units[name])
-        dataset(h5, "diverged_at", result.diverged_at, "s")
+            write_dataset(met, name, np.asarray(value), result.metric_units[name])
+        write_dataset(h5, "diverged_at", result.diverged_at, "s")
         if result.designs:
             X = np.column_stack([result.designs[k] for k in result.designs])
-            dataset(h5.create_group("designs"), "X", X, "SI",
-                    names=np.array(list(result.designs), dtype="S"))
+            write_dataset(h5.create_group("designs"), "X", X, "SI",
+                     names=np.array(list(result.designs), dtype="S"))
         modes = modal_analysis(result.model)
-        dataset(h5.create_group("modal"), "frequency", modes.frequency, "Hz",
-                dominant=np.array(modes.dominant[0], dtype="S"))
+        write_dataset(h5.create_group("modal"), "frequency", modes.frequency, "Hz",
+                 dominant=np.array(modes.dominant[0], dtype="S"))
     return Path(path)
 
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..config import load_config
 from .. import plots
-from ..io import atomic_h5, dataset
+from ..io import atomic_h5, write_dataset
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..simulate import simulate
 from . import KINDS, Kind, Report
@@ -108,17 +108,17 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
             grp.attrs["distribution"] = spec.distribution
             grp.attrs["corners"] = ",".join(active)
 
-            dataset(grp, "c_max_share", SHARES, "1")
-            dataset(grp, "achieved_share", values["share"][1:], "1")
-            dataset(grp, "base_share", values["share"][0], "1")
-            dataset(grp, "final_threshold", threshold, unit)
+            write_dataset(grp, "c_max_share", SHARES, "1")
+            write_dataset(grp, "achieved_share", values["share"][1:], "1")
+            write_dataset(grp, "base_share", values["share"][0], "1")
+            write_dataset(grp, "final_threshold", threshold, unit)
             for key, group in (("base", grp.create_group("base")),
                                ("cdf", grp.create_group("cdf")),
                                ("reduction", grp.create_group("reduction"))):
                 for name, m_unit in METRIC_UNITS.items():
                     data = {"base": base[name], "cdf": values[name][1:],
                             "reduction": reduction[name]}[key]
-                    dataset(group, name, data, "%" if key == "reduction" else m_unit)
+                    write_dataset(group, name, data, "%" if key == "reduction" else m_unit)
     if plot is not None:
         plots.sensitivity(plot, title, 100 * SHARES, "C_max share requested (1 - N) [%]",
                           [{"SW": reduction["SW"]},

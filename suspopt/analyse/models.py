@@ -48,7 +48,7 @@ import numpy as np
 from .. import plots
 from ..config import Config, ConfigError, load_config
 from ..config.metrics import MetricSpec
-from ..io import atomic_h5, dataset
+from ..io import atomic_h5, write_dataset
 from ..metrics import psd
 from ..simulate import Result, simulate
 from ..specs import METRICS, evaluate_spec
@@ -245,22 +245,22 @@ def write_models(path: str | Path, comparison: ModelComparison,
             g = top.create_group(m.label.replace("/", "_"))
             g.attrs.update(source=str(m.source), config=m.config.text,
                            preset=m.config.vehicle.preset, road=m.config.road.kind)
-            dataset(g, "time", m.time, "s")
+            write_dataset(g, "time", m.time, "s")
             sig = g.create_group("signals")
             for name, values in m.signals.items():
-                dataset(sig, name, values, m.units[name])
+                write_dataset(sig, name, values, m.units[name])
             spectra = g.create_group("psd")
-            dataset(spectra, "frequency", m.psd_frequency, "Hz")
+            write_dataset(spectra, "frequency", m.psd_frequency, "Hz")
             for name, values in m.psd.items():
-                dataset(spectra, name, values, m.units[f"PSD of {name}"])
-            dataset(g.create_group("modal"), "frequency", m.natural_frequency, "Hz",
-                    dominant=np.array(m.dominant, dtype="S"))
+                write_dataset(spectra, name, values, m.units[f"PSD of {name}"])
+            write_dataset(g.create_group("modal"), "frequency", m.natural_frequency, "Hz",
+                          dominant=np.array(m.dominant, dtype="S"))
         value = h5.create_group("comparison/value")
         difference = h5.create_group("comparison/difference")
         for name in comparison.metric_names:
-            dataset(value, name, comparison.value[name], comparison.metric_units[name],
-                    models=labels)
-            dataset(difference, name, comparison.difference[name], "%", models=labels)
+            write_dataset(value, name, comparison.value[name],
+                          comparison.metric_units[name], models=labels)
+            write_dataset(difference, name, comparison.difference[name], "%", models=labels)
     return Path(path)
 
 

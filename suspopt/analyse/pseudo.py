@@ -34,9 +34,9 @@ column for X, F, G, S, as ``suspopt optimise`` writes them) and ``names``:
   ``/pareto/S (N, s)``, its supplementary objectives re-simulated (if the config has any);
 - ``/pseudo`` with attribute ``labels``; per change ``/pseudo/<label>/``: ``F (N, m)``,
   ``G (N, k)``, ``S (N, s)`` (the config's supplementary objectives, if any), ``change (N, m)``
-  and ``S_change (N, s)`` [%], ``failed (N,)`` [1]; attributes ``label``, ``config`` (the changed config's YAML text) and
-  the change (``road_class`` or ``road_source``; ``load_mass`` [kg] and ``mass_change`` [kg];
-  ``controller_source``).
+  and ``S_change (N, s)`` [%], ``failed (N,)`` [1]; attributes ``label``, ``config`` (the
+  changed config's YAML text) and the change (``road_class`` or ``road_source``;
+  ``load_mass`` [kg] and ``mass_change`` [kg]; ``controller_source``).
 """
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError
-from ..io import atomic_h5, dataset
+from ..io import atomic_h5, write_dataset
 from ..seat import build_seat, passenger_mass_change
 from . import KINDS, Kind, Report
 from .pareto import FrontValues, ParetoSet, config_with, evaluate_front, read_pareto
@@ -263,7 +263,7 @@ def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> 
 
 
 def _columns(group, name: str, data, names, units) -> None:
-    dataset(group, name, data, units, names=np.array(names, dtype="S"))
+    write_dataset(group, name, data, units, names=np.array(names, dtype="S"))
 
 
 def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
@@ -294,7 +294,7 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
                 _columns(g, "S_change", fronts.supplementary_change(i),
                          values.supplementary_names, ["%"] * values.S.shape[1])
             _columns(g, "change", fronts.change(i), values.obj_names, ["%"] * len(p.obj_names))
-            dataset(g, "failed", values.failed.astype(np.int8), "1")
+            write_dataset(g, "failed", values.failed.astype(np.int8), "1")
     return Path(path)
 
 

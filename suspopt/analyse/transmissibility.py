@@ -34,7 +34,7 @@ import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError, load_config
-from ..io import atomic_h5, dataset
+from ..io import atomic_h5, write_dataset
 from ..metrics import transmissibility, coherence, weighted_rms
 from ..seat import (CONSTRAINT_UNITS, base_transmissibility, build_seat, linearise,
                     natural_frequencies, seat_constraints)
@@ -115,19 +115,19 @@ def write_transmissibility(path: str | Path, data: SeatTransmissibility, cfg: Co
     with atomic_h5(path, cfg, command) as h5:
         h5.attrs["seat_kind"] = data.kind
         lin, sim = h5.create_group("linear"), h5.create_group("simulated")
-        dataset(lin, "frequency", data.linear_frequency, "Hz")
-        dataset(sim, "frequency", data.simulated_frequency, "Hz")
+        write_dataset(lin, "frequency", data.linear_frequency, "Hz")
+        write_dataset(sim, "frequency", data.simulated_frequency, "Hz")
         coh = sim.create_group("coherence")
         for j, name in enumerate(data.dof_names):
-            dataset(lin, name, data.linear[..., j], "-")
-            dataset(sim, name, data.simulated[..., j], "-")
-            dataset(coh, name, data.coherence[..., j], "-")
-        dataset(h5.create_group("statics"), "static_deflection", data.static_deflection, "m")
-        dataset(h5.create_group("modal"), "frequency", data.natural_frequency, "Hz",
-                dof_names=np.array(data.dof_names, dtype="S"))
+            write_dataset(lin, name, data.linear[..., j], "-")
+            write_dataset(sim, name, data.simulated[..., j], "-")
+            write_dataset(coh, name, data.coherence[..., j], "-")
+        write_dataset(h5.create_group("statics"), "static_deflection", data.static_deflection, "m")
+        write_dataset(h5.create_group("modal"), "frequency", data.natural_frequency, "Hz",
+                      dof_names=np.array(data.dof_names, dtype="S"))
         con = h5.create_group("constraints")
         for name, values in data.constraints.items():
-            dataset(con, name, values, CONSTRAINT_UNITS[name])
+            write_dataset(con, name, values, CONSTRAINT_UNITS[name])
     return Path(path)
 
 
