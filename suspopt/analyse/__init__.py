@@ -20,7 +20,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-__all__ = ["Report", "Kind", "KINDS", "analysis_kinds"]
+import numpy as np
+
+__all__ = ["Report", "Kind", "KINDS", "analysis_kinds", "relative_change"]
 
 
 @dataclass
@@ -44,6 +46,13 @@ class Kind:
     run: Callable[..., Report]
     many: bool = False
     options: tuple[str, ...] = ()
+
+
+def relative_change(value, reference) -> np.ndarray:
+    """``100 (value - reference) / reference`` [%], NaN or inf where the reference is 0 or NaN
+    (the percentages of Tables 3.3-3.21, 4.2-4.3, 8.12-8.13; their signs are each table's)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return 100.0 * (np.asarray(value, dtype=float) - reference) / reference
 
 
 #: kind name -> Kind

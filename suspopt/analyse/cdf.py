@@ -25,7 +25,7 @@ from .. import plots
 from ..io import atomic_h5, write_dataset
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..simulate import simulate
-from . import KINDS, Kind, Report
+from . import KINDS, Kind, Report, relative_change
 
 __all__ = ["SHARES", "METRIC_UNITS", "semi_active_metrics", "run"]
 
@@ -90,8 +90,7 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
     result = simulate(cfg, params={path + "c_max_share": shares, path + "learn_time": learn})
     values = semi_active_metrics(result, share_after=spec.learn_time)
     base = {k: v[0] for k, v in values.items()}
-    with np.errstate(divide="ignore", invalid="ignore"):
-        reduction = {k: 100.0 * (base[k] - values[k][1:]) / base[k] for k in METRIC_UNITS}
+    reduction = {k: 0.0 - relative_change(values[k][1:], base[k]) for k in METRIC_UNITS}
     corners = result.model.corners
     active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]
     laws = sorted({cfg.vehicle.corners[c].damper.law for c in active})

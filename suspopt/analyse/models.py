@@ -53,7 +53,7 @@ from ..metrics import psd
 from ..simulate import Result, simulate
 from ..specs import METRICS, evaluate_spec
 from ..vehicle import build_vehicle, modal_analysis
-from . import KINDS, Kind, Report
+from . import KINDS, Kind, Report, relative_change
 
 __all__ = ["ModelResponse", "ModelComparison", "compare_models", "write_models",
            "plot_models", "run", "TIME_SIGNALS", "PSD_SIGNALS", "PSD_SEGMENT"]
@@ -224,11 +224,8 @@ def compare_models(sources: Sequence[str | Path], reference: str | Path | None =
                                  metric_units=units)
     for name in names:
         value = np.array([m.metrics.get(name, np.nan) for m in models])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            diff = 100.0 * (value - _reference_value(models[ref], name)) / \
-                _reference_value(models[ref], name)
         comparison.value[name] = value
-        comparison.difference[name] = diff
+        comparison.difference[name] = relative_change(value, _reference_value(models[ref], name))
     return comparison
 
 

@@ -52,7 +52,7 @@ from .. import plots
 from ..config import Config, ConfigError
 from ..io import atomic_h5, write_dataset
 from ..seat import build_seat, passenger_mass_change
-from . import KINDS, Kind, Report
+from . import KINDS, Kind, Report, relative_change
 from .pareto import FrontValues, ParetoSet, config_with, evaluate_front, read_pareto
 
 __all__ = ["Variant", "PseudoFronts", "road_variants", "mass_variants",
@@ -90,16 +90,11 @@ class PseudoFronts:
 
     def change(self, i: int) -> np.ndarray:
         """(N, m) change of each objective under variant ``i`` [%] (NaN where it failed)."""
-        return _change(self.values[i].F, self.pareto.F)
+        return relative_change(self.values[i].F, self.pareto.F)
 
     def supplementary_change(self, i: int) -> np.ndarray:
         """(N, s) change of each supplementary objective under variant ``i`` [%]."""
-        return _change(self.values[i].S, self.stored_S)
-
-
-def _change(new: np.ndarray, old: np.ndarray) -> np.ndarray:
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return 100.0 * (new - old) / old
+        return relative_change(self.values[i].S, self.stored_S)
 
 
 def _yaml_mapping(path: Path, option: str) -> dict:
