@@ -137,6 +137,14 @@ class Problem(_PymooProblem):
         values[:, self._integer] = np.round(values[:, self._integer])
         return values
 
+    def to_search(self, values) -> np.ndarray:
+        """The search coordinates ``X`` of physical values (N, n_var): the inverse of
+        :meth:`to_physical` (``log10`` on a log scale), e.g. to re-evaluate a Pareto file's
+        designs."""
+        X = np.array(np.atleast_2d(values), dtype=float)
+        X[:, self._log] = np.log10(X[:, self._log])
+        return X
+
     def params(self, X) -> dict[str, np.ndarray]:
         """``simulate``'s ``params``: each variable's dotted path -> its (N,) values."""
         values = self.to_physical(X)

@@ -1,0 +1,284 @@
+"""k-optimality and k-ε optimality (Sec 6.1.1, Eq 6.10-6.12), and the Pareto-theory picks
+(Fig. 8.21): choosing one design from a Pareto set. Every objective is minimised.
+
+**Levels (Eq 6.10).** For solution ``i`` of a set of ``N`` solutions with ``m`` objectives,
+
+    k_i = min over j != i of  sum_l Γ(Δ_l(i, j))  - 1,      Δ_l(i, j) = f_l(i) - f_l(j).
+
+k-optimality (Das) takes the crisp merit ``Γ(Δ) = 1`` if ``Δ <= 0``, else 0 (Eq 6.11): the sum
+counts the objectives in which ``i`` is not worse than ``j``, and the level is that count for
+the least favourable ``j``, minus 1. So ``k = m - 1`` for a solution better than every other in
+every objective (the utopia point), ``k >= 0`` for a Pareto-optimal solution and ``k = -1``
+where some solution is better in every objective. k-ε optimality (Gobbi et al.) softens the
+merit with an indifference threshold ``ε_l`` per objective (Eq 6.12 as reference/ERRATA.md
+mends it): ``Γ = 1`` if ``Δ <= 0``, ``1 - Δ/ε`` if ``0 < Δ < ε``, ``0`` if ``Δ >= ε``. The
+level becomes continuous in ``[-1, m - 1]``; it is never below the k-optimality level and
+tends to it as ``ε -> 0`` (``ε_l = 0`` *is* Eq 6.11 for that objective).
+
+**Choice.** The thesis takes the solution of the highest level and tunes ε until only one
+solution holds it (Sec 6.2.2, 7.2.2). :func:`kesort` reports every solution within ``tie_tol``
+of the top level as ``ties`` and chooses the first of them.
+
+**Level convention.** Eq 6.10 subtracts 1, so the top level is ``m - 1``. The thesis's text
+and figures read the levels one higher: with six objectives its optima are "above level five
+but below six" (Sec 7.3) and "of level five, i.e. it dominates five out of six objectives"
+(Sec 6.3), which only fits ``min sum Γ`` without the ``- 1``. suspopt keeps Eq 6.10; add 1 to
+compare with the thesis's figures.
+
+**Normalisation and ε.** Each objective is normalised over the set, by its maximum
+(``NF = F / max F``, Eq 7.12; needs a positive maximum) or min-max
+(``NF = (F - min F) / (max F - min F)``). The threshold is either absolute (``eps``, in the
+objectives' own units, one value or one per objective) or ``ε_l = P · max NF_l`` (Eq 6.19,
+7.13). Γ depends on ``Δ_l / ε_l`` only, so an absolute ε gives the same levels whatever the
+normalisation; with ``P`` the normalisation sets the scale: by the maximum (the thesis's
+choice) ε is ``P`` times each objective's largest value, min-max makes it ``P`` times its
+range over the set (for an objective whose values sit in a narrow band far from 0). Either way
+the levels are invariant to a change of an objective's unit. ``P="auto"`` takes the smallest
+``P`` of a grid over ``P_range`` that yields a single best solution: the thesis chose ``P`` by
+hand for this (0.55-0.65 in Ch. 6, 0.10-0.20 in Ch. 7).
+
+**Cost.** The pairwise comparison is ``N² m`` work, done in row blocks of about
+``chunk_bytes`` of memory, so 10,000 solutions × 10 objectives take seconds in about 64 MB
+(``benchmarks/bench_kesort.py``); ``P="auto"`` repeats it once per grid point tried.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+__all__ = ["kesort", "KEpsilonSort", "k_eps_levels", "normalise_objectives", "pareto_picks",
+           "check_options", "NORMALISATIONS"]
+
+#: Normalisations of the objectives before ε = P · max NF (Eq 7.12 and min-max).
+NORMALISATIONS = ("max", "minmax")
+
+_CHUNK_BYTES = 64 * 2 ** 20
+
+
+@dataclass(frozen=True)
+class KEpsilonSort:
+    """Result of :func:`kesort` for ``N`` solutions and ``m`` objectives.
+
+    ``k_eps (N,)``: k-ε levels (Eq 6.10 with Eq 6.12); ``k (N,)``: k-optimality levels (Eq 6.10
+    with Eq 6.11), integers from -1 to m - 1, computed when first read (one more pass over
+    the pairs); ``chosen``: index of the solution of the highest k-ε level (the first of
+    ``ties``); ``ties``: indices of every solution within ``tie_tol`` of that level; ``epsilon (m,)``: the thresholds in the objectives' units; ``P``: the factor
+    of Eq 6.19/7.13 (None for an absolute ``eps``); ``P_auto``: whether ``P`` was searched;
+    ``normalisation``; ``NF (N, m)``: the normalised objectives; ``names``.
+    """
+
+    k_eps: np.ndarray
+    chosen: int
+    ties: np.ndarray
+    epsilon: np.ndarray
+    P: float | None
+    P_auto: bool
+    normalisation: str
+    NF: np.ndarray
+    names: tuple[str, ...]
+
+    @cached_property
+    def k(self) -> np.ndarray:
+        # the normalisation keeps each objective's order, so the crisp levels are F's own
+        return k_eps_levels(self.NF, 0.0)
+
+    @property
+    def unique(self) -> bool:
+        """True when one solution alone holds the highest level."""
+        return len(self.ties) == 1
+
+
+def _objectives(F) -> np.ndarray:
+    F = np.array(F, dtype=float)
+    if F.ndim != 2 or F.shape[0] == 0 or F.shape[1] == 0:
+        raise ValueError(f"F must be (N solutions, m objectives) with N, m >= 1; got shape "
+                         f"{F.shape}")
+    bad = np.argwhere(~np.isfinite(F))
+    if len(bad):
+        i, j = bad[0]
+        raise ValueError(f"F[{i}, {j}] is {F[i, j]}: objectives must be finite (drop failed "
+                         f"designs first)")
+    return F
+
+
+def _names(names: Sequence[str] | None, m: int) -> tuple[str, ...]:
+    if names is None:
+        return tuple(f"f{j + 1}" for j in range(m))
+    if len(names) != m:
+        raise ValueError(f"{len(names)} names for {m} objectives")
+    return tuple(names)
+
+
+def normalise_objectives(F, how: str = "max", names: Sequence[str] | None = None
+                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(NF, offset, scale)`` with ``NF = (F - offset) / scale`` column by column.
+
+    ``max``: offset 0, scale ``max F`` (Eq 7.12); a column whose maximum is not positive is an
+    error (dividing by it would reverse or break the order). ``minmax``: offset ``min F``, scale
+    ``max F - min F`` (1 for a constant column, which becomes 0).
+    """
+    F = _objectives(F)
+    names = _names(names, F.shape[1])
+    if how == "max":
+        scale = F.max(axis=0)
+        for j in np.flatnonzero(scale <= 0):
+            raise ValueError(f"objective {names[j]} has maximum {scale[j]:g} <= 0 over the "
+                             f"set: normalising by the maximum (Eq 7.12) needs a positive "
+                             f"one; use min-max normalisation")
+        offset = np.zeros_like(scale)
+    elif how == "minmax":
+        offset = F.min(axis=0)
+        spread = F.max(axis=0) - offset
+        scale = np.where(spread > 0, spread, 1.0)
+    else:
+        raise ValueError(f"unknown normalisation {how!r}; use one of {', '.join(NORMALISATIONS)}")
+    return (F - offset) / scale, offset, scale
+
+
+def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
+    """k-ε levels (Eq 6.10, Γ of Eq 6.12 with the ERRATA) of the rows of ``F (N, m)``.
+
+    ``eps``: one threshold or one per objective, in the units of ``F``; ``eps_l = 0`` gives the
+    crisp merit of Eq 6.11 for that objective, so ``eps = 0`` returns the k-optimality levels.
+    A single solution (no other to compare with) gets the top level ``m - 1``. The comparison
+    runs in blocks of rows of about ``chunk_bytes`` bytes; no Python loop over solutions.
+    """
+    F = _objectives(F)
+    N, m = F.shape
+    eps = np.broadcast_to(np.asarray(eps, dtype=float), (m,))
+    if (eps < 0).any() or not np.isfinite(eps).all():
+        raise ValueError(f"eps must be finite and >= 0; got {eps.tolist()}")
+    if N == 1:
+        return np.full(1, m - 1.0)
+    soft = eps > 0
+    # Γ = clip(1 - Δ/ε, 0, 1) = clip((1 + f_j/ε) - f_i/ε, 0, 1): one subtraction per pair
+    scaled = F.copy()
+    scaled[:, soft] /= eps[soft]
+    shifted = scaled + 1.0
+    rows = int(max(1, min(N, chunk_bytes // (16 * N))))
+    total, merit = np.empty((rows, N)), np.empty((rows, N))
+    levels = np.empty(N)
+    for start in range(0, N, rows):
+        stop = min(start + rows, N)
+        S, T = total[:stop - start], merit[:stop - start]
+        S.fill(0.0)
+        for j in range(m):
+            if soft[j]:
+                np.subtract(shifted[None, :, j], scaled[start:stop, j, None], out=T)
+                np.clip(T, 0.0, 1.0, out=T)
+            else:
+                np.less_equal(F[start:stop, j, None], F[None, :, j], out=T)
+            S += T
+        S[np.arange(stop - start), np.arange(start, stop)] = np.inf    # not against itself
+        levels[start:stop] = S.min(axis=1) - 1.0
+    return levels
+
+
+def _ties(levels: np.ndarray, tie_tol: float) -> np.ndarray:
+    return np.flatnonzero(levels >= levels.max() - tie_tol)
+
+
+def check_options(eps=None, P: float | str | None = None, normalise: str = "max",
+                  P_range: tuple[float, float] = (0.01, 1.0), P_step: float = 0.01) -> None:
+    """Raise ValueError for options :func:`kesort` cannot use (before any work is done)."""
+    if eps is not None and P is not None:
+        raise ValueError("give either eps (absolute thresholds) or P (eps = P max NF), not both")
+    if eps is not None:
+        values = np.asarray(eps, dtype=float)
+        if values.ndim > 1 or (values < 0).any() or not np.isfinite(values).all():
+            raise ValueError(f"eps must be one value or one per objective, finite and >= 0; "
+                             f"got {values.tolist()}")
+    elif P is not None and P != "auto":
+        if not float(P) > 0:
+            raise ValueError(f"P must be > 0 or 'auto'; got {P}")
+    else:
+        lo, hi = (float(p) for p in P_range)
+        if not 0 < lo <= hi or not P_step > 0:
+            raise ValueError(f"P_range must satisfy 0 < low <= high and P_step > 0; got "
+                             f"{tuple(P_range)}, {P_step}")
+    if normalise not in NORMALISATIONS:
+        raise ValueError(f"unknown normalisation {normalise!r}; use one of "
+                         f"{', '.join(NORMALISATIONS)}")
+
+
+def kesort(F, eps=None, *, P: float | str | None = None, normalise: str = "max",
+           names: Sequence[str] | None = None, P_range: tuple[float, float] = (0.01, 1.0),
+           P_step: float = 0.01, tie_tol: float = 1e-9,
+           chunk_bytes: int = _CHUNK_BYTES) -> KEpsilonSort:
+    """Sort the solutions ``F (N, m)`` (minimised) by k-ε optimality and choose one.
+
+    Give either ``eps`` (absolute thresholds in the units of ``F``: one value or ``(m,)``) or
+    ``P``: a number for ``ε_l = P · max NF_l`` (Eq 6.19, 7.13), or ``"auto"`` (the default when
+    neither is given) for the smallest ``P`` on the grid ``P_range[0], P_range[0] + P_step,
+    ... <= P_range[1]`` that leaves one solution alone at the top level; if none does, the
+    largest ``P`` is kept and ``unique`` is False. ``normalise``: ``max`` (Eq 7.12) or
+    ``minmax`` (see the module docstring). Returns a :class:`KEpsilonSort`.
+    """
+    check_options(eps, P, normalise, P_range, P_step)
+    F = _objectives(F)
+    names = _names(names, F.shape[1])
+    NF, _, scale = normalise_objectives(F, normalise, names)
+    if eps is not None:
+        eps_nf = np.broadcast_to(np.asarray(eps, dtype=float), scale.shape) / scale
+        levels, P_value, auto = k_eps_levels(NF, eps_nf, chunk_bytes), None, False
+    elif P is None or P == "auto":
+        P_value, eps_nf, levels = _auto_P(NF, P_range, P_step, tie_tol, chunk_bytes)
+        auto = True
+    else:
+        P_value = float(P)
+        eps_nf = P_value * NF.max(axis=0)
+        levels, auto = k_eps_levels(NF, eps_nf, chunk_bytes), False
+    ties = _ties(levels, tie_tol)
+    return KEpsilonSort(k_eps=levels, chosen=int(ties[0]), ties=ties, epsilon=eps_nf * scale,
+                        P=P_value, P_auto=auto, normalisation=normalise, NF=NF, names=names)
+
+
+def _auto_P(NF: np.ndarray, P_range, P_step: float, tie_tol: float, chunk_bytes: int):
+    """The smallest P of the grid with a single best solution: (P, ε in NF units, levels)."""
+    lo, hi = (float(p) for p in P_range)
+    steps = np.arange(int(np.floor((hi - lo) / P_step + 1e-9)) + 1)
+    grid = np.round(lo + P_step * steps, 12)        # 0.15, not 0.15000000000000002
+    peak = NF.max(axis=0)
+    for P_value in grid:
+        levels = k_eps_levels(NF, P_value * peak, chunk_bytes)
+        if len(_ties(levels, tie_tol)) == 1:
+            break
+    return float(P_value), P_value * peak, levels
+
+
+def pareto_picks(F, names: Sequence[str] | None = None) -> dict[str, int]:
+    """The Pareto-theory picks of Fig. 8.21: indices into ``F (N, m)`` (minimised).
+
+    ``best_<name>`` for each objective (names default ``f1``, ``f2``, ...): the edge of the
+    front where that objective is lowest, i.e. the optimum of the single-objective problem
+    (ties broken by the lowest sum of the other objectives after min-max normalisation, so
+    the edge is itself non-dominated). ``knee``: the best compromise, Fig. 8.21's "Mid"
+    solution, taken as the solution nearest (Euclidean) to the utopia point once each
+    objective is scaled from the ideal point (the lowest values) to the nadir point estimated
+    from the edges (the payoff table: the worst value of each objective among the
+    ``best_<name>`` solutions), ``argmin_i ||(F_i - ideal) / (nadir - ideal)||``.
+
+    Why this knee: Sec 8.4 picks "the mid solution of the Pareto front [that] corresponds to
+    the best compromise of the two objectives" without a formula. The distance to the utopia
+    point (compromise programming) reads the same for any ``m``, unlike the farthest point from
+    the line joining the two edges, which exists for two objectives only; the scaling makes it
+    independent of the objectives' units, and taking the nadir from the edges keeps dominated
+    designs far off the front (a pooled or re-simulated set) from moving it. It is always
+    non-dominated (a solution that dominates another is nearer the utopia point), and on a
+    convex two-objective front it lands in the middle, where Fig. 8.21 puts "Mid".
+    """
+    F = _objectives(F)
+    names = _names(names, F.shape[1])
+    NF, _, _ = normalise_objectives(F, "minmax", names)
+    total = NF.sum(axis=1)
+    picks = {f"best_{name}": int(np.lexsort((total - NF[:, j], F[:, j]))[0])
+             for j, name in enumerate(names)}
+    ideal = F.min(axis=0)
+    span = F[list(picks.values())].max(axis=0) - ideal
+    scaled = (F - ideal) / np.where(span > 0, span, 1.0)
+    picks["knee"] = int(np.argmin(np.einsum("ij,ij->i", scaled, scaled)))
+    return picks

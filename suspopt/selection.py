@@ -1,0 +1,418 @@
+"""Choose designs from Pareto sets: the run behind ``suspopt kesort`` (Sec 6.2.2, 7.2.2).
+
+1. :func:`read_pareto` reads a ``suspopt optimise`` file (``/pareto/X`` physical values,
+   ``/pareto/F``, ``/pareto/G`` with ``names`` and ``units``; root attribute ``config``, the
+   YAML text: layout in :mod:`suspopt.optimise.run`).
+2. :func:`evaluate_pareto` gives every design its objectives, main then supplementary, under
+   a config: the file's own, or another one with the same design variables (the same designs
+   with a CDF controller: the thesis's "pseudo Pareto fronts", Sec 7.2.2, Fig. 7.4b). When
+   that needs a simulation (supplementary objectives, another config) the designs are
+   re-simulated in ONE batch through :meth:`suspopt.Problem.evaluate`, the optimiser's own
+   objective code; otherwise the file's ``F`` and ``G`` are used as they are.
+3. :func:`select` pools the sets (Fig. 7.6), keeps the case each design came from, drops the
+   designs whose simulation failed (and, unless asked, the infeasible ones), sorts the pool
+   and each case alone by k-ε optimality (:func:`suspopt.kesort.kesort`; Fig. 7.5: the
+   optimum of each case, Fig. 7.6: the optimum among all; each sort normalises over its own
+   designs, Eq 7.11-7.12) and takes the Pareto-theory picks (:func:`~suspopt.kesort.pareto_picks`).
+4. :func:`write_selection` writes ``/kesort`` atomically (:func:`suspopt.io.atomic_h5`).
+
+A *case* is a label: the sets of several files carry one label to form one case (Ch. 6 Part A
+pools the optima of C1-C4).
+
+HDF5 layout, every dataset with a ``units`` attribute (one per column for F and X):
+
+- ``/kesort/F (N, m)`` main + supplementary objectives, ``names``; ``/kesort/X (N, n)``
+  physical design variables, ``names`` (the union over the cases; NaN where a case has no such
+  variable); ``/kesort/k_eps (N,)``, ``/kesort/k (N,)`` (k-optimality), ``/kesort/chosen``
+  (index of the pool's optimum), ``/kesort/ties``; ``/kesort/case (N,)`` labels,
+  ``/kesort/source (N,)`` (the Pareto set it came from: index into ``/kesort/sets``),
+  ``/kesort/row (N,)`` (its row in that file's ``/pareto``), ``/kesort/feasible (N,)``;
+  ``/kesort/picks/<best_f1 ... knee>`` (indices); ``/kesort/sets/{file, label, config}``:
+  each Pareto set's file, case label and the YAML text of the config that evaluated it.
+- attributes of ``/kesort``: ``epsilon (m,)`` in the objectives' units, ``P`` (NaN for an
+  absolute ε), ``P_auto``, ``normalisation``, ``unique``, ``cases`` (the labels in order).
+- with several cases, ``/kesort/cases/<label>/`` holds the sort of that case alone:
+  ``rows`` (its designs' indices in ``/kesort``), ``k_eps``, ``k`` (over ``rows``),
+  ``chosen`` and ``ties`` (indices in ``/kesort``), ``picks/<key>``, with the same attributes.
+- root attributes: those of :func:`~suspopt.io.atomic_h5`, with the first set's config.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from .config import Config, ConfigError, load_config
+from .config.loader import load_config_text
+from .io import atomic_h5, write_dataset
+from .kesort import KEpsilonSort, kesort, pareto_picks
+from .optimise.problem import PENALTY, Problem
+
+__all__ = ["ParetoSet", "DesignSet", "CaseSort", "Selection", "read_pareto", "evaluate_pareto",
+           "load_design_sets", "select", "write_selection"]
+
+_FAILED = "simulation_failed"
+_AGREE = 1e-6            # relative: re-simulated main objectives against the file's
+
+
+@dataclass(frozen=True)
+class ParetoSet:
+    """A Pareto set as ``suspopt optimise`` wrote it: ``X (N, n)`` physical values,
+    ``F (N, m)``, ``G (N, k)``, their names and units, and the config's YAML text."""
+
+    path: Path
+    X: np.ndarray
+    var_names: list[str]
+    var_units: list[str]
+    F: np.ndarray
+    obj_names: list[str]
+    G: np.ndarray
+    constraint_names: list[str]
+    config_text: str
+
+    def config(self) -> Config:
+        """The config the set was optimised with; errors point into the file
+        (``PARETO.h5:config:LINE``), and relative paths resolve from the file's folder."""
+        return load_config_text(self.config_text, self.path.with_name(self.path.name
+                                                                      + ":config"))
+
+
+@dataclass(frozen=True)
+class DesignSet:
+    """The designs of one Pareto set with every objective evaluated under ``config``:
+    ``F (N, m)`` main then supplementary objectives (``names``, ``units``); ``feasible (N,)``
+    (every constraint ``g <= 0``); ``failed (N,)`` (the simulation diverged or gave NaN);
+    ``resimulated``: whether the designs were simulated again; ``notes`` for the report."""
+
+    label: str
+    source: Path
+    config: Config
+    X: np.ndarray
+    var_names: list[str]
+    var_units: list[str]
+    F: np.ndarray
+    names: list[str]
+    units: list[str]
+    feasible: np.ndarray
+    failed: np.ndarray
+    resimulated: bool
+    notes: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class CaseSort:
+    """The sort of one case alone: ``rows`` (its designs in the pool), ``sort`` over those
+    rows, ``picks`` (indices in the pool)."""
+
+    label: str
+    rows: np.ndarray
+    sort: KEpsilonSort
+    picks: dict[str, int]
+
+    @property
+    def chosen(self) -> int:
+        """The case's optimum, as an index in the pool."""
+        return int(self.rows[self.sort.chosen])
+
+    @property
+    def ties(self) -> np.ndarray:
+        return self.rows[self.sort.ties]
+
+
+@dataclass(frozen=True)
+class Selection:
+    """The pooled designs (``N`` rows) and their sorts; see the module docstring for the
+    meaning of each field (they are the ``/kesort`` datasets)."""
+
+    F: np.ndarray
+    names: list[str]
+    units: list[str]
+    X: np.ndarray
+    var_names: list[str]
+    var_units: list[str]
+    case: np.ndarray
+    cases: list[str]
+    source: np.ndarray
+    row: np.ndarray
+    feasible: np.ndarray
+    sets: list[DesignSet]
+    sort: KEpsilonSort
+    picks: dict[str, int]
+    case_sorts: dict[str, CaseSort] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def chosen(self) -> int:
+        return self.sort.chosen
+
+    def level_in_case(self, i: int) -> float:
+        """The k-ε level of design ``i`` (an index in the pool) in the sort of its case alone
+        (its pooled level when there is one case)."""
+        cs = self.case_sorts.get(self.case[i])
+        if cs is None:
+            return float(self.sort.k_eps[i])
+        return float(cs.sort.k_eps[np.flatnonzero(cs.rows == i)[0]])
+
+
+def _text(value) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _labels(ds: h5py.Dataset, key: str, path: Path, columns: int) -> list[str]:
+    names = [_text(n) for n in np.atleast_1d(ds.attrs.get(key, []))]
+    if len(names) != columns:
+        raise ConfigError(f"{path}: {ds.name}: attribute {key!r} has {len(names)} entries for "
+                          f"{columns} columns")
+    return names
+
+
+def read_pareto(path: str | Path) -> ParetoSet:
+    """Read a ``suspopt optimise`` output; ConfigError naming the file and key if it is not
+    one."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: no such file")
+    try:
+        h5 = h5py.File(path, "r")
+    except OSError:
+        raise ConfigError(f"{path}: not an HDF5 file") from None
+    with h5:
+        data = {}
+        for key in ("X", "F", "G"):
+            ds = h5.get(f"pareto/{key}")
+            if not isinstance(ds, h5py.Dataset):
+                raise ConfigError(f"{path}: /pareto/{key}: missing (is this a suspopt optimise "
+                                  f"file?)")
+            values = np.array(ds[()], dtype=float)
+            if values.ndim != 2:
+                raise ConfigError(f"{path}: /pareto/{key}: expected a 2-D dataset, got shape "
+                                  f"{values.shape}")
+            data[key] = (values, _labels(ds, "names", path, values.shape[1]),
+                         _labels(ds, "units", path, values.shape[1]))
+        rows = {key: value[0].shape[0] for key, value in data.items()}
+        if len(set(rows.values())) != 1:
+            raise ConfigError(f"{path}: /pareto: X, F and G have {rows['X']}, {rows['F']} and "
+                              f"{rows['G']} rows")
+        if rows["X"] == 0:
+            raise ConfigError(f"{path}: /pareto/X: the set is empty")
+        if "config" not in h5.attrs:
+            raise ConfigError(f"{path}: attribute 'config' (the YAML text) is missing; give "
+                              f"--config")
+        text = _text(h5.attrs["config"])
+    (X, var_names, var_units), (F, obj_names, _), (G, constraint_names, _) = \
+        data["X"], data["F"], data["G"]
+    return ParetoSet(path, X, var_names, var_units, F, obj_names, G, constraint_names, text)
+
+
+def evaluate_pareto(pareto: ParetoSet, cfg: Config | None = None,
+                    label: str | None = None) -> DesignSet:
+    """The designs of ``pareto`` with their main and supplementary objectives under ``cfg``
+    (default: the file's own config), in one batch; see the module docstring."""
+    own = cfg is None
+    cfg = pareto.config() if own else cfg
+    problem = Problem.from_config(cfg)
+    where = cfg.source if cfg.source is not None else "the config"
+    if sorted(pareto.var_names) != sorted(problem.var_names):
+        raise ConfigError(f"{pareto.path}: /pareto/X holds {', '.join(pareto.var_names)}; "
+                          f"{where} varies {', '.join(problem.var_names)}: the designs do not "
+                          f"fit its design_variables")
+    X = pareto.X[:, [pareto.var_names.index(n) for n in problem.var_names]]
+    names = problem.obj_names + problem.supplementary_names
+    units = problem.obj_units + problem.supplementary_units
+    notes = []
+    if own and pareto.obj_names != problem.obj_names:
+        raise ConfigError(f"{pareto.path}: /pareto/F holds {', '.join(pareto.obj_names)} but "
+                          f"its config's main objectives are {', '.join(problem.obj_names)}")
+    resimulate = not own or bool(problem.supplementary_names)
+    if resimulate:
+        F, G, S = problem.evaluate(problem.to_search(X), return_values_of=["F", "G", "S"])
+        if own:
+            gap = _relative_gap(F, pareto.F)
+            if gap > _AGREE:
+                notes.append(f"{pareto.path}: the re-simulated main objectives differ from the "
+                             f"file's by up to {gap:.2g} (relative): the file was written by "
+                             f"another version of the model")
+        F = np.hstack([F, S])
+        constraint_names = problem.constraint_names
+    else:
+        F, G, constraint_names = pareto.F, pareto.G, pareto.constraint_names
+    failed = ~np.isfinite(F).all(axis=1) | (F >= PENALTY).any(axis=1)
+    if constraint_names and constraint_names[-1] == _FAILED:
+        failed |= G[:, -1] > 0
+        G = G[:, :-1]
+    feasible = (G <= 0).all(axis=1) & ~failed
+    default = (cfg.source.stem if not own and cfg.source is not None else pareto.path.stem)
+    return DesignSet(label or default, pareto.path, cfg, X, problem.var_names,
+                     problem.var_units, F, names, units, feasible, failed, resimulate,
+                     tuple(notes))
+
+
+def _relative_gap(a: np.ndarray, b: np.ndarray) -> float:
+    sound = (np.abs(b) < PENALTY).all(axis=1) & (np.abs(a) < PENALTY).all(axis=1)
+    if not sound.any():
+        return 0.0
+    a, b = a[sound], b[sound]
+    return float(np.max(np.abs(a - b) / np.maximum(np.abs(b), np.finfo(float).tiny)))
+
+
+def load_design_sets(files: Sequence[str | Path], configs: Sequence[str | Path] = (),
+                     labels: Sequence[str] = ()) -> list[DesignSet]:
+    """Read and evaluate Pareto files for :func:`select`, as ``suspopt kesort`` takes them.
+
+    ``configs``: none (each file's own), one (for every file) or one per file. ``labels``: none
+    or one per file; files with the same label form one case. Default labels are the config's
+    name when one is given, else the file's, made unique (``name#2``) so that only labels you
+    give merge files.
+    """
+    files = [Path(f) for f in files]
+    if not files:
+        raise ConfigError("give at least one Pareto file")
+    if len(configs) not in (0, 1, len(files)):
+        raise ConfigError(f"--config: give one config for every file, or one per file "
+                          f"({len(files)}); got {len(configs)}")
+    if len(labels) not in (0, len(files)):
+        raise ConfigError(f"--label: give one label per file ({len(files)}); got "
+                          f"{len(labels)}")
+    for lab in labels:
+        if not lab or "/" in lab:
+            raise ConfigError(f"--label {lab!r}: a label must be non-empty and have no '/'")
+    per_file = list(configs) * len(files) if len(configs) == 1 else list(configs)
+    loaded: dict[Path, Config] = {}
+    sets = []
+    for i, path in enumerate(files):
+        cfg = None
+        if per_file:
+            cfg_path = Path(per_file[i])
+            if cfg_path not in loaded:
+                loaded[cfg_path] = load_config(cfg_path)
+            cfg = loaded[cfg_path]
+        sets.append(evaluate_pareto(read_pareto(path), cfg, labels[i] if labels else None))
+    if not labels:
+        seen: dict[str, int] = {}
+        for i, s in enumerate(sets):
+            seen[s.label] = seen.get(s.label, 0) + 1
+            if seen[s.label] > 1:
+                sets[i] = replace(s, label=f"{s.label}#{seen[s.label]}")
+    return sets
+
+
+def select(sets: Sequence[DesignSet], eps=None, *, P=None, normalise: str = "max",
+           feasible_only: bool = True, P_range=(0.01, 1.0), P_step: float = 0.01
+           ) -> Selection:
+    """Pool ``sets`` and sort them by k-ε optimality (see the module docstring); ``eps``,
+    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`suspopt.kesort.kesort`.
+    ConfigError when the sets have different objectives or no design is left to sort."""
+    sets = list(sets)
+    names, units = sets[0].names, sets[0].units
+    for s in sets[1:]:
+        if sorted(s.names) != sorted(names):
+            raise ConfigError(f"{s.source} ({s.label}): objectives {', '.join(s.names)} differ "
+                              f"from {sets[0].source} ({sets[0].label}): "
+                              f"{', '.join(names)}; pooled sets need the same ones")
+        for name, unit in zip(s.names, s.units):
+            if unit != units[names.index(name)]:
+                raise ConfigError(f"{s.source} ({s.label}): objective {name} is in {unit}, in "
+                                  f"{units[names.index(name)]} for {sets[0].source}")
+    var_names, var_units = [], []
+    for s in sets:
+        for n, u in zip(s.var_names, s.var_units):
+            if n not in var_names:
+                var_names.append(n)
+                var_units.append(u)
+    notes = [note for s in sets for note in s.notes]
+    keep = [~s.failed & (s.feasible if feasible_only else True) for s in sets]
+    for s, k in zip(sets, keep):
+        dropped_failed, dropped = int(s.failed.sum()), int(len(k) - k.sum())
+        if dropped:
+            why = f"{dropped_failed} failed simulation" if dropped_failed else ""
+            if dropped > dropped_failed:
+                why += (", " if why else "") + f"{dropped - dropped_failed} infeasible"
+            notes.append(f"{s.source} ({s.label}): left out {dropped} of {len(k)} designs "
+                         f"({why})")
+    cases = list(dict.fromkeys(s.label for s in sets))
+    for label in cases:
+        if not any(k.any() for s, k in zip(sets, keep) if s.label == label):
+            files = ", ".join(str(s.source) for s in sets if s.label == label)
+            hint = "" if not feasible_only else "; --keep-infeasible sorts infeasible ones too"
+            raise ConfigError(f"{files}: no design of case {label} to sort (every one failed "
+                              f"or is infeasible){hint}")
+    F = np.vstack([s.F[k][:, [s.names.index(n) for n in names]] for s, k in zip(sets, keep)])
+    X = np.vstack([_columns(s.X[k], s.var_names, var_names) for s, k in zip(sets, keep)])
+    case = np.concatenate([np.full(k.sum(), s.label, dtype=object) for s, k in zip(sets, keep)])
+    source = np.concatenate([np.full(k.sum(), i) for i, k in enumerate(keep)])
+    row = np.concatenate([np.flatnonzero(k) for k in keep])
+    feasible = np.concatenate([s.feasible[k] for s, k in zip(sets, keep)])
+    options = dict(eps=eps, P=P, normalise=normalise, names=names, P_range=P_range,
+                   P_step=P_step)
+    try:
+        pool = kesort(F, **options)
+        case_sorts = {}
+        if len(cases) > 1:
+            for label in cases:
+                rows = np.flatnonzero(case == label)
+                picks = {k: int(rows[v]) for k, v in pareto_picks(F[rows], names).items()}
+                case_sorts[label] = CaseSort(label, rows, kesort(F[rows], **options), picks)
+    except ValueError as exc:
+        raise ConfigError(f"{', '.join(str(s.source) for s in sets)}: {exc}") from None
+    return Selection(F=F, names=names, units=units, X=X, var_names=var_names,
+                     var_units=var_units, case=case, cases=cases, source=source, row=row,
+                     feasible=feasible, sets=sets, sort=pool, picks=pareto_picks(F, names),
+                     case_sorts=case_sorts, notes=notes)
+
+
+def _columns(X: np.ndarray, have: list[str], want: list[str]) -> np.ndarray:
+    """``X`` with columns ``want`` (NaN for a variable the set does not have)."""
+    out = np.full((len(X), len(want)), np.nan)
+    for j, name in enumerate(want):
+        if name in have:
+            out[:, j] = X[:, have.index(name)]
+    return out
+
+
+def _write_sort(group: h5py.Group, sort: KEpsilonSort, rows: np.ndarray | None,
+                picks: dict[str, int]) -> None:
+    """k_eps, k, chosen, ties and picks of one sort; indices in the pool (``rows`` maps a
+    case's own indices to the pool's)."""
+    index = (lambda i: i) if rows is None else (lambda i: rows[i])
+    if rows is not None:
+        write_dataset(group, "rows", rows, "1")
+    write_dataset(group, "k_eps", sort.k_eps, "1")
+    write_dataset(group, "k", sort.k, "1")
+    write_dataset(group, "chosen", int(index(sort.chosen)), "1")
+    write_dataset(group, "ties", np.asarray(index(sort.ties), dtype=int), "1")
+    grp = group.create_group("picks")
+    for key, value in picks.items():
+        write_dataset(grp, key, int(value), "1")
+    group.attrs.update(epsilon=sort.epsilon, P=np.nan if sort.P is None else sort.P,
+                       P_auto=sort.P_auto, normalisation=sort.normalisation,
+                       unique=sort.unique)
+
+
+def write_selection(path: str | Path, selection: Selection, command: str | None = None
+                    ) -> Path:
+    """Write ``/kesort`` (module docstring) to a new HDF5 file, atomically."""
+    s = selection
+    with atomic_h5(path, s.sets[0].config, command) as h5:
+        grp = h5.create_group("kesort")
+        write_dataset(grp, "F", s.F, s.units, names=np.array(s.names, dtype="S"))
+        write_dataset(grp, "X", s.X, s.var_units, names=np.array(s.var_names, dtype="S"))
+        write_dataset(grp, "case", np.array(list(s.case), dtype="S"), "1")
+        write_dataset(grp, "source", s.source, "1")
+        write_dataset(grp, "row", s.row, "1")
+        write_dataset(grp, "feasible", s.feasible, "1")
+        _write_sort(grp, s.sort, None, s.picks)
+        grp.attrs["cases"] = np.array(s.cases, dtype="S")
+        sets = grp.create_group("sets")
+        text = h5py.string_dtype()
+        write_dataset(sets, "file", np.array([str(d.source) for d in s.sets], dtype=text), "1")
+        write_dataset(sets, "label", np.array([d.label for d in s.sets], dtype=text), "1")
+        write_dataset(sets, "config", np.array([d.config.text for d in s.sets], dtype=text), "1")
+        if s.case_sorts:
+            cases = grp.create_group("cases")
+            for label, cs in s.case_sorts.items():
+                _write_sort(cases.create_group(label), cs.sort, cs.rows, cs.picks)
+    return Path(path)
