@@ -99,8 +99,7 @@ def test_every_bundled_config_validates():
     from typer.testing import CliRunner
     from suspopt.cli import app
 
-    # configs/*/controllers/ hold fragments for analyse controllers --with (tested there)
-    configs = sorted(p for p in CONFIGS.rglob("*.yaml") if "controllers" not in p.parts)
+    configs = sorted(CONFIGS.rglob("*.yaml"))
     assert len(configs) >= 47
     runner = CliRunner()
     for cfg in configs:

@@ -11,51 +11,55 @@ ones they were optimised for and compares the objectives ("pseudo" Pareto fronts
 - ``masses`` (Sec 8.4.3, Fig. 8.24, Table 8.13): another passenger, the whole load on the
   isolator ``m ± 20 kg``, seated by :func:`suspopt.seat.passenger_mass_change` (NSS1-NSS3 keep
   ``X_ST``, their ``K_v`` follows the load and ``K_h`` stays as built; PS and NSS4 keep their
-  stiffnesses and their ``X_ST`` follows the load). Where the stiffness ratio ``α`` is itself a
-  design variable, each design's ``α`` takes the same factor ``m_old/m_new``.
+  stiffnesses and their ``X_ST`` follows the load). The new masses are written into the
+  changed config; where the stiffness ratio ``α`` is itself a design variable, each design's
+  ``α`` takes the same factor ``m_old/m_new`` (the changed designs are written too).
 - ``controllers`` (Sec 7.3, Fig. 7.4b): another controller. ``--with FILE.yaml`` (a config or
   a fragment) supplies a ``control:`` section and/or dampers (``vehicle.corner_defaults.damper``,
   ``vehicle.corners.<c>.damper``), which replace the stored config's; the designs' own values
-  (e.g. ``c_min``, ``c_max``) are then applied on top. ``configs/ch7/controllers/cdf.yaml``
-  gives SH-2-CDF and SH-ADD-2-CDF from the SH-2 and SH-ADD-2 fronts.
+  (e.g. ``c_min``, ``c_max``) are then applied on top. ``configs/ch7/sh_2_cdf.yaml`` and
+  ``sh_add_2_cdf.yaml`` give SH-2-CDF and SH-ADD-2-CDF from the SH-2 and SH-ADD-2 fronts.
 
-Each change is ONE batched simulation of all N designs (:func:`evaluate_front`). The change of
-each objective is ``100 (f_changed - f_stored) / f_stored`` in % (Tables 8.12-8.13: positive
-when the objective grows). A design whose simulation fails under the change gets NaN
-objectives and ``failed = 1`` (the optimiser's penalty values are not reported). The file holds
-no supplementary objectives (Eq 7.7-7.10 in Ch. 7), so when the config has some, the stored
+The Pareto file is read and its designs evaluated by :mod:`suspopt.selection` (the code
+``suspopt kesort`` uses): each change is ONE batched simulation of all N designs
+(:func:`~suspopt.selection.evaluate_pareto`). The change of each objective is
+``100 (f_changed - f_stored) / f_stored`` in % (Tables 8.12-8.13: positive when the objective
+grows). A design whose simulation fails under the change gets NaN objectives and
+``failed = 1`` (the optimiser's penalty values are not reported). The file holds no
+supplementary objectives (Eq 7.7-7.10 in Ch. 7), so when the config has some, the stored
 designs are simulated once more with the stored config for theirs, to compare them too.
 
 HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text, plus
 ``analysis`` (the kind) and ``source`` (the Pareto file)); every dataset has ``units`` (one per
-column for X, F, G, S, as ``suspopt optimise`` writes them) and ``names``:
+column for X, F, S, as ``suspopt optimise`` writes them; X, F, S also ``names``):
 
-- ``/pareto/X (N, n)``, ``/pareto/F (N, m)``, ``/pareto/G (N, k)``: the stored front, and
+- ``/pareto/X (N, n)``, ``/pareto/F (N, m)``: the stored front, ``/pareto/feasible (N,)``, and
   ``/pareto/S (N, s)``, its supplementary objectives re-simulated (if the config has any);
 - ``/pseudo`` with attribute ``labels``; per change ``/pseudo/<label>/``: ``F (N, m)``,
-  ``G (N, k)``, ``S (N, s)`` (the config's supplementary objectives, if any), ``change (N, m)``
-  and ``S_change (N, s)`` [%], ``failed (N,)`` [1]; attributes ``label``, ``config`` (the
-  changed config's YAML text) and the change (``road_class`` or ``road_source``;
-  ``load_mass`` [kg] and ``mass_change`` [kg]; ``controller_source``).
+  ``S (N, s)`` (if any), ``change (N, m)`` and ``S_change (N, s)`` [%], ``feasible (N,)``,
+  ``failed (N,)`` [1], and ``X (N, n)`` when the change alters the designs' own values;
+  attributes ``label``, ``config`` (the changed config's YAML text) and the change
+  (``road_class`` or ``road_source``; ``load_mass`` [kg] and ``mass_change`` [kg];
+  ``controller_source``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
-from functools import partial
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError
+from ..config.loader import load_config_text
 from ..io import atomic_h5, write_dataset
 from ..seat import build_seat, passenger_mass_change
+from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
 from . import KINDS, Kind, Report, relative_change
-from .pareto import FrontValues, ParetoSet, config_with, evaluate_front, read_pareto
 
-__all__ = ["Variant", "PseudoFronts", "road_variants", "mass_variants",
+__all__ = ["Variant", "PseudoFronts", "config_with", "road_variants", "mass_variants",
            "controller_variants", "pseudo_fronts", "write_pseudo_fronts", "plot_pseudo_fronts",
            "MASS_CHANGES", "run_roads", "run_masses", "run_controllers"]
 
@@ -68,33 +72,44 @@ _ROAD_CLASSES = ("A", "B", "C", "D", "E")
 
 @dataclass
 class Variant:
-    """One change of a stored front: ``config`` to simulate with, ``extra`` design
-    parameters computed from the designs' own (or None), ``attrs`` that describe it."""
+    """One change of a stored front: ``config`` to simulate with, ``X (N, n)`` the designs'
+    physical values under the change (None: the stored ones), ``attrs`` that describe it."""
 
     label: str
     config: Config
-    extra: Callable[[Mapping[str, np.ndarray]], dict[str, np.ndarray]] | None = None
+    X: np.ndarray | None = None
     attrs: dict = field(default_factory=dict)
 
 
 @dataclass
 class PseudoFronts:
-    """A stored front and its pseudo-fronts: ``values[i]`` under ``variants[i]``;
-    ``stored_S (N, s)`` the supplementary objectives of the stored designs."""
+    """A stored front and its pseudo-fronts. ``stored`` and ``sets[i]`` (under
+    ``variants[i]``) hold main then supplementary objectives (``names``, ``units``; the first
+    ``m`` are the main ones); :meth:`values` reads them with NaN for failed designs."""
 
     kind: str
     pareto: ParetoSet
+    stored: DesignSet
     variants: list[Variant]
-    values: list[FrontValues]
-    stored_S: np.ndarray
+    sets: list[DesignSet]
+
+    @property
+    def m(self) -> int:
+        return self.pareto.F.shape[1]
+
+    @property
+    def reference(self) -> np.ndarray:
+        """(N, m + s): the file's main objectives, then the re-simulated supplementary ones."""
+        return np.hstack([self.pareto.F, self.stored.F[:, self.m:]])
+
+    def values(self, i: int) -> np.ndarray:
+        """(N, m + s) objectives under variant ``i`` (NaN where the simulation failed)."""
+        s = self.sets[i]
+        return np.where(s.failed[:, None], np.nan, s.F)
 
     def change(self, i: int) -> np.ndarray:
-        """(N, m) change of each objective under variant ``i`` [%] (NaN where it failed)."""
-        return relative_change(self.values[i].F, self.pareto.F)
-
-    def supplementary_change(self, i: int) -> np.ndarray:
-        """(N, s) change of each supplementary objective under variant ``i`` [%]."""
-        return relative_change(self.values[i].S, self.stored_S)
+        """(N, m + s) change of each objective under variant ``i`` [%]."""
+        return relative_change(self.values(i), self.reference)
 
 
 def _yaml_mapping(path: Path, option: str) -> dict:
@@ -114,6 +129,30 @@ def _yaml_mapping(path: Path, option: str) -> dict:
 
 # --- changes -------------------------------------------------------------------------------
 
+def config_with(pareto: ParetoSet, edit: Callable[[dict], None], what: str) -> Config:
+    """The stored config with ``edit`` applied to its YAML data (a dict, edited in place);
+    the result's text is the edited YAML. ``what`` names the edit in error messages, which
+    then refer to the lines of that text (written to the analysis's HDF5 as ``config``)."""
+    import yaml
+
+    data = yaml.safe_load(pareto.config_text)
+    edit(data)
+    text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+    try:
+        return load_config_text(text, pareto.path.with_name(pareto.path.name + ":config"))
+    except ConfigError as exc:
+        raise ConfigError(f"{exc} (the config of {pareto.path.name} with {what})") from None
+
+
+def _set_path(data: dict, path: str, value: float) -> None:
+    """``data[a][b][c] = value`` for the dotted ``path`` ``a.b.c``, making missing levels."""
+    *parents, key = path.split(".")
+    for part in parents:
+        if not isinstance(data.get(part), dict):
+            data[part] = {}
+        data = data[part]
+    data[key] = value
+
 def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
     """One variant per road: an ISO 8608 class letter (A-E: the stored road with that class)
     or a config file whose ``road`` and ``simulation`` sections replace the stored ones."""
@@ -124,10 +163,11 @@ def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
     for road in roads:
         if road.upper() in _ROAD_CLASSES:
             letter = road.upper()
-            if pareto.config.road.kind != "iso8608":
+            kind = pareto.config().road.kind
+            if kind != "iso8608":
                 raise ConfigError(f"--road {road}: a road class needs an ISO 8608 road; the "
-                                  f"road of {pareto.path.name} is {pareto.config.road.kind} "
-                                  f"(give a config file instead)")
+                                  f"road of {pareto.path.name} is {kind} (give a config file "
+                                  f"instead)")
 
             def set_class(data, letter=letter):
                 data["road"]["road_class"] = letter
@@ -156,42 +196,49 @@ def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
     return variants
 
 
-def _mass_change(cfg: Config, load_mass: float, params: Mapping[str, np.ndarray]
-                 ) -> dict[str, np.ndarray]:
-    """The passenger change's parameters for every design (Sec 8.4.3). The rule is
-    :func:`passenger_mass_change`'s; it scales ``seat.stiffness_ratio`` from the config's
-    value, so a design's own ratio takes the factor the rule gives a ratio of 1."""
-    P = len(next(iter(params.values())))
-    changed = passenger_mass_change(cfg, np.full(P, load_mass))
-    path = "seat.stiffness_ratio"
-    if path in changed and path in params:
-        unit = cfg.model_copy(update={"seat": cfg.seat.model_copy(update={"stiffness_ratio": 1.0})})
-        changed[path] = params[path] * passenger_mass_change(unit, np.full(P, load_mass))[path]
-    return changed
-
-
 def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) -> list[Variant]:
-    """One variant per change of the whole load on the isolator [kg] (Sec 8.4.3: ±20 kg)."""
-    cfg = pareto.config
+    """One variant per change of the whole load on the isolator [kg] (Sec 8.4.3: ±20 kg).
+
+    The rule is :func:`passenger_mass_change`'s; its new masses go into the config. It scales
+    ``seat.stiffness_ratio`` from the config's value, so where that ratio is a design variable
+    each design's own takes the factor the rule gives a ratio of 1."""
+    cfg = pareto.config()
     if cfg.seat is None:
         raise ConfigError(f"{pareto.path}: analyse masses needs a seat, and the optimised "
                           f"config has no seat: section")
-    for var in cfg.design_variables:
-        if var.path == "seat.mass" or var.path.startswith("seat.passenger."):
+    paths = {v.label: v.path for v in cfg.design_variables}
+    for path in paths.values():
+        if path == "seat.mass" or path.startswith("seat.passenger."):
             raise ConfigError(f"{pareto.path}: analyse masses changes the passenger, and "
-                              f"{var.path} is a design variable")
+                              f"{path} is a design variable")
     if not changes:
         raise ConfigError("analyse masses: give at least one --mass-change KG")
     load = float(build_seat(cfg).isolator["load_mass"][0])
     lowest = cfg.seat.mass if cfg.seat.passenger is not None else 0.0
+    ratio = "seat.stiffness_ratio"
+    designed = [j for j, name in enumerate(pareto.var_names) if paths.get(name) == ratio]
     variants = []
     for delta in changes:
         new = load + float(delta)
         if not new > lowest:
             raise ConfigError(f"--mass-change {delta:g}: the load would be {new:g} kg, not "
                               f"above the {'seat mass' if lowest else 'zero'} ({lowest:g} kg)")
-        variants.append(Variant(f"{new:g} kg", cfg, partial(_mass_change, cfg, new),
-                                attrs={"load_mass": new, "mass_change": float(delta)}))
+        changed = {path: float(value[0]) for path, value in
+                   passenger_mass_change(cfg, new).items()}
+        X = None
+        if ratio in changed and designed:
+            unit = cfg.model_copy(update={"seat": cfg.seat.model_copy(
+                update={"stiffness_ratio": 1.0})})
+            X = pareto.X.copy()
+            X[:, designed] *= passenger_mass_change(unit, new)[ratio][0]
+
+        def seat_passenger(data, changed=changed):
+            for path, value in changed.items():
+                _set_path(data, path, value)
+
+        variants.append(Variant(f"{new:g} kg",
+                                config_with(pareto, seat_passenger, f"a {new:g} kg load"),
+                                X, attrs={"load_mass": new, "mass_change": float(delta)}))
     return variants
 
 
@@ -201,7 +248,7 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
     ``vehicle.corners.<c>`` that corner's)."""
     if not sources:
         raise ConfigError("analyse controllers: give at least one --with FILE.yaml")
-    corners = set(pareto.config.vehicle.corners)
+    corners = set(pareto.config().vehicle.corners)
     variants = []
     for source in sources:
         source = Path(source)
@@ -220,7 +267,7 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
             raise ConfigError(f"--with {source}: corner(s) {', '.join(unknown)} are not in "
                               f"{pareto.path.name} (it has {', '.join(sorted(corners))})")
 
-        def replace(data, control=control, default=default, own=own):
+        def controller(data, control=control, default=default, own=own):
             if control is not None:
                 data["control"] = control
             veh = data["vehicle"]
@@ -235,7 +282,7 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
                     veh["corners"][name] = {}
                 veh["corners"][name]["damper"] = damper
 
-        cfg = config_with(pareto, replace, f"the controller of {source}")
+        cfg = config_with(pareto, controller, f"the controller of {source}")
         variants.append(Variant(source.stem, cfg, attrs={"controller_source": str(source)}))
     return variants
 
@@ -243,53 +290,55 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
 # --- evaluation, output ----------------------------------------------------------------------
 
 def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> PseudoFronts:
-    """Evaluate the stored designs under every variant, one batch each."""
+    """Evaluate the stored designs under every variant, one batch each; the stored designs
+    are simulated too when the config has supplementary objectives (the file has none)."""
     labels = [v.label for v in variants]
     if len(set(labels)) != len(labels):
         raise ConfigError(f"analyse {kind}: the changes must differ (got {', '.join(labels)})")
-    values = [evaluate_front(pareto, v.config, v.extra) for v in variants]
-    stored_S = evaluate_front(pareto).S if values[0].S.shape[1] else values[0].S
-    for v in values:      # the optimiser's penalty values stand for "failed": report NaN
-        failed = v.failed
-        v.F[failed] = np.nan
-        v.S[failed] = np.nan
-    return PseudoFronts(kind=kind, pareto=pareto, variants=list(variants), values=values,
-                        stored_S=stored_S)
+    stored = evaluate_pareto(pareto)
+    sets = [evaluate_pareto(pareto if v.X is None else replace(pareto, X=v.X), v.config,
+                            v.label) for v in variants]
+    for v, s in zip(variants, sets):
+        if s.names != stored.names:
+            raise ConfigError(f"{pareto.path}: with {v.label} the objectives are "
+                              f"{', '.join(s.names)}, not {', '.join(stored.names)}")
+    return PseudoFronts(kind=kind, pareto=pareto, stored=stored, variants=list(variants),
+                        sets=sets)
 
 
 def _columns(group, name: str, data, names, units) -> None:
-    write_dataset(group, name, data, units, names=np.array(names, dtype="S"))
+    write_dataset(group, name, data, list(units), names=np.array(names, dtype="S"))
 
 
 def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
                         command: str | None = None) -> Path:
     """Write ``fronts`` with the layout of the module docstring (atomically)."""
-    p = fronts.pareto
-    with atomic_h5(path, p.config, command) as h5:
+    p, m = fronts.pareto, fronts.m
+    names, units = fronts.stored.names, fronts.stored.units
+    with atomic_h5(path, p.config(), command) as h5:
         h5.attrs["analysis"] = fronts.kind
         h5.attrs["source"] = str(p.path)
         grp = h5.create_group("pareto")
         _columns(grp, "X", p.X, p.var_names, p.var_units)
-        _columns(grp, "F", p.F, p.obj_names, p.obj_units)
-        _columns(grp, "G", p.G, p.constraint_names, p.constraint_units)
-        first = fronts.values[0]
-        if fronts.stored_S.shape[1]:
-            _columns(grp, "S", fronts.stored_S, first.supplementary_names,
-                     first.supplementary_units)
+        _columns(grp, "F", p.F, names[:m], units[:m])
+        write_dataset(grp, "feasible", fronts.stored.feasible.astype(np.int8), "1")
+        if len(names) > m:
+            _columns(grp, "S", fronts.reference[:, m:], names[m:], units[m:])
         pseudo = h5.create_group("pseudo")
         pseudo.attrs["labels"] = np.array([v.label for v in fronts.variants], dtype="S")
-        for i, (variant, values) in enumerate(zip(fronts.variants, fronts.values)):
+        for i, (variant, s) in enumerate(zip(fronts.variants, fronts.sets)):
             g = pseudo.create_group(variant.label.replace("/", "_"))
             g.attrs.update(label=variant.label, config=variant.config.text, **variant.attrs)
-            _columns(g, "F", values.F, values.obj_names, values.obj_units)
-            _columns(g, "G", values.G, values.constraint_names, values.constraint_units)
-            if values.S.shape[1]:
-                _columns(g, "S", values.S, values.supplementary_names,
-                         values.supplementary_units)
-                _columns(g, "S_change", fronts.supplementary_change(i),
-                         values.supplementary_names, ["%"] * values.S.shape[1])
-            _columns(g, "change", fronts.change(i), values.obj_names, ["%"] * len(p.obj_names))
-            write_dataset(g, "failed", values.failed.astype(np.int8), "1")
+            values, change = fronts.values(i), fronts.change(i)
+            _columns(g, "F", values[:, :m], names[:m], units[:m])
+            _columns(g, "change", change[:, :m], names[:m], ["%"] * m)
+            if len(names) > m:
+                _columns(g, "S", values[:, m:], names[m:], units[m:])
+                _columns(g, "S_change", change[:, m:], names[m:], ["%"] * (len(names) - m))
+            if variant.X is not None:
+                _columns(g, "X", variant.X, p.var_names, p.var_units)
+            write_dataset(g, "feasible", s.feasible.astype(np.int8), "1")
+            write_dataset(g, "failed", s.failed.astype(np.int8), "1")
     return Path(path)
 
 
@@ -302,14 +351,15 @@ def _is_comfort(cfg: Config) -> list[bool]:
 def plot_pseudo_fronts(fronts: PseudoFronts, path: str | Path, title: str,
                        marks: Mapping[str, int] | None = None) -> Path:
     """The stored front and its pseudo-fronts, and the design variables along the stored
-    front (:func:`suspopt.plots.pareto_fronts`)."""
-    p = fronts.pareto
+    front (:func:`suspopt.plots.pareto_fronts`); ``marks`` (name -> design) are starred."""
+    p, m = fronts.pareto, fronts.m
     curves = [(f"optimised ({p.path.name})", p.F)]
-    curves += [(v.label, values.F) for v, values in zip(fronts.variants, fronts.values)]
+    curves += [(v.label, fronts.values(i)[:, :m]) for i, v in enumerate(fronts.variants)]
     variables = [(name, unit, p.X[:, j]) for j, (name, unit)
                  in enumerate(zip(p.var_names, p.var_units))]
-    return plots.pareto_fronts(path, title, list(zip(p.obj_names, p.obj_units)), curves,
-                               variables, marks=marks, comfort=_is_comfort(p.config))
+    objectives = list(zip(fronts.stored.names[:m], fronts.stored.units[:m]))
+    return plots.pareto_fronts(path, title, objectives, curves, variables, marks=marks,
+                               comfort=_is_comfort(p.config()))
 
 
 def _spread(N: int, rows: int = _TABLE_ROWS) -> np.ndarray:
@@ -317,30 +367,26 @@ def _spread(N: int, rows: int = _TABLE_ROWS) -> np.ndarray:
 
 
 def _report(fronts: PseudoFronts, title: str) -> Report:
-    p = fronts.pareto
-    columns = ["#"] + [f"{n} [{u}]" for n, u in zip(p.obj_names, p.obj_units)]
+    p, m = fronts.pareto, fronts.m
+    names, units = fronts.stored.names, fronts.stored.units
+    columns = ["#"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
     for v in fronts.variants:
-        columns += [f"{v.label}: {n} (change)" for n in p.obj_names]
-    changes = [fronts.change(i) for i in range(len(fronts.variants))]
+        columns += [f"{v.label}: {n} (change)" for n in names[:m]]
     rows = []
-    for k in _spread(p.N):
+    for k in _spread(len(p.X)):
         row = [str(k)] + [f"{f:.4g}" for f in p.F[k]]
-        for values, change in zip(fronts.values, changes):
-            row += ["failed" if values.failed[k] else f"{f:.4g} ({c:+.0f} %)"
-                    for f, c in zip(values.F[k], change[k])]
+        for i, s in enumerate(fronts.sets):
+            row += ["failed" if s.failed[k] else f"{f:.4g} ({c:+.0f} %)"
+                    for f, c in zip(fronts.values(i)[k, :m], fronts.change(i)[k, :m])]
         rows.append(row)
-    notes = [f"{len(rows)} of {p.N} designs of {p.path.name}, sorted by {p.obj_names[0]}; "
-             f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)"]
-    for i, (v, values) in enumerate(zip(fronts.variants, fronts.values)):
-        change = np.hstack([changes[i], fronts.supplementary_change(i)])
-        spans = []
-        for j, name in enumerate(p.obj_names + values.supplementary_names):
-            c = change[~values.failed, j]
-            if c.size:
-                spans.append(f"{name} {np.min(c):+.1f} to {np.max(c):+.1f} % "
-                             f"(median {np.median(c):+.1f} %)")
-        notes.append(f"{v.label}: {int(values.feasible.sum())} of {p.N} designs feasible, "
-                     f"{int(values.failed.sum())} failed; " + "; ".join(spans))
+    notes = [f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}; "
+             f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)", *fronts.stored.notes]
+    for i, (v, s) in enumerate(zip(fronts.variants, fronts.sets)):
+        change = fronts.change(i)[~s.failed]
+        spans = [f"{name} {np.min(c):+.1f} to {np.max(c):+.1f} % (median {np.median(c):+.1f} %)"
+                 for name, c in zip(names, change.T) if c.size]
+        notes.append(f"{v.label}: {int(s.feasible.sum())} of {len(p.X)} designs feasible, "
+                     f"{int(s.failed.sum())} failed; " + "; ".join(spans))
     return Report(title=title, columns=columns, rows=rows, notes=notes)
 
 
