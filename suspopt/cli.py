@@ -192,17 +192,19 @@ def analyse(kind: str = typer.Argument(..., help="analysis kind"),
         report = spec.run(sources if spec.many else sources[0], output, plot, **options)
     except (ConfigError, FileNotFoundError, ValueError) as exc:
         _fail(str(exc))
-    table = Table(title=report.title)
-    for col in report.columns:
-        table.add_column(col)
+    from rich.markup import escape
+
+    table = Table(title=escape(report.title))
+    for col in report.columns:           # units in brackets are text, not rich markup
+        table.add_column(escape(col))
     for row in report.rows:
-        table.add_row(*row)
+        table.add_row(*(escape(cell) for cell in row))
     out.print(table)
     for note in report.notes:
-        out.print(note)
+        out.print(note, markup=False)
     for path in (output, plot):
         if path is not None:
-            out.print(f"wrote {path}")
+            out.print(f"wrote {path}", markup=False)
 
 
 def _progress_line(p) -> str:

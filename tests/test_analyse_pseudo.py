@@ -10,7 +10,6 @@ design takes numpy's 2-D matrix product instead of the batched one.)
 
 from __future__ import annotations
 
-import re
 from dataclasses import replace
 from types import SimpleNamespace
 
@@ -25,12 +24,11 @@ import suspopt.analyse.pseudo
 from suspopt.analyse.pseudo import controller_variants, mass_variants
 from suspopt.cli import app
 from suspopt.config.loader import load_config_text
-from suspopt.optimise import optimise
 from suspopt.params import ParamView
 from suspopt.seat import build_seat
 from suspopt.selection import evaluate_pareto, read_pareto
 
-from conftest import CONFIGS
+from conftest import CONFIGS, optimised_front
 
 
 def run(*args):
@@ -39,23 +37,9 @@ def run(*args):
                            stderr=result.stderr, exception=result.exception)
 
 
-def tiny(text: str, duration: float, population: int = 10, generations: int = 2) -> str:
-    """A config's text with a tiny budget and a short run."""
-    text = re.sub(r"(?m)^(  population:) \d+", rf"\1 {population}", text)
-    text = re.sub(r"(?m)^(  generations:) \d+", rf"\1 {generations}", text)
-    return re.sub(r"(?m)^simulation: \{duration: [0-9.]+", f"simulation: {{duration: {duration}",
-                  text)
-
-
 def front(folder, name: str, duration: float, **budget):
-    """Optimise a tiny version of a bundled config; return (config path, Pareto file)."""
-    path = folder / f"{name.replace('/', '_')}.yaml"
-    path.write_text(tiny((CONFIGS / f"{name}.yaml").read_text(), duration, **budget))
-    out = folder / f"{path.stem}.h5"
-    optimise(suspopt.load_config(path), out)
-    with h5py.File(out) as h5:
-        assert len(h5["pareto/X"]) >= 2        # several designs (and the exactness needs it)
-    return path, out
+    """A tiny optimised front (two designs or more: the exactness below needs it)."""
+    return optimised_front(folder, name, duration, **budget)
 
 
 @pytest.fixture(scope="module")

@@ -55,13 +55,14 @@ from .. import plots
 from ..config import Config, ConfigError
 from ..config.loader import load_config_text
 from ..io import atomic_h5, write_dataset
+from ..kesort import pareto_picks
 from ..seat import build_seat, passenger_mass_change
 from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
 from . import KINDS, Kind, Report, relative_change
 
-__all__ = ["Variant", "PseudoFronts", "config_with", "road_variants", "mass_variants",
-           "controller_variants", "pseudo_fronts", "write_pseudo_fronts", "plot_pseudo_fronts",
-           "MASS_CHANGES", "run_roads", "run_masses", "run_controllers"]
+__all__ = ["Variant", "PseudoFronts", "config_with", "read_sections", "road_variants",
+           "mass_variants", "controller_variants", "pseudo_fronts", "write_pseudo_fronts",
+           "plot_pseudo_fronts", "MASS_CHANGES", "run_roads", "run_masses", "run_controllers"]
 
 #: Passenger changes of Sec 8.4.3 [kg]: 20 kg lighter and heavier.
 MASS_CHANGES = (-20.0, 20.0)
@@ -98,6 +99,12 @@ class PseudoFronts:
         return self.pareto.F.shape[1]
 
     @property
+    def picks(self) -> dict[str, int]:
+        """The edges and knee of the stored front (:func:`suspopt.kesort.pareto_picks`,
+        Fig. 8.21; Tables 8.12-8.13 report the edges)."""
+        return pareto_picks(self.pareto.F, self.pareto.obj_names)
+
+    @property
     def reference(self) -> np.ndarray:
         """(N, m + s): the file's main objectives, then the re-simulated supplementary ones."""
         return np.hstack([self.pareto.F, self.stored.F[:, self.m:]])
@@ -112,7 +119,8 @@ class PseudoFronts:
         return relative_change(self.values(i), self.reference)
 
 
-def _yaml_mapping(path: Path, option: str) -> dict:
+def read_sections(path: Path, option: str) -> dict:
+    """The YAML mapping of config sections in ``path``; ConfigError naming ``option``."""
     import yaml
 
     try:
@@ -179,7 +187,7 @@ def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
         path = Path(road)
         if not path.exists():
             raise ConfigError(f"--road {road}: neither a road class (A-E) nor a file")
-        other = _yaml_mapping(path, "--road")
+        other = read_sections(path, "--road")
         if not isinstance(other.get("road"), dict):
             raise ConfigError(f"--road {road}: the file has no road: section")
         section = dict(other["road"])
@@ -252,7 +260,7 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
     variants = []
     for source in sources:
         source = Path(source)
-        other = _yaml_mapping(source, "--with")
+        other = read_sections(source, "--with")
         vehicle = other.get("vehicle") or {}
         control = other.get("control")
         default = (vehicle.get("corner_defaults") or {}).get("damper")
@@ -322,6 +330,9 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
         _columns(grp, "X", p.X, p.var_names, p.var_units)
         _columns(grp, "F", p.F, names[:m], units[:m])
         write_dataset(grp, "feasible", fronts.stored.feasible.astype(np.int8), "1")
+        picks = grp.create_group("picks")
+        for key, row in fronts.picks.items():
+            write_dataset(picks, key, row, "1")
         if len(names) > m:
             _columns(grp, "S", fronts.reference[:, m:], names[m:], units[m:])
         pseudo = h5.create_group("pseudo")
@@ -351,14 +362,16 @@ def _is_comfort(cfg: Config) -> list[bool]:
 def plot_pseudo_fronts(fronts: PseudoFronts, path: str | Path, title: str,
                        marks: Mapping[str, int] | None = None) -> Path:
     """The stored front and its pseudo-fronts, and the design variables along the stored
-    front (:func:`suspopt.plots.pareto_fronts`); ``marks`` (name -> design) are starred."""
+    front (:func:`suspopt.plots.pareto_fronts`); ``marks`` (name -> design, default the
+    picks) are starred."""
     p, m = fronts.pareto, fronts.m
     curves = [(f"optimised ({p.path.name})", p.F)]
     curves += [(v.label, fronts.values(i)[:, :m]) for i, v in enumerate(fronts.variants)]
     variables = [(name, unit, p.X[:, j]) for j, (name, unit)
                  in enumerate(zip(p.var_names, p.var_units))]
     objectives = list(zip(fronts.stored.names[:m], fronts.stored.units[:m]))
-    return plots.pareto_fronts(path, title, objectives, curves, variables, marks=marks,
+    return plots.pareto_fronts(path, title, objectives, curves, variables,
+                               marks=fronts.picks if marks is None else marks,
                                comfort=_is_comfort(p.config()))
 
 
@@ -369,17 +382,21 @@ def _spread(N: int, rows: int = _TABLE_ROWS) -> np.ndarray:
 def _report(fronts: PseudoFronts, title: str) -> Report:
     p, m = fronts.pareto, fronts.m
     names, units = fronts.stored.names, fronts.stored.units
-    columns = ["#"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
+    columns = ["#", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
     for v in fronts.variants:
         columns += [f"{v.label}: {n} (change)" for n in names[:m]]
+    picked: dict[int, list[str]] = {}
+    for key, row in fronts.picks.items():
+        picked.setdefault(row, []).append(key)
     rows = []
-    for k in _spread(len(p.X)):
-        row = [str(k)] + [f"{f:.4g}" for f in p.F[k]]
+    for k in sorted(set(_spread(len(p.X)).tolist()) | set(picked)):
+        row = [str(k), ", ".join(picked.get(k, []))] + [f"{f:.4g}" for f in p.F[k]]
         for i, s in enumerate(fronts.sets):
             row += ["failed" if s.failed[k] else f"{f:.4g} ({c:+.0f} %)"
                     for f, c in zip(fronts.values(i)[k, :m], fronts.change(i)[k, :m])]
         rows.append(row)
-    notes = [f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}; "
+    notes = [f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}, with "
+             f"the edges and knee of the front (suspopt.kesort.pareto_picks, Fig. 8.21); "
              f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)", *fronts.stored.notes]
     for i, (v, s) in enumerate(zip(fronts.variants, fronts.sets)):
         change = fronts.change(i)[~s.failed]
