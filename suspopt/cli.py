@@ -139,39 +139,72 @@ def simulate(config: Path = typer.Argument(..., help="YAML config file"),
         out.print(f"wrote {output}")
 
 
+#: Options of ``analyse`` that only some kinds take: keyword -> flag.
+_ANALYSE_OPTIONS = {"reference": "--reference", "road": "--road", "with_": "--with",
+                    "mass_change": "--mass-change"}
+
+
 @app.command()
 def analyse(kind: str = typer.Argument(..., help="analysis kind"),
-            source: Path = typer.Argument(..., help="YAML config or result HDF5 file"),
+            sources: list[Path] = typer.Argument(
+                ..., help="YAML config, or Pareto HDF5 file; models takes several configs"),
             output: Optional[Path] = typer.Option(None, "-o", "--output",
                                                   help="HDF5 file for the numbers"),
             plot: Optional[Path] = typer.Option(None, "--plot",
-                                                help="figure file (.png or .svg)")) -> None:
+                                                help="figure file (.png or .svg)"),
+            reference: Optional[Path] = typer.Option(
+                None, "--reference", help="models: the config the others are compared with "
+                "(default the first)"),
+            road: Optional[list[str]] = typer.Option(
+                None, "--road", help="roads: an ISO 8608 class (A-E), or a config whose road "
+                "and simulation sections replace the stored ones; repeatable"),
+            with_: Optional[list[Path]] = typer.Option(
+                None, "--with", help="controllers: YAML whose control: section and dampers "
+                "replace the stored ones; repeatable"),
+            mass_change: Optional[list[float]] = typer.Option(
+                None, "--mass-change", help="masses: change of the load on the seat, in kg; "
+                "repeatable (default -20 and +20)")) -> None:
     """Run an analysis (see the README for the kinds) and print its table."""
     from .analyse import analysis_kinds
+    from .plots import check_path
 
     kinds = analysis_kinds()
     if kind not in kinds:
         _fail(f"analyse: unknown kind {kind!r}; available: {', '.join(sorted(kinds))}")
-    if not source.exists():
-        _fail(f"{source}: no such file")
+    spec = kinds[kind]
+    if len(sources) > 1 and not spec.many:
+        _fail(f"analyse {kind} takes one SOURCE, got {len(sources)}")
+    for source in sources:
+        if not source.exists():
+            _fail(f"{source}: no such file")
+    given = {"reference": reference, "road": road or None, "with_": with_ or None,
+             "mass_change": mass_change or None}
+    options = {key: value for key, value in given.items() if value is not None}
+    wrong = [_ANALYSE_OPTIONS[key] for key in options if key not in spec.options]
+    if wrong:
+        _fail(f"analyse {kind} does not take {', '.join(wrong)}")
     for path in (output, plot):
         if path is not None and not path.parent.exists():
             _fail(f"{path}: folder {path.parent} does not exist")
     try:
-        report = kinds[kind](source, output, plot)
+        if plot is not None:
+            check_path(plot)
+        report = spec.run(sources if spec.many else sources[0], output, plot, **options)
     except (ConfigError, FileNotFoundError, ValueError) as exc:
         _fail(str(exc))
-    table = Table(title=report.title)
-    for col in report.columns:
-        table.add_column(col)
+    from rich.markup import escape
+
+    table = Table(title=escape(report.title))
+    for col in report.columns:           # units in brackets are text, not rich markup
+        table.add_column(escape(col))
     for row in report.rows:
-        table.add_row(*row)
+        table.add_row(*(escape(cell) for cell in row))
     out.print(table)
     for note in report.notes:
-        out.print(note)
+        out.print(note, markup=False)
     for path in (output, plot):
         if path is not None:
-            out.print(f"wrote {path}")
+            out.print(f"wrote {path}", markup=False)
 
 
 def _progress_line(p) -> str:

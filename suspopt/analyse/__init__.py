@@ -1,18 +1,28 @@
-"""Analyses behind ``suspopt analyse KIND SOURCE``.
+"""Analyses behind ``suspopt analyse KIND SOURCE...``.
 
-Each kind is a library function ``run(source, output=None, plot=None) -> Report`` that reads a
-config (or a result file), computes, writes its numbers to HDF5 when ``output`` is given and a
-figure when ``plot`` is given, and returns a :class:`Report` for the CLI to render. Kinds are
-listed in :data:`KINDS` by the module that implements them.
+Each kind is a library function ``run(source, output=None, plot=None, **options) -> Report``
+that reads its input (a config, several configs, or a Pareto file), computes, writes its
+numbers to HDF5 when ``output`` is given and a figure when ``plot`` is given, and returns a
+:class:`Report` for the CLI to render. Kinds are listed in :data:`KINDS` by the module that
+implements them, as a :class:`Kind` that says whether ``run`` takes one source or a list of
+them and which keyword options it accepts (the CLI passes only those).
+
+| kind | source | module |
+|---|---|---|
+| ``models`` | several configs (Ch. 3) | :mod:`.models` |
+| ``cdf-sensitivity`` | a config with an adaptive threshold (Figs. 4.7, 4.10) | :mod:`.cdf` |
+| ``roads``, ``masses``, ``controllers`` | a Pareto file (Sec 8.4.2-8.4.3, Ch. 7) | :mod:`.pseudo` |
+| ``transmissibility`` | a config with a seat (Eq 2.86, Fig. 8.26) | :mod:`.transmissibility` |
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 
-__all__ = ["Report", "KINDS", "analysis_kinds"]
+import numpy as np
+
+__all__ = ["Report", "Kind", "KINDS", "analysis_kinds", "relative_change"]
 
 
 @dataclass
@@ -25,12 +35,34 @@ class Report:
     notes: list[str] = field(default_factory=list)
 
 
-#: kind name -> run(source: Path, output: Path | None, plot: Path | None) -> Report
-KINDS: dict[str, Callable[[Path, Path | None, Path | None], Report]] = {}
+@dataclass(frozen=True)
+class Kind:
+    """An analysis kind: ``run(source | sources, output, plot, **options)``.
+
+    ``many``: ``run`` takes a list of sources (else exactly one path); ``options``: the names
+    of the keyword options ``run`` accepts besides ``output`` and ``plot``.
+    """
+
+    run: Callable[..., Report]
+    many: bool = False
+    options: tuple[str, ...] = ()
 
 
-def analysis_kinds() -> dict[str, Callable[[Path, Path | None, Path | None], Report]]:
+def relative_change(value, reference) -> np.ndarray:
+    """``100 (value - reference) / reference`` [%], NaN or inf where the reference is 0 or NaN
+    (the percentages of Tables 3.3-3.21, 4.2-4.3, 8.12-8.13; their signs are each table's)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return 100.0 * (np.asarray(value, dtype=float) - reference) / reference
+
+
+#: kind name -> Kind
+KINDS: dict[str, Kind] = {}
+
+
+def analysis_kinds() -> dict[str, Kind]:
     """Every available analysis kind, importing the modules that provide them."""
     from . import cdf  # noqa: F401  (registers cdf-sensitivity)
+    from . import models  # noqa: F401  (registers models)
+    from . import pseudo  # noqa: F401  (registers roads, masses, controllers)
     from . import transmissibility  # noqa: F401  (registers transmissibility)
     return dict(KINDS)

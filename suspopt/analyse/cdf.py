@@ -21,10 +21,11 @@ from pathlib import Path
 import numpy as np
 
 from ..config import load_config
-from ..io import atomic_h5
+from .. import plots
+from ..io import atomic_h5, write_dataset
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..simulate import simulate
-from . import KINDS, Report
+from . import KINDS, Kind, Report, relative_change
 
 __all__ = ["SHARES", "METRIC_UNITS", "semi_active_metrics", "run"]
 
@@ -75,34 +76,10 @@ def _check(cfg) -> None:
                         "simulation.duration: the threshold is never fitted")
 
 
-def _dataset(group, name: str, data, units: str) -> None:
-    group.create_dataset(name, data=data).attrs["units"] = units
-
-
-def _plot(path: Path, shares, base_share, reduction, title: str) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(7, 6))
-    top.plot(100 * shares, reduction["SW"], "o-", color="k", label="SW")
-    for name in ("RC", "ST", "TD", "DE"):
-        bottom.plot(100 * shares, reduction[name], "o-", label=name)
-    for ax in (top, bottom):
-        ax.axhline(0, color="0.6", lw=0.8)
-        ax.axvline(100 * base_share, color="0.4", ls="--", lw=0.8)
-        ax.set_ylabel("reduction vs base law [%]")
-        ax.legend(loc="best")
-        ax.grid(alpha=0.3)
-    bottom.set_xlabel("C_max share requested (1 - N) [%]; dashed: base law's share")
-    top.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-
-
 def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
     """Sweep the C_max share 20-70 % against the base law (module docstring)."""
+    if plot is not None:
+        plots.check_path(plot)
     cfg = load_config(source)
     _check(cfg)
     spec = cfg.control.threshold
@@ -113,8 +90,7 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
     result = simulate(cfg, params={path + "c_max_share": shares, path + "learn_time": learn})
     values = semi_active_metrics(result, share_after=spec.learn_time)
     base = {k: v[0] for k, v in values.items()}
-    with np.errstate(divide="ignore", invalid="ignore"):
-        reduction = {k: 100.0 * (base[k] - values[k][1:]) / base[k] for k in METRIC_UNITS}
+    reduction = {k: 0.0 - relative_change(values[k][1:], base[k]) for k in METRIC_UNITS}
     corners = result.model.corners
     active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]
     laws = sorted({cfg.vehicle.corners[c].damper.law for c in active})
@@ -131,19 +107,23 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
             grp.attrs["distribution"] = spec.distribution
             grp.attrs["corners"] = ",".join(active)
 
-            _dataset(grp, "c_max_share", SHARES, "1")
-            _dataset(grp, "achieved_share", values["share"][1:], "1")
-            _dataset(grp, "base_share", values["share"][0], "1")
-            _dataset(grp, "final_threshold", threshold, unit)
+            write_dataset(grp, "c_max_share", SHARES, "1")
+            write_dataset(grp, "achieved_share", values["share"][1:], "1")
+            write_dataset(grp, "base_share", values["share"][0], "1")
+            write_dataset(grp, "final_threshold", threshold, unit)
             for key, group in (("base", grp.create_group("base")),
                                ("cdf", grp.create_group("cdf")),
                                ("reduction", grp.create_group("reduction"))):
                 for name, m_unit in METRIC_UNITS.items():
                     data = {"base": base[name], "cdf": values[name][1:],
                             "reduction": reduction[name]}[key]
-                    _dataset(group, name, data, "%" if key == "reduction" else m_unit)
+                    write_dataset(group, name, data, "%" if key == "reduction" else m_unit)
     if plot is not None:
-        _plot(plot, SHARES, base["share"], reduction, title)
+        plots.sensitivity(plot, title, 100 * SHARES, "C_max share requested (1 - N) [%]",
+                          [{"SW": reduction["SW"]},
+                           {k: reduction[k] for k in ("RC", "ST", "TD", "DE")}],
+                          "reduction vs base law [%]", marker=100 * base["share"],
+                          marker_label="base law's share")
 
     rows = [[f"{100 * s:.0f}", f"{100 * a:.1f}", " ".join(f"{x:.3g}" for x in thr),
              *(f"{reduction[k][i]:+.1f}" for k in METRIC_UNITS)]
@@ -161,4 +141,4 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
                   rows=rows, notes=notes)
 
 
-KINDS["cdf-sensitivity"] = run
+KINDS["cdf-sensitivity"] = Kind(run)

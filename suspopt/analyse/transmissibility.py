@@ -1,4 +1,4 @@
-"""``suspopt analyse transmissibility CONFIG``: seat transmissibility and STHT (Eq 2.86).
+"""``suspopt analyse transmissibility CONFIG|PARETO.h5``: seat transmissibility, STHT (Eq 2.86).
 
 For a config with a ``seat:`` section, the acceleration transmissibility ``|z̈_i / z̈_s|`` from
 the floor under the seat (``z_s``) to every seat DOF ``i`` (``seat``, NSS4's ``seat.inner``, the
@@ -15,6 +15,16 @@ STHT, the seat-to-head transmissibility, is the ``head`` entry: Eq 2.86 with i =
 floor's acceleration as input, as in Fig. 8.26 (``T = z̈_head / z̈_s``). The seat
 transmissibility of Fig. 2.18b is the ``seat`` entry.
 
+For a Pareto file (``suspopt optimise`` output, Sec 8.4.4, Fig. 8.26), the same for the
+Pareto-theory picks of its front (:func:`suspopt.kesort.pareto_picks`, Fig. 8.21): the edges
+``best_<objective>`` (the thesis's Edge 1 and Edge 2: in Ch. 8 ``best_X_ST`` and
+``best_RC_se``) and the ``knee`` (its Mid), simulated in one batch. The thesis adds the
+passenger and keeps only the seat's 13.6 kg as the seat mass; ``with_`` (``--with FILE.yaml``)
+does that: the ``seat.mass`` and ``seat.passenger`` of that file (e.g.
+``configs/ch8/<seat>_class_a_passenger.yaml``) replace the stored ones. NSS1-NSS3 keep the
+designs' ``X_ST`` (their ``K_v = m g / X_ST`` follows the load), PS and NSS4 keep their
+stiffnesses, as in Sec 8.4.3.
+
 HDF5 layout (every dataset has a ``units`` attribute; root attributes as every suspopt file):
 
 - ``/linear/frequency (F,)`` [Hz], ``/linear/<dof> (P, F)`` [-];
@@ -22,26 +32,40 @@ HDF5 layout (every dataset has a ``units`` attribute; root attributes as every s
   ``/simulated/coherence/<dof> (P, F2)`` [-];
 - ``/statics/static_deflection (P,)`` [m] (X_ST);
 - ``/modal/frequency (P, m)`` [Hz]: undamped, floor held still, attr ``dof_names``;
-- ``/constraints/<name> (P,)`` (:func:`suspopt.seat.seat_constraints`, ``g <= 0`` feasible).
+- ``/constraints/<name> (P,)`` (:func:`suspopt.seat.seat_constraints`, ``g <= 0`` feasible);
+- ``/weighted_rms/<signal> (P,)`` [m/s^2]: ISO 2631-1 Wk r.m.s. of ``seat.acc`` and
+  ``head.acc`` in the simulation;
+- for a Pareto file, ``/designs/X (P, n)`` and ``/designs/F (P, m)`` (with ``names``, one unit
+  per column), ``/designs/row (P,)`` [1] (the rows of the file's ``/pareto``) and the attribute
+  ``picks`` of ``/designs`` (each design's pick names, e.g. ``best_X_ST``, ``knee``).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import h5py
 import numpy as np
 
+from .. import plots
 from ..config import Config, ConfigError, load_config
-from ..io import atomic_h5
+from ..io import atomic_h5, write_dataset
+from ..kesort import pareto_picks
 from ..metrics import transmissibility, coherence, weighted_rms
+from ..optimise import Problem
+from ..params import ParamView
 from ..seat import (CONSTRAINT_UNITS, base_transmissibility, build_seat, linearise,
                     natural_frequencies, seat_constraints)
+from ..selection import ParetoSet, read_pareto
 from ..simulate import simulate
-from . import KINDS, Report
+from . import KINDS, Kind, Report
+from .pseudo import config_with, read_sections
 
-__all__ = ["SeatTransmissibility", "seat_transmissibility", "write_transmissibility",
-           "plot_transmissibility", "run", "LINEAR_FREQUENCIES", "SEGMENT"]
+__all__ = ["SeatTransmissibility", "FrontDesigns", "seat_transmissibility", "front_designs",
+           "with_passenger", "write_transmissibility", "plot_transmissibility",
+           "plot_front_transmissibility", "run", "LINEAR_FREQUENCIES", "SEGMENT"]
 
 #: Frequency grid of the linear spectra [Hz].
 LINEAR_FREQUENCIES = np.geomspace(0.1, 50.0, 500)
@@ -74,18 +98,42 @@ class SeatTransmissibility:
     weighted_rms: dict[str, np.ndarray]
 
 
-def seat_transmissibility(cfg: Config, segment: float = SEGMENT) -> SeatTransmissibility:
-    """Linear and simulated transmissibility of ``cfg``'s seat (see the module docstring).
+@dataclass
+class FrontDesigns:
+    """Designs picked from a Pareto front: ``rows (P,)`` in the file's ``/pareto``, their
+    ``X (P, n)`` physical values and ``F (P, m)`` objectives (names, SI units), and the
+    ``picks`` each design is (e.g. ``["best_X_ST"]``, ``["best_RC_se", "knee"]``)."""
+
+    rows: np.ndarray
+    picks: list[list[str]]
+    X: np.ndarray
+    F: np.ndarray
+    var_names: list[str]
+    var_units: list[str]
+    obj_names: list[str]
+    obj_units: list[str]
+    paths: list[str]
+
+    def params(self) -> dict[str, np.ndarray]:
+        """``simulate``'s ``params`` of the picked designs (dotted path -> (P,))."""
+        return {path: self.X[:, j] for j, path in enumerate(self.paths)}
+
+
+def seat_transmissibility(cfg: Config, segment: float = SEGMENT,
+                          params: Mapping[str, np.ndarray] | None = None
+                          ) -> SeatTransmissibility:
+    """Linear and simulated transmissibility of ``cfg``'s seat (see the module docstring),
+    for one design or, with ``params`` (dotted path -> (P,)), for P designs in one batch.
 
     ``segment`` is the Welch segment length [s] of the simulated estimate (at most the run).
     """
     if cfg.seat is None:
         raise ConfigError(f"{cfg.source or '<config>'}: analyse transmissibility needs a seat: "
                           f"section")
-    seat = build_seat(cfg)
+    seat = build_seat(cfg, ParamView(cfg, params))
     lin = linearise(seat)
     linear = np.abs(base_transmissibility(lin, LINEAR_FREQUENCIES))
-    result = simulate(cfg)
+    result = simulate(cfg, params)
     fs = cfg.simulation.output_rate
     nperseg = int(round(segment * fs))
     floor = result.signals["seat.base_acc"]
@@ -98,8 +146,44 @@ def seat_transmissibility(cfg: Config, segment: float = SEGMENT) -> SeatTransmis
         kind=seat.kind, dof_names=seat.dof_names, linear_frequency=LINEAR_FREQUENCIES,
         linear=linear, simulated_frequency=f_sim, simulated=np.swapaxes(tr, 1, 2),
         coherence=np.swapaxes(coh, 1, 2), static_deflection=seat.static_deflection,
-        natural_frequency=natural_frequencies(lin), constraints=seat_constraints(cfg),
+        natural_frequency=natural_frequencies(lin), constraints=seat_constraints(cfg, params),
         weighted_rms=rms)
+
+
+def front_designs(pareto: ParetoSet) -> FrontDesigns:
+    """The edges and the knee of ``pareto``'s front (:func:`suspopt.kesort.pareto_picks`),
+    each design once, in the order of the picks."""
+    cfg = pareto.config()
+    problem = Problem.from_config(cfg)
+    picks: dict[int, list[str]] = {}
+    for name, row in pareto_picks(pareto.F, pareto.obj_names).items():
+        picks.setdefault(row, []).append(name)
+    rows = np.array(list(picks))
+    path_of = {v.label: v.path for v in cfg.design_variables}
+    return FrontDesigns(rows=rows, picks=list(picks.values()), X=pareto.X[rows],
+                        F=pareto.F[rows], var_names=pareto.var_names,
+                        var_units=pareto.var_units, obj_names=pareto.obj_names,
+                        obj_units=problem.obj_units,
+                        paths=[path_of[name] for name in pareto.var_names])
+
+
+def with_passenger(pareto: ParetoSet, source: str | Path) -> Config:
+    """The stored config with the ``seat.mass`` and ``seat.passenger`` of ``source`` (Sec
+    8.4.4: the Table 2.3 passenger on the 13.6 kg seat in place of the lumped 95 kg)."""
+    source = Path(source)
+    seat = read_sections(source, "--with").get("seat")
+    if not isinstance(seat, dict) or "passenger" not in seat:
+        raise ConfigError(f"--with {source}: the file has no seat.passenger")
+
+    def seat_passenger(data):
+        if not isinstance(data.get("seat"), dict):
+            raise ConfigError(f"{pareto.path}: analyse transmissibility needs a seat, and the "
+                              f"optimised config has no seat: section")
+        data["seat"]["passenger"] = seat["passenger"]
+        if "mass" in seat:
+            data["seat"]["mass"] = seat["mass"]
+
+    return config_with(pareto, seat_passenger, f"the passenger of {source}")
 
 
 def _acc_signal(dof: str) -> str:
@@ -109,30 +193,37 @@ def _acc_signal(dof: str) -> str:
 
 
 def write_transmissibility(path: str | Path, data: SeatTransmissibility, cfg: Config,
-                           command: str | None = None) -> Path:
-    """Write ``data`` with the layout of the module docstring (atomically)."""
-    def put(group, name, values, units, **attrs):
-        ds = group.create_dataset(name, data=values)
-        ds.attrs["units"] = units
-        for key, value in attrs.items():
-            ds.attrs[key] = value
-
+                           command: str | None = None,
+                           designs: FrontDesigns | None = None) -> Path:
+    """Write ``data`` with the layout of the module docstring (atomically); ``designs`` when
+    they were picked from a front."""
     with atomic_h5(path, cfg, command) as h5:
         h5.attrs["seat_kind"] = data.kind
         lin, sim = h5.create_group("linear"), h5.create_group("simulated")
-        put(lin, "frequency", data.linear_frequency, "Hz")
-        put(sim, "frequency", data.simulated_frequency, "Hz")
+        write_dataset(lin, "frequency", data.linear_frequency, "Hz")
+        write_dataset(sim, "frequency", data.simulated_frequency, "Hz")
         coh = sim.create_group("coherence")
         for j, name in enumerate(data.dof_names):
-            put(lin, name, data.linear[..., j], "-")
-            put(sim, name, data.simulated[..., j], "-")
-            put(coh, name, data.coherence[..., j], "-")
-        put(h5.create_group("statics"), "static_deflection", data.static_deflection, "m")
-        put(h5.create_group("modal"), "frequency", data.natural_frequency, "Hz",
-            dof_names=np.array(data.dof_names, dtype="S"))
+            write_dataset(lin, name, data.linear[..., j], "-")
+            write_dataset(sim, name, data.simulated[..., j], "-")
+            write_dataset(coh, name, data.coherence[..., j], "-")
+        write_dataset(h5.create_group("statics"), "static_deflection", data.static_deflection, "m")
+        write_dataset(h5.create_group("modal"), "frequency", data.natural_frequency, "Hz",
+                      dof_names=np.array(data.dof_names, dtype="S"))
         con = h5.create_group("constraints")
         for name, values in data.constraints.items():
-            put(con, name, values, CONSTRAINT_UNITS[name])
+            write_dataset(con, name, values, CONSTRAINT_UNITS[name])
+        rms = h5.create_group("weighted_rms")
+        for name, values in data.weighted_rms.items():
+            write_dataset(rms, name, values, "m/s^2")
+        if designs is not None:
+            grp = h5.create_group("designs")
+            grp.attrs["picks"] = np.array([", ".join(p) for p in designs.picks], dtype="S")
+            write_dataset(grp, "row", designs.rows, "1")
+            write_dataset(grp, "X", designs.X, list(designs.var_units),
+                          names=np.array(designs.var_names, dtype="S"))
+            write_dataset(grp, "F", designs.F, list(designs.obj_units),
+                          names=np.array(designs.obj_names, dtype="S"))
     return Path(path)
 
 
@@ -140,34 +231,42 @@ def plot_transmissibility(data: SeatTransmissibility, path: str | Path,
                           design: int = 0) -> Path:
     """Figure of the seat transmissibility and (with a passenger) STHT of one design: linear
     model as lines, simulation (H1) as dots where the coherence is at least 0.8."""
-    try:
-        from matplotlib.figure import Figure
-    except ImportError:
-        raise ValueError("--plot needs matplotlib: pip install 'suspopt[plot]'") from None
-    fig = Figure(figsize=(7.0, 4.5), layout="constrained")
-    ax = fig.subplots()
     f_sim = data.simulated_frequency
     band = (f_sim >= data.linear_frequency[0]) & (f_sim <= 30.0)
-    for name, label, colour in (("seat", "seat  z̈_seat/z̈_s", "C0"),
-                                ("head", "STHT  z̈_head/z̈_s", "C3")):
+    lines, points = [], []
+    for name, label in (("seat", "seat  z̈_seat/z̈_s"), ("head", "STHT  z̈_head/z̈_s")):
         if name not in data.dof_names:
             continue
         j = data.dof_names.index(name)
-        ax.plot(data.linear_frequency, data.linear[design, :, j], color=colour,
-                label=f"{label} (linearised)")
+        lines.append((f"{label} (linearised)", data.linear_frequency,
+                      data.linear[design, :, j]))
         good = band & (data.coherence[design, :, j] >= _MIN_COHERENCE)
-        ax.plot(f_sim[good], data.simulated[design, good, j], ".", color=colour, ms=3,
-                label=f"{label} (simulated, H1)")
-    ax.set_xscale("log")
-    ax.set_xlim(data.linear_frequency[0], 30.0)
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("acceleration transmissibility [-]")
-    ax.set_title(f"{data.kind.upper()} seat, X_ST = {1e3 * data.static_deflection[design]:.1f}"
-                 f" mm (Eq 2.86)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.savefig(path, dpi=120)
-    return Path(path)
+        points.append((f"{label} (simulated, H1)", f_sim[good], data.simulated[design, good, j]))
+    title = (f"{data.kind.upper()} seat, X_ST = {1e3 * data.static_deflection[design]:.1f} mm "
+             f"(Eq 2.86)")
+    return plots.transmissibilities(path, title, lines, points,
+                                    f_range=(data.linear_frequency[0], 30.0))
+
+
+def plot_front_transmissibility(data: SeatTransmissibility, designs: FrontDesigns,
+                                path: str | Path, title: str) -> Path:
+    """STHT (or, without a passenger, the seat transmissibility) of each picked design
+    (Fig. 8.26): linearised as lines, simulated (H1) as dots where coherent."""
+    name = "head" if "head" in data.dof_names else "seat"
+    j = data.dof_names.index(name)
+    f_sim = data.simulated_frequency
+    band = (f_sim >= data.linear_frequency[0]) & (f_sim <= 30.0)
+    lines, points = [], []
+    for p, picks in enumerate(designs.picks):
+        label = f"{' = '.join(picks)} (#{designs.rows[p]}, X_ST " \
+                f"{1e3 * data.static_deflection[p]:.1f} mm)"
+        lines.append((label, data.linear_frequency, data.linear[p, :, j]))
+        good = band & (data.coherence[p, :, j] >= _MIN_COHERENCE)
+        points.append((f"{' = '.join(picks)} (simulated, H1)", f_sim[good],
+                       data.simulated[p, good, j]))
+    what = "STHT z̈_head/z̈_s" if name == "head" else "seat TR z̈_seat/z̈_s"
+    return plots.transmissibilities(path, f"{title}: {what} (Eq 2.86)", lines, points,
+                                    f_range=(data.linear_frequency[0], 30.0))
 
 
 def _peak(f: np.ndarray, values: np.ndarray, valid: np.ndarray | None = None):
@@ -181,8 +280,60 @@ def _peak(f: np.ndarray, values: np.ndarray, valid: np.ndarray | None = None):
     return values[i], f[i]
 
 
-def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
-    """The ``transmissibility`` analysis of ``source`` (a YAML config with a seat)."""
+def _run_front(source: Path, output: Path | None, plot: Path | None,
+               with_: Sequence[Path]) -> Report:
+    """The picks of a Pareto file (module docstring)."""
+    if len(with_) > 1:
+        raise ConfigError("analyse transmissibility takes one --with FILE.yaml")
+    pareto = read_pareto(source)
+    cfg = with_passenger(pareto, with_[0]) if with_ else pareto.config()
+    designs = front_designs(pareto)
+    data = seat_transmissibility(cfg, params=designs.params())
+    title = f"{data.kind.upper()} front of {pareto.path.name}"
+    if output is not None:
+        write_transmissibility(output, data, cfg, designs=designs)
+    if plot is not None:
+        plot_front_transmissibility(data, designs, plot, title)
+    name = "head" if "head" in data.dof_names else "seat"
+    label = "STHT" if name == "head" else "seat TR"
+    j = data.dof_names.index(name)
+    rows = []
+    for p, picks in enumerate(designs.picks):
+        lin = _peak(data.linear_frequency, data.linear[p, :, j])
+        sim = _peak(data.simulated_frequency, data.simulated[p, :, j],
+                    data.coherence[p, :, j] >= _MIN_COHERENCE)
+        rms = data.weighted_rms.get(f"{name}.acc")
+        rows.append([" = ".join(picks), str(designs.rows[p]),
+                     *(f"{f:.4g}" for f in designs.F[p]),
+                     f"{1e3 * data.static_deflection[p]:.2f}",
+                     f"{lin[0]:.3f} @ {lin[1]:.2f}", f"{sim[0]:.3f} @ {sim[1]:.2f}",
+                     "-" if rms is None else f"{rms[p]:.4f}"])
+    columns = ["design", "#", *(f"{n} [{u}]" for n, u in zip(designs.obj_names,
+                                                             designs.obj_units)),
+               "X_ST simulated [mm]", f"{label} peak, linear [- @ Hz]",
+               f"{label} peak, simulated [- @ Hz]", f"Wk r.m.s. {name}.acc [m/s^2]"]
+    notes = [f"picks of the front (suspopt.kesort.pareto_picks, Fig. 8.21): the edges "
+             f"best_<objective> and the knee; objectives as stored; X_ST, peaks and r.m.s. "
+             f"{'with the passenger of ' + str(with_[0]) if with_ else 'as stored'}",
+             "TR = |z̈_i / z̈_s| from the floor z_s (Eq 2.86); peaks in 0.5-20 Hz, simulated "
+             f"where the coherence is >= {_MIN_COHERENCE}"]
+    if name != "head":
+        notes.append("no passenger: STHT needs one, e.g. --with "
+                     "configs/ch8/<seat>_class_a_passenger.yaml (Sec 8.4.4)")
+    return Report(title=f"transmissibility - {title}", columns=columns, rows=rows,
+                  notes=notes)
+
+
+def run(source: Path, output: Path | None = None, plot: Path | None = None,
+        with_: Sequence[Path] = ()) -> Report:
+    """The ``transmissibility`` analysis of ``source``: a YAML config with a seat, or a Pareto
+    file (then ``with_`` may give the passenger, module docstring)."""
+    if plot is not None:
+        plots.check_path(plot)
+    if h5py.is_hdf5(source):
+        return _run_front(Path(source), output, plot, with_)
+    if with_:
+        raise ConfigError(f"analyse transmissibility {source}: --with is for a Pareto file")
     cfg = load_config(source)
     data = seat_transmissibility(cfg)
     if output is not None:
@@ -213,4 +364,4 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
                   columns=["quantity", "unit", "value"], rows=rows, notes=notes)
 
 
-KINDS["transmissibility"] = run
+KINDS["transmissibility"] = Kind(run, options=("with_",))

@@ -1,0 +1,448 @@
+"""Pseudo Pareto fronts: the designs of a stored front re-simulated under a change.
+
+The thesis re-simulates the optimal designs of a Pareto front under conditions other than the
+ones they were optimised for and compares the objectives ("pseudo" Pareto fronts):
+
+- ``roads`` (Sec 8.4.2, Fig. 8.23, Table 8.12): other road profiles. ``--road B`` keeps the
+  stored road and changes its ISO 8608 class only (same seed, speed and length: the same
+  realisation scaled); ``--road CONFIG.yaml`` takes that config's ``road`` and ``simulation``
+  sections (e.g. ``configs/ch8/ps_class_b.yaml``: class B at 85 km/h over 1000 m, as the thesis
+  drives each class at its own speed).
+- ``masses`` (Sec 8.4.3, Fig. 8.24, Table 8.13): another passenger, the whole load on the
+  isolator ``m ± 20 kg``, seated by :func:`suspopt.seat.passenger_mass_change` (NSS1-NSS3 keep
+  ``X_ST``, their ``K_v`` follows the load and ``K_h`` stays as built; PS and NSS4 keep their
+  stiffnesses and their ``X_ST`` follows the load). The new masses are written into the
+  changed config; where the stiffness ratio ``α`` is itself a design variable, each design's
+  ``α`` takes the same factor ``m_old/m_new`` (the changed designs are written too).
+- ``controllers`` (Sec 7.3, Fig. 7.4b): another controller. ``--with FILE.yaml`` (a config or
+  a fragment) supplies a ``control:`` section and/or dampers (``vehicle.corner_defaults.damper``,
+  ``vehicle.corners.<c>.damper``), which replace the stored config's; the designs' own values
+  (e.g. ``c_min``, ``c_max``) are then applied on top. ``configs/ch7/sh_2_cdf.yaml`` and
+  ``sh_add_2_cdf.yaml`` give SH-2-CDF and SH-ADD-2-CDF from the SH-2 and SH-ADD-2 fronts.
+
+The Pareto file is read and its designs evaluated by :mod:`suspopt.selection` (the code
+``suspopt kesort`` uses): each change is ONE batched simulation of all N designs
+(:func:`~suspopt.selection.evaluate_pareto`). The change of each objective is
+``100 (f_changed - f_stored) / f_stored`` in % (Tables 8.12-8.13: positive when the objective
+grows). A design whose simulation fails under the change gets NaN objectives and
+``failed = 1`` (the optimiser's penalty values are not reported). The file holds no
+supplementary objectives (Eq 7.7-7.10 in Ch. 7), so when the config has some, the stored
+designs are simulated once more with the stored config for theirs, to compare them too.
+
+HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text, plus
+``analysis`` (the kind) and ``source`` (the Pareto file)); every dataset has ``units`` (one per
+column for X, F, S, as ``suspopt optimise`` writes them; X, F, S also ``names``):
+
+- ``/pareto/X (N, n)``, ``/pareto/F (N, m)``: the stored front, ``/pareto/feasible (N,)``, and
+  ``/pareto/S (N, s)``, its supplementary objectives re-simulated (if the config has any);
+- ``/pseudo`` with attribute ``labels``; per change ``/pseudo/<label>/``: ``F (N, m)``,
+  ``S (N, s)`` (if any), ``change (N, m)`` and ``S_change (N, s)`` [%], ``feasible (N,)``,
+  ``failed (N,)`` [1], and ``X (N, n)`` when the change alters the designs' own values;
+  attributes ``label``, ``config`` (the changed config's YAML text) and the change
+  (``road_class`` or ``road_source``; ``load_mass`` [kg] and ``mass_change`` [kg];
+  ``controller_source``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from .. import plots
+from ..config import Config, ConfigError
+from ..config.loader import load_config_text
+from ..io import atomic_h5, write_dataset
+from ..kesort import pareto_picks
+from ..seat import build_seat, passenger_mass_change
+from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
+from . import KINDS, Kind, Report, relative_change
+
+__all__ = ["Variant", "PseudoFronts", "config_with", "read_sections", "road_variants",
+           "mass_variants", "controller_variants", "pseudo_fronts", "write_pseudo_fronts",
+           "plot_pseudo_fronts", "MASS_CHANGES", "run_roads", "run_masses", "run_controllers"]
+
+#: Passenger changes of Sec 8.4.3 [kg]: 20 kg lighter and heavier.
+MASS_CHANGES = (-20.0, 20.0)
+#: Rows of the printed table: designs spread along the front.
+_TABLE_ROWS = 12
+_ROAD_CLASSES = ("A", "B", "C", "D", "E")
+
+
+@dataclass
+class Variant:
+    """One change of a stored front: ``config`` to simulate with, ``X (N, n)`` the designs'
+    physical values under the change (None: the stored ones), ``attrs`` that describe it."""
+
+    label: str
+    config: Config
+    X: np.ndarray | None = None
+    attrs: dict = field(default_factory=dict)
+
+
+@dataclass
+class PseudoFronts:
+    """A stored front and its pseudo-fronts. ``stored`` and ``sets[i]`` (under
+    ``variants[i]``) hold main then supplementary objectives (``names``, ``units``; the first
+    ``m`` are the main ones); :meth:`values` reads them with NaN for failed designs."""
+
+    kind: str
+    pareto: ParetoSet
+    stored: DesignSet
+    variants: list[Variant]
+    sets: list[DesignSet]
+
+    @property
+    def m(self) -> int:
+        return self.pareto.F.shape[1]
+
+    @property
+    def picks(self) -> dict[str, int]:
+        """The edges and knee of the stored front (:func:`suspopt.kesort.pareto_picks`,
+        Fig. 8.21; Tables 8.12-8.13 report the edges)."""
+        return pareto_picks(self.pareto.F, self.pareto.obj_names)
+
+    @property
+    def reference(self) -> np.ndarray:
+        """(N, m + s): the file's main objectives, then the re-simulated supplementary ones."""
+        return np.hstack([self.pareto.F, self.stored.F[:, self.m:]])
+
+    def values(self, i: int) -> np.ndarray:
+        """(N, m + s) objectives under variant ``i`` (NaN where the simulation failed)."""
+        s = self.sets[i]
+        return np.where(s.failed[:, None], np.nan, s.F)
+
+    def change(self, i: int) -> np.ndarray:
+        """(N, m + s) change of each objective under variant ``i`` [%]."""
+        return relative_change(self.values(i), self.reference)
+
+
+def read_sections(path: Path, option: str) -> dict:
+    """The YAML mapping of config sections in ``path``; ConfigError naming ``option``."""
+    import yaml
+
+    try:
+        data = yaml.safe_load(path.read_text())
+    except FileNotFoundError:
+        raise ConfigError(f"{option} {path}: no such file") from None
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise ConfigError(f"{option} {path}: cannot read it as YAML "
+                          f"({exc.__class__.__name__})") from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{option} {path}: must be a YAML mapping of config sections")
+    return data
+
+
+# --- changes -------------------------------------------------------------------------------
+
+def config_with(pareto: ParetoSet, edit: Callable[[dict], None], what: str) -> Config:
+    """The stored config with ``edit`` applied to its YAML data (a dict, edited in place);
+    the result's text is the edited YAML. ``what`` names the edit in error messages, which
+    then refer to the lines of that text (written to the analysis's HDF5 as ``config``)."""
+    import yaml
+
+    data = yaml.safe_load(pareto.config_text)
+    edit(data)
+    text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+    try:
+        return load_config_text(text, pareto.path.with_name(pareto.path.name + ":config"))
+    except ConfigError as exc:
+        raise ConfigError(f"{exc} (the config of {pareto.path.name} with {what})") from None
+
+
+def _set_path(data: dict, path: str, value: float) -> None:
+    """``data[a][b][c] = value`` for the dotted ``path`` ``a.b.c``, making missing levels."""
+    *parents, key = path.split(".")
+    for part in parents:
+        if not isinstance(data.get(part), dict):
+            data[part] = {}
+        data = data[part]
+    data[key] = value
+
+def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
+    """One variant per road: an ISO 8608 class letter (A-E: the stored road with that class)
+    or a config file whose ``road`` and ``simulation`` sections replace the stored ones."""
+    if not roads:
+        raise ConfigError("analyse roads: give at least one --road CLASS (A-E) or "
+                          "--road CONFIG.yaml")
+    variants = []
+    for road in roads:
+        if road.upper() in _ROAD_CLASSES:
+            letter = road.upper()
+            kind = pareto.config().road.kind
+            if kind != "iso8608":
+                raise ConfigError(f"--road {road}: a road class needs an ISO 8608 road; the "
+                                  f"road of {pareto.path.name} is {kind} (give a config file "
+                                  f"instead)")
+
+            def set_class(data, letter=letter):
+                data["road"]["road_class"] = letter
+                data["road"].pop("level", None)     # a level would override the class
+
+            cfg = config_with(pareto, set_class, f"road class {letter}")
+            variants.append(Variant(f"class {letter}", cfg, attrs={"road_class": letter}))
+            continue
+        path = Path(road)
+        if not path.exists():
+            raise ConfigError(f"--road {road}: neither a road class (A-E) nor a file")
+        other = read_sections(path, "--road")
+        if not isinstance(other.get("road"), dict):
+            raise ConfigError(f"--road {road}: the file has no road: section")
+        section = dict(other["road"])
+        if section.get("kind") == "file" and not Path(section.get("path", "")).is_absolute():
+            section["path"] = str((path.parent / section["path"]).resolve())
+
+        def set_road(data, section=section, simulation=other.get("simulation")):
+            data["road"] = section
+            if simulation is not None:
+                data["simulation"] = simulation
+
+        cfg = config_with(pareto, set_road, f"the road of {path}")
+        variants.append(Variant(path.stem, cfg, attrs={"road_source": str(path)}))
+    return variants
+
+
+def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) -> list[Variant]:
+    """One variant per change of the whole load on the isolator [kg] (Sec 8.4.3: ±20 kg).
+
+    The rule is :func:`passenger_mass_change`'s; its new masses go into the config. It scales
+    ``seat.stiffness_ratio`` from the config's value, so where that ratio is a design variable
+    each design's own takes the factor the rule gives a ratio of 1."""
+    cfg = pareto.config()
+    if cfg.seat is None:
+        raise ConfigError(f"{pareto.path}: analyse masses needs a seat, and the optimised "
+                          f"config has no seat: section")
+    paths = {v.label: v.path for v in cfg.design_variables}
+    for path in paths.values():
+        if path == "seat.mass" or path.startswith("seat.passenger."):
+            raise ConfigError(f"{pareto.path}: analyse masses changes the passenger, and "
+                              f"{path} is a design variable")
+    if not changes:
+        raise ConfigError("analyse masses: give at least one --mass-change KG")
+    load = float(build_seat(cfg).isolator["load_mass"][0])
+    lowest = cfg.seat.mass if cfg.seat.passenger is not None else 0.0
+    ratio = "seat.stiffness_ratio"
+    designed = [j for j, name in enumerate(pareto.var_names) if paths.get(name) == ratio]
+    variants = []
+    for delta in changes:
+        new = load + float(delta)
+        if not new > lowest:
+            raise ConfigError(f"--mass-change {delta:g}: the load would be {new:g} kg, not "
+                              f"above the {'seat mass' if lowest else 'zero'} ({lowest:g} kg)")
+        changed = {path: float(value[0]) for path, value in
+                   passenger_mass_change(cfg, new).items()}
+        X = None
+        if ratio in changed and designed:
+            unit = cfg.model_copy(update={"seat": cfg.seat.model_copy(
+                update={"stiffness_ratio": 1.0})})
+            X = pareto.X.copy()
+            X[:, designed] *= passenger_mass_change(unit, new)[ratio][0]
+
+        def seat_passenger(data, changed=changed):
+            for path, value in changed.items():
+                _set_path(data, path, value)
+
+        variants.append(Variant(f"{new:g} kg",
+                                config_with(pareto, seat_passenger, f"a {new:g} kg load"),
+                                X, attrs={"load_mass": new, "mass_change": float(delta)}))
+    return variants
+
+
+def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Variant]:
+    """One variant per file whose ``control:`` section and dampers replace the stored ones
+    (a damper in ``vehicle.corner_defaults`` replaces every corner's, one under
+    ``vehicle.corners.<c>`` that corner's)."""
+    if not sources:
+        raise ConfigError("analyse controllers: give at least one --with FILE.yaml")
+    corners = set(pareto.config().vehicle.corners)
+    variants = []
+    for source in sources:
+        source = Path(source)
+        other = read_sections(source, "--with")
+        vehicle = other.get("vehicle") or {}
+        control = other.get("control")
+        default = (vehicle.get("corner_defaults") or {}).get("damper")
+        own = {c: v["damper"] for c, v in (vehicle.get("corners") or {}).items()
+               if isinstance(v, dict) and "damper" in v}
+        if control is None and default is None and not own:
+            raise ConfigError(f"--with {source}: the file has no control: section and no "
+                              f"damper (vehicle.corner_defaults.damper or "
+                              f"vehicle.corners.<corner>.damper)")
+        unknown = sorted(set(own) - corners)
+        if unknown:
+            raise ConfigError(f"--with {source}: corner(s) {', '.join(unknown)} are not in "
+                              f"{pareto.path.name} (it has {', '.join(sorted(corners))})")
+
+        def controller(data, control=control, default=default, own=own):
+            if control is not None:
+                data["control"] = control
+            veh = data["vehicle"]
+            if default is not None:
+                veh.setdefault("corner_defaults", {})["damper"] = default
+                for corner in (veh.get("corners") or {}).values():
+                    if isinstance(corner, dict):
+                        corner.pop("damper", None)
+            for name, damper in own.items():
+                veh.setdefault("corners", {})
+                if not isinstance(veh["corners"].get(name), dict):
+                    veh["corners"][name] = {}
+                veh["corners"][name]["damper"] = damper
+
+        cfg = config_with(pareto, controller, f"the controller of {source}")
+        variants.append(Variant(source.stem, cfg, attrs={"controller_source": str(source)}))
+    return variants
+
+
+# --- evaluation, output ----------------------------------------------------------------------
+
+def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> PseudoFronts:
+    """Evaluate the stored designs under every variant, one batch each; the stored designs
+    are simulated too when the config has supplementary objectives (the file has none)."""
+    labels = [v.label for v in variants]
+    if len(set(labels)) != len(labels):
+        raise ConfigError(f"analyse {kind}: the changes must differ (got {', '.join(labels)})")
+    stored = evaluate_pareto(pareto)
+    sets = [evaluate_pareto(pareto if v.X is None else replace(pareto, X=v.X), v.config,
+                            v.label) for v in variants]
+    for v, s in zip(variants, sets):
+        if s.names != stored.names:
+            raise ConfigError(f"{pareto.path}: with {v.label} the objectives are "
+                              f"{', '.join(s.names)}, not {', '.join(stored.names)}")
+    return PseudoFronts(kind=kind, pareto=pareto, stored=stored, variants=list(variants),
+                        sets=sets)
+
+
+def _columns(group, name: str, data, names, units) -> None:
+    write_dataset(group, name, data, list(units), names=np.array(names, dtype="S"))
+
+
+def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
+                        command: str | None = None) -> Path:
+    """Write ``fronts`` with the layout of the module docstring (atomically)."""
+    p, m = fronts.pareto, fronts.m
+    names, units = fronts.stored.names, fronts.stored.units
+    with atomic_h5(path, p.config(), command) as h5:
+        h5.attrs["analysis"] = fronts.kind
+        h5.attrs["source"] = str(p.path)
+        grp = h5.create_group("pareto")
+        _columns(grp, "X", p.X, p.var_names, p.var_units)
+        _columns(grp, "F", p.F, names[:m], units[:m])
+        write_dataset(grp, "feasible", fronts.stored.feasible.astype(np.int8), "1")
+        picks = grp.create_group("picks")
+        for key, row in fronts.picks.items():
+            write_dataset(picks, key, row, "1")
+        if len(names) > m:
+            _columns(grp, "S", fronts.reference[:, m:], names[m:], units[m:])
+        pseudo = h5.create_group("pseudo")
+        pseudo.attrs["labels"] = np.array([v.label for v in fronts.variants], dtype="S")
+        for i, (variant, s) in enumerate(zip(fronts.variants, fronts.sets)):
+            g = pseudo.create_group(variant.label.replace("/", "_"))
+            g.attrs.update(label=variant.label, config=variant.config.text, **variant.attrs)
+            values, change = fronts.values(i), fronts.change(i)
+            _columns(g, "F", values[:, :m], names[:m], units[:m])
+            _columns(g, "change", change[:, :m], names[:m], ["%"] * m)
+            if len(names) > m:
+                _columns(g, "S", values[:, m:], names[m:], units[m:])
+                _columns(g, "S_change", change[:, m:], names[m:], ["%"] * (len(names) - m))
+            if variant.X is not None:
+                _columns(g, "X", variant.X, p.var_names, p.var_units)
+            write_dataset(g, "feasible", s.feasible.astype(np.int8), "1")
+            write_dataset(g, "failed", s.failed.astype(np.int8), "1")
+    return Path(path)
+
+
+def _is_comfort(cfg: Config) -> list[bool]:
+    """Which main objectives are ISO 2631-1 weighted r.m.s. accelerations (their comfort
+    levels are drawn)."""
+    return [spec.metric == "rms_weighted" for spec in cfg.objectives.main]
+
+
+def plot_pseudo_fronts(fronts: PseudoFronts, path: str | Path, title: str,
+                       marks: Mapping[str, int] | None = None) -> Path:
+    """The stored front and its pseudo-fronts, and the design variables along the stored
+    front (:func:`suspopt.plots.pareto_fronts`); ``marks`` (name -> design, default the
+    picks) are starred."""
+    p, m = fronts.pareto, fronts.m
+    curves = [(f"optimised ({p.path.name})", p.F)]
+    curves += [(v.label, fronts.values(i)[:, :m]) for i, v in enumerate(fronts.variants)]
+    variables = [(name, unit, p.X[:, j]) for j, (name, unit)
+                 in enumerate(zip(p.var_names, p.var_units))]
+    objectives = list(zip(fronts.stored.names[:m], fronts.stored.units[:m]))
+    return plots.pareto_fronts(path, title, objectives, curves, variables,
+                               marks=fronts.picks if marks is None else marks,
+                               comfort=_is_comfort(p.config()))
+
+
+def _spread(N: int, rows: int = _TABLE_ROWS) -> np.ndarray:
+    return np.unique(np.linspace(0, N - 1, min(rows, N)).round().astype(int))
+
+
+def _report(fronts: PseudoFronts, title: str) -> Report:
+    p, m = fronts.pareto, fronts.m
+    names, units = fronts.stored.names, fronts.stored.units
+    columns = ["#", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
+    for v in fronts.variants:
+        columns += [f"{v.label}: {n} (change)" for n in names[:m]]
+    picked: dict[int, list[str]] = {}
+    for key, row in fronts.picks.items():
+        picked.setdefault(row, []).append(key)
+    rows = []
+    for k in sorted(set(_spread(len(p.X)).tolist()) | set(picked)):
+        row = [str(k), ", ".join(picked.get(k, []))] + [f"{f:.4g}" for f in p.F[k]]
+        for i, s in enumerate(fronts.sets):
+            row += ["failed" if s.failed[k] else f"{f:.4g} ({c:+.0f} %)"
+                    for f, c in zip(fronts.values(i)[k, :m], fronts.change(i)[k, :m])]
+        rows.append(row)
+    notes = [f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}, with "
+             f"the edges and knee of the front (suspopt.kesort.pareto_picks, Fig. 8.21); "
+             f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)", *fronts.stored.notes]
+    for i, (v, s) in enumerate(zip(fronts.variants, fronts.sets)):
+        change = fronts.change(i)[~s.failed]
+        spans = [f"{name} {np.min(c):+.1f} to {np.max(c):+.1f} % (median {np.median(c):+.1f} %)"
+                 for name, c in zip(names, change.T) if c.size]
+        notes.append(f"{v.label}: {int(s.feasible.sum())} of {len(p.X)} designs feasible, "
+                     f"{int(s.failed.sum())} failed; " + "; ".join(spans))
+    return Report(title=title, columns=columns, rows=rows, notes=notes)
+
+
+def _run(kind: str, source: Path, output: Path | None, plot: Path | None,
+         variants: Callable[[ParetoSet], list[Variant]], what: str) -> Report:
+    if plot is not None:
+        plots.check_path(plot)
+    pareto = read_pareto(source)
+    fronts = pseudo_fronts(kind, pareto, variants(pareto))
+    title = f"{kind}: {pareto.path.name} {what}"
+    if output is not None:
+        write_pseudo_fronts(output, fronts)
+    if plot is not None:
+        plot_pseudo_fronts(fronts, plot, title)
+    return _report(fronts, title)
+
+
+def run_roads(source: Path, output: Path | None = None, plot: Path | None = None,
+              road: Sequence[str] = ()) -> Report:
+    """``suspopt analyse roads PARETO.h5 --road B --road C`` (Sec 8.4.2, Table 8.12)."""
+    return _run("roads", source, output, plot, lambda p: road_variants(p, road),
+                "on other roads (Sec 8.4.2)")
+
+
+def run_masses(source: Path, output: Path | None = None, plot: Path | None = None,
+               mass_change: Sequence[float] = MASS_CHANGES) -> Report:
+    """``suspopt analyse masses PARETO.h5 [--mass-change -20 --mass-change 20]`` (Sec 8.4.3,
+    Table 8.13)."""
+    return _run("masses", source, output, plot, lambda p: mass_variants(p, mass_change),
+                "with other passengers (Sec 8.4.3)")
+
+
+def run_controllers(source: Path, output: Path | None = None, plot: Path | None = None,
+                    with_: Sequence[Path] = ()) -> Report:
+    """``suspopt analyse controllers PARETO.h5 --with OTHER.yaml`` (Sec 7.3, Fig. 7.4b)."""
+    return _run("controllers", source, output, plot,
+                lambda p: controller_variants(p, with_), "with other controllers (Fig. 7.4b)")
+
+
+KINDS["roads"] = Kind(run_roads, options=("road",))
+KINDS["masses"] = Kind(run_masses, options=("mass_change",))
+KINDS["controllers"] = Kind(run_controllers, options=("with_",))
