@@ -11,7 +11,7 @@ quantile; Student-t EM).
 Two figures per variant: ``total``, the process CPU time of the whole call over the passive
 call's (best of several interleaved rounds; CPU time because the development machine is shared
 and wall time swings by tens of per cent), and ``own``, the time spent inside the controller
-(start, step, record: the laws, the sampling, the refits) over the passive call's. ``total``
+(start, sample, record: the laws, the sampling, the refits) over the passive call's. ``total``
 also contains the simulator storing the controller's records (three per-corner signals and the
 coefficient), which are stored once per change (every ΔT) and expanded only when read; the
 last row keeps every 4th step instead of every step. Run: ``python benchmarks/bench_control.py``.
@@ -65,12 +65,16 @@ def variants(cfg) -> dict:
 
 
 class _Timed:
-    """A controller whose start, step and record add their wall time to ``spent``."""
+    """A controller whose start, sample and record add their wall time to ``spent``; every
+    other attribute is the controller's own."""
 
     def __init__(self, inner):
-        self.inner, self.units, self.spent = inner, inner.units, 0.0
-        for name in ("start", "step", "record"):
+        self.inner, self.spent = inner, 0.0
+        for name in ("start", "sample", "record"):
             setattr(self, name, self._timed(getattr(inner, name)))
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
 
     def _timed(self, method):
         def call(*args):

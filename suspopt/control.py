@@ -55,7 +55,8 @@ a whole multiple of the integration step) and the command is held in between (ze
 With an actuator lag ``τ`` the coefficient follows the command per integration step as the
 exact first-order response, ``c <- c_cmd - (c_cmd - c) exp(-dt/τ)`` (i.e.
 ``c += (c_cmd - c)(1 - exp(-dt/τ))``), the value at the end of the step being used over the
-step, so ``τ -> 0`` is the instantaneous damper. The laws that need ``z̈_s`` (add, sh_add_1,
+step, so ``τ -> 0`` is the instantaneous damper; the simulator applies it to the damper
+coefficients every step (:attr:`SemiActiveController.lag_decay`). The laws that need ``z̈_s`` (add, sh_add_1,
 sh_add_2) evaluate the equations of motion at sample instants only, with the coefficient in
 force just before the sample.
 
@@ -346,10 +347,17 @@ class SemiActiveController:
         self._linear_weight, self._crossover = linear_weight, crossover
         self._skyhook_weight = skyhook_weight
         self._nb = model.n_body
-        self._wheels = model.wheels
-        self._travel = model.travel
-        self._body_t = np.ascontiguousarray(np.swapaxes(model.travel_map[:, :, :model.n_body],
-                                                        1, 2))
+        # one product gives the travel rates, the body's velocities at the corners and the
+        # wheels' velocities: rows [J; J_body; wheels] of the vehicle velocities
+        J = model.travel_map
+        body = np.zeros_like(J)
+        body[:, :, :model.n_body] = J[:, :, :model.n_body]
+        wheels = np.zeros((1,) + J.shape[1:])
+        wheels[0, np.arange(N), model.wheels.start + np.arange(N)] = 1.0
+        self._rates_t = np.ascontiguousarray(np.swapaxes(np.concatenate(
+            [J, body, np.broadcast_to(wheels, J.shape)], axis=1), 1, 2))
+        self._body_t = np.ascontiguousarray(np.swapaxes(J[:, :, :model.n_body], 1, 2))
+        self.samples = 0               # samples taken: the records change only with them
         self._every = sample_every
         self._decay = np.exp(-dt / np.where(actuator_lag > 0, actuator_lag, 1.0)) \
             * (actuator_lag > 0)
@@ -373,28 +381,35 @@ class SemiActiveController:
         self._N = N
 
     def start(self, P: int) -> np.ndarray:
-        """Coefficients at rest: the soft state (P, 1, N)."""
-        self._c = np.broadcast_to(self._c_min, (P, 1, self._N)).copy()
-        self._cmd = self._c
-        self._condition = np.zeros_like(self._c)
-        self._stiff = np.zeros(self._c.shape, dtype=bool)
+        """Command at rest: the soft state (P, 1, N)."""
+        self._cmd = np.broadcast_to(self._c_min, (P, 1, self._N)).copy()
+        self._condition = np.zeros_like(self._cmd)
+        self._stiff = np.zeros(self._cmd.shape, dtype=bool)
         self._records: dict[str, np.ndarray] | None = None
-        return self._c
+        return self._cmd
 
-    def step(self, k: int, t: float, state) -> np.ndarray:
-        """Coefficients held over integration step ``k`` (see the protocol in simulate.py)."""
-        if k % self._every == 0:
-            self._sample(t, state)
-        if self._lagged:
-            self._c = self._cmd - (self._cmd - self._c) * self._decay
-            return self._c
+    @property
+    def sample_every(self) -> int:
+        """Integration steps per sample (ΔT / dt)."""
+        return self._every
+
+    @property
+    def lag_decay(self) -> np.ndarray | None:
+        """The actuator's factor ``exp(-dt/τ)`` per integration step (P, 1, 1), 0 without a
+        lag; None when no design has one."""
+        return self._decay if self._lagged else None
+
+    def sample(self, k: int, t: float, state) -> np.ndarray:
+        """The command (P, 1, N) [N s/m] from the sample at step ``k`` (``t = k dt``), held
+        until the next sample (see the protocol in simulate.py)."""
+        self._sample(t, state)
         return self._cmd
 
     def _sample(self, t: float, state) -> None:
-        v = state.velocity()
-        travel_vel = self._travel(v)
-        body_vel = matvec(self._body_t, v[..., :self._nb])
-        wheel_vel = v[..., self._wheels]
+        N = self._N
+        rates = matvec(self._rates_t, state.velocity())
+        travel_vel, body_vel, wheel_vel = (rates[..., :N], rates[..., N:2 * N],
+                                           rates[..., 2 * N:])
         body_acc = matvec(self._body_t, state.acceleration()[..., :self._nb]) \
             if self._needs_acc else None
         condition = None
@@ -421,6 +436,7 @@ class SemiActiveController:
         self._cmd = np.where(stiff, c_stiff, self._c_min)
         self._condition, self._stiff = condition, stiff
         self._records = None
+        self.samples += 1
 
     def _refit(self, t: float, condition: np.ndarray) -> None:
         """Store the sample; at each design's refit instants set its threshold to the

@@ -48,22 +48,26 @@ _BLOCK = 64
 class Controller(Protocol):
     """A semi-active damper controller (built by :mod:`suspopt.control`).
 
-    The integrator calls ``start`` once, then ``step(k, t, state)`` at the start of every
-    integration step; ``step`` returns the damping coefficients ``(P, 1, N)`` [N s/m] held
-    over that step, so a digital controller changes them only at its own sample instants
-    (zero-order hold), and hands out a new array whenever they change. ``state.velocity()``
-    gives the vehicle velocities ``(P, 1, n)`` at the current instant, ``state.acceleration()``
-    the accelerations (computed only when called, with the coefficients in force before this
-    step). ``record`` returns the controller's quantities ``{name: (P, N)}`` at output
-    instants, a new dict whenever they change; they become the signals ``<name>.<corner>``
-    with units ``units[name]``.
+    The integrator calls ``start(P)`` once for the command at rest ``(P, 1, N)`` [N s/m], then
+    ``sample(k, t, state)`` at every ``sample_every``-th step (from step 0) for the command
+    held until the next sample (zero-order hold). ``state.velocity()`` gives the vehicle
+    velocities ``(P, 1, n)`` at that instant, ``state.acceleration()`` the accelerations
+    (computed only when called, with the coefficients in force before the sample). With
+    ``lag_decay`` (P, 1, 1) the dampers follow the command as a first-order actuator,
+    ``c <- c_cmd - (c_cmd - c) lag_decay`` every integration step. ``record`` returns the
+    controller's quantities ``{name: (P, N)}``; they change only when ``samples`` (the number
+    of samples taken) does, and become the signals ``<name>.<corner>`` with units
+    ``units[name]``.
     """
 
     units: dict[str, str]
+    samples: int
+    sample_every: int
+    lag_decay: np.ndarray | None
 
     def start(self, P: int) -> np.ndarray: ...
 
-    def step(self, k: int, t: float, state: "_VehicleState") -> np.ndarray: ...
+    def sample(self, k: int, t: float, state: "_VehicleState") -> np.ndarray: ...
 
     def record(self) -> dict[str, np.ndarray]: ...
 
@@ -226,13 +230,14 @@ class _Held:
 
 @dataclass
 class _Trajectory:
-    """What one integration produced: states (2n, P, T), accelerations (n, P, T), the held
-    damping coefficients and controller records (or None / empty without a controller) and
-    the divergence times (P,)."""
+    """What one integration produced: states (2n, P, T), accelerations (n, P, T), the damping
+    coefficients (held between changes, or (N, P, T) when a lagged actuator changes them
+    every step) and controller records (or None / empty without a controller) and the
+    divergence times (P,)."""
 
     states: np.ndarray
     accelerations: np.ndarray
-    damping: _Held | None
+    damping: _Held | np.ndarray | None
     records: dict[str, _Held]
     diverged_at: np.ndarray
 
@@ -279,55 +284,73 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     # moved to the (rows, P, T) records as a transposed copy: cache-friendly, unlike moving
     # the whole time-major record at the end (ten times slower for 1000 designs)
     states, accelerations = np.empty((n2, P, n_out)), np.empty((n, P, n_out))
-    by_time = [a.reshape(-1, n_out) for a in (states, accelerations)]
-    blocks = [np.empty((_BLOCK, n2, P)), np.empty((_BLOCK, n, P))]
-    by_sample = [b.reshape(_BLOCK, -1) for b in blocks]
+    y2, _, unscaled_mass, acc2, acc = first[:5]
+    recorded = [(y, states), (acc, accelerations)]        # (buffer, its record)
     # controller quantities are stored when they change (damping and records apart: a lagged
     # damper changes every step, the records only at sample instants)
     held_damping: list[np.ndarray] = []
     held_records: list[dict[str, np.ndarray]] = []
     damping_index = np.empty(n_out, dtype=np.intp)
     records_index = np.empty(n_out, dtype=np.intp)
-    last: list = [None, None]
-    damping = controller.start(P) if controller is not None else None
+    last: list = [None, -1]
     diverged_at = np.full(P, np.nan)
     step_index = [0]
-    y2, _, unscaled_mass, acc2, acc = first[:5]
 
     def vehicle_acceleration() -> np.ndarray:
         evaluate(y2, offsets[step_index[0]], coef, unscaled_mass, acc2, acc)
         return np.transpose(acc[:n_vehicle, :P], (1, 2, 0)).copy()
     vehicle = _VehicleState(np.transpose(y[n:n + n_vehicle, :P], (1, 2, 0)),
                             vehicle_acceleration)
+    if controller is not None:
+        damping = coef[asm.damper_rows]                   # (N, width, 1), a view
+        command = controller.start(P).transpose(2, 0, 1)
+        damping[...] = command
+        sample_every, decay = controller.sample_every, controller.lag_decay
+        if decay is not None:
+            decay = widen(decay.transpose(2, 0, 1), width)
+            lagging = np.empty_like(damping)
+            lagged = np.empty((damping.shape[0], P, n_out))    # a new value every step
+            recorded.append((damping, lagged))
+        changed = [True]
 
     def control(k: int) -> None:
-        nonlocal damping
-        step_index[0] = 2 * k
-        new = controller.step(k, k * dt, vehicle)
-        if new is not damping:
-            damping = new
-            coef[asm.damper_rows] = np.transpose(damping, (2, 0, 1))
+        """The controller's sample at step k (when due) and the actuator's response."""
+        nonlocal command
+        if k % sample_every == 0:
+            step_index[0] = 2 * k
+            command = controller.sample(k, k * dt, vehicle).transpose(2, 0, 1)
+            if decay is None:
+                damping[...] = command
+                changed[0] = True
+        if decay is not None:                 # c <- c_cmd - (c_cmd - c) exp(-dt/τ)
+            np.subtract(command, damping, out=lagging)
+            np.multiply(lagging, decay, out=lagging)
+            np.subtract(command, lagging, out=damping)
+
+    blocks = []                             # (buffer, time-major block and its 2-D view, record)
+    for buffer, record in recorded:
+        block = np.empty((_BLOCK,) + record.shape[:2])
+        blocks.append((buffer, block, block.reshape(_BLOCK, -1), record.reshape(-1, n_out)))
 
     def keep(j: int) -> None:
-        """Sample j: the state and the accelerations just evaluated into s1."""
+        """Sample j: the state, the accelerations just evaluated into s1 (and a lagged
+        damper's coefficients)."""
         row = j % _BLOCK
-        blocks[0][row] = y[:, :P, 0]
-        blocks[1][row] = acc[:, :P, 0]
+        for buffer, block, _, _ in blocks:
+            block[row] = buffer[:, :P, 0]
         if row == _BLOCK - 1 or j == n_out - 1:
-            for target, source in zip(by_time, by_sample):
-                target[:, j - row:j + 1] = source[:row + 1].T
+            for _, _, by_sample, by_time in blocks:
+                by_time[:, j - row:j + 1] = by_sample[:row + 1].T
         if controller is not None:
-            if damping is not last[0]:
-                held_damping.append(damping[:, 0].copy())
-                last[0] = damping
-            records = controller.record()
-            if records is not last[1]:
-                held_records.append({name: np.array(value) for name, value in records.items()})
-                last[1] = records
+            if decay is None and changed[0]:
+                held_damping.append(damping[:, :P, 0].T.copy())
+                changed[0] = False
+            if controller.samples != last[1]:          # the records change with samples only
+                held_records.append({name: np.array(value)
+                                     for name, value in controller.record().items()})
+                last[1] = controller.samples
             damping_index[j], records_index[j] = len(held_damping) - 1, len(held_records) - 1
 
-    if controller is not None:
-        coef[asm.damper_rows] = np.transpose(damping, (2, 0, 1))
     third, multiply, add = 1.0 / 3.0, np.multiply, np.add
     q_rate1, v1 = first[5], first[6]
     with np.errstate(over="ignore", invalid="ignore"):
@@ -366,7 +389,8 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
 
     damping_held, records_held = None, {}
     if controller is not None:
-        damping_held = _Held(np.stack(held_damping), damping_index)
+        damping_held = lagged if decay is not None \
+            else _Held(np.stack(held_damping), damping_index)
         records_held = {name: _Held(np.stack([h[name] for h in held_records]), records_index)
                         for name in held_records[0]}
     return _Trajectory(states=states, accelerations=accelerations, damping=damping_held,
@@ -556,7 +580,7 @@ class Result:
     designs: dict[str, np.ndarray]
     _assembled: _Assembled
     attachments: tuple[Attachment, ...] = ()
-    held_damping: _Held | None = None
+    held_damping: _Held | np.ndarray | None = None
     controller_records: dict[str, _Held] = field(default_factory=dict)
     controller_units: dict[str, str] = field(default_factory=dict)
     metrics: dict[str, np.ndarray] = field(default_factory=dict)
@@ -614,8 +638,8 @@ class Result:
     @property
     def damping_history(self) -> np.ndarray | None:
         """(N, P, T) damping coefficients of a controlled run [N s/m], None when passive."""
-        if self.held_damping is None:
-            return None
+        if self.held_damping is None or isinstance(self.held_damping, np.ndarray):
+            return self.held_damping
         if self._damping_full is None:
             self._damping_full = self.held_damping.full()
         return self._damping_full
