@@ -112,11 +112,8 @@ class Attachment(Protocol):
 
 
 def _product(matrix: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
-    """``out = matrix @ x`` for a (P, r, c) matrix per design and columns ``x (c, P*S)``
-    ordered design-major."""
-    P = matrix.shape[0]
-    np.einsum("prc,cps->rps", matrix, x.reshape(x.shape[0], P, -1),
-              out=out.reshape(out.shape[0], P, -1))
+    """``out = matrix @ x`` for a (P, r, c) matrix per design and columns ``x (c, P)``."""
+    np.einsum("prc,cp->rp", matrix, x, out=out)
 
 
 class _Assembled:
@@ -128,7 +125,8 @@ class _Assembled:
     the elastic rows, and ``q'' = M^-1 G2 @ F`` with ``G2 = [G, G]`` (``G = -D_qᵀ``, masked
     where a one-way seat does not push the body). ``offset`` holds the inputs' part
     ``[D_u u; D_u u']``. A semi-active damper's coefficients are the rows ``damper_rows`` of
-    ``coef``. The integrator and the signals computed afterwards use this one evaluation.
+    ``coef``. The deformation and force maps are shared by all designs unless a group's map
+    differs between them (``(P, ...)`` arrays, multiplied per design by :func:`_product`).
     """
 
     def __init__(self, network: Network, P: int, controlled: str | None = None):
@@ -179,20 +177,20 @@ class _Assembled:
         off = np.concatenate([self.input_map @ u, self.input_map @ u_dot])
         return np.ascontiguousarray(off.T)[:, :, None, None]
 
-    def evaluator(self, S: int = 1, width: int | None = None
+    def evaluator(self, width: int | None = None
                   ) -> Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
                                  np.ndarray], None]:
         """A function ``(y2, offset, coef, inverse_mass, acc2, acc) -> None`` that writes
-        ``q''`` of S samples of ``width`` designs (default P) into ``acc``.
+        ``q''`` of ``width`` design columns (default P) into ``acc``.
 
-        ``y2 = [q; v]`` (2n, width*S); ``offset`` (2R, 1|width, 1|S); ``coef`` (2R, width,
-        1|S); ``inverse_mass`` (n, width, 1), scaled when the caller wants a multiple of q'';
-        ``acc2``/``acc`` the (n, width*S) and (n, width, S) views of the output. Its buffers
-        for the deformations and forces are allocated once, with the non-linear parts' views
-        into them, so that the integrator's stages allocate nothing.
+        ``y2 = [q; v]`` (2n, width); ``offset`` (2R, 1|width, 1); ``coef`` (2R, width, 1);
+        ``inverse_mass`` (n, width, 1), scaled when the caller wants a multiple of q'';
+        ``acc2``/``acc`` the (n, width) and (n, width, 1) views of the output. Its buffers for
+        the deformations and forces are allocated once, with the non-linear parts' views into
+        them, so that the integrator's stages allocate nothing.
         """
         R, width = self.R, width or self.P
-        e, F = np.empty((2 * R, width, S)), np.empty((self.F_rows, width, S))
+        e, F = np.empty((2 * R, width, 1)), np.empty((self.F_rows, width, 1))
         e2, F2, linear = e.reshape(2 * R, -1), F.reshape(self.F_rows, -1), F[:2 * R]
         extras = [(F[rows], F[rates], e[rows], e[rates], F[out], make(width), uses)
                   for rows, rates, out, make, uses in self.extras]
