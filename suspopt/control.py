@@ -703,6 +703,7 @@ class SemiActiveController:
             self._level = np.where(below[None, None, :], share, 1.0 - share)[:, 0, :]
             self._period = refit_factor * learn_time
             self._next_fit = learn_time.astype(float).copy()
+            self._next_due = float(np.min(self._next_fit))     # the earliest of them
             self._history = np.empty((n_steps // sample_every + 1,) + threshold.shape[::2])
             self._n_history = 0
             self._distribution = distribution
@@ -778,9 +779,9 @@ class SemiActiveController:
         quantile of the history (Fig. 4.4: first at t >= T_learn, then every κ T_learn)."""
         self._history[self._n_history] = condition[:, 0]
         self._n_history += 1
-        due = t + self._half_step >= self._next_fit
-        if not due.any():
+        if t + self._half_step < self._next_due:
             return
+        due = t + self._half_step >= self._next_fit
         idx = np.flatnonzero(due)
         history = self._history[:self._n_history]
         if self._t_summary is not None:              # bounded: from the summary, see its class
@@ -798,6 +799,7 @@ class SemiActiveController:
         self._threshold[idx, 0] = threshold
         late = t + self._half_step - self._next_fit[idx]
         self._next_fit[idx] += self._period[idx] * (np.floor(late / self._period[idx]) + 1.0)
+        self._next_due = float(np.min(self._next_fit))
 
     def record(self) -> dict[str, np.ndarray]:
         """Damper state, condition and threshold of the latest sample, (P, N) each (computed
