@@ -6,7 +6,8 @@ dt = 1 ms with ΔT = 4 ms and every step kept. For P = 1, 100 and 1000 designs (
 stiffness drawn within +-20 %) it times one batched simulate call of: the passive damper
 (c = C_min), SH-2, SH-ADD-2 (which evaluates the equations of motion at each sample), SH-2 with
 a 10 ms actuator lag, and SH-2 with an adaptive CDF threshold refitted every 1 s (empirical
-quantile; Student-t EM).
+quantile; Student-t, fitted from the controller's bounded summary of the history,
+``suspopt.control.StudentTSummary``).
 
 Two figures per variant: ``total``, the process CPU time of the whole call over the passive
 call's (best of several interleaved rounds; CPU time because the development machine is shared
