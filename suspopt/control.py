@@ -71,7 +71,6 @@ history.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -80,7 +79,7 @@ from scipy.special import digamma, gammaln, ndtri, polygamma, stdtrit
 from .config import Config, ConfigError
 from .config.control import Control
 from .params import ParamView
-from .vehicle import VehicleModel, matvec
+from .vehicle import VehicleModel
 
 __all__ = [
     "LAWS", "Law", "law_condition", "stiff_coefficient", "fit_student_t", "distribution_quantile",
@@ -649,6 +648,18 @@ def _per_design(pv: ParamView, path: str, low: float, high: float | None = None,
     return value
 
 
+def _rows_map(matrix: np.ndarray) -> np.ndarray:
+    """A (1|P, r, n) map of the vehicle's DOFs as (r, n) when every design shares it."""
+    return np.ascontiguousarray(matrix[0] if matrix.shape[0] == 1 else matrix)
+
+
+def _by_rows(matrix: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """``matrix @ rows`` for the vehicle's DOF rows ``(n, P)`` [m/s or m/s^2], as the per-corner
+    layout (P, 1, r) of the laws (a view)."""
+    out = np.dot(matrix, rows) if matrix.ndim == 2 else np.einsum("prc,cp->rp", matrix, rows)
+    return out.T[:, None, :]
+
+
 class SemiActiveController:
     """Digital controller of the semi-active dampers (see the module docstring); implements the
     simulator's ``Controller`` protocol. Built by :func:`build_controller`.
@@ -688,9 +699,9 @@ class SemiActiveController:
         body[:, :, :model.n_body] = J[:, :, :model.n_body]
         wheels = np.zeros((1,) + J.shape[1:])
         wheels[0, np.arange(N), model.wheels.start + np.arange(N)] = 1.0
-        self._rates_t = np.ascontiguousarray(np.swapaxes(np.concatenate(
-            [J, body, np.broadcast_to(wheels, J.shape)], axis=1), 1, 2))
-        self._body_t = np.ascontiguousarray(np.swapaxes(J[:, :, :model.n_body], 1, 2))
+        self._rates = _rows_map(np.concatenate([J, body, np.broadcast_to(wheels, J.shape)],
+                                               axis=1))
+        self._body = _rows_map(body)
         self.samples = 0               # samples taken: the records change only with them
         self._every = sample_every
         self._decay = np.exp(-dt / np.where(actuator_lag > 0, actuator_lag, 1.0)) \
@@ -721,7 +732,6 @@ class SemiActiveController:
         self._cmd = np.broadcast_to(self._c_min, (P, 1, self._N)).copy()
         self._condition = np.zeros_like(self._cmd)
         self._stiff = np.zeros(self._cmd.shape, dtype=bool)
-        self._records: dict[str, np.ndarray] | None = None
         return self._cmd
 
     @property
@@ -743,11 +753,10 @@ class SemiActiveController:
 
     def _sample(self, t: float, state) -> None:
         N = self._N
-        rates = matvec(self._rates_t, state.velocity())
+        rates = _by_rows(self._rates, state.velocity())
         travel_vel, body_vel, wheel_vel = (rates[..., :N], rates[..., N:2 * N],
                                            rates[..., 2 * N:])
-        body_acc = matvec(self._body_t, state.acceleration()[..., :self._nb]) \
-            if self._needs_acc else None
+        body_acc = _by_rows(self._body, state.acceleration()) if self._needs_acc else None
         condition = None
         for law, mask in self._groups:
             x = law_condition(law, travel_vel, body_vel, wheel_vel, body_acc, self._crossover,
@@ -771,7 +780,6 @@ class SemiActiveController:
                 c_stiff = c if mask is None else np.where(mask, c, c_stiff)
         self._cmd = np.where(stiff, c_stiff, self._c_min)
         self._condition, self._stiff = condition, stiff
-        self._records = None
         self.samples += 1
 
     def _refit(self, t: float, condition: np.ndarray) -> None:
@@ -802,18 +810,27 @@ class SemiActiveController:
         self._next_due = float(np.min(self._next_fit))
 
     def record(self) -> dict[str, np.ndarray]:
-        """Damper state, condition and threshold of the latest sample, (P, N) each (computed
-        once per sample: they change only at sample instants)."""
-        if self._records is None:
-            state = np.where(self._switchable, (self._cmd - self._c_min) / self._range,
-                             self._stiff)[:, 0]
-            condition, threshold = self._condition[:, 0], self._threshold[:, 0]
-            if self._passive.any():
-                state, condition, threshold = (np.where(self._passive, np.nan, a)
-                                               for a in (state, condition, threshold))
-            self._records = {"damper_state": state, "control_condition": condition,
-                             "control_threshold": threshold}
-        return self._records
+        """What the latest sample decided, (P, N) each, as :meth:`published` turns it into
+        the records: the command [N s/m], whether the law asked for the stiff state, the
+        condition and the threshold in force. Arrays the controller never writes again."""
+        return {"command": self._cmd[:, 0], "stiff": self._stiff[:, 0],
+                "condition": self._condition[:, 0], "threshold": self._threshold[:, 0]}
+
+    def published(self, raw: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """The records (S, P, N) from :meth:`record`'s values of S samples stacked: damper
+        state (the command's place in the range, ``(c - C_min)/(C_max - C_min)``: 0 soft,
+        1 stiff, fractional for the continuous laws; where ``C_min = C_max``, whether the law
+        asked for the stiff state), condition and threshold; NaN at passive corners.
+        Computed once for the whole run."""
+        switchable, c_min, span = (a[:, 0] for a in (self._switchable, self._c_min,
+                                                      self._range))
+        state = np.where(switchable, (raw["command"] - c_min) / span, raw["stiff"])
+        records = {"damper_state": state, "control_condition": raw["condition"],
+                   "control_threshold": raw["threshold"]}
+        if self._passive.any():
+            records = {name: np.where(self._passive, np.nan, value)
+                       for name, value in records.items()}
+        return records
 
 
 def build_controller(cfg: Config, pv: ParamView, model: VehicleModel

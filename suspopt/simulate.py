@@ -51,12 +51,13 @@ class Controller(Protocol):
     The integrator calls ``start(P)`` once for the command at rest ``(P, 1, N)`` [N s/m], then
     ``sample(k, t, state)`` at every ``sample_every``-th step (from step 0) for the command
     held until the next sample (zero-order hold). ``state.velocity()`` gives the vehicle
-    velocities ``(P, 1, n)`` at that instant, ``state.acceleration()`` the accelerations
+    velocities ``(n, P)`` at that instant, ``state.acceleration()`` the accelerations
     (computed only when called, with the coefficients in force before the sample). With
     ``lag_decay`` (P, 1, 1) the dampers follow the command as a first-order actuator,
-    ``c <- c_cmd - (c_cmd - c) lag_decay`` every integration step. ``record`` returns the
-    controller's quantities ``{name: (P, N)}``; they change only when ``samples`` (the number
-    of samples taken) does, and become the signals ``<name>.<corner>`` with units
+    ``c <- c_cmd - (c_cmd - c) lag_decay`` every integration step. ``record`` returns what
+    the latest sample decided ``{name: (P, N)}`` (it changes only when ``samples``, the number
+    of samples taken, does); ``published`` turns those of the whole run, stacked ``(S, P,
+    N)``, into the records that become the signals ``<name>.<corner>`` with units
     ``units[name]``.
     """
 
@@ -71,9 +72,12 @@ class Controller(Protocol):
 
     def record(self) -> dict[str, np.ndarray]: ...
 
+    def published(self, raw: dict[str, np.ndarray]) -> dict[str, np.ndarray]: ...
+
 
 class _VehicleState:
-    """The vehicle's motion at the current step, as the controller reads it (AoS views)."""
+    """The vehicle's motion at the current step, as the controller reads it: one row per
+    vehicle DOF, one column per design."""
 
     __slots__ = ("_velocity", "_acceleration")
 
@@ -81,11 +85,11 @@ class _VehicleState:
         self._velocity, self._acceleration = velocity, acceleration
 
     def velocity(self) -> np.ndarray:
-        """(P, 1, n_vehicle) [m/s, rad/s]."""
+        """(n_vehicle, P) [m/s, rad/s] (a view of the integrator's state)."""
         return self._velocity
 
     def acceleration(self) -> np.ndarray:
-        """(P, 1, n_vehicle) [m/s^2, rad/s^2]."""
+        """(n_vehicle, P) [m/s^2, rad/s^2]."""
         return self._acceleration()
 
 
@@ -293,15 +297,16 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     last: list = [None, -1]
     diverged_at = np.full(P, np.nan)
     step_index = [0]
+    third, multiply, add, subtract = 1.0 / 3.0, np.multiply, np.add, np.subtract
 
     def vehicle_acceleration() -> np.ndarray:
         evaluate(y2, offsets[step_index[0]], coef, unscaled_mass, acc2, acc)
-        return np.transpose(acc[:n_vehicle, :P], (1, 2, 0)).copy()
-    vehicle = _VehicleState(np.transpose(y[n:n + n_vehicle, :P], (1, 2, 0)),
-                            vehicle_acceleration)
+        return acc[:n_vehicle, :P, 0].copy()
+    vehicle = _VehicleState(y[n:n + n_vehicle, :P, 0], vehicle_acceleration)
     if controller is not None:
         damping = coef[asm.damper_rows]                   # (N, width, 1), a view
-        command = controller.start(P).transpose(2, 0, 1)
+        command = np.empty_like(damping)
+        command[...] = controller.start(P).transpose(2, 0, 1)
         damping[...] = command
         sample_every, decay = controller.sample_every, controller.lag_decay
         if decay is not None:
@@ -313,17 +318,16 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
 
     def control(k: int) -> None:
         """The controller's sample at step k (when due) and the actuator's response."""
-        nonlocal command
         if k % sample_every == 0:
             step_index[0] = 2 * k
-            command = controller.sample(k, k * dt, vehicle).transpose(2, 0, 1)
+            command[...] = controller.sample(k, k * dt, vehicle).transpose(2, 0, 1)
             if decay is None:
                 damping[...] = command
                 changed[0] = True
         if decay is not None:                 # c <- c_cmd - (c_cmd - c) exp(-dt/τ)
-            np.subtract(command, damping, out=lagging)
-            np.multiply(lagging, decay, out=lagging)
-            np.subtract(command, lagging, out=damping)
+            subtract(command, damping, out=lagging)
+            multiply(lagging, decay, out=lagging)
+            subtract(command, lagging, out=damping)
 
     blocks = []                             # (buffer, time-major block and its 2-D view, record)
     for buffer, record in recorded:
@@ -344,17 +348,15 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
                 held_damping.append(damping[:, :P, 0].T.copy())
                 changed[0] = False
             if controller.samples != last[1]:          # the records change with samples only
-                held_records.append({name: np.array(value)
-                                     for name, value in controller.record().items()})
+                held_records.append(controller.record())
                 last[1] = controller.samples
             damping_index[j], records_index[j] = len(held_damping) - 1, len(held_records) - 1
 
-    third, multiply, add = 1.0 / 3.0, np.multiply, np.add
     q_rate1, v1 = first[5], first[6]
     with np.errstate(over="ignore", invalid="ignore"):
         for k in range(n_steps):
             i = 2 * k
-            if controller is not None:
+            if controller is not None and (decay is not None or k % sample_every == 0):
                 control(k)
             evaluate(y2, offsets[i], coef, unscaled_mass, acc2, acc)
             if k % every == 0:
@@ -389,8 +391,9 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     if controller is not None:
         damping_held = lagged if decay is not None \
             else _Held(np.stack(held_damping), damping_index)
-        records_held = {name: _Held(np.stack([h[name] for h in held_records]), records_index)
-                        for name in held_records[0]}
+        raw = {name: np.stack([h[name] for h in held_records]) for name in held_records[0]}
+        records_held = {name: _Held(values, records_index)
+                        for name, values in controller.published(raw).items()}
     return _Trajectory(states=states, accelerations=accelerations, damping=damping_held,
                        records=records_held, diverged_at=diverged_at)
 
