@@ -16,6 +16,8 @@ and wall time swings by tens of per cent), and ``own``, the time spent inside th
 also contains the simulator storing the controller's records (three per-corner signals and the
 coefficient), which are stored once per change (every ΔT) and expanded only when read; the
 last row keeps every 4th step instead of every step. Run: ``python benchmarks/bench_control.py``.
+Like the command line, it first makes the allocator reuse freed memory
+(:func:`suspopt.reuse_memory`); ``--default-allocator`` leaves it as it is.
 Prints a table; asserts nothing.
 """
 
@@ -23,6 +25,7 @@ from __future__ import annotations
 
 import importlib
 import platform
+import sys
 import time
 from pathlib import Path
 
@@ -108,8 +111,10 @@ def run(cfg, params) -> tuple[float, float, float]:
 
 
 def main() -> None:
+    memory = "reused" if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory() \
+        else "default"
     print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
-          f"numpy {np.__version__} | {platform.machine()}")
+          f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}")
     print("cells: CPU time over the passive run's (total) / time inside the controller over "
           "the passive run's (own)")
     rng = np.random.default_rng(2026)

@@ -14,6 +14,8 @@ on the first ``--per-design`` designs (default 40) and its rate is per design. T
 path is timed as the best of ``REPEATS`` calls on the whole population.
 
 Run: ``python benchmarks/bench_optimise.py``. Prints a table; asserts nothing.
+Like the command line, it first makes the allocator reuse freed memory
+(:func:`suspopt.reuse_memory`); ``--default-allocator`` leaves it as it is.
 """
 
 from __future__ import annotations
@@ -89,15 +91,19 @@ def per_design(cfg, values: dict[str, float], time_grid: np.ndarray) -> np.ndarr
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--default-allocator", action="store_true",
+                        help="leave glibc's allocator as it is (the command line makes it "
+                        "reuse freed memory, suspopt.reuse_memory)")
     parser.add_argument("--per-design", type=int, default=40,
                         help="designs evaluated one by one with solve_ivp")
     args = parser.parse_args()
+    memory = "reused" if not args.default_allocator and suspopt.reuse_memory() else "default"
     cfg = suspopt.load_config(CONFIG)
     problem = suspopt.Problem.from_config(cfg)
     rng = np.random.default_rng(2026)
     problem.evaluate(problem.xl[None] + 0.5 * (problem.xu - problem.xl)[None])   # warm-up
     print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
-          f"numpy {np.__version__} | {platform.machine()}")
+          f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}")
     print(f"Ch. 5 HC2 problem ({CONFIG.name}): {problem.n_var} variables, {problem.n_obj} "
           f"objectives, {problem.n_ieq_constr} constraints, {cfg.simulation.duration} s at "
           f"dt = {cfg.simulation.dt} s")

@@ -6,11 +6,14 @@ every 2 ms. The issue's target is under 1 s for one design. Also timed: the same
 dt = 1.5 ms (near RK4's stability limit: the passenger's damped modes reach |λ| ≈ 1500 1/s),
 the vehicle alone, to show where the time goes, and 100 designs (C_v from 200 to 2000 N s/m)
 in one batch. Run: ``python benchmarks/bench_seat.py``. Prints a table; asserts nothing.
+Like the command line, it first makes the allocator reuse freed memory
+(:func:`suspopt.reuse_memory`); ``--default-allocator`` leaves it as it is.
 """
 
 from __future__ import annotations
 
 import platform
+import sys
 import time
 from pathlib import Path
 
@@ -35,8 +38,10 @@ def timed(cfg, params=None) -> tuple[float, float]:
 
 
 def main() -> None:
+    memory = "reused" if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory() \
+        else "default"
     print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
-          f"numpy {np.__version__} | {platform.machine()}")
+          f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}")
     cases = []
     cfg = suspopt.load_config(CONFIG)
     cfg.metrics = []                          # time the simulation and one signal only

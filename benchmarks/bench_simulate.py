@@ -5,11 +5,14 @@ dt = 1 ms (configs/quickstart.yaml); designs drawn uniformly inside the Table 5.
 the ERRATA's k_nl range). Each size is timed as the best of three calls (the first call of a
 size also pays the operating system for memory the process has not touched before). Run:
 ``python benchmarks/bench_simulate.py``. Prints a table; asserts nothing.
+Like the command line, it first makes the allocator reuse freed memory
+(:func:`suspopt.reuse_memory`); ``--default-allocator`` leaves it as it is.
 """
 
 from __future__ import annotations
 
 import platform
+import sys
 import time
 from pathlib import Path
 
@@ -33,11 +36,13 @@ def designs(P: int, rng: np.random.Generator) -> dict[str, np.ndarray]:
 
 
 def main() -> None:
+    memory = "reused" if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory() \
+        else "default"
     cfg = suspopt.load_config(CONFIG)
     rng = np.random.default_rng(2026)
     suspopt.simulate(cfg, params=designs(2, rng))          # warm-up (imports, caches)
     print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
-          f"numpy {np.__version__} | {platform.machine()}")
+          f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}")
     print(f"HC2 Ch. 5 problem: {cfg.simulation.duration} s at dt = {cfg.simulation.dt} s "
           f"({cfg.simulation.n_steps} RK4 steps)")
     print(f"{'P':>6} {'wall [s]':>10} {'designs/s':>12} {'body acc metric (mean RMS)':>28}")

@@ -25,6 +25,14 @@ out = Console()
 err = Console(stderr=True)
 
 
+@app.callback()
+def _main() -> None:
+    """Simulate, optimise and select vehicle and seat suspensions from YAML."""
+    from .memory import reuse_memory
+
+    reuse_memory()          # a command's repeated batches reuse their memory (suspopt.memory)
+
+
 def _fail(message: str) -> None:
     """Report bad input in one line and exit with code 2."""
     err.print(f"error: {message}", markup=False, highlight=False, soft_wrap=True)

@@ -280,10 +280,11 @@ class Mechanism:
 
     ``node``: index of that mass among the seat's DOFs; ``law(s, width=None)``: the function
     ``w -> s F(w)``, F the force on that mass [N] at the mechanism coordinate ``w`` (the travel
-    from where the geometry is symmetric, the springs horizontal), its constants folded for the
-    scale ``s`` (and widened to ``width`` design columns); ``rest``: ``w`` at static equilibrium, (P, 1), or None for 0 (NSS1-NSS3; NSS4
-    rests at ``u_0``); ``series``: ``(k1, k2, k3)`` about ``rest`` when the Taylor form is used,
-    else None; ``limit``: the largest ``|w|`` the geometry allows [m], (P, 1), or None.
+    from where the geometry is symmetric, the springs horizontal), its constants folded for
+    the scale ``s`` (and widened to ``width`` design columns); ``rest``: ``w`` at static
+    equilibrium, (P, 1), or None for 0 (NSS1-NSS3; NSS4 rests at ``u_0``); ``series``:
+    ``(k1, k2, k3)`` about ``rest`` when the Taylor form is used, else None; ``limit``: the
+    largest ``|w|`` the geometry allows [m], (P, 1), or None.
     """
 
     node: int

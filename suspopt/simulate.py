@@ -448,7 +448,8 @@ def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller
     traj = _integrate(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller)
     out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
     return Result(config=cfg, model=model, time=t_grid[out_idx], states=traj.states,
-                  accelerations=traj.accelerations, road=z[:, None, out_idx], road_vel=zd[:, None, out_idx],
+                  accelerations=traj.accelerations, road=z[:, None, out_idx],
+                  road_vel=zd[:, None, out_idx],
                   diverged_at=traj.diverged_at, designs=dict(pv.params), _assembled=asm,
                   attachments=tuple(attachments), held_damping=traj.damping,
                   controller_records=traj.records,
