@@ -297,7 +297,7 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     last: list = [None, -1]
     diverged_at = np.full(P, np.nan)
     step_index = [0]
-    third, multiply, add, subtract = 1.0 / 3.0, np.multiply, np.add, np.subtract
+    third, multiply, add = 1.0 / 3.0, np.multiply, np.add
 
     def vehicle_acceleration() -> np.ndarray:
         evaluate(y2, offsets[step_index[0]], coef, unscaled_mass, acc2, acc)
@@ -311,7 +311,7 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
         sample_every, decay = controller.sample_every, controller.lag_decay
         if decay is not None:
             decay = widen(decay.transpose(2, 0, 1), width)
-            lagging = np.empty_like(damping)
+            rise, pulled = 1.0 - decay, np.empty_like(damping)
             lagged = np.empty((damping.shape[0], P, n_out))    # a new value every step
             recorded.append((damping, lagged))
         changed = [True]
@@ -324,10 +324,11 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
             if decay is None:
                 damping[...] = command
                 changed[0] = True
-        if decay is not None:                 # c <- c_cmd - (c_cmd - c) exp(-dt/τ)
-            subtract(command, damping, out=lagging)
-            multiply(lagging, decay, out=lagging)
-            subtract(command, lagging, out=damping)
+            else:
+                multiply(command, rise, out=pulled)
+        if decay is not None:   # c <- c_cmd - (c_cmd - c) exp(-dt/τ) = c e + c_cmd (1 - e)
+            multiply(damping, decay, out=damping)
+            add(damping, pulled, out=damping)
 
     blocks = []                             # (buffer, time-major block and its 2-D view, record)
     for buffer, record in recorded:
