@@ -257,8 +257,10 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     more and evaluates the accelerations.
 
     A single design is integrated as two identical columns: BLAS multiplies one column by a
-    matrix-vector kernel whose rounding differs from the matrix-matrix kernel's, and a design
-    must give the same bits alone as in any batch.
+    matrix-vector kernel whose rounding differs from the matrix-matrix kernel's. A design's
+    bits then match those it gets in a batch of the same order of size; OpenBLAS picks other
+    kernels for much wider batches, which round some rows differently (by an ulp), so a design
+    re-simulated alone agrees with its run in a population to rounding.
     """
     n, P = asm.n, asm.P
     n2, width = 2 * n, max(P, 2)
@@ -294,7 +296,7 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     held_records: list[dict[str, np.ndarray]] = []
     damping_index = np.empty(n_out, dtype=np.intp)
     records_index = np.empty(n_out, dtype=np.intp)
-    last: list = [None, -1]
+    last_samples = [-1]
     diverged_at = np.full(P, np.nan)
     step_index = [0]
     third, multiply, add = 1.0 / 3.0, np.multiply, np.add
@@ -348,9 +350,9 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
             if decay is None and changed[0]:
                 held_damping.append(damping[:, :P, 0].T.copy())
                 changed[0] = False
-            if controller.samples != last[1]:          # the records change with samples only
+            if controller.samples != last_samples[0]:  # the records change with samples only
                 held_records.append(controller.record())
-                last[1] = controller.samples
+                last_samples[0] = controller.samples
             damping_index[j], records_index[j] = len(held_damping) - 1, len(held_records) - 1
 
     q_rate1, v1 = first[5], first[6]
