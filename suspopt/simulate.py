@@ -257,10 +257,10 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     more and evaluates the accelerations.
 
     A single design is integrated as two identical columns: BLAS multiplies one column by a
-    matrix-vector kernel whose rounding differs from the matrix-matrix kernel's. A design's
-    bits then match those it gets in a batch of the same order of size; OpenBLAS picks other
-    kernels for much wider batches, which round some rows differently (by an ulp), so a design
-    re-simulated alone agrees with its run in a population to rounding.
+    matrix-vector kernel whose rounding differs from the matrix-matrix kernel's. Beyond that,
+    OpenBLAS chooses its kernels by the shapes, batch width included, and some choices round
+    some rows differently (by an ulp): a design re-simulated in a batch of another width agrees
+    with its first run to rounding, while the same batch repeats bit for bit.
     """
     n, P = asm.n, asm.P
     n2, width = 2 * n, max(P, 2)
