@@ -187,7 +187,8 @@ class _Assembled:
         """A function ``(y2, offset, coef, inverse_mass, acc2, acc) -> None`` that writes
         ``q''`` of ``width`` design columns (default P) into ``acc``.
 
-        ``y2 = [q; v]`` (2n, width); ``offset`` (2R, 1|width, 1); ``coef`` (2R, width, 1);
+        ``y2 = [q; v]`` (2n, width); ``offset`` (2R, 1|width, 1), or None where the inputs
+        are zero; ``coef`` (2R, width, 1);
         ``inverse_mass`` (n, width, 1), scaled when the caller wants a multiple of q'';
         ``acc2``/``acc`` the (n, width) and (n, width, 1) views of the output. Its buffers for
         the deformations and forces are allocated once, with the non-linear parts' views into
@@ -203,7 +204,8 @@ class _Assembled:
 
         def evaluate(y2, offset, coef, inverse_mass, acc2, acc) -> None:
             product(D2, y2, out=e2)
-            e.__iadd__(offset)
+            if offset is not None:
+                e.__iadd__(offset)
             multiply(coef, e, out=linear)
             for elastic, viscous, disp, rate, out, fn, uses_force in extras:
                 fn(disp, rate, add(elastic, viscous) if uses_force else None, out)
@@ -271,6 +273,8 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     half = 0.5 * dt
     if offsets.size * width <= _WIDE_OFFSETS:          # small batches: no broadcasting
         offsets = widen(offsets, width)
+    # the inputs' part of each half-step, None where it is zero (a bump's road before and after)
+    offsets = [o if active else None for o, active in zip(offsets, offsets.any(axis=(1, 2, 3)))]
     # Each stage's slope is scaled by the step it is used with, so that a stage state is one
     # addition: s1 = dt/2 k1, s2 = dt/2 k2, s3 = dt k3, s4 = dt/6 k4, and
     # y += dt/6 (k1 + 2 k2 + 2 k3 + k4) = (s1 + 2 s2 + s3)/3 + s4. The first stage is
