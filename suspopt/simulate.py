@@ -298,8 +298,8 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     # damper changes every step, the records only at sample instants)
     held_damping: list[np.ndarray] = []
     held_records: list[dict[str, np.ndarray]] = []
-    damping_index = np.empty(n_out, dtype=np.intp)
-    records_index = np.empty(n_out, dtype=np.intp)
+    damping_changes: list[int] = []         # the samples at which a new value was stored
+    records_changes: list[int] = []
     last_samples = [-1]
     diverged_at = np.full(P, np.nan)
     step_index = [0]
@@ -311,9 +311,7 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     vehicle = _VehicleState(y[n:n + n_vehicle, :P, 0], vehicle_acceleration)
     if controller is not None:
         damping = coef[asm.damper_rows]                   # (N, width, 1), a view
-        command = np.empty_like(damping)
-        command[...] = controller.start(P).transpose(2, 0, 1)
-        damping[...] = command
+        damping[...] = controller.start(P).transpose(2, 0, 1)
         sample_every, decay = controller.sample_every, controller.lag_decay
         if decay is not None:
             decay = widen(decay.transpose(2, 0, 1), width)
@@ -326,12 +324,12 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
         """The controller's sample at step k (when due) and the actuator's response."""
         if k % sample_every == 0:
             step_index[0] = 2 * k
-            command[...] = controller.sample(k, k * dt, vehicle).transpose(2, 0, 1)
+            new = controller.sample(k, k * dt, vehicle).transpose(2, 0, 1)
             if decay is None:
-                damping[...] = command
+                damping[...] = new
                 changed[0] = True
             else:
-                multiply(command, rise, out=pulled)
+                multiply(new, rise, out=pulled)
         if decay is not None:   # c <- c_cmd - (c_cmd - c) exp(-dt/τ) = c e + c_cmd (1 - e)
             multiply(damping, decay, out=damping)
             add(damping, pulled, out=damping)
@@ -353,11 +351,12 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
         if controller is not None:
             if decay is None and changed[0]:
                 held_damping.append(damping[:, :P, 0].T.copy())
+                damping_changes.append(j)
                 changed[0] = False
             if controller.samples != last_samples[0]:  # the records change with samples only
                 held_records.append(controller.record())
+                records_changes.append(j)
                 last_samples[0] = controller.samples
-            damping_index[j], records_index[j] = len(held_damping) - 1, len(held_records) - 1
 
     q_rate1, v1 = first[5], first[6]
     with np.errstate(over="ignore", invalid="ignore"):
@@ -396,9 +395,13 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
 
     damping_held, records_held = None, {}
     if controller is not None:
+        def held_at(changes: list[int]) -> np.ndarray:
+            """Which stored value holds at each sample."""
+            return np.searchsorted(changes, np.arange(n_out), side="right") - 1
         damping_held = lagged if decay is not None \
-            else _Held(np.stack(held_damping), damping_index)
+            else _Held(np.stack(held_damping), held_at(damping_changes))
         raw = {name: np.stack([h[name] for h in held_records]) for name in held_records[0]}
+        records_index = held_at(records_changes)
         records_held = {name: _Held(values, records_index)
                         for name, values in controller.published(raw).items()}
     return _Trajectory(states=states, accelerations=accelerations, damping=damping_held,
