@@ -39,7 +39,7 @@ CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 PROBLEMS = {"QC Table 4.1, class C, 5 s": (CONFIGS / "ch4" / "sh_2_class_c.yaml", 5.0),
             "FC Table 3.1, class B, 2 s": (CONFIGS / "ch3" / "part1b_fc_class_b.yaml", 2.0)}
 #: (designs, rounds, output_dt [s]; None keeps every step as the configs do)
-SIZES = ((1, 5, None), (100, 3, None), (1000, 2, None), (1000, 2, 0.004))
+SIZES = ((1, 5, None), (100, 4, None), (1000, 4, None), (1000, 4, 0.004))
 _simulate_module = importlib.import_module("suspopt.simulate")
 _build_controller = _simulate_module.build_controller
 
