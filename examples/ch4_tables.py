@@ -1,9 +1,9 @@
 """Tables 4.2 and 4.3 of the thesis (SH-2 vs SH-2-CDF, SH-ADD-2 vs SH-ADD-2-CDF) from the HDF5
 files that ``suspopt simulate`` wrote for configs/ch4 (examples/ch4_runs.sh).
 
-Run from the repository root (a few minutes on two cores):
+Run from the repository root:
 
-    examples/ch4_runs.sh out/ch4                     # the CLI runs
+    examples/ch4_runs.sh out/ch4                     # the CLI runs (about a minute)
     python examples/ch4_tables.py out/ch4 > ch4_tables.md
 
 For each law and road the base run (``OUT/<law>_<road>.h5``) and the CDF run

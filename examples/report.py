@@ -1486,6 +1486,9 @@ def main() -> None:
         (args.report / f"ch{number}.md").write_text(doc.text())
     steps = read_steps(args.out)
     wall = args.wall if args.wall is not None else sum(steps.values())
+    tsv = args.out / "run.tsv"
+    finished = (dt.datetime.fromtimestamp(tsv.stat().st_mtime).astimezone()
+                .isoformat(timespec="seconds") if tsv.is_file() else "unknown")
     dirty = git("status", "--porcelain", "--untracked-files=no")
     doc = Doc(args.report)
     doc("# suspopt: reproduction report of the thesis", "",
@@ -1496,7 +1499,8 @@ def main() -> None:
     doc.table(["", ""], [
         ["suspopt version", suspopt.__version__],
         ["git commit", git("rev-parse", "HEAD") + (" (uncommitted changes)" if dirty else "")],
-        ["date", dt.datetime.now().astimezone().isoformat(timespec="seconds")],
+        ["runs finished", finished],
+        ["report written", dt.datetime.now().astimezone().isoformat(timespec="seconds")],
         ["machine", f"{platform.platform()}, {platform.machine()}, Python "
                     f"{platform.python_version()}, numpy {np.__version__}"],
         ["total wall time of the runs", f"{wall:.0f} s ({wall / 60:.1f} min)"],
