@@ -1,70 +1,58 @@
-"""Tables 4.2 and 4.3 of the thesis (SH-2 vs SH-2-CDF, SH-ADD-2 vs SH-ADD-2-CDF) from configs/ch4.
+"""Tables 4.2 and 4.3 of the thesis (SH-2 vs SH-2-CDF, SH-ADD-2 vs SH-ADD-2-CDF) from the HDF5
+files that ``suspopt simulate`` wrote for configs/ch4 (examples/ch4_runs.sh).
 
-Run from the repository root (a few minutes on two cores):
+Run from the repository root:
 
-    python examples/ch4_tables.py > ch4_tables.md
+    examples/ch4_runs.sh out/ch4                     # the CLI runs (about a minute)
+    python examples/ch4_tables.py out/ch4 > ch4_tables.md
 
-For each law and road it simulates the base config (``<law>_<road>.yaml``) and the CDF config
-(``<law>_cdf_<road>.yaml``) and prints, in markdown:
+For each law and road the base run (``OUT/<law>_<road>.h5``) and the CDF run
+(``OUT/<law>_cdf_<road>.h5``) give, in markdown:
 
-1. the tables in the form of Tables 4.2-4.3, each cell beside the thesis's printed value;
-   change = (X_base - X_CDF) / X_base * 100 % as in the thesis (positive: smaller with CDF);
-2. the thresholds and the C_max shares the three fits give (student_t, the thesis's stated
-   fit; normal, its computation T = mu + Z sigma; empirical, the configs' choice), with the SW
-   and RC changes of each.
+1. the tables in the form of Tables 4.2-4.3, each value beside the thesis's printed one
+   (examples/thesis_values.yaml); change = (X_base - X_CDF) / X_base * 100 % as in the thesis
+   (positive: smaller with CDF);
+2. the thresholds and C_max shares the three fits give (student_t, the thesis's stated fit;
+   normal, its computation T = mu + Z sigma; empirical, the configs' choice), with the changes
+   of each. The runs with the other two fits are copies of the CDF configs that
+   ``python examples/ch4_tables.py --fits OUT`` writes to ``OUT/fits/`` from the config stored
+   in each CDF run's file: on the random roads with ``distribution`` changed; on the bump with
+   the fixed threshold of that fit designed offline from the base law's run (Sec 4.2.3). It
+   stops if a bump config's own threshold is not the offline empirical design (except with
+   SUSPOPT_QUICK=1, whose shortened runs design other thresholds).
 
-On the bump the threshold is designed offline from the base law's run (Sec 4.2.3); the script
-recomputes it and stops if the config's value disagrees.
+The metrics are suspopt.analyse.cdf.semi_active_metrics of the stored signals.
 """
 
 from __future__ import annotations
 
+import argparse
+import os
+import re
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
+import h5py
 import numpy as np
 
-import suspopt
-from suspopt.analyse.cdf import semi_active_metrics
-from suspopt.control import threshold_for_share
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import mdtables as md                                           # noqa: E402
 
-CONFIGS = Path(__file__).resolve().parents[1] / "configs" / "ch4"
+from suspopt.analyse.cdf import semi_active_metrics             # noqa: E402
+from suspopt.config.loader import load_config_text              # noqa: E402
+from suspopt.control import threshold_for_share                 # noqa: E402
+from suspopt.io import read_simulation_signals                  # noqa: E402
+
 ROADS = {"bump": "Road bump", "class_a": "Road class A", "class_b": "Road class B",
          "class_c": "Road class C"}
-LAWS = {"sh_2": ("SH-2", "SH-2-CDF", "4.2", "T_A"), "sh_add_2": ("SH-ADD-2", "SH-ADD-2-CDF",
-                                                                 "4.3", "T_B")}
+LAWS = {"sh_2": ("SH-2", "SH-2-CDF", "4.2", "T_A"),
+        "sh_add_2": ("SH-ADD-2", "SH-ADD-2-CDF", "4.3", "T_B")}
 FITS = ("student_t", "normal", "empirical")
-#: Thesis Tables 4.2-4.3 as printed: threshold and (base, CDF, printed change %) per index.
-THESIS = {
-    ("sh_2", "bump"): (3.3e-2, {"SW": (281, 71, 74.73), "RC": (1.67, 1.66, 0.60),
-                                "ST": (8.00, 8.40, -5.00), "TD": (3.15, 3.13, 0.63),
-                                "DE": (3.71, 3.57, 3.59)}),
-    ("sh_2", "class_a"): (2.4e-4, {"SW": (1638, 958, 41.51), "RC": (0.28, 0.25, 10.71),
-                                   "ST": (0.88, 0.92, -4.55), "TD": (0.44, 0.42, 4.55),
-                                   "DE": (0.74, 0.62, 15.92)}),
-    ("sh_2", "class_b"): (6e-4, {"SW": (2254, 1360, 39.66), "RC": (0.45, 0.41, 8.89),
-                                 "ST": (1.35, 1.40, -3.70), "TD": (0.71, 0.68, 4.49),
-                                 "DE": (1.88, 1.67, 10.93)}),
-    ("sh_2", "class_c"): (15e-4, {"SW": (3609, 2188, 39.37), "RC": (0.68, 0.62, 8.82),
-                                  "ST": (2.16, 2.25, -4.17), "TD": (1.06, 1.00, 5.48),
-                                  "DE": (3.95, 3.59, 9.03)}),
-    ("sh_add_2", "bump"): (-31, {"SW": (165, 43, 73.94), "RC": (1.61, 1.60, 0.62),
-                                 "ST": (7.80, 8.10, -3.85), "TD": (3.10, 3.10, 0.0),
-                                 "DE": (3.44, 3.24, 5.70)}),
-    ("sh_add_2", "class_a"): (-0.31, {"SW": (2376, 566, 76.18), "RC": (0.24, 0.21, 12.50),
-                                      "ST": (0.91, 1.00, -9.89), "TD": (0.42, 0.40, 4.76),
-                                      "DE": (0.62, 0.54, 12.90)}),
-    ("sh_add_2", "class_b"): (-0.70, {"SW": (3453, 702, 79.67), "RC": (0.39, 0.35, 10.26),
-                                      "ST": (1.38, 1.47, -6.52), "TD": (0.66, 0.64, 3.03),
-                                      "DE": (2.65, 1.44, 12.73)}),
-    ("sh_add_2", "class_c"): (-2.10, {"SW": (5369, 982, 81.71), "RC": (0.60, 0.53, 11.67),
-                                      "ST": (2.28, 2.49, -9.21), "TD": (0.99, 0.94, 5.05),
-                                      "DE": (3.65, 3.24, 11.23)}),
-}
-#: Display: label, unit, factor from SI, format.
-INDEX = {"SW": ("Switches", "#", 1.0, "{:.0f}"), "RC": ("RC", "m/s²", 1.0, "{:.3f}"),
-         "ST": ("ST (r.m.s.)", "mm", 1e3, "{:.2f}"), "TD": ("TD (r.m.s.)", "mm", 1e3, "{:.2f}"),
-         "DE": ("DE", "W (thesis: kJ/s)", 1.0, "{:.2f}")}
+#: Display: label, our unit, the printed unit's factor from SI, significant digits.
+INDEX = {"SW": ("Switches", "#", 1.0, 4), "RC": ("RC", "m/s²", 1.0, 3),
+         "ST": ("ST (r.m.s.)", "mm", 1e3, 3), "TD": ("TD (r.m.s.)", "mm", 1e3, 3),
+         "DE": ("DE", "W", 1.0, 3)}
 
 
 def change(base: float, cdf: float) -> float:
@@ -72,66 +60,156 @@ def change(base: float, cdf: float) -> float:
     return 100.0 * (base - cdf) / base
 
 
-def study(law: str, road: str) -> dict:
-    """Base and CDF runs of one law on one road, with the three fits' variants."""
-    base_cfg = suspopt.load_config(CONFIGS / f"{law}_{road}.yaml")
-    cdf_cfg = suspopt.load_config(CONFIGS / f"{law}_cdf_{road}.yaml")
-    base = semi_active_metrics(suspopt.simulate(base_cfg))
-    spec = cdf_cfg.control.threshold
-    fits = {}
-    if spec.mode == "fixed":          # the bump: offline design from the base law's run
-        condition = suspopt.simulate(base_cfg).signals["control_condition.F1"]
-        offline = {fit: float(threshold_for_share(condition, 0.27, law, fit)[0]) for fit in FITS}
-        if not np.isclose(offline["empirical"], spec.value, rtol=1e-3, atol=0.0):
-            sys.exit(f"{law}_cdf_{road}.yaml: value {spec.value} differs from the offline "
-                     f"empirical design {offline['empirical']:.6g}; update the config")
-        result = suspopt.simulate(cdf_cfg, params={
-            "control.threshold.value": [offline[fit] for fit in FITS]})
-        metrics = semi_active_metrics(result)
-        for i, fit in enumerate(FITS):
-            fits[fit] = ({k: v[i] for k, v in metrics.items()}, offline[fit])
+def stored_config(path: Path):
+    """The config a ``suspopt simulate`` file was written with, and its YAML text."""
+    with h5py.File(path, "r") as h5:
+        text = h5.attrs["config"]
+    return load_config_text(text, path.with_name(path.name + ":config")), text
+
+
+def stored_metrics(path: Path, share_after: float = 0.0) -> dict[str, float]:
+    """semi_active_metrics of one stored run (design 0), from its file."""
+    cfg, _ = stored_config(path)
+    time, signals = read_simulation_signals(path)
+    run = SimpleNamespace(config=cfg, time=time, signals=signals,
+                          model=SimpleNamespace(corners=tuple(cfg.vehicle.corners)))
+    return {k: float(v[0]) for k, v in semi_active_metrics(run, share_after).items()}
+
+
+def offline_thresholds(base: Path, law: str, share: float) -> dict[str, float]:
+    """The bump's thresholds designed offline from the base law's run, one per fit."""
+    _, signals = read_simulation_signals(base)
+    condition = signals["control_condition.F1"]
+    return {fit: float(threshold_for_share(condition, share, law, fit)[0]) for fit in FITS}
+
+
+def fit_variant(text: str, fit: str, value: float | None) -> str:
+    """A CDF config's YAML with another fit: the distribution (adaptive) or the fixed value."""
+    if value is None:
+        new, n = re.subn(r"(?m)^(\s*distribution:) *\w+", rf"\1 {fit}", text)
     else:
+        new, n = re.subn(r"(?m)^(\s*value:) *[-+0-9.eE]+", rf"\g<1> {value:.6g}", text)
+    if n != 1:
+        sys.exit(f"cannot set the {fit} fit in the config (found {n} places)")
+    return new
+
+
+def write_fit_configs(out: Path) -> list[Path]:
+    """OUT/fits/<law>_cdf_<road>_<fit>.yaml for the fits the configs do not use."""
+    share = md.thesis_values()["ch4"]["c_max_share"]
+    written = []
+    for law in LAWS:
+        for road in ROADS:
+            cdf_cfg, text = stored_config(out / f"{law}_cdf_{road}.h5")
+            spec = cdf_cfg.control.threshold
+            offline = None
+            if spec.mode == "fixed":
+                offline = offline_thresholds(out / f"{law}_{road}.h5", law, share)
+                if (not np.isclose(offline["empirical"], spec.value, rtol=1e-3, atol=0.0)
+                        and os.environ.get("SUSPOPT_QUICK") != "1"):
+                    sys.exit(f"{law}_cdf_{road}: the config's threshold {spec.value} is not the "
+                             f"offline empirical design {offline['empirical']:.6g}; update the "
+                             f"config")
+            fit_used = "empirical" if offline else spec.distribution
+            for fit in FITS:
+                if fit == fit_used:
+                    continue
+                path = out / "fits" / f"{law}_cdf_{road}_{fit}.yaml"
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_text(fit_variant(text, fit, offline[fit] if offline else None))
+                written.append(path)
+    return written
+
+
+def collect(out: Path) -> dict:
+    """Every law and road: base metrics, and per fit (metrics, threshold); the configs' fit."""
+    results = {}
+    for law in LAWS:
+        for road in ROADS:
+            cdf_file = out / f"{law}_cdf_{road}.h5"
+            cdf_cfg, _ = stored_config(cdf_file)
+            spec = cdf_cfg.control.threshold
+            fixed = spec.mode == "fixed"
+            fit_used = "empirical" if fixed else spec.distribution
+            share_after = 0.0 if fixed else spec.learn_time
+            fits = {}
+            for fit in FITS:
+                path = cdf_file if fit == fit_used else out / "fits" / f"{law}_cdf_{road}_{fit}.h5"
+                cfg, _ = stored_config(path)
+                if fixed:
+                    threshold = cfg.control.threshold.value
+                else:
+                    threshold = float(read_simulation_signals(path)[1]["control_threshold.F1"][0, -1])
+                fits[fit] = (stored_metrics(path, share_after), threshold)
+            results[law, road] = {"base": stored_metrics(out / f"{law}_{road}.h5"),
+                                  "fits": fits, "config_fit": fit_used}
+    return results
+
+
+def table_markdown(results: dict, law: str) -> str:
+    """Table 4.2 or 4.3 in the thesis's form: ours, the thesis's, their difference."""
+    base_name, cdf_name, table, symbol = LAWS[law]
+    thesis = md.thesis_values()["ch4"]
+    printed = thesis["tables"][table]["roads"]
+    rows = []
+    for road, road_name in ROADS.items():
+        r = results[law, road]
+        cdf, threshold = r["fits"][r["config_fit"]]
+        t = printed[road]
+        rows.append([f"*{road_name}*", f"*{symbol}*", f"*{md.num(threshold)}*",
+                     f"*{md.printed(t['threshold'])}*", "", "", "", "", "", ""])
+        for key, (label, unit, factor, digits) in INDEX.items():
+            b, c = factor * r["base"][key], factor * cdf[key]
+            tb, tc, tp = t[key]
+            unit_cell = unit if thesis["units"][key] == unit.replace("²", "^2") else \
+                f"{unit} (thesis: {thesis['units'][key]})"
+            rows.append(["", f"{label} [{unit_cell}]", md.num(b, digits), md.printed(tb),
+                         md.pct(md.difference(b, tb)), md.num(c, digits), md.printed(tc),
+                         md.pct(md.difference(c, tc)), md.pct(change(b, c), False),
+                         md.pct(tp, False)])
+        rows.append(["", "C_max share [%]", md.num(100 * r["base"]["share"]), "-", "",
+                     md.num(100 * cdf["share"]), md.num(100 * thesis["c_max_share"]), "", "",
+                     ""])
+    header = ["road", "index", base_name, "thesis", "diff.", cdf_name, "thesis", "diff.",
+              "change", "thesis change"]
+    return md.table(header, rows)
+
+
+def fits_markdown(results: dict) -> str:
+    """Threshold, C_max share and the changes of each fit, beside the thesis's threshold."""
+    thesis = md.thesis_values()["ch4"]["tables"]
+    rows = []
+    for (law, road), r in results.items():
+        printed = thesis[LAWS[law][2]]["roads"][road]["threshold"]
         for fit in FITS:
-            cfg = cdf_cfg.model_copy(deep=True)
-            cfg.control.threshold.distribution = fit
-            result = suspopt.simulate(cfg)
-            metrics = semi_active_metrics(result, share_after=spec.learn_time)
-            fits[fit] = ({k: v[0] for k, v in metrics.items()},
-                         float(result.signals["control_threshold.F1"][0, -1]))
-    return {"base": {k: v[0] for k, v in base.items()}, "fits": fits,
-            "config_fit": spec.distribution if spec.mode == "adaptive" else "empirical"}
+            cdf, threshold = r["fits"][fit]
+            mark = " (configs)" if fit == r["config_fit"] else ""
+            rows.append([LAWS[law][0], road, fit + mark, md.num(threshold), md.printed(printed),
+                         md.pct(100 * cdf["share"], False)]
+                        + [md.pct(change(r["base"][k], cdf[k]), False) for k in INDEX])
+    header = ["law", "road", "fit", "T", "T thesis", "C_max share", "SW change", "RC change",
+              "ST change", "TD change", "DE change"]
+    return md.table(header, rows)
 
 
 def main() -> None:
-    results = {(law, road): study(law, road) for law in LAWS for road in ROADS}
-    for law, (base_name, cdf_name, table, symbol) in LAWS.items():
-        print(f"\n**Table {table} form: {base_name} against {cdf_name}** (ours, thesis in "
-              "brackets; change = (X - X_CDF)/X)\n")
-        print(f"| index | unit | {base_name} | {cdf_name} | change |")
-        print("|---|---|---|---|---|")
-        for road, road_name in ROADS.items():
-            r = results[law, road]
-            cdf, threshold = r["fits"][r["config_fit"]]
-            thesis_t, thesis = THESIS[law, road]
-            print(f"| *{road_name} / {symbol} = {threshold:.3g} ({thesis_t:g})* | | | | |")
-            for key, (label, unit, factor, fmt) in INDEX.items():
-                b, c = r["base"][key], cdf[key]
-                tb, tc, tp = thesis[key]
-                print(f"| {label} | {unit} | {fmt.format(factor * b)} ({tb:g}) | "
-                      f"{fmt.format(factor * c)} ({tc:g}) | {change(b, c):.1f} % ({tp:g} %) |")
-            print(f"| C_max share | % | {100 * r['base']['share']:.1f} | "
-                  f"{100 * cdf['share']:.1f} (27) | |")
-    print("\n**Threshold fits at a requested 27 % C_max share** (changes as above)\n")
-    print("| law | road | fit | T (thesis) | C_max share achieved | SW change | RC change | "
-          "ST change | TD change | DE change |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
-    for (law, road), r in results.items():
-        for fit in FITS:
-            cdf, threshold = r["fits"][fit]
-            cells = " | ".join(f"{change(r['base'][k], cdf[k]):.1f} %"
-                               for k in ("SW", "RC", "ST", "TD", "DE"))
-            print(f"| {LAWS[law][0]} | {road} | {fit} | {threshold:.3g} "
-                  f"({THESIS[law, road][0]:g}) | {100 * cdf['share']:.1f} % | {cells} |")
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", type=Path, help="folder of examples/ch4_runs.sh")
+    parser.add_argument("--fits", action="store_true",
+                        help="write the configs of the other fits to OUT/fits and list them")
+    args = parser.parse_args()
+    if args.fits:
+        for path in write_fit_configs(args.out):
+            print(path)
+        return
+    results = collect(args.out)
+    for law, (base_name, cdf_name, table, _) in LAWS.items():
+        print(f"\n**Table {table} form: {base_name} against {cdf_name}** (diff. = (ours - "
+              "thesis)/thesis; change = (X - X_CDF)/X)\n")
+        print(table_markdown(results, law))
+    print(f"\n**Threshold fits at a requested "
+          f"{100 * md.thesis_values()['ch4']['c_max_share']:.0f} % C_max share**\n")
+    print(fits_markdown(results))
 
 
 if __name__ == "__main__":

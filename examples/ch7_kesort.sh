@@ -15,7 +15,7 @@ keep=()
 "$here/examples/ch7_optimise.sh" "$out"
 configs=()
 for name in sh_2 add sh_add_2 sh_2_cdf sh_add_2_cdf; do
-    configs+=(-c "$("$here/examples/quick_config.sh" "$here/configs/ch7/$name.yaml" "$out/configs")")
+    configs+=(-c "$("$here/examples/budget_config.sh" "$here/configs/ch7/$name.yaml" "$out/configs")")
 done
 echo "== Table 7.4: SH-2, ADD, SH-ADD-2, SH-2-CDF, SH-ADD-2-CDF"
 suspopt kesort "$out"/{sh_2,add,sh_add_2,sh_2,sh_add_2}.h5 "${configs[@]}" \

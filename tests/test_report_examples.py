@@ -1,0 +1,110 @@
+"""The reproduction report's pieces (examples/): the thesis's values file, the budget copies,
+and Chapter 3's tables from small synthetic `analyse models` files. The report itself runs
+outside the suite (examples/reproduce_thesis.sh; SUSPOPT_QUICK=1 for its structure)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+sys.path.insert(0, str(EXAMPLES))
+
+import mdtables as md  # noqa: E402
+
+pytest.importorskip("matplotlib")
+import report  # noqa: E402
+
+THESIS = md.thesis_values()
+
+
+def test_thesis_values_are_complete():
+    ch3 = THESIS["ch3"]
+    assert set(ch3["tables"]) == {f"3.{i}" for i in range(3, 22)}
+    for number, table in ch3["tables"].items():
+        assert set(report.CH3_FILES) >= {number}
+        for row in table["rows"]:
+            assert row["unit"] in md.UNITS, (number, row)
+            assert set(row) - {"quantity", "label", "unit"} <= set(ch3["columns"]), row
+    for table in THESIS["ch4"]["tables"].values():
+        assert set(table["roads"]) == {"bump", "class_a", "class_b", "class_c"}
+        for road in table["roads"].values():
+            assert all(len(road[k]) == 3 for k in ("SW", "RC", "ST", "TD", "DE"))
+    ch5 = THESIS["ch5"]
+    for case in ch5["cases"].values():
+        assert set(case["variables"]) == set(ch5["variables"])
+        assert set(case["metrics"]) == set(ch5["metrics"])
+        assert all(len(v) == 5 for v in [*case["variables"].values(),
+                                         *case["metrics"].values(), case["time"]])
+    assert set(THESIS["ch6"]["objectives"]) == {f"f{i}" for i in range(1, 7)}
+    assert all(len(v["values"]) == 5 for v in THESIS["ch7"]["objectives"].values())
+    assert set(THESIS["ch8"]["table_8_12"]) == set(THESIS["ch8"]["seats"])
+
+
+def test_number_cells():
+    assert md.num(0.12345) == "0.123" and md.num(102620.0) == "102620"
+    assert md.num(float("nan")) == "-" and md.printed(None) == "-"
+    assert md.pct(md.difference(1.1, 1.0)) == "+10.0 %"
+    assert md.table(["a", "b"], [["1", "x|y"]]).splitlines()[2] == "| 1 | x\\|y |"
+
+
+def test_budget_copies(tmp_path):
+    cfg = Path(__file__).resolve().parents[1] / "configs" / "ch5" / "case1_s2.yaml"
+    run = lambda env: subprocess.run([str(EXAMPLES / "budget_config.sh"), str(cfg),  # noqa: E731
+                                      str(tmp_path)], capture_output=True, text=True,
+                                     env={"PATH": "/usr/bin:/bin", **env}, check=True).stdout
+    assert run({}).strip() == str(cfg)
+    copy = Path(run({"SUSPOPT_MAX_EVALUATIONS": "5000", "SUSPOPT_GENERATIONS": "7"}).strip())
+    text = copy.read_text()
+    assert "  max_evaluations: 5000\n" in text and "  generations: 7\n" in text
+    assert "  population: 1000\n" in text
+    quick = Path(run({"SUSPOPT_QUICK": "1"}).strip()).read_text()
+    assert "  population: 8\n" in quick and "max_evaluations" not in quick
+
+
+def _models_file(path: Path, labels: list[str], metrics: set[str], rng) -> None:
+    with h5py.File(path, "w") as h5:
+        h5.attrs["models"] = np.array(labels, dtype="S")
+        for group in ("value", "difference"):
+            g = h5.create_group(f"comparison/{group}")
+            for m in metrics:
+                g.create_dataset(m, data=rng.uniform(0.5, 1.5, len(labels))).attrs["units"] = "SI"
+
+
+def _metrics_file(path: Path, metrics: set[str], rng) -> None:
+    with h5py.File(path, "w") as h5:
+        for m in metrics:
+            h5.create_dataset(f"metrics/{m}", data=rng.uniform(0.5, 1.5, 1))
+
+
+def test_chapter3_tables_from_synthetic_files(tmp_path):
+    rng = np.random.default_rng(0)
+    d = tmp_path / "ch3"
+    (d / "checks").mkdir(parents=True)
+    models = {"part1a": ["qc", "hc1", "hc2", "fc"], "part1b": ["qc", "hc1", "hc2", "fc"],
+              "part2a": ["fc_no_arb", "fc_arb"], "part2b": ["qc_ct0", "qc_ct49"]}
+    for (part, road) in set(report.CH3_FILES.values()):
+        metrics = {r["quantity"] for n, (p, rd) in report.CH3_FILES.items() if (p, rd) == (part, road)
+                   for r in THESIS["ch3"]["tables"][n]["rows"]}
+        _models_file(d / f"{part}_models_{road}.h5",
+                     [f"{part}_{m}_{road}" for m in models[part]], metrics, rng)
+    transient = {"peak.body.heave_acc"}
+    random_road = {"RC", "max_body_acc", "VST.F1", "MST.F1", "VTD.F1", "MTD.F1"}
+    _metrics_file(d / "part1a_qc_bump.h5", transient, rng)
+    _metrics_file(d / "checks" / "part1a_qc_bump_dt_half.h5", transient, rng)
+    _metrics_file(d / "checks" / "part1a_qc_class_b_double_length.h5", random_road, rng)
+    for seed in range(1, 6):
+        for m in ("qc", "fc"):
+            _metrics_file(d / "checks" / f"part1a_{m}_class_b_seed_{seed}.h5", random_road, rng)
+    doc = report.Doc(tmp_path / "report")
+    headline = report.chapter3(tmp_path, doc)
+    text = doc.text()
+    for number in THESIS["ch3"]["tables"]:
+        assert f"**Table {number}:" in text
+    assert "| Peak, M_p | m/s^2 | QC |" in text and "thesis inside?" in text
+    assert headline and headline[0].startswith("Ch. 3:")
