@@ -22,8 +22,8 @@ By virtual work these give the equations of motion of every preset (Eq 2.1-2.2, 
 ``C`` used for statics, modes and frequency responses come from the same network.
 
 The parameter fields of :class:`VehicleModel` are batched over P designs with shapes
-``(P, 1, N)``, broadcasting against states ``(P, S, n)``; matrices identical for all designs
-are stored once.
+``(P, 1, N)`` (the network holds them as ``(N, P, 1)`` rows); matrices identical for all
+designs are stored once.
 """
 
 from __future__ import annotations
@@ -46,13 +46,6 @@ _INERTIA_FIELD = {"heave": "mass", "roll": "roll_inertia", "pitch": "pitch_inert
 def _shared(a: np.ndarray) -> np.ndarray:
     """Collapse a (P, ...) array to (1, ...) when every design has the same values."""
     return a[:1] if a.shape[0] > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape)) else a
-
-
-def matvec(matrix_t: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """``y @ matrix_t`` for states ``y (P, S, a)`` and a (1|P, a, b) transposed matrix."""
-    if matrix_t.shape[0] == 1:
-        return (y.reshape(-1, y.shape[-1]) @ matrix_t[0]).reshape(*y.shape[:-1], -1)
-    return np.matmul(y, matrix_t)
 
 
 @dataclass
@@ -98,11 +91,6 @@ class VehicleModel:
         """Slice of the wheel heaves in ``q``."""
         return slice(self.n_body, self.n_body + len(self.corners))
 
-    def travel(self, q: np.ndarray) -> np.ndarray:
-        """Suspension travel ST (Eq 2.26 form) of every corner, (P, S, N) [m]; + = extension.
-        Applied to velocities it gives the travel rate."""
-        return matvec(self._travel_map_t, q)
-
     def point_map(self, x: float, y: float) -> np.ndarray:
         """Row (n,) giving the body's vertical displacement at the body point (x, y) [m]
         (x + forward, y + right) from q: z_s + y φ - x θ."""
@@ -110,9 +98,6 @@ class VehicleModel:
         for j, dof in enumerate(self.body_dofs):
             row[j] = {"heave": 1.0, "roll": y, "pitch": -x}[dof]
         return row
-
-    def __post_init__(self):
-        self._travel_map_t = np.swapaxes(self.travel_map, 1, 2)
 
 
 def _corner_geometry(pv: ParamView, preset: str, corners: tuple[str, ...]):

@@ -96,10 +96,10 @@ def test_static_tyre_loads_carry_the_weight(load):
 def test_travel_sign_convention(load):
     """ST_i = z_s + y_i φ - x_i θ - z_ui (DESIGN.md; Eq 2.26 with ERRATA)."""
     model = build_vehicle(load("ch3/part1a_fc_bump.yaml"))
-    q = np.zeros((1, 1, model.n_dof))
-    q[..., 1] = 0.01  # roll
-    q[..., 2] = 0.02  # pitch
-    st = model.travel(q)[0, 0]
+    q = np.zeros((model.n_dof, 1, 1))
+    q[1] = 0.01  # roll
+    q[2] = 0.02  # pitch
+    st = model.network.group("suspension").deformation(q, None)[:, 0, 0]
     b1, b2, aF, aR = 0.7, 0.75, 1.4, 1.47
     expect = [b1 * .01 - aF * .02, -b2 * .01 - aF * .02, b1 * .01 + aR * .02,
               -b2 * .01 + aR * .02]
