@@ -58,7 +58,9 @@ class Controller(Protocol):
     the latest sample decided ``{name: (P, N)}`` (it changes only when ``samples``, the number
     of samples taken, does); ``published`` turns those of the whole run, stacked ``(S, P,
     N)``, into the records that become the signals ``<name>.<corner>`` with units
-    ``units[name]``.
+    ``units[name]``, the records' names being the keys of ``units``; a run publishes them
+    when one is first read. The integrator keeps the arrays that ``start``, ``sample`` and
+    ``record`` return without copying them: the controller must not write them afterwards.
     """
 
     units: dict[str, str]
@@ -214,14 +216,22 @@ class _Assembled:
         return evaluate
 
 
-@dataclass
 class _Held:
     """A controller quantity held between changes: the distinct values ``(S, P, N)`` and, for
     each output sample, which of them held ``(T,)``. Expanded to ``(N, P, T)`` on demand, so a
-    coefficient that changes only every ΔT is stored once per change, not per sample."""
+    coefficient that changes only every ΔT is stored once per change, not per sample. The
+    values may be given as a function that makes them: they are then made on first use (a run
+    whose metrics never read them does not pay for them)."""
 
-    values: np.ndarray
-    index: np.ndarray
+    def __init__(self, values: np.ndarray | Callable[[], np.ndarray], index: np.ndarray):
+        self._values, self.index = values, index
+
+    @property
+    def values(self) -> np.ndarray:
+        """``(S, P, N)``."""
+        if callable(self._values):
+            self._values = self._values()
+        return self._values
 
     def corner(self, c: int) -> np.ndarray:
         """(P, T) series of corner ``c``."""
@@ -230,6 +240,33 @@ class _Held:
     def full(self) -> np.ndarray:
         """(N, P, T) series of every corner."""
         return np.transpose(self.values[self.index], (2, 1, 0))
+
+
+class _HeldRecords(Mapping):
+    """The controller's records by name, each a :class:`_Held` of one index: published (see
+    the ``Controller`` protocol) from the values kept at each sample when one is first read."""
+
+    def __init__(self, names: Sequence[str], publish: Callable[[], dict[str, np.ndarray]],
+                 index: np.ndarray):
+        self._names, self._publish, self._index = tuple(names), publish, index
+        self._held: dict[str, _Held] | None = None
+
+    def __getitem__(self, name: str) -> _Held:
+        if name not in self._names:
+            raise KeyError(name)
+        if self._held is None:
+            self._held = {n: _Held(v, self._index) for n, v in self._publish().items()}
+            self._publish = None
+        return self._held[name]
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._names
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
 
 
 @dataclass
@@ -242,8 +279,14 @@ class _Trajectory:
     states: np.ndarray
     accelerations: np.ndarray
     damping: _Held | np.ndarray | None
-    records: dict[str, _Held]
+    records: Mapping[str, _Held]
     diverged_at: np.ndarray
+
+
+def _stacked(arrays: list[np.ndarray]) -> np.ndarray:
+    """``np.stack(arrays)`` of equal-shaped arrays (of at least one dimension) by one
+    concatenation: for thousands of small arrays np.stack takes about three times as long."""
+    return np.concatenate(arrays).reshape((len(arrays),) + arrays[0].shape)
 
 
 def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, n_steps: int,
@@ -296,7 +339,7 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     recorded = [(y, states), (acc, accelerations)]        # (buffer, its record)
     # controller quantities are stored when they change (damping and records apart: a lagged
     # damper changes every step, the records only at sample instants)
-    held_damping: list[np.ndarray] = []
+    held_damping: list[np.ndarray] = []     # (P, N) views of the commands
     held_records: list[dict[str, np.ndarray]] = []
     damping_changes: list[int] = []         # the samples at which a new value was stored
     records_changes: list[int] = []
@@ -311,7 +354,8 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     vehicle = _VehicleState(y[n:n + n_vehicle, :P, 0], vehicle_acceleration)
     if controller is not None:
         damping = coef[asm.damper_rows]                   # (N, width, 1), a view
-        damping[...] = controller.start(P).transpose(2, 0, 1)
+        command = [controller.start(P)]                   # the latest command (P, 1, N)
+        damping[...] = command[0].transpose(2, 0, 1)
         sample_every, decay = controller.sample_every, controller.lag_decay
         if decay is not None:
             decay = widen(decay.transpose(2, 0, 1), width)
@@ -324,7 +368,8 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
         """The controller's sample at step k (when due) and the actuator's response."""
         if k % sample_every == 0:
             step_index[0] = 2 * k
-            new = controller.sample(k, k * dt, vehicle).transpose(2, 0, 1)
+            command[0] = controller.sample(k, k * dt, vehicle)
+            new = command[0].transpose(2, 0, 1)
             if decay is None:
                 damping[...] = new
                 changed[0] = True
@@ -349,8 +394,8 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
             for _, _, by_sample, by_time in blocks:
                 by_time[:, j - row:j + 1] = by_sample[:row + 1].T
         if controller is not None:
-            if decay is None and changed[0]:
-                held_damping.append(damping[:, :P, 0].T.copy())
+            if decay is None and changed[0]:            # the damping is the command
+                held_damping.append(command[0][:, 0])
                 damping_changes.append(j)
                 changed[0] = False
             if controller.samples != last_samples[0]:  # the records change with samples only
@@ -399,11 +444,12 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
             """Which stored value holds at each sample."""
             return np.searchsorted(changes, np.arange(n_out), side="right") - 1
         damping_held = lagged if decay is not None \
-            else _Held(np.stack(held_damping), held_at(damping_changes))
-        raw = {name: np.stack([h[name] for h in held_records]) for name in held_records[0]}
-        records_index = held_at(records_changes)
-        records_held = {name: _Held(values, records_index)
-                        for name, values in controller.published(raw).items()}
+            else _Held(lambda: _stacked(held_damping), held_at(damping_changes))
+
+        def publish() -> dict[str, np.ndarray]:
+            return controller.published({name: _stacked([h[name] for h in held_records])
+                                         for name in held_records[0]})
+        records_held = _HeldRecords(controller.units, publish, held_at(records_changes))
     return _Trajectory(states=states, accelerations=accelerations, damping=damping_held,
                        records=records_held, diverged_at=diverged_at)
 
@@ -593,7 +639,7 @@ class Result:
     _assembled: _Assembled
     attachments: tuple[Attachment, ...] = ()
     held_damping: _Held | np.ndarray | None = None
-    controller_records: dict[str, _Held] = field(default_factory=dict)
+    controller_records: Mapping[str, _Held] = field(default_factory=dict)
     controller_units: dict[str, str] = field(default_factory=dict)
     metrics: dict[str, np.ndarray] = field(default_factory=dict)
     metric_units: dict[str, str] = field(default_factory=dict)
