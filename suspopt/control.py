@@ -517,9 +517,9 @@ class StudentTSummary:
     was set, the column is rebinned from the raw history on ``(μ, s/2)`` and refitted; the
     doubling bounds the rebinning to twice the samples in all. A fit that collapsed onto an
     atom (ν at its lower bound, see :func:`fit_student_t`) restarts at the next refit from the
-    summary's median and interquartile range, as the exact fit starts afresh.
-    Columns whose samples are all equal give ``s = 0`` and are binned once they differ; a
-    non-finite sample makes the column's fit NaN from then on.
+    summary's median and interquartile range, as the exact fit starts afresh. Columns whose
+    samples are all equal give ``s = 0`` and are binned once they differ; a non-finite sample
+    makes the column's fit NaN from then on.
 
     Columns are independent (designs x corners, flattened); :meth:`fit` takes the history as
     an array ``(n, columns)`` whose rows only ever grow.
@@ -883,7 +883,7 @@ class SemiActiveController:
         state (the command's place in the range, ``(c - C_min)/(C_max - C_min)``: 0 soft,
         1 stiff, fractional for the continuous laws; where ``C_min = C_max``, whether the law
         asked for the stiff state), condition and threshold; NaN at passive corners.
-        Computed once for the whole run."""
+        Computed once for the whole run, when a record is first read."""
         switchable, c_min, span = (a[:, 0] for a in (self._switchable, self._c_min,
                                                       self._range))
         state = raw["command"] - c_min
