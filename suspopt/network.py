@@ -161,13 +161,20 @@ class Network:
         damping = damping or {}
         return {g.name: g.parts(q, v, u, u_dot, damping.get(g.name)) for g in self.groups}
 
-    def generalised_force(self, q, v, u=None, u_dot=None, damping=None) -> np.ndarray:
-        """``-Σ D_qᵀ F`` on the DOFs, (n, P, S) [N, N m]."""
-        total = np.zeros((self.n,) + np.broadcast_shapes(q.shape[1:], v.shape[1:]))
+    def generalised_forces(self, q, v, u=None, u_dot=None, damping=None
+                           ) -> tuple[np.ndarray, np.ndarray]:
+        """``-Σ D_qᵀ F`` on the DOFs (n, P, S) [N, N m] and ``-Σ D_uᵀ F`` on the inputs
+        (n_u, P, S) [N] (the reaction on the road or the floor), from one evaluation of the
+        element forces."""
+        shape = np.broadcast_shapes(q.shape[1:], v.shape[1:])
+        dofs = np.zeros((self.n,) + shape)
+        inputs = np.zeros((len(self.input_names),) + shape)
         for g, (elastic, viscous) in zip(self.groups,
                                           self.forces(q, v, u, u_dot, damping).values()):
-            total += apply(g.force_map, elastic + viscous)
-        return total
+            force = elastic + viscous
+            dofs += apply(g.force_map, force)
+            inputs -= apply(g.input_map.T, force)
+        return dofs, inputs
 
     def linear_model(self) -> LinearModel:
         """Linear matrices about rest: each group adds ``D_qᵀ diag(k + dF_x/dδ) D_q`` to K,

@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from .config import Config, ConfigError
-from .network import Elements, Network, apply, widen
+from .network import Elements, Network, widen
 from .params import ParamView
 from .vehicle import _shared
 
@@ -375,13 +375,8 @@ class SeatModel:
               base_vel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Forces on the seat's DOFs (m, P, S) and on the floor (P, S), upward +, from the
         states ``q, v (m, P, S)`` and the floor's motion ``base, base_vel (P, S)``."""
-        u, u_dot = base[None], base_vel[None]
-        own = self.network.generalised_force(q, v, u, u_dot)
-        floor = 0.0
-        for g, (elastic, viscous) in zip(self.network.groups,
-                                          self.network.forces(q, v, u, u_dot).values()):
-            floor = floor - apply(g.input_map.T, elastic + viscous)[0]
-        return own, floor
+        own, floor = self.network.generalised_forces(q, v, base[None], base_vel[None])
+        return own, floor[0]
 
     def signal_names(self) -> list[str]:
         return list(self._signals)
