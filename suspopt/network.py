@@ -100,7 +100,10 @@ class Elements:
     def parts(self, q, v, u, u_dot, damping=None) -> tuple[np.ndarray, np.ndarray]:
         """The elastic part ``k δ + F_x`` and the damping part ``c δ̇`` of the elements' force,
         (m, P, S) each [N]; ``damping`` (m, P, 1|S) replaces c (a semi-active damper)."""
-        disp, rate = self.deformation(q, u), self.deformation(v, u_dot)
+        return self.parts_at(self.deformation(q, u), self.deformation(v, u_dot), damping)
+
+    def parts_at(self, disp, rate, damping=None) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`parts` from the deformations ``δ, δ̇`` (m, P, S)."""
         elastic = self.stiffness * disp
         viscous = (self.damping if damping is None else damping) * rate
         if self.extra is not None:

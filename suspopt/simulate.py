@@ -314,10 +314,11 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     s1, s2, s3, s4 = (np.empty((n2, width, 1)) for _ in range(4))
     coef = np.broadcast_to(asm.coef, asm.coef.shape[:1] + (width, 1)).copy()
     half = 0.5 * dt
+    active = offsets.any(axis=(1, 2, 3))
     if offsets.size * width <= _WIDE_OFFSETS:          # small batches: no broadcasting
         offsets = widen(offsets, width)
     # the inputs' part of each half-step, None where it is zero (a bump's road before and after)
-    offsets = [o if active else None for o, active in zip(offsets, offsets.any(axis=(1, 2, 3)))]
+    offsets = [o if a else None for o, a in zip(offsets, active)]
     # Each stage's slope is scaled by the step it is used with, so that a stage state is one
     # addition: s1 = dt/2 k1, s2 = dt/2 k2, s3 = dt k3, s4 = dt/6 k4, and
     # y += dt/6 (k1 + 2 k2 + 2 k3 + k4) = (s1 + 2 s2 + s3)/3 + s4. The first stage is
@@ -337,12 +338,11 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
     states, accelerations = np.empty((n2, P, n_out)), np.empty((n, P, n_out))
     y2, _, unscaled_mass, acc2, acc = first[:5]
     recorded = [(y, states), (acc, accelerations)]        # (buffer, its record)
-    # controller quantities are stored when they change (damping and records apart: a lagged
-    # damper changes every step, the records only at sample instants)
+    # controller quantities are stored when they change, at the controller's samples (a lagged
+    # damper's coefficients apart: they change every step and are recorded like a state)
     held_damping: list[np.ndarray] = []     # (P, N) views of the commands
     held_records: list[dict[str, np.ndarray]] = []
-    damping_changes: list[int] = []         # the samples at which a new value was stored
-    records_changes: list[int] = []
+    changes: list[int] = []                 # the output samples at which they were stored
     last_samples = [-1]
     diverged_at = np.full(P, np.nan)
     step_index = [0]
@@ -362,7 +362,6 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
             rise, pulled = 1.0 - decay, np.empty_like(damping)
             lagged = np.empty((damping.shape[0], P, n_out))    # a new value every step
             recorded.append((damping, lagged))
-        changed = [True]
 
     def control(k: int) -> None:
         """The controller's sample at step k (when due) and the actuator's response."""
@@ -372,7 +371,6 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
             new = command[0].transpose(2, 0, 1)
             if decay is None:
                 damping[...] = new
-                changed[0] = True
             else:
                 multiply(new, rise, out=pulled)
         if decay is not None:   # c <- c_cmd - (c_cmd - c) exp(-dt/τ) = c e + c_cmd (1 - e)
@@ -393,15 +391,12 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
         if row == _BLOCK - 1 or j == n_out - 1:
             for _, _, by_sample, by_time in blocks:
                 by_time[:, j - row:j + 1] = by_sample[:row + 1].T
-        if controller is not None:
-            if decay is None and changed[0]:            # the damping is the command
-                held_damping.append(command[0][:, 0])
-                damping_changes.append(j)
-                changed[0] = False
-            if controller.samples != last_samples[0]:  # the records change with samples only
-                held_records.append(controller.record())
-                records_changes.append(j)
-                last_samples[0] = controller.samples
+        if controller is not None and controller.samples != last_samples[0]:
+            held_records.append(controller.record())      # they change with samples only
+            if decay is None:
+                held_damping.append(command[0][:, 0])     # the damping is the command
+            changes.append(j)
+            last_samples[0] = controller.samples
 
     q_rate1, v1 = first[5], first[6]
     with np.errstate(over="ignore", invalid="ignore"):
@@ -440,16 +435,14 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
 
     damping_held, records_held = None, {}
     if controller is not None:
-        def held_at(changes: list[int]) -> np.ndarray:
-            """Which stored value holds at each sample."""
-            return np.searchsorted(changes, np.arange(n_out), side="right") - 1
+        held_at = np.searchsorted(changes, np.arange(n_out), side="right") - 1  # which holds
         damping_held = lagged if decay is not None \
-            else _Held(lambda: _stacked(held_damping), held_at(damping_changes))
+            else _Held(lambda: _stacked(held_damping), held_at)
 
         def publish() -> dict[str, np.ndarray]:
             return controller.published({name: _stacked([h[name] for h in held_records])
                                          for name in held_records[0]})
-        records_held = _HeldRecords(controller.units, publish, held_at(records_changes))
+        records_held = _HeldRecords(controller.units, publish, held_at)
     return _Trajectory(states=states, accelerations=accelerations, damping=damping_held,
                        records=records_held, diverged_at=diverged_at)
 
@@ -718,11 +711,9 @@ class Result:
         suspension's spring force F_K and damper force F_C, Eq 2.30-2.32; the tyre's
         F_T parts, Eq 2.28-2.29), with the controller's damping where it has one."""
         if group not in self._forces:
-            g = self.model.network.group(group)
-            nv, n = self.model.n_dof, self.n
             damping = self.damping_history if group == "suspension" else None
-            self._forces[group] = g.parts(self.states[:nv], self.states[n:n + nv], self.road,
-                                          self.road_vel, damping)
+            self._forces[group] = self.model.network.group(group).parts_at(
+                self.deformation(group), self.deformation(group, rate=True), damping)
         return self._forces[group]
 
     def acceleration(self) -> np.ndarray:
