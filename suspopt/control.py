@@ -56,9 +56,9 @@ With an actuator lag ``τ`` the coefficient follows the command per integration 
 exact first-order response, ``c <- c_cmd - (c_cmd - c) exp(-dt/τ)`` (i.e.
 ``c += (c_cmd - c)(1 - exp(-dt/τ))``), the value at the end of the step being used over the
 step, so ``τ -> 0`` is the instantaneous damper; the simulator applies it to the damper
-coefficients every step (:attr:`SemiActiveController.lag_decay`). The laws that need ``z̈_s`` (add, sh_add_1,
-sh_add_2) evaluate the equations of motion at sample instants only, with the coefficient in
-force just before the sample.
+coefficients every step (:attr:`SemiActiveController.lag_decay`). The laws that need ``z̈_s``
+(add, sh_add_1, sh_add_2) evaluate the equations of motion at sample instants only, with the
+coefficient in force just before the sample.
 
 **CDF threshold** (Ch. 4): see :class:`suspopt.config.control.Threshold` and
 :func:`threshold_for_share`. An adaptive threshold keeps every sample of the condition
@@ -749,7 +749,6 @@ class SemiActiveController:
         self._range = np.where(self._switchable, c_max - c_min, 1.0)
         self._linear_weight, self._crossover = linear_weight, crossover
         self._skyhook_weight = skyhook_weight
-        self._nb = model.n_body
         # one product gives the travel rates, the body's velocities at the corners and the
         # wheels' velocities: rows [J; J_body; wheels] of the vehicle velocities
         J = model.travel_map

@@ -63,8 +63,8 @@ class Elements:
     ``(δ, δ̇, k δ + c δ̇, out)`` that writes F_x (m, width, S) [N] into ``out`` for ``width``
     design columns (its parameters widened to them, :func:`widen`), with ``extra_slope`` its
     derivative dF_x/dδ at rest (m, P, 1) [N/m] for the linearised model (None for 0) and
-    ``extra_uses_force`` whether F_x reads its third argument; ``reacts`` (n,) bool marks the DOFs that feel the
-    group's force (None: all - a one-way seat's links do not push the body).
+    ``extra_uses_force`` whether F_x reads its third argument; ``reacts`` (n,) bool marks the
+    DOFs that feel the group's force (None: all - a one-way seat's links do not push the body).
     """
 
     name: str
