@@ -35,6 +35,7 @@ import mdtables as md                                           # noqa: E402
 import suspopt                                                  # noqa: E402
 from suspopt import plots                                       # noqa: E402
 from suspopt.analyse import relative_change                     # noqa: E402
+from suspopt.analyse.cdf import c_max_share                     # noqa: E402
 from suspopt.config.metrics import MetricSpec                   # noqa: E402
 from suspopt.selection import read_pareto                       # noqa: E402
 
@@ -217,6 +218,27 @@ def performance(path: Path, X: np.ndarray, road_length: float | None = None
     return values
 
 
+def batched_performance(designs: dict, road_length: float | None = None) -> dict:
+    """:func:`performance` of several optimise files' designs ``{key: (path, X (p, n))}`` in
+    one batch, ``{key: metrics}``. The files' configs must share the vehicle, road, simulation
+    and design variables (checked): the first one simulates them all."""
+    def model(path: Path) -> dict:
+        dump = read_pareto(path).config().model_dump(mode="json")
+        return {k: dump[k] for k in ("vehicle", "road", "simulation", "design_variables")}
+    items = list(designs.items())
+    first = model(items[0][1][0])
+    for key, (path, _) in items[1:]:
+        if model(path) != first:
+            raise ValueError(f"{path}: another model than {items[0][1][0]}; cannot batch")
+    values = performance(items[0][1][0], np.concatenate([X for _, X in designs.values()]),
+                         road_length)
+    out, start = {}, 0
+    for key, (_, X) in items:
+        out[key] = {name: v[start:start + len(X)] for name, v in values.items()}
+        start += len(X)
+    return out
+
+
 # --- the report's pieces -----------------------------------------------------------------------
 
 class Doc:
@@ -363,7 +385,8 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
     qc_acc_thesis = ch3_printed("3.3")["peak.body.heave_acc"]["qc"]
     roll = ch3_printed("3.14")["steady_state.body.roll"]
     left_vtd = ch3_printed("3.17")["VTD.F2"]
-    seeds = {m: [read_metrics(checks / f"part1a_{m}_class_b_seed_{s}.h5") for s in range(1, 6)]
+    seeds = {m: [read_metrics(d / f"part1a_{m}_class_b.h5")]      # seed 1: the config's own
+             + [read_metrics(checks / f"part1a_{m}_class_b_seed_{s}.h5") for s in range(2, 6)]
              for m in ("qc", "fc")}
     double = read_metrics(checks / "part1a_qc_class_b_double_length.h5")
     comp2 = read_models(d / "part2a_models_bump.h5", "part2a", "bump")
@@ -602,7 +625,7 @@ def chapter5(out: Path, doc: Doc) -> list[str]:
     d = out / "ch5"
     ref = THESIS["ch5"]
     runs = {(c, s): read_run(d / f"case{c}_s{s}.h5") for c in range(1, 6) for s in range(1, 6)}
-    perf = {key: performance(run.path, run.X[:1]) for key, run in runs.items()}
+    perf = batched_performance({key: (run.path, run.X[:1]) for key, run in runs.items()})
     weights = runs[4, 1].weights
     cfg = read_pareto(runs[1, 1].path).config()
     bounds = {dv.name: (dv.lower, dv.upper) for dv in cfg.design_variables}
@@ -768,8 +791,8 @@ def chapter5(out: Path, doc: Doc) -> list[str]:
              "a case, and its gradient runs 'get trapped' in Cases 2, 4 and 5; ours reach the",
              "GA's optimum.")
     bump = read_pareto(runs[1, 1].path).config().road.length
-    longer = {key: performance(runs[key].path, runs[key].X[:1], 2 * bump)
-              for key in ((1, 1), (3, 1))}
+    longer = batched_performance({key: (runs[key].path, runs[key].X[:1])
+                                  for key in ((1, 1), (3, 1))}, 2 * bump)
     t_mst = [v for case in ref["cases"].values() for v in case["metrics"]["MST_F1"]]
     t_ft = [v for k in ("F_T_F1", "F_T_R1") for case in ref["cases"].values()
             for v in case["metrics"][k]]
@@ -1028,14 +1051,12 @@ def dominated_share(A: np.ndarray, B: np.ndarray) -> float:
 
 
 def stiff_share(path: Path) -> np.ndarray:
-    """Share of the samples at C_max of every design of a front, base law (mean over corners
-    of damper_state), simulated again in one batch."""
+    """Share of the samples at C_max of every design of a front, base law (mean over its
+    semi-active corners of damper_state), simulated again in one batch."""
     pareto = read_pareto(path)
     cfg = pareto.config()
     params = {dv.path: pareto.X[:, j] for j, dv in enumerate(cfg.design_variables)}
-    result = suspopt.simulate(cfg, params=params)
-    return np.mean([np.mean(result.signals[f"damper_state.{c}"], axis=-1)
-                    for c in cfg.vehicle.corners], axis=0)
+    return c_max_share(suspopt.simulate(cfg, params=params))
 
 
 def chapter7(out: Path, doc: Doc) -> list[str]:
@@ -1206,7 +1227,8 @@ F_MIN = 0.2          # [Hz] lowest frequency searched for a resonance
 
 
 def stht_peaks(path: Path) -> dict[str, Stht]:
-    """Per pick (edges, knee) of a front's STHT file (``analyse transmissibility``)."""
+    """Per pick (edges, knee) of a front's STHT file (``analyse transmissibility``); a design
+    that is several picks (an edge that is also the knee) serves each of them."""
     with h5py.File(path, "r") as h5:
         picks = [text(p) for p in h5["designs"].attrs["picks"]]
         fl, lin = h5["linear/frequency"][()], h5["linear/head"][()]
@@ -1219,10 +1241,12 @@ def stht_peaks(path: Path) -> dict[str, Stht]:
         k = int(np.argmax(np.where(band, lin[i], -np.inf)))
         ok = (coherence[i] >= 0.8) & (fs >= F_MIN)
         j = int(np.argmax(np.where(ok, sim[i], -np.inf)))
-        out[pick] = Stht(float(x_st[i]), float(fl[k]), float(lin[i, k]),
-                         k == int(np.argmax(band)), float(fs[j]) if ok.any() else math.nan,
-                         float(sim[i, j]) if ok.any() else math.nan,
-                         bool(ok.any()) and j == int(np.argmax(ok)))
+        peak = Stht(float(x_st[i]), float(fl[k]), float(lin[i, k]),
+                    k == int(np.argmax(band)), float(fs[j]) if ok.any() else math.nan,
+                    float(sim[i, j]) if ok.any() else math.nan,
+                    bool(ok.any()) and j == int(np.argmax(ok)))
+        for name in pick.split(", "):            # the file joins a design's picks
+            out[name] = peak
     return out
 
 

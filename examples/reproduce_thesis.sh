@@ -66,7 +66,7 @@ variant() {     # variant CONFIG NAME SED-EXPR...: CONFIG (after the budget) edi
 ch3_checks() {  # the measurements behind Ch. 3's "why they differ": step size, seed, length
     variant "$here/configs/ch3/part1a_qc_bump.yaml" part1a_qc_bump_dt_half \
         -e 's/dt: 1\.0e-3/dt: 5.0e-4/'
-    for seed in 1 2 3 4 5; do
+    for seed in 2 3 4 5; do      # seed 1 is the configs' own, run by ch3_models.sh
         for model in qc fc; do
             variant "$here/configs/ch3/part1a_${model}_class_b.yaml" \
                 "part1a_${model}_class_b_seed_$seed" -e "s/^(  seed:) 1$/\1 $seed/"

@@ -27,12 +27,23 @@ from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..simulate import simulate
 from . import KINDS, Kind, Report, relative_change
 
-__all__ = ["SHARES", "METRIC_UNITS", "semi_active_metrics", "run"]
+__all__ = ["SHARES", "METRIC_UNITS", "c_max_share", "semi_active_metrics", "run"]
 
 #: C_max shares of the sweep (the thesis's 20-70 %, Sec 4.3 item 4).
 SHARES = np.round(np.arange(0.20, 0.7001, 0.05), 2)
 #: Units of :func:`semi_active_metrics`.
 METRIC_UNITS = {"SW": "1", "RC": "m/s^2", "ST": "m", "TD": "m", "DE": "W"}
+
+
+def c_max_share(result, share_after: float = 0.0) -> np.ndarray:
+    """The mean damper state (the C_max share of the on-off laws) over the samples at
+    ``t >= share_after``, averaged over the semi-active corners, (P,)."""
+    cfg, sig = result.config, result.signals
+    active = [c for c in result.model.corners
+              if cfg.vehicle.corners[c].damper.kind == "semi_active"]
+    late = result.time >= share_after - 0.5 * cfg.simulation.dt
+    return np.mean([np.mean(sig[f"damper_state.{c}"][:, late], axis=-1) for c in active],
+                   axis=0)
 
 
 def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarray]:
@@ -45,7 +56,6 @@ def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarra
     cfg, sig, t = result.config, result.signals, result.time
     corners = result.model.corners
     active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]
-    late = t >= share_after - 0.5 * cfg.simulation.dt
     return {
         "SW": np.sum([damper_switches(sig[f"damper_state.{c}"]) for c in active], axis=0),
         "RC": weighted_rms(sig["body.heave_acc"], cfg.simulation.output_rate, "Wk"),
@@ -55,8 +65,7 @@ def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarra
                        for c in corners], axis=0),
         "DE": np.sum([mean_dissipated_power(sig[f"damper_force.{c}"], sig[f"travel_vel.{c}"], t)
                       for c in corners], axis=0),
-        "share": np.mean([np.mean(sig[f"damper_state.{c}"][:, late], axis=-1) for c in active],
-                         axis=0),
+        "share": c_max_share(result, share_after),
     }
 
 
