@@ -60,8 +60,8 @@ class VehicleModel:
     stiffness: np.ndarray       # (1|P, n, n) K [N/m, N m/rad]
     damping: np.ndarray         # (1|P, n, n) C [N s/m]
     travel_map: np.ndarray      # (1|P, N, n) J: ST = J q
-    corner_x: np.ndarray        # (P, N) longitudinal corner position [m], + forward
-    corner_y: np.ndarray        # (P, N) lateral corner position [m], + right
+    input_stiffness: np.ndarray  # (1|P, n, N) B_k: the road's force per m under each wheel
+    input_damping: np.ndarray   # (1|P, n, N) B_c: per m/s [N s/m]
     unsprung_mass: np.ndarray   # (P, 1, N) [kg]
     tyre_stiffness: np.ndarray  # (P, 1, N) [N/m]
     tyre_damping: np.ndarray    # (P, 1, N) [N s/m]
@@ -69,13 +69,10 @@ class VehicleModel:
     spring_cubic: np.ndarray    # (P, 1, N) [N/m^3]
     damper: np.ndarray          # (P, 1, N) passive coefficient, C_min if semi-active [N s/m]
     static_tyre_load: np.ndarray  # (P, 1, N) tyre load at rest, compression positive [N]
-    tyre_lift_off: bool
     gravity: float
     offsets: np.ndarray         # (N,) distance behind the front axle [m] (wheelbase delay)
     sides: tuple[str, ...]      # 'right' | 'left' per corner
     dof_names: tuple[str, ...]
-    bar_map: np.ndarray | None  # (1|P, B, n) anti-roll bar twist = bar_map q [rad]
-    bar_stiffness: np.ndarray | None  # (P, 1, B) [N m/rad]
     network: Network            # the equations of motion (module docstring)
 
     @property
@@ -176,13 +173,11 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     return VehicleModel(
         preset=veh.preset, body_dofs=body_dofs, corners=corners, P=P,
         mass=_shared(mass[:, None, :]), stiffness=_shared(K), damping=_shared(C),
-        travel_map=shared_J, corner_x=x, corner_y=y,
-        unsprung_mass=mu[e], tyre_stiffness=kt[e], tyre_damping=ct[e], spring_linear=kl[e],
+        travel_map=shared_J, input_stiffness=_shared(linear.input_stiffness),
+        input_damping=_shared(linear.input_damping), unsprung_mass=mu[e], tyre_stiffness=kt[e], tyre_damping=ct[e], spring_linear=kl[e],
         spring_cubic=knl[e], damper=c[e], static_tyre_load=static[e],
-        tyre_lift_off=veh.tyre_lift_off, gravity=veh.gravity, offsets=offsets, sides=sides,
-        dof_names=dof_names,
-        bar_map=None if bar_map is None else _shared(bar_map),
-        bar_stiffness=None if bar_k is None else bar_k[:, None, :], network=network)
+        gravity=veh.gravity, offsets=offsets, sides=sides, dof_names=dof_names,
+        network=network)
 
 
 def _rows(a: np.ndarray) -> np.ndarray:
@@ -310,8 +305,10 @@ def frequency_response(model: VehicleModel, f: np.ndarray, speed: float | None =
 
     The same unit-amplitude road height ``exp(jωt)`` enters under each wheel in ``corners``
     (default all), the rear ones delayed by ``offset/speed`` when a speed is given: the
-    complex DOF amplitudes solve ``(K - ω² M + jω C) Q = (k_T + jω c_T) R``. Body
-    accelerations are ``-ω² Q``. Duffing and lift-off are not in the linear model.
+    complex DOF amplitudes solve ``(K - ω² M + jω C) Q = (B_k + jω B_c) R``, the road's
+    terms ``B_k, B_c`` (the tyres' ``k_T, c_T`` on the wheels) from the network's linear
+    model. Body accelerations are ``-ω² Q``. Duffing and lift-off are not in the linear
+    model.
     """
     f = np.atleast_1d(np.asarray(f, dtype=float))
     omega = 2 * np.pi * f
@@ -324,7 +321,7 @@ def frequency_response(model: VehicleModel, f: np.ndarray, speed: float | None =
     C = np.broadcast_to(model.damping, (model.P, n, n))
     dyn = K[:, None] - omega[None, :, None, None] ** 2 * (m[:, None, :, None] * np.eye(n)) \
         + 1j * omega[None, :, None, None] * C[:, None]
-    rhs = np.zeros((model.P, f.size, n), dtype=complex)
-    rhs[..., model.wheels] = (model.tyre_stiffness + 1j * omega[None, :, None]
-                              * model.tyre_damping) * road[None]
-    return np.linalg.solve(dyn, rhs[..., None])[..., 0]
+    B = model.input_stiffness[:, None] + 1j * omega[None, :, None, None] \
+        * model.input_damping[:, None]                                 # (P|1, F, n, N)
+    rhs = np.broadcast_to(B @ road[None, :, :, None], (model.P, f.size, n, 1))
+    return np.linalg.solve(dyn, rhs)[..., 0]
