@@ -16,7 +16,7 @@ Figures of the thesis they correspond to:
 - :func:`sensitivity`: the CDF threshold sweep (Figs. 4.7, 4.10);
 - :func:`transmissibilities`: seat transmissibility and STHT (Eq 2.86, Figs. 2.18b, 8.26);
 - :func:`plot_kesort`: the k-ε levels over a front (Figs. 6.7, 7.5, 7.6), from a
-  :class:`suspopt.selection.Selection` (pyplot, Agg backend).
+  :class:`suspopt.selection.Selection`.
 """
 
 from __future__ import annotations
@@ -257,16 +257,12 @@ def plot_kesort(selection, path: str | Path) -> Path:
     the k-ε level of every design against the first objective (Fig. 6.7). With one objective
     only the right panel is drawn.
     """
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    s, path = selection, Path(path)
+    s, path = selection, check_path(path)
     F, levels, names, units = s.F, s.sort.k_eps, s.names, s.units
     markers = "os^Dv<>phX*"
     two = F.shape[1] > 1
-    fig, axes = plt.subplots(1, 2 if two else 1, figsize=(12 if two else 6, 5), squeeze=False)
-    front, level_ax = (axes[0, 0], axes[0, 1]) if two else (None, axes[0, 0])
+    fig, axes = new_figure(2 if two else 1, panel_size=(6.0, 5.0))
+    front, level_ax = (axes[0], axes[1]) if two else (None, axes[0])
     lo, hi = float(levels.min()), float(levels.max())
     for c, label in enumerate(s.cases):
         rows = s.case == label
@@ -303,7 +299,4 @@ def plot_kesort(selection, path: str | Path) -> Path:
     level_ax.set_title("k-ε levels" + (f", P = {P:.3g}" if P is not None else ""))
     level_ax.grid(alpha=0.3)
     level_ax.legend(loc="best", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save(fig, path)

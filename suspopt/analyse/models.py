@@ -52,7 +52,7 @@ from ..io import atomic_h5, write_dataset
 from ..metrics import psd
 from ..simulate import Result, simulate
 from ..specs import METRICS, evaluate_spec
-from ..vehicle import build_vehicle, modal_analysis
+from ..vehicle import modal_analysis
 from . import KINDS, Kind, Report, relative_change
 
 __all__ = ["ModelResponse", "ModelComparison", "compare_models", "write_models",
@@ -162,7 +162,7 @@ def _response(label: str, source: Path, cfg: Config, result: Result,
                 units[name] = unit
                 corner = name.rpartition(".")[2]
                 order[name] = (j, _CORNERS.index(corner) if corner in _CORNERS else -1)
-    modes = modal_analysis(build_vehicle(cfg))
+    modes = modal_analysis(result.model)
     dominant = [str(d) for d in modes.dominant[0]]
     wheels = [f for f, d in zip(modes.frequency[0], dominant) if d.startswith("wheel.")]
     natural = {dof: modes.frequency[0, dominant.index(dof)] for dof in _NATURAL
