@@ -388,18 +388,20 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
     picked: dict[int, list[str]] = {}
     for key, row in fronts.picks.items():
         picked.setdefault(row, []).append(key)
+    values = [fronts.values(i) for i in range(len(fronts.sets))]
+    changes = [fronts.change(i) for i in range(len(fronts.sets))]
     rows = []
     for k in sorted(set(_spread(len(p.X)).tolist()) | set(picked)):
         row = [str(k), ", ".join(picked.get(k, []))] + [f"{f:.4g}" for f in p.F[k]]
-        for i, s in enumerate(fronts.sets):
+        for s, value, change in zip(fronts.sets, values, changes):
             row += ["failed" if s.failed[k] else f"{f:.4g} ({c:+.0f} %)"
-                    for f, c in zip(fronts.values(i)[k, :m], fronts.change(i)[k, :m])]
+                    for f, c in zip(value[k, :m], change[k, :m])]
         rows.append(row)
     notes = [f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}, with "
              f"the edges and knee of the front (suspopt.kesort.pareto_picks, Fig. 8.21); "
              f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)", *fronts.stored.notes]
-    for i, (v, s) in enumerate(zip(fronts.variants, fronts.sets)):
-        change = fronts.change(i)[~s.failed]
+    for v, s, change in zip(fronts.variants, fronts.sets, changes):
+        change = change[~s.failed]
         spans = [f"{name} {np.min(c):+.1f} to {np.max(c):+.1f} % (median {np.median(c):+.1f} %)"
                  for name, c in zip(names, change.T) if c.size]
         notes.append(f"{v.label}: {int(s.feasible.sum())} of {len(p.X)} designs feasible, "
