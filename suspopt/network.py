@@ -34,7 +34,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-__all__ = ["Elements", "Network", "LinearModel", "apply", "widen"]
+__all__ = ["Elements", "Network", "LinearModel", "apply", "parameter_rows", "widen"]
 
 
 def apply(matrix: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -43,6 +43,12 @@ def apply(matrix: np.ndarray, x: np.ndarray) -> np.ndarray:
     if matrix.ndim == 2:
         return (matrix @ x.reshape(x.shape[0], -1)).reshape(matrix.shape[0], *x.shape[1:])
     return np.einsum("prc,cps->rps", matrix, x)
+
+
+def parameter_rows(values: np.ndarray) -> np.ndarray:
+    """Per-design values ``(P, rows)`` (element parameters, DOF masses) in the network layout
+    ``(rows, P, 1)``, contiguous."""
+    return np.ascontiguousarray(values.T)[:, :, None]
 
 
 def widen(a: np.ndarray, width: int) -> np.ndarray:

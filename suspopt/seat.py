@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from .config import Config, ConfigError
-from .network import Elements, Network, widen
+from .network import Elements, Network, parameter_rows, widen
 from .params import ParamView
 from .vehicle import _shared
 
@@ -556,7 +556,7 @@ def seat_network(dof_names: tuple[str, ...], mass: np.ndarray, links: list,
         groups.append(Elements("mechanism", carried, -np.ones((1, 1)), zero, zero,
                                extra=mechanism.element_force,
                                extra_slope=-mechanism.slope()[None, :, None]))
-    return Network(dof_names, ("floor",), np.ascontiguousarray(mass.T)[:, :, None],
+    return Network(dof_names, ("floor",), parameter_rows(mass),
                    tuple(groups))
 
 

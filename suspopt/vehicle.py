@@ -34,7 +34,7 @@ import numpy as np
 
 from .config import Config, ConfigError
 from .config.vehicle import PRESET_BODY_DOFS, PRESET_CORNERS
-from .network import Elements, Network, widen
+from .network import Elements, Network, parameter_rows, widen
 from .params import ParamView
 
 __all__ = ["VehicleModel", "build_vehicle", "vehicle_network", "modal_analysis", "ModalResult",
@@ -180,9 +180,6 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
         network=network)
 
 
-def _rows(a: np.ndarray) -> np.ndarray:
-    """(P, m) per-design element values as (m, P, 1) network parameters."""
-    return np.ascontiguousarray(a.T)[:, :, None]
 
 
 def vehicle_network(dof_names: tuple[str, ...], mass: np.ndarray, travel_map: np.ndarray,
@@ -200,30 +197,31 @@ def vehicle_network(dof_names: tuple[str, ...], mass: np.ndarray, travel_map: np
     n = mass.shape[1]
     nb = n - N
     squeeze = (lambda a: a[0]) if travel_map.shape[0] == 1 else (lambda a: a)
-    cubic = _rows(spring_cubic)
+    cubic = parameter_rows(spring_cubic)
 
     def duffing(width: int):
         k_nl = widen(cubic, width)
         return lambda disp, rate, force, out: np.multiply(k_nl, disp * disp * disp,
                                                           out=out)     # k_nl ST^3 (Eq 2.31)
-    groups = [Elements("suspension", squeeze(travel_map), np.zeros((N, N)), _rows(spring_linear),
-                       _rows(damper), extra=duffing if np.any(spring_cubic) else None)]
+    groups = [Elements("suspension", squeeze(travel_map), np.zeros((N, N)),
+                       parameter_rows(spring_linear), parameter_rows(damper),
+                       extra=duffing if np.any(spring_cubic) else None)]
     wheels = np.zeros((N, n))
     wheels[np.arange(N), nb + np.arange(N)] = 1.0
-    groups.append(Elements("tyre", wheels, -np.eye(N), _rows(tyre_stiffness),
-                           _rows(tyre_damping)))
+    groups.append(Elements("tyre", wheels, -np.eye(N), parameter_rows(tyre_stiffness),
+                           parameter_rows(tyre_damping)))
     if bar_map is not None:
         groups.append(Elements("anti_roll_bar", squeeze(bar_map),
-                               np.zeros((bar_map.shape[1], N)), _rows(bar_stiffness),
+                               np.zeros((bar_map.shape[1], N)), parameter_rows(bar_stiffness),
                                np.zeros((bar_map.shape[1], P, 1))))
     return Network(dof_names, tuple(f"road.{i}" for i in range(N)),
-                   np.ascontiguousarray(mass.T)[:, :, None], tuple(groups))
+                   parameter_rows(mass), tuple(groups))
 
 
 def tyre_lift_off(static_load: np.ndarray):
     """Non-linear part of a tyre that cannot pull: ``F_T`` is capped at the static load
     ``(P, N)`` [N], so the total normal load ``static - F_T`` never falls below 0."""
-    rows = _rows(static_load)
+    rows = parameter_rows(static_load)
 
     def make(width: int):
         load = widen(rows, width)
