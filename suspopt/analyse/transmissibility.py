@@ -227,21 +227,28 @@ def write_transmissibility(path: str | Path, data: SeatTransmissibility, cfg: Co
     return Path(path)
 
 
+def _curves(data: SeatTransmissibility, curves: Sequence[tuple[int, int, str, str]]):
+    """The lines (linearised) and points (simulated, H1, where the coherence is at least
+    ``_MIN_COHERENCE``, up to 30 Hz) of ``curves``: (design, DOF index, line label, point
+    label) each."""
+    f_sim = data.simulated_frequency
+    band = (f_sim >= data.linear_frequency[0]) & (f_sim <= 30.0)
+    lines, points = [], []
+    for design, j, line_label, point_label in curves:
+        lines.append((line_label, data.linear_frequency, data.linear[design, :, j]))
+        good = band & (data.coherence[design, :, j] >= _MIN_COHERENCE)
+        points.append((point_label, f_sim[good], data.simulated[design, good, j]))
+    return lines, points
+
+
 def plot_transmissibility(data: SeatTransmissibility, path: str | Path,
                           design: int = 0) -> Path:
     """Figure of the seat transmissibility and (with a passenger) STHT of one design: linear
     model as lines, simulation (H1) as dots where the coherence is at least 0.8."""
-    f_sim = data.simulated_frequency
-    band = (f_sim >= data.linear_frequency[0]) & (f_sim <= 30.0)
-    lines, points = [], []
-    for name, label in (("seat", "seat  z̈_seat/z̈_s"), ("head", "STHT  z̈_head/z̈_s")):
-        if name not in data.dof_names:
-            continue
-        j = data.dof_names.index(name)
-        lines.append((f"{label} (linearised)", data.linear_frequency,
-                      data.linear[design, :, j]))
-        good = band & (data.coherence[design, :, j] >= _MIN_COHERENCE)
-        points.append((f"{label} (simulated, H1)", f_sim[good], data.simulated[design, good, j]))
+    lines, points = _curves(data, [
+        (design, data.dof_names.index(name), f"{label} (linearised)", f"{label} (simulated, H1)")
+        for name, label in (("seat", "seat  z̈_seat/z̈_s"), ("head", "STHT  z̈_head/z̈_s"))
+        if name in data.dof_names])
     title = (f"{data.kind.upper()} seat, X_ST = {1e3 * data.static_deflection[design]:.1f} mm "
              f"(Eq 2.86)")
     return plots.transmissibilities(path, title, lines, points,
@@ -254,16 +261,10 @@ def plot_front_transmissibility(data: SeatTransmissibility, designs: FrontDesign
     (Fig. 8.26): linearised as lines, simulated (H1) as dots where coherent."""
     name = "head" if "head" in data.dof_names else "seat"
     j = data.dof_names.index(name)
-    f_sim = data.simulated_frequency
-    band = (f_sim >= data.linear_frequency[0]) & (f_sim <= 30.0)
-    lines, points = [], []
-    for p, picks in enumerate(designs.picks):
-        label = f"{' = '.join(picks)} (#{designs.rows[p]}, X_ST " \
-                f"{1e3 * data.static_deflection[p]:.1f} mm)"
-        lines.append((label, data.linear_frequency, data.linear[p, :, j]))
-        good = band & (data.coherence[p, :, j] >= _MIN_COHERENCE)
-        points.append((f"{' = '.join(picks)} (simulated, H1)", f_sim[good],
-                       data.simulated[p, good, j]))
+    lines, points = _curves(data, [
+        (p, j, f"{' = '.join(picks)} (#{designs.rows[p]}, X_ST "
+               f"{1e3 * data.static_deflection[p]:.1f} mm)",
+         f"{' = '.join(picks)} (simulated, H1)") for p, picks in enumerate(designs.picks)])
     what = "STHT z̈_head/z̈_s" if name == "head" else "seat TR z̈_seat/z̈_s"
     return plots.transmissibilities(path, f"{title}: {what} (Eq 2.86)", lines, points,
                                     f_range=(data.linear_frequency[0], 30.0))
