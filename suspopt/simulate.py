@@ -603,7 +603,13 @@ class SignalMap(Mapping):
         if head == "tyre_force":
             # the normal load, compression +: static load less the tyre element's force
             elastic, viscous = r.element_forces("tyre")
-            return m.static_tyre_load[:, 0, c, None] - (elastic[c] + viscous[c])
+            static = m.static_tyre_load[:, 0, c, None]
+            force = elastic[c] + viscous[c]
+            if r.config.vehicle.tyre_lift_off:
+                # a lifted tyre carries exactly 0: the force is capped at the static load, and
+                # adding the capped parts back up can round past the cap by an ulp
+                force = np.minimum(force, static)
+            return static - force
         raise KeyError(name)
 
 
