@@ -122,7 +122,7 @@ def test_models_on_a_random_road_compare_ride_metrics_per_corner(tmp_path):
     ("one", "at least two configs"),
     ("mixed", "one kind of road"),
     ("reference", "not one of the configs compared"),
-    ("pareto", "cannot read config"),
+    ("pareto", "not a YAML config"),
 ])
 def test_models_bad_input_exits_2_with_one_line_and_no_output(tmp_path, case, needle):
     qc = short(tmp_path, "part1a_qc_bump", 3.0)

@@ -14,10 +14,13 @@ class Section(BaseModel):
     """Base class of all config sections.
 
     Unknown keys are errors (a misspelt key must never be silently ignored) and fields are
-    validated on assignment so that a programmatic edit is checked like a YAML value.
+    validated on assignment so that a programmatic edit is checked like a YAML value. Types
+    are strict: a number field takes a number (an integer field a whole number written
+    without a point), never a boolean or a string, and a text field takes text.
     """
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False)
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False,
+                              strict=True)
 
 
 def check_known(what: str, name: str, known: Iterable[str]) -> str:

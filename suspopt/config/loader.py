@@ -22,6 +22,7 @@ from .road import RoadConfig
 from .seat import SeatConfig
 from .simulation import Output, Simulation
 from .vehicle import Vehicle
+from .yamlio import YamlError, parse_yaml, read_text
 
 __all__ = ["Config", "ConfigError", "load_config", "load_config_text", "config_schema"]
 
@@ -149,7 +150,8 @@ def _format(err: dict, lines: dict, data: Any) -> tuple[str, int | None]:
     elif err["type"] == "missing":
         msg = "required key is missing"
     elif not custom and "input" in err and not isinstance(err["input"], (dict, list)):
-        msg = f"{msg} (got {err['input']!r})"
+        got = repr(err["input"])
+        msg = f"{msg} (got {got if len(got) <= 40 else got[:37] + '...'})"
     return f"{dotted}: {msg}", _line_of(loc, lines)
 
 
@@ -200,16 +202,15 @@ def _allowed_keys(loc: tuple) -> list[str]:
 
 
 def load_config_text(text: str, source: Path | None = None) -> Config:
-    """Parse and validate YAML text; raise ConfigError with file, line and key path."""
+    """Parse and validate YAML text; raise ConfigError with file, line and key path.
+
+    The YAML is read by :func:`suspopt.config.yamlio.parse_yaml`: safe tags, the YAML 1.2
+    core schema, bounded depth and size, no duplicate keys."""
     name = str(source) if source is not None else "<config>"
     try:
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = f"{mark.line + 1}" if mark is not None else "?"
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise ConfigError(f"{name}:{line}: malformed YAML: {problem}") from None
+        data, node = parse_yaml(text)
+    except YamlError as exc:
+        raise ConfigError(f"{name}{f':{exc.line}' if exc.line else ''}: {exc}") from None
     if not isinstance(data, dict):
         raise ConfigError(f"{name}:1: the config must be a mapping of sections "
                           f"(vehicle, road, simulation, ...)")
@@ -233,14 +234,15 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
 
 
 def load_config(path: str | Path) -> Config:
-    """Read and validate a YAML config file."""
+    """Read and validate a YAML config file (a regular UTF-8 file of at most
+    :data:`~suspopt.config.yamlio.MAX_CONFIG_BYTES`)."""
     path = Path(path)
     try:
-        text = path.read_text()
+        text = read_text(path)
     except FileNotFoundError:
         raise ConfigError(f"{path}: no such config file") from None
-    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read config ({exc.__class__.__name__})") from None
+    except YamlError as exc:
+        raise ConfigError(f"{path}{f':{exc.line}' if exc.line else ''}: {exc}") from None
     return load_config_text(text, path)
 
 

@@ -150,7 +150,7 @@ class FileRoad(_DeterministicRoad):
     """
 
     kind: Literal["file"] = Field(description="profile read from a CSV file")
-    path: Path = Field(description="CSV file with columns distance [m], height [m] and an "
+    path: Path = Field(strict=False, description="CSV file with columns distance [m], height [m] and an "
                        "optional header line; relative to the config file's directory")
     scale: _Finite = Field(1.0, description="factor applied to the heights [-]")
 
