@@ -11,9 +11,9 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field, NonNegativeFloat, PositiveFloat, model_validator
+from pydantic import Field, model_validator
 
-from .base import Section
+from .base import Duration, Section, quantity
 
 __all__ = ["Threshold", "Control", "DEFAULT_SAMPLE_TIME"]
 
@@ -38,8 +38,8 @@ class Threshold(Section):
 
     mode: Literal["fixed", "adaptive"] = Field(
         description="fixed: T = value; adaptive: T re-fitted from the condition history")
-    value: float | None = Field(
-        None, allow_inf_nan=False,
+    value: quantity(-1e12, 1e12) | None = Field(
+        None,
         description="fixed threshold T in the unit of the laws' condition (m^2/s^2 for SH-2, "
         "SH-L, SH-ADD-1, groundhook, hybrid; m^2/s^3 for ADD; m^2/s^4 for SH-ADD-2); mode "
         "fixed only")
@@ -47,10 +47,10 @@ class Threshold(Section):
         None, gt=0, lt=1, allow_inf_nan=False,
         description="share of the samples to operate at C_max, the thesis's 1 - N% (0.27 in "
         "Tables 4.2-4.3) [-]; mode adaptive only")
-    learn_time: PositiveFloat = Field(
+    learn_time: Duration = Field(
         5.0, description="T_learn: the base law runs until t >= learn_time, then the first fit "
         "is made [s] (Fig. 4.4; the thesis says 'a few seconds')")
-    refit_factor: PositiveFloat = Field(
+    refit_factor: quantity(1e-3, 1e3) = Field(
         1.0, description="kappa: the threshold is re-fitted every refit_factor * learn_time "
         "seconds (Fig. 4.4) [-]")
     distribution: Literal["student_t", "normal", "empirical"] = Field(
@@ -85,10 +85,10 @@ class Control(Section):
     updated exactly once per integration step.
     """
 
-    sample_time: PositiveFloat = Field(
+    sample_time: quantity(1e-7, 10.0) = Field(
         DEFAULT_SAMPLE_TIME, description="controller sample time ΔT [s], a whole multiple of "
         "simulation.dt (Sec 4.2: 4 ms)")
-    actuator_lag: NonNegativeFloat = Field(
+    actuator_lag: quantity(0.0, 10.0) = Field(
         0.0, description="time constant τ of the damper's first-order response to a new "
         "command [s]; 0 switches instantly")
     threshold: Threshold | None = Field(

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field, PositiveFloat, field_validator
+from pydantic import Field, field_validator
 
 from ..specs import METRICS
-from .base import Section, check_known
+from .base import Duration, Section, check_known, quantity
 
 __all__ = ["MetricSpec"]
 
@@ -25,8 +25,8 @@ class MetricSpec(Section):
     weighting: Literal["Wk", "Wd", "Wf", "Wc", "We", "Wj"] | None = Field(
         None, description="ISO 2631-1 frequency weighting for rms_weighted, vdv, mtvv, "
         "crest_factor (none: unweighted)")
-    tau: PositiveFloat = Field(1.0, description="running r.m.s. integration time for mtvv [s]")
-    band: PositiveFloat = Field(0.02, description="settling band for transient metrics [-]")
+    tau: Duration = Field(1.0, description="running r.m.s. integration time for mtvv [s]")
+    band: quantity(0.0, 1.0, closed=False) = Field(0.02, description="settling band for transient metrics [-]")
 
     @field_validator("metric")
     @classmethod

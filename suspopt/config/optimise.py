@@ -21,16 +21,21 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal
 
-from pydantic import (Field, NonNegativeFloat, PositiveFloat, PositiveInt, field_validator,
-                      model_validator)
+from pydantic import Field, field_validator, model_validator
 
-from .base import Section, check_known
+from .base import Section, Seed, check_known, quantity
 from .metrics import MetricSpec
 
 __all__ = ["QUANTITIES", "ALGORITHMS", "DesignVariable", "Objective", "Constraint",
            "Objectives", "WeightedSum", "Balance", "Hybrid", "Gradient", "Optimiser"]
 
-_Finite = Annotated[float, Field(allow_inf_nan=False)]
+#: a bound or limit in a field's or a metric's SI unit
+_Finite = quantity(-1e15, 1e15)
+
+
+def _count(high: int) -> Any:
+    """A whole number from 1 to ``high``."""
+    return Annotated[int, Field(ge=1, le=high)]
 
 #: Design quantities that need no simulation.
 QUANTITIES: dict[str, str] = {
@@ -123,7 +128,7 @@ class Constraint(Objective):
 
     min: _Finite | None = Field(None, description="lowest allowed value (g = min - value)")
     max: _Finite | None = Field(None, description="highest allowed value (g = value - max)")
-    mu: PositiveFloat | None = Field(
+    mu: quantity(0.0, 1.0, closed=False) | None = Field(
         None, description="μ of the NSS3 condition d < μ R (Table 8.9 #4; quantity "
         "seat.geometry only; default 0.8, Sec 8.3.4)")
     conditions: list[str] | None = Field(
@@ -174,17 +179,17 @@ class Balance(Section):
     magnitude above the others for ``factor: 10`` (Case 5).
     """
 
-    samples: PositiveInt = Field(100, description="random designs simulated to balance")
+    samples: _count(1_000_000) = Field(100, description="random designs simulated to balance")
     dominant: str | None = Field(None, description="name of the objective that dominates "
                                  "(Case 5: f1)")
-    factor: PositiveFloat = Field(10.0, description="how much the dominant term outweighs "
+    factor: quantity(0.0, 1e6, closed=False) = Field(10.0, description="how much the dominant term outweighs "
                                   "the others [-] (Case 5: 10)")
 
 
 class WeightedSum(Section):
     """Pseudo multi-objective optimisation, Eq 5.7: minimise ``sum_i w_i f_i``."""
 
-    weights: list[NonNegativeFloat] | None = Field(
+    weights: list[quantity(0.0, 1e12)] | None = Field(
         None, description="one weight per main objective, in the order of objectives.main")
     balance: Balance | None = Field(None, description="derive the weights from random "
                                     "designs instead (Cases 4-5)")
@@ -201,7 +206,7 @@ class WeightedSum(Section):
 class Hybrid(Section):
     """GA, then SLSQP from the GA's best inside a box around it (Sec 5.1.1, S3-S4)."""
 
-    ga_generations: PositiveInt = Field(10, description="generations of the GA before the "
+    ga_generations: _count(1_000_000) = Field(10, description="generations of the GA before the "
                                         "gradient takes over (Sec 5.1.1: 10)")
     shrink: float = Field(0.2, gt=0, le=1, description="the gradient's box: the GA best ± "
                           "shrink/2 of each variable's range, cut by the original bounds [-]")
@@ -220,19 +225,19 @@ class Optimiser(Section):
     algorithm: str = Field(description="ga | nsga2 | gradient | hybrid, or a pymoo algorithm: "
                            + ", ".join(k for k in ALGORITHMS if k not in
                                        ("ga", "nsga2", "gradient", "hybrid")))
-    seed: int = Field(description="seed of the run's random generator (required: runs are "
+    seed: Seed = Field(description="seed of the run's random generator (required: runs are "
                       "reproducible bit for bit)")
-    population: PositiveInt | None = Field(None, description="population size (S1/S3: 200, "
+    population: _count(1_000_000) | None = Field(None, description="population size (S1/S3: 200, "
                                            "S2/S4: 1000); not for gradient")
-    generations: PositiveInt | None = Field(
+    generations: _count(1_000_000) | None = Field(
         None, description="most generations (gradient: SLSQP iterations; hybrid: GA "
         "generations plus SLSQP iterations)")
-    max_evaluations: PositiveInt | None = Field(None, description="most designs simulated")
-    tolerance: PositiveFloat = Field(
+    max_evaluations: _count(10 ** 10) | None = Field(None, description="most designs simulated")
+    tolerance: quantity(0.0, 1.0, closed=False) = Field(
         1.0e-6, description="stop when the best objective improves less than this over "
         "stall_generations (GA; Ch. 5: 1e-6), or SLSQP's ftol on the objective scaled by its "
         "value at the start")
-    stall_generations: PositiveInt = Field(30, description="window of the tolerance test of "
+    stall_generations: _count(100_000) = Field(30, description="window of the tolerance test of "
                                            "population algorithms")
     weighted_sum: WeightedSum | None = Field(None, description="combine the main objectives "
                                              "into one (Eq 5.7)")

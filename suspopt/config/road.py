@@ -24,7 +24,7 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from .base import Section
+from .base import RoadHeight, RoadLength, Seed, Section, Speed, quantity
 
 __all__ = [
     "Tracks", "BumpStep", "BumpHalfSine", "Iso8608Road", "FileRoad", "RoadConfig",
@@ -33,8 +33,10 @@ __all__ = [
 
 Tracks = Literal["identical", "independent", "right_only", "left_only"]
 
-_Finite = Annotated[float, Field(allow_inf_nan=False)]
-_Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+#: [s] when the front wheels reach a bump
+_Start = quantity(0.0, 1e5)
+#: [cycles/m] spatial frequencies, down to a 10 km wavelength and up to a 1 cm one
+_SpatialFrequency = quantity(1e-4, 100.0)
 _TRACKS_DESCRIPTION = (
     "what the two sides see: 'identical' (left = right), 'independent' (left is an independent "
     "realisation; iso8608 only), 'right_only' / 'left_only' (the other side is flat)")
@@ -44,7 +46,7 @@ _SPEED_DESCRIPTION = "constant vehicle speed V [m/s]"
 class _Road(Section):
     """Fields every road kind has."""
 
-    speed: _Positive = Field(description=_SPEED_DESCRIPTION)
+    speed: Speed = Field(description=_SPEED_DESCRIPTION)
     tracks: Tracks = Field("identical", description=_TRACKS_DESCRIPTION)
     wheelbase_delay: bool = Field(True, description="rear wheels meet the road (a_F + a_R)/V "
                                   "after the front ones (Sec 2.5.2); false feeds both axles "
@@ -72,11 +74,10 @@ class BumpStep(_DeterministicRoad):
     """
 
     kind: Literal["bump_step"] = Field(description="rectangular bump, Eq 2.103-2.104")
-    height: _Finite = Field(description="plateau height h [m]; negative for a pothole")
-    length: _Positive = Field(description="length of the raised plateau on the road [m] (the "
+    height: RoadHeight = Field(description="plateau height h [m]; negative for a pothole")
+    length: RoadLength = Field(description="length of the raised plateau on the road [m] (the "
                               "thesis's L, Fig. 2.21); a wheel stays on it for length/speed s")
-    start: float = Field(ge=0, allow_inf_nan=False,
-                         description="time at which the front wheels reach the bump t0 [s]")
+    start: _Start = Field(description="time at which the front wheels reach the bump t0 [s]")
 
 
 class BumpHalfSine(_DeterministicRoad):
@@ -87,11 +88,10 @@ class BumpHalfSine(_DeterministicRoad):
     """
 
     kind: Literal["bump_half_sine"] = Field(description="half-sine bump, Eq 2.101-2.102")
-    height: _Finite = Field(description="crest height h [m]; negative for a dip")
-    length: _Positive = Field(description="base length of the half-sine on the road L_b [m] "
+    height: RoadHeight = Field(description="crest height h [m]; negative for a dip")
+    length: RoadLength = Field(description="base length of the half-sine on the road L_b [m] "
                               "(the thesis's L/2, ERRATA Eq 2.101); crossing lasts length/speed s")
-    start: float = Field(ge=0, allow_inf_nan=False,
-                         description="time at which the front wheels reach the bump t0 [s]")
+    start: _Start = Field(description="time at which the front wheels reach the bump t0 [s]")
 
 
 class Iso8608Road(_Road):
@@ -106,22 +106,22 @@ class Iso8608Road(_Road):
     road_class: Literal["A", "B", "C", "D", "E"] | None = Field(
         None, description="ISO 8608 class; sets G_d(n0) to the class's geometric mean "
         "(A 16, B 64, C 256, D 1024, E 4096 x 1e-6 m^3)")
-    level: _Positive | None = Field(
+    level: quantity(1e-12, 1.0) | None = Field(
         None, description="displacement PSD level G_d(n0) at n0 = 0.1 cycles/m [m^3]; "
         "overrides road_class")
     convention: Literal["iso8608", "thesis"] = Field(
         description="amplitude convention: 'iso8608' A_i = sqrt(2 G_d(n_i) dn) (one-sided PSD, "
         "the standard's meaning) or 'thesis' A_i = sqrt(Phi(Omega_i) dOmega / pi) (Eq 2.99; "
         "1/sqrt(2 pi) times smaller)")
-    waviness: _Positive = Field(2.0, description="waviness w, the PSD slope exponent (Eq 2.93) [-]")
-    n_min: _Positive = Field(0.011, description="lowest spatial frequency generated [cycles/m]")
-    n_max: _Positive = Field(2.83, validate_default=True,
+    waviness: quantity(0.1, 10.0) = Field(2.0, description="waviness w, the PSD slope exponent (Eq 2.93) [-]")
+    n_min: _SpatialFrequency = Field(0.011, description="lowest spatial frequency generated [cycles/m]")
+    n_max: _SpatialFrequency = Field(2.83, validate_default=True,
                              description="highest spatial frequency generated [cycles/m]")
     n_waves: int | None = Field(
-        None, ge=2, description="number of harmonics N, uniformly spaced from n_min to n_max "
+        None, ge=2, le=10_000_000, description="number of harmonics N, uniformly spaced from n_min to n_max "
         "inclusive (Eq 2.100); default: the smallest N whose spacing (n_max - n_min)/(N - 1) is "
         "at most 1/L, L the length of road the wheels travel [m], so the road does not repeat")
-    seed: int = Field(0, ge=0, description="seed of the random phases; the same seed gives the "
+    seed: Seed = Field(0, description="seed of the random phases; the same seed gives the "
                       "same road bit for bit (default 0)")
 
     @field_validator("n_max")
@@ -152,7 +152,7 @@ class FileRoad(_DeterministicRoad):
     kind: Literal["file"] = Field(description="profile read from a CSV file")
     path: Path = Field(strict=False, description="CSV file with columns distance [m], height [m] and an "
                        "optional header line; relative to the config file's directory")
-    scale: _Finite = Field(1.0, description="factor applied to the heights [-]")
+    scale: quantity(-1e3, 1e3) = Field(1.0, description="factor applied to the heights [-]")
 
     @field_validator("path")
     @classmethod

@@ -29,38 +29,39 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import Field, NonNegativeFloat, PositiveFloat, model_validator
+from pydantic import Field, model_validator
 
-from .base import Section
+from .base import Damping, Mass, Ratio, Section, SeatLength, Stiffness, quantity
 
 __all__ = ["Position", "Segment", "Link", "Passenger", "PassiveSeat", "CarrellaSeat", "LeSeat",
            "YanSeat", "KDamperSeat", "SeatConfig", "TABLE_2_3"]
 
-_Finite = Annotated[float, Field(allow_inf_nan=False)]
+#: [m] a point of the body relative to its centre of gravity
+_BodyPoint = quantity(-100.0, 100.0)
 
 
 class Position(Section):
     """Where the seat stands on the body (DESIGN.md: x + forward, y + right of the CG)."""
 
-    x: _Finite = Field(0.0, description="longitudinal distance ahead of the body's centre of "
+    x: _BodyPoint = Field(0.0, description="longitudinal distance ahead of the body's centre of "
                        "gravity [m] (Ch. 7: e = 0.4)")
-    y: _Finite = Field(0.0, description="lateral distance to the right of the centre of "
+    y: _BodyPoint = Field(0.0, description="lateral distance to the right of the centre of "
                        "gravity [m]")
 
 
 class Segment(Section):
     """One body part of the passenger and the spring-damper joining it to the part below."""
 
-    mass: PositiveFloat = Field(description="mass of the body part m_i [kg]")
-    stiffness: PositiveFloat = Field(description="stiffness k_i to the part below [N/m]")
-    damping: NonNegativeFloat = Field(description="damping c_i to the part below [N s/m]")
+    mass: Mass = Field(description="mass of the body part m_i [kg]")
+    stiffness: Stiffness = Field(description="stiffness k_i to the part below [N/m]")
+    damping: Damping = Field(description="damping c_i to the part below [N s/m]")
 
 
 class Link(Section):
     """A spring-damper between two body parts."""
 
-    stiffness: PositiveFloat = Field(description="stiffness [N/m]")
-    damping: NonNegativeFloat = Field(description="damping [N s/m]")
+    stiffness: Stiffness = Field(description="stiffness [N/m]")
+    damping: Damping = Field(description="damping [N s/m]")
 
 
 #: Table 2.3: mass [kg], stiffness [N/m] and damping [N s/m] of each part, and what its k, c
@@ -124,10 +125,10 @@ class Passenger(Section):
 class _Seat(Section):
     """Fields every isolator has."""
 
-    mass: PositiveFloat = Field(
+    mass: Mass = Field(
         description="mass moving on the isolator m_se [kg]: the seat alone (13.6) with a "
         "passenger model, the seat and the lumped passenger (Ch. 8: 95) without one")
-    damping: NonNegativeFloat = Field(
+    damping: Damping = Field(
         description="damper C_v [N s/m]: floor to seat (PS, NSS1-NSS3), seat to inner mass "
         "(NSS4)")
     position: Position = Field(default_factory=Position,
@@ -152,7 +153,7 @@ class PassiveSeat(_Seat):
     """PS: linear spring and damper, Eq 2.40 (ERRATA: the seat mass accelerates, x'')."""
 
     kind: Literal["ps"] = Field(description="passive seat, Eq 2.40")
-    stiffness: PositiveFloat = Field(description="spring K_v [N/m] (Table 8.2: 1e4-1.5e5)")
+    stiffness: Stiffness = Field(description="spring K_v [N/m] (Table 8.2: 1e4-1.5e5)")
 
 
 class CarrellaSeat(_NegativeStiffnessSeat):
@@ -163,10 +164,10 @@ class CarrellaSeat(_NegativeStiffnessSeat):
     """
 
     kind: Literal["nss1"] = Field(description="Carrella et al. isolator, Eq 2.41-2.45")
-    stiffness_ratio: NonNegativeFloat = Field(description="α = K_h/K_v [-] (Table 8.4: 0-5)")
+    stiffness_ratio: Ratio = Field(description="α = K_h/K_v [-] (Table 8.4: 0-5)")
     gamma: float = Field(gt=0, lt=1, description="γ = a_o/L_o = cos θ_o [-] (Table 8.4: "
                          "0.01-0.99)")
-    wall_distance: PositiveFloat = Field(description="a_o, horizontal distance from the seat "
+    wall_distance: SeatLength = Field(description="a_o, horizontal distance from the seat "
                                          "axis to the springs' anchors [m] (Table 8.4: 0.1-0.3)")
 
 
@@ -178,12 +179,12 @@ class LeSeat(_NegativeStiffnessSeat):
     """
 
     kind: Literal["nss2"] = Field(description="Le et al. isolator, Eq 2.46-2.52")
-    stiffness_ratio: NonNegativeFloat = Field(description="α = K_h/K_v [-] (Table 8.6: 0-1)")
-    spring_free_length: PositiveFloat = Field(description="L_o, free length of a horizontal "
-                                              "spring [m] (Table 8.6: 0.1-0.3)")
-    wall_distance: PositiveFloat = Field(description="a_o, distance from the seat axis to a "
+    stiffness_ratio: Ratio = Field(description="α = K_h/K_v [-] (Table 8.6: 0-1)")
+    spring_free_length: SeatLength = Field(description="L_o, free length of a horizontal "
+                                           "spring [m] (Table 8.6: 0.1-0.3)")
+    wall_distance: SeatLength = Field(description="a_o, distance from the seat axis to a "
                                          "spring's anchor [m] (Table 8.6: 0.1-0.3)")
-    bar_length: PositiveFloat = Field(description="b, length of a bar [m] (Table 8.6: "
+    bar_length: SeatLength = Field(description="b, length of a bar [m] (Table 8.6: "
                                       "0.05-0.3)")
 
     @model_validator(mode="after")
@@ -205,13 +206,13 @@ class YanSeat(_NegativeStiffnessSeat):
     """
 
     kind: Literal["nss3"] = Field(description="Yan et al. isolator, Eq 2.53-2.58")
-    stiffness_ratio: NonNegativeFloat = Field(description="α = K_h/K_v [-] (Table 8.8: 0-5)")
-    cam_radius: PositiveFloat = Field(description="R, cam radius [m] (Table 8.8: 0.01-0.25)")
-    roller_radius: PositiveFloat = Field(description="r, roller radius [m] (Table 8.8: "
+    stiffness_ratio: Ratio = Field(description="α = K_h/K_v [-] (Table 8.8: 0-5)")
+    cam_radius: SeatLength = Field(description="R, cam radius [m] (Table 8.8: 0.01-0.25)")
+    roller_radius: SeatLength = Field(description="r, roller radius [m] (Table 8.8: "
                                          "0.01-0.25)")
-    cam_offset: NonNegativeFloat = Field(description="d, distance from the cam centre [m] "
+    cam_offset: quantity(0.0, 10.0) = Field(description="d, distance from the cam centre [m] "
                                          "(Table 8.8: 0-0.25)")
-    precompression: PositiveFloat = Field(
+    precompression: SeatLength = Field(
         description="u_2, precompression of the horizontal springs [m]; no default on purpose: "
         "Sec 2.2.4 uses 0.01, Ch. 8 (Sec 8.2.2) 0.001 (ERRATA)")
 
@@ -235,19 +236,19 @@ class KDamperSeat(_NegativeStiffnessSeat):
     """
 
     kind: Literal["nss4"] = Field(description="KDamper, Eq 2.59-2.69")
-    support_stiffness: PositiveFloat = Field(description="K_S, floor to seat [N/m] (Table 8.10: "
+    support_stiffness: Stiffness = Field(description="K_S, floor to seat [N/m] (Table 8.10: "
                                              "1e4-1.5e5)")
-    inner_stiffness: PositiveFloat = Field(description="K_v, seat to inner mass [N/m] "
+    inner_stiffness: Stiffness = Field(description="K_v, seat to inner mass [N/m] "
                                            "(Table 8.10: 2e3-7e4)")
-    horizontal_stiffness: NonNegativeFloat = Field(description="K_h, each horizontal spring "
+    horizontal_stiffness: quantity(0.0, 1e10) = Field(description="K_h, each horizontal spring "
                                                    "[N/m] (Table 8.10: 2e3-7e4)")
-    spring_free_length: PositiveFloat = Field(description="L_o, free length of a horizontal "
-                                              "spring [m] (Table 8.10: 0.1-0.3)")
-    wall_distance: PositiveFloat = Field(description="a_o [m] (Table 8.10: 0.1-0.3)")
-    bar_length: PositiveFloat = Field(description="b, bar length [m] (Table 8.10: 0.1-0.3)")
-    hinge_offset: _Finite = Field(0.001, description="u_0, the hinge's height above the "
+    spring_free_length: SeatLength = Field(description="L_o, free length of a horizontal "
+                                           "spring [m] (Table 8.10: 0.1-0.3)")
+    wall_distance: SeatLength = Field(description="a_o [m] (Table 8.10: 0.1-0.3)")
+    bar_length: SeatLength = Field(description="b, bar length [m] (Table 8.10: 0.1-0.3)")
+    hinge_offset: quantity(-10.0, 10.0) = Field(0.001, description="u_0, the hinge's height above the "
                                   "horizontal at rest [m] (Sec 2.2.5: 1 mm)")
-    inner_mass: PositiveFloat = Field(1.0, description="m_d, inner mass [kg] (Sec 2.2.5: 1)")
+    inner_mass: Mass = Field(1.0, description="m_d, inner mass [kg] (Sec 2.2.5: 1)")
 
     @model_validator(mode="after")
     def _hinge_within_bar(self) -> "KDamperSeat":

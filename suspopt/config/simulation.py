@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pydantic import Field, PositiveFloat, model_validator
+from pydantic import Field, model_validator
 
-from .base import Section
+from .base import Duration, Section, Step
 
 __all__ = ["Simulation", "Output"]
 
@@ -12,9 +12,9 @@ __all__ = ["Simulation", "Output"]
 class Simulation(Section):
     """Fixed-step integration settings (classical 4th-order Runge-Kutta)."""
 
-    duration: PositiveFloat = Field(description="simulated time [s]")
-    dt: PositiveFloat = Field(1.0e-3, description="integration step [s]")
-    output_dt: PositiveFloat | None = Field(
+    duration: Duration = Field(description="simulated time [s]")
+    dt: Step = Field(1.0e-3, description="integration step [s]")
+    output_dt: Step | None = Field(
         None, description="output sample interval [s], a whole multiple of dt (default dt)")
 
     @model_validator(mode="after")

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar, Literal, Union
 
-from pydantic import (Discriminator, Field, NonNegativeFloat, PositiveFloat, Tag,
-                      model_validator)
+from pydantic import Discriminator, Field, Tag, model_validator
 
-from .base import Section
+from .base import (CubicStiffness, Damping, Inertia, Mass, Section, Stiffness,
+                   TorsionalStiffness, VehicleLength, quantity)
 
 __all__ = [
     "PRESET_CORNERS", "PRESET_BODY_DOFS", "DAMPER_LAWS", "LAW_PARAMETERS", "Spring", "Tyre",
@@ -51,16 +51,16 @@ _REQUIRED_BODY = {
 class Spring(Section):
     """Suspension spring, Eq 2.30 (linear) or Eq 2.31 (Duffing): F_K = k_l ST + k_nl ST^3."""
 
-    linear: PositiveFloat = Field(description="linear stiffness k_l [N/m]")
-    cubic: float = Field(0.0, description="cubic (Duffing) coefficient k_nl [N/m^3]; "
+    linear: Stiffness = Field(description="linear stiffness k_l [N/m]")
+    cubic: CubicStiffness = Field(0.0, description="cubic (Duffing) coefficient k_nl [N/m^3]; "
                          "positive hardens (the thesis's case), negative softens")
 
 
 class Tyre(Section):
     """Tyre spring and optional damper, Eq 2.28-2.29."""
 
-    stiffness: PositiveFloat = Field(description="tyre vertical stiffness k_T [N/m]")
-    damping: NonNegativeFloat = Field(0.0, description="tyre damping c_T [N s/m] (Eq 2.29; "
+    stiffness: Stiffness = Field(description="tyre vertical stiffness k_T [N/m]")
+    damping: Damping = Field(0.0, description="tyre damping c_T [N s/m] (Eq 2.29; "
                                       "the thesis mostly takes 0)")
 
 
@@ -68,7 +68,7 @@ class PassiveDamper(Section):
     """Passive suspension damper, Eq 2.32: F_C = c dST/dt."""
 
     kind: Literal["passive"] = Field("passive", description="damper type (default passive)")
-    c: NonNegativeFloat = Field(description="viscous damping coefficient [N s/m]")
+    c: Damping = Field(description="viscous damping coefficient [N s/m]")
 
     #: field holding the coefficient of the linear analyses (modes, frequency response)
     soft_field: ClassVar[str] = "c"
@@ -95,16 +95,16 @@ class SemiActiveDamper(Section):
     """
 
     kind: Literal["semi_active"] = Field(description="damper type")
-    c_min: NonNegativeFloat = Field(description="soft damping coefficient C_min [N s/m]")
-    c_max: NonNegativeFloat = Field(description="stiff damping coefficient C_max [N s/m], "
+    c_min: Damping = Field(description="soft damping coefficient C_min [N s/m]")
+    c_max: Damping = Field(description="stiff damping coefficient C_max [N s/m], "
                                     "at least c_min")
     law: Literal[DAMPER_LAWS] = Field(description="control law: " + " | ".join(DAMPER_LAWS))
     linear_weight: float | None = Field(
         None, ge=0, le=1, allow_inf_nan=False,
         description="SH-L tuning parameter alpha of Eq 2.35 in [0, 1] [-]; 1 gives SH-2 "
         "(law sh_l only)")
-    crossover_frequency: PositiveFloat | None = Field(
-        None, allow_inf_nan=False,
+    crossover_frequency: quantity(1e-3, 1e5) | None = Field(
+        None,
         description="frequency-range selector alpha of Eq 2.37-2.39 [rad/s] (the thesis uses "
         "39 rad/s, about 6 Hz; laws sh_add_1 and sh_add_2 only)")
     skyhook_weight: float | None = Field(
@@ -146,7 +146,7 @@ Damper = Annotated[
 class Corner(Section):
     """One corner: an unsprung mass on a tyre, joined to the body by a spring and a damper."""
 
-    unsprung_mass: PositiveFloat = Field(description="unsprung mass m_u [kg]")
+    unsprung_mass: Mass = Field(description="unsprung mass m_u [kg]")
     tyre: Tyre
     spring: Spring
     damper: Damper
@@ -159,13 +159,13 @@ class Body(Section):
     ``y = +b_right`` (right, F1/R1) / ``-b_left`` (left, F2/R2).
     """
 
-    mass: PositiveFloat = Field(description="sprung mass of the model [kg] (QC: m_s/4, HC: m_s/2)")
-    roll_inertia: PositiveFloat | None = Field(None, description="roll inertia about x [kg m^2]")
-    pitch_inertia: PositiveFloat | None = Field(None, description="pitch inertia about y [kg m^2]")
-    a_front: PositiveFloat | None = Field(None, description="CG to front axle a_F [m]")
-    a_rear: PositiveFloat | None = Field(None, description="CG to rear axle a_R [m]")
-    b_right: PositiveFloat | None = Field(None, description="CG to right wheels b_1 [m]")
-    b_left: PositiveFloat | None = Field(None, description="CG to left wheels b_2 [m]")
+    mass: Mass = Field(description="sprung mass of the model [kg] (QC: m_s/4, HC: m_s/2)")
+    roll_inertia: Inertia | None = Field(None, description="roll inertia about x [kg m^2]")
+    pitch_inertia: Inertia | None = Field(None, description="pitch inertia about y [kg m^2]")
+    a_front: VehicleLength | None = Field(None, description="CG to front axle a_F [m]")
+    a_rear: VehicleLength | None = Field(None, description="CG to rear axle a_R [m]")
+    b_right: VehicleLength | None = Field(None, description="CG to right wheels b_1 [m]")
+    b_left: VehicleLength | None = Field(None, description="CG to left wheels b_2 [m]")
 
 
 class AntiRollBars(Section):
@@ -175,8 +175,8 @@ class AntiRollBars(Section):
     angle ``(z_right - z_left)/(b_right + b_left)`` (ERRATA for Eq 2.11-2.12, 2.25).
     """
 
-    front: NonNegativeFloat = Field(0.0, description="front bar k_AR,F [N m/rad]")
-    rear: NonNegativeFloat = Field(0.0, description="rear bar k_AR,R [N m/rad]")
+    front: TorsionalStiffness = Field(0.0, description="front bar k_AR,F [N m/rad]")
+    rear: TorsionalStiffness = Field(0.0, description="rear bar k_AR,R [N m/rad]")
 
 
 def _deep_merge(base: dict, over: dict) -> dict:
@@ -205,7 +205,7 @@ class Vehicle(Section):
     anti_roll_bars: AntiRollBars = Field(default_factory=AntiRollBars)
     tyre_lift_off: bool = Field(False, description="tyres cannot pull (no tensile force); the "
                                 "thesis assumes permanent contact, so off by default")
-    gravity: PositiveFloat = Field(9.81, description="gravitational acceleration [m/s^2]")
+    gravity: quantity(0.1, 100.0) = Field(9.81, description="gravitational acceleration [m/s^2]")
 
     @model_validator(mode="before")
     @classmethod
