@@ -7,14 +7,16 @@ one batch; every field not in ``params`` keeps its config value for all designs.
 from __future__ import annotations
 
 import difflib
+import functools
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, get_args
 
+import annotated_types
 import numpy as np
 
 from .config import Config, ConfigError
 
-__all__ = ["ParamView", "numeric_paths"]
+__all__ = ["ParamView", "numeric_paths", "field_range"]
 
 
 def _walk(node: Any, prefix: str, out: dict[str, float]) -> None:
@@ -30,6 +32,50 @@ def numeric_paths(cfg: Config) -> dict[str, float]:
     out: dict[str, float] = {}
     _walk(cfg.model_dump(), "", out)
     return out
+
+
+@functools.cache
+def _limits(model: type, name: str) -> tuple[float, bool, float, bool]:
+    """``(low, low_closed, high, high_closed)`` of a float field of a config section, read
+    from its annotation's constraints (the ranges of :mod:`suspopt.config.base`)."""
+    low, low_closed, high, high_closed = -np.inf, True, np.inf, True
+    info = model.model_fields[name]
+    metadata = list(info.metadata)
+    for arg in get_args(info.annotation):           # Annotated[...] | None
+        for inner in getattr(arg, "__metadata__", ()):
+            metadata += getattr(inner, "metadata", [])
+    for item in metadata:
+        if isinstance(item, annotated_types.Ge):
+            low, low_closed = float(item.ge), True
+        elif isinstance(item, annotated_types.Gt):
+            low, low_closed = float(item.gt), False
+        elif isinstance(item, annotated_types.Le):
+            high, high_closed = float(item.le), True
+        elif isinstance(item, annotated_types.Lt):
+            high, high_closed = float(item.lt), False
+    return low, low_closed, high, high_closed
+
+
+def field_range(cfg: Config, path: str) -> tuple[float, bool, float, bool]:
+    """The range a numeric config field accepts, ``(low, low_closed, high, high_closed)``
+    (infinite where it has no bound)."""
+    node: Any = cfg
+    parts = path.split(".")
+    for part in parts[:-1]:
+        node = node[part] if isinstance(node, dict) else getattr(node, part)
+    return _limits(type(node), parts[-1])
+
+
+def _check_range(cfg: Config, path: str, values: np.ndarray) -> None:
+    """ConfigError unless every design's value lies in the field's range."""
+    low, low_closed, high, high_closed = field_range(cfg, path)
+    bad = (values < low) | (values > high) | (~low_closed & (values == low)) \
+        | (~high_closed & (values == high))
+    if bad.any():
+        where = np.flatnonzero(bad)
+        span = f"{'[' if low_closed else '('}{low:g}, {high:g}{']' if high_closed else ')'}"
+        raise ConfigError(f"params: {path}: must be in {span}, got {values[where[0]]:g} "
+                          f"(designs {where[:5].tolist()})")
 
 
 class ParamView:
@@ -53,6 +99,7 @@ class ParamView:
                 raise ConfigError(f"params: {path}: values must be a 1-D array of designs")
             if not np.all(np.isfinite(arr)):
                 raise ConfigError(f"params: {path}: values must be finite")
+            _check_range(cfg, path, arr)
             sizes.add(arr.size)
             self.params[path] = arr
         if len(sizes) > 1:

@@ -278,7 +278,7 @@ BAD = {
                     "road is one per run", 19),
     "bound_rejected": ({"path: vehicle.corners.F1.damper.c, lower: 2.0e3":
                         "path: vehicle.corners.F1.unsprung_mass, lower: 0"},
-                       "vehicle.corners.F1.unsprung_mass: must be > 0", 19),
+                       "vehicle.corners.F1.unsprung_mass: must be in [0.001, 1e+06], got 0", 19),
     "signal": ({"signal: body.heave_acc}": "signal: body.heave_ac}"},
                "did you mean body.heave_acc", 23),
     "ga_two_objectives": ({"algorithm: nsga2": "algorithm: ga"}, "add optimiser.weighted_sum", 30),

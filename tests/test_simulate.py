@@ -183,5 +183,8 @@ def test_bad_params_are_config_errors(load):
     with pytest.raises(suspopt.ConfigError, match="same length"):
         suspopt.simulate(cfg, params={"vehicle.corners.F1.spring.linear": [1e4, 2e4],
                                       "vehicle.corners.R1.damper.c": [1e3]})
-    with pytest.raises(suspopt.ConfigError, match="> 0"):
+    with pytest.raises(suspopt.ConfigError, match=r"mass: must be in \[0.001, 1e\+06\], got -1 "
+                       r"\(designs \[1\]\)"):
         suspopt.simulate(cfg, params={"vehicle.body.mass": [1000.0, -1.0]})
+    with pytest.raises(suspopt.ConfigError, match=r"cubic: must be in .* got 1e\+300"):
+        suspopt.simulate(cfg, params={"vehicle.corners.F1.spring.cubic": [1e300]})
