@@ -53,16 +53,11 @@ def _command() -> str:
 @app.command()
 def validate(config: Path = typer.Argument(..., help="YAML config file")) -> None:
     """Check a config file and report the first problem with its line."""
-    from .simulate import check
+    from .checks import check_config
 
     cfg = _load(config)
     try:
-        check(cfg)
-        if cfg.design_variables or cfg.objectives or cfg.optimiser:
-            from .optimise import Problem, build_optimiser
-            problem = Problem.from_config(cfg)
-            if cfg.optimiser is not None:
-                build_optimiser(cfg, problem)
+        check_config(cfg)
     except ConfigError as exc:
         _fail(str(exc))
     out.print(f"{config}: valid ({cfg.vehicle.preset}, road {cfg.road.kind})")

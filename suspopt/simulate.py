@@ -23,6 +23,7 @@ import difflib
 
 import numpy as np
 
+from .checks import check_steps, full_network
 from .config import Config
 from .control import build_controller
 from .network import Network, widen
@@ -33,7 +34,7 @@ from .seat import SIGNAL_HEADS as _SEAT_HEADS, build_attachments
 from .seat import signal_units as _seat_signal_units
 from .vehicle import VehicleModel, build_vehicle
 
-__all__ = ["simulate", "check", "signal_names", "signal_units", "Result", "SignalMap",
+__all__ = ["simulate", "prepare", "signal_names", "signal_units", "Result", "SignalMap",
            "Controller", "Attachment", "DIVERGENCE_LIMIT"]
 
 #: |state| above this (m, rad, m/s, rad/s) counts as divergence.
@@ -447,9 +448,12 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
                        records=records_held, diverged_at=diverged_at)
 
 
-def _prepare(cfg: Config, params: Mapping[str, Any] | None):
-    """Designs, model, controller and attachments of a run; metric specs checked against the
-    signals the run will have (so bad specs fail before any integration)."""
+def prepare(cfg: Config, params: Mapping[str, Any] | None = None):
+    """Designs, model, controller and attachments of a run, after the checks that need no
+    integration (so that bad input fails before any): the time grid and the road against
+    ``dt`` (:func:`suspopt.checks.check_steps`), and the metric specs and ``output.signals``
+    against the signals the run will have."""
+    check_steps(cfg)
     pv = ParamView(cfg, params)
     model = build_vehicle(cfg, pv)
     controller: Controller | None = build_controller(cfg, pv, model)
@@ -460,12 +464,13 @@ def _prepare(cfg: Config, params: Mapping[str, Any] | None):
             spec_signals(spec, available, model.corners)
         except ValueError as exc:
             raise cfg.error(("metrics", i, "signal"), str(exc)) from None
+    if cfg.output.signals != "all":
+        for i, name in enumerate(cfg.output.signals):
+            if name not in available:
+                close = difflib.get_close_matches(name, available, n=3)
+                raise cfg.error(("output", "signals", i), f"unknown signal {name!r}" + (
+                    f"; did you mean {', '.join(close)}?" if close else ""))
     return pv, model, controller, attachments
-
-
-def check(cfg: Config) -> None:
-    """Raise ConfigError for problems only the assembled model reveals (metric signals)."""
-    _prepare(cfg, None)
 
 
 def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> "Result":
@@ -475,7 +480,7 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> "Result":
     shape (P,). Returns a :class:`Result` whose signals are (P, T) and whose ``metrics`` hold
     the config's ``metrics:`` specs as (P,) arrays.
     """
-    pv, model, controller, attachments = _prepare(cfg, params)
+    pv, model, controller, attachments = prepare(cfg, params)
     result = _run(cfg, pv, model, controller, attachments)
     for spec in cfg.metrics:
         for name, values, unit in evaluate_spec(spec, result, result.signal_unit):
@@ -490,10 +495,7 @@ def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller
     n_steps, every = sim.n_steps, sim.output_every
     t_grid = np.arange(2 * n_steps + 1) * (0.5 * sim.dt)
     z, zd = road_inputs(cfg.road, model.offsets, model.sides, t_grid, base_dir=cfg.base_dir)
-    network = model.network
-    for att in attachments:
-        network = network.attach(att.network, model.point_map(*att.point), att.coupled)
-    asm = _Assembled(network, pv.P, controlled="suspension" if controller else None)
+    asm = _Assembled(full_network(model, attachments), pv.P, controlled="suspension" if controller else None)
     traj = _integrate(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller)
     out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
     return Result(config=cfg, model=model, time=t_grid[out_idx], states=traj.states,

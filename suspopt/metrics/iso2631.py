@@ -44,7 +44,7 @@ __all__ = [
 
 _Q_BAND = 1.0 / math.sqrt(2.0)
 _WRAP_DECAY = 1e-8
-_MIN_FS = 100.0
+MIN_SAMPLE_RATE = 100.0
 _UNWEIGHTED = "none"
 
 MTVV_RATIO_LIMIT = 1.5
@@ -171,8 +171,8 @@ def _check(a: np.ndarray, fs: float) -> tuple[np.ndarray, float]:
     a = np.asarray(a, dtype=float)
     if a.ndim == 0 or a.shape[-1] == 0:
         raise ValueError("acceleration must have a non-empty time axis (last axis)")
-    if not fs >= _MIN_FS:
-        raise ValueError(f"sampling rate fs = {fs} Hz is below the supported {_MIN_FS:g} Hz")
+    if not fs >= MIN_SAMPLE_RATE:
+        raise ValueError(f"sampling rate fs = {fs} Hz is below the supported {MIN_SAMPLE_RATE:g} Hz")
     return a, float(fs)
 
 

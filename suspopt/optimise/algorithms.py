@@ -364,22 +364,64 @@ _RESERVED = ("termination", "seed", "callback", "display", "verbose", "evaluator
              "save_history", "pop_size")
 
 
+def _flag(value) -> bool:
+    return isinstance(value, bool)
+
+
+def _real(low: float, high: float):
+    return lambda value: (isinstance(value, (int, float)) and not isinstance(value, bool)
+                          and low <= value <= high)
+
+
+def _choice(*values):
+    return lambda value: isinstance(value, str) and value in values
+
+
+_DE_VARIANTS = tuple(f"DE/{selection}/{n}/{crossover}" for selection in
+                     ("rand", "best", "target-to-best") for n in (1, 2)
+                     for crossover in ("bin", "exp"))
+#: The options a config may pass to a pymoo constructor: plain data (a config cannot hold a
+#: pymoo object, and nothing read from a file runs as code), each with its check and what it
+#: takes.
+DATA_OPTIONS: dict[str, tuple] = {
+    "eliminate_duplicates": (_flag, "true or false"),
+    "return_least_infeasible": (_flag, "true or false"),
+    "n_offsprings": (lambda v: isinstance(v, int) and not isinstance(v, bool)
+                     and 1 <= v <= 1_000_000, "a whole number from 1 to 1000000"),
+    "CR": (_real(0.0, 1.0), "a number in [0, 1]"),
+    "F": (_real(1e-6, 2.0), "a number in (0, 2]"),
+    "gamma": (_real(0.0, 1.0), "a number in [0, 1]"),
+    "variant": (_choice(*_DE_VARIANTS), "one of " + ", ".join(_DE_VARIANTS)),
+    "de_repair": (_choice("bounce-back", "midway", "rand-init", "to-bounds"),
+                  "bounce-back, midway, rand-init or to-bounds"),
+}
+
+
 def pymoo_algorithm(target: str, options: dict, population: int | None, n_obj: int):
     """Construct the pymoo algorithm ``"module:Class"`` with ``options`` and ``population``;
-    ValueError naming a bad option (with close matches)."""
+    ValueError naming a bad option (with close matches) or a value of the wrong kind
+    (:data:`DATA_OPTIONS`)."""
     import difflib
 
     module, name = target.split(":")
     cls = getattr(importlib.import_module(module), name)
     allowed = _init_parameters(cls)
     options = dict(options)
-    for key in options:
+    for key, value in options.items():
         if key in _RESERVED:
             raise ValueError(f"option {key!r} is set by suspopt (from the optimiser section)")
         if key not in allowed:
             close = difflib.get_close_matches(key, sorted(allowed), n=3)
             raise ValueError(f"{name} has no option {key!r}" + (
                 f"; did you mean {', '.join(close)}?" if close else ""))
+        if key not in DATA_OPTIONS:
+            usable = sorted(k for k in DATA_OPTIONS if k in allowed)
+            raise ValueError(f"{name}'s option {key!r} takes a pymoo object, which a config "
+                             f"cannot give; the options it takes from a config are "
+                             f"{', '.join(usable) or 'none'}")
+        check, takes = DATA_OPTIONS[key]
+        if not check(value):
+            raise ValueError(f"option {key!r} takes {takes}, got {value!r:.40}")
     if population is not None:
         if "pop_size" not in allowed:
             raise ValueError(f"{name} has no population; remove optimiser.population")

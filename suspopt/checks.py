@@ -1,0 +1,228 @@
+"""Checks of a run that the config's types alone cannot make, shared by ``validate`` and every
+command that simulates, so that what ``validate`` accepts no other command rejects.
+
+- :func:`check_steps`: the duration is a whole number of integration steps; the controller's
+  and the output's sample intervals are whole multiples of ``dt``; the front wheels reach a
+  bump within the run; every bump spans at least :data:`MIN_STEPS_PER_BUMP` steps and the
+  shortest wave of a random road at least :data:`MIN_STEPS_PER_WAVE`; the output sample rate
+  suits the ISO 2631 weightings of the metrics.
+- :func:`stability_limit` and :func:`check_stability`: ``dt`` within classical RK4's
+  stability limit for every mode of the linearised model (vehicle, seat and passenger).
+
+Each raises :class:`~suspopt.config.ConfigError` naming the key, its line and the limit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from .config import Config
+from .config.road import BumpHalfSine, BumpStep, Iso8608Road
+from .network import Network
+
+__all__ = ["MIN_STEPS_PER_BUMP", "MIN_STEPS_PER_WAVE", "check_steps", "stability_limit",
+           "check_stability", "full_network"]
+
+#: A bump (the time a wheel takes to cross it) must span this many integration steps: RK4
+#: samples the road at half steps, and a half-sine crossed in 10 steps moves the peak body
+#: acceleration of the Ch. 5 half car by under 1 % against dt/10.
+MIN_STEPS_PER_BUMP = 10
+#: The shortest wave of a random road (period ``1/(n_max V)``) must span this many steps,
+#: 8 half-step samples of the road per period.
+MIN_STEPS_PER_WAVE = 4
+#: Relative slack on "a whole number of steps" (durations written in decimal, such as 7.2 s
+#: at dt = 1 ms, are not exact binary multiples).
+_WHOLE = 1e-9
+
+
+def _whole(ratio: float) -> bool:
+    return abs(ratio - round(ratio)) <= _WHOLE * max(1.0, ratio)
+
+
+def check_steps(cfg: Config) -> None:
+    """The time grid, the road's features against ``dt`` and the metrics' sample rate (module
+    docstring)."""
+    from .metrics.iso2631 import MIN_SAMPLE_RATE
+    from .specs import METRICS
+
+    sim, road = cfg.simulation, cfg.road
+    if not _whole(sim.duration / sim.dt):
+        raise cfg.error(("simulation", "duration"), f"{sim.duration:g} s is not a whole number "
+                        f"of steps dt = {sim.dt:g} s ({sim.duration / sim.dt:.6g} steps); "
+                        f"give a multiple of dt")
+    if isinstance(road, (BumpStep, BumpHalfSine)):
+        if road.start >= sim.duration:
+            raise cfg.error(("road", "start"), f"the bump starts at {road.start:g} s, after "
+                            f"the run ends (simulation.duration = {sim.duration:g} s)")
+        crossing = road.length / road.speed
+        if crossing < MIN_STEPS_PER_BUMP * sim.dt * (1 - _WHOLE):
+            raise cfg.error(("simulation", "dt"), f"{sim.dt:g} s steps over the bump: a wheel "
+                            f"crosses it in {crossing:.4g} s (road.length/road.speed), which "
+                            f"must span at least {MIN_STEPS_PER_BUMP} steps; use dt <= "
+                            f"{crossing / MIN_STEPS_PER_BUMP:.3g} s")
+    if isinstance(road, Iso8608Road):
+        period = 1.0 / (road.n_max * road.speed)
+        if period < MIN_STEPS_PER_WAVE * sim.dt * (1 - _WHOLE):
+            raise cfg.error(("simulation", "dt"), f"{sim.dt:g} s steps over the road's "
+                            f"shortest wave: 1/(n_max V) = {period:.4g} s must span at least "
+                            f"{MIN_STEPS_PER_WAVE} steps; use dt <= "
+                            f"{period / MIN_STEPS_PER_WAVE:.3g} s or a lower road.n_max")
+    rate = sim.output_rate
+    specs = [(("metrics", i), spec) for i, spec in enumerate(cfg.metrics)]
+    if cfg.objectives is not None:
+        specs += [(("objectives", "main", i), s) for i, s in enumerate(cfg.objectives.main)]
+        specs += [(("objectives", "supplementary", i), s)
+                  for i, s in enumerate(cfg.objectives.supplementary)]
+    specs += [(("constraints", i), spec) for i, spec in enumerate(cfg.constraints)]
+    for loc, spec in specs:
+        if spec.metric is not None and METRICS[spec.metric].kind == "iso2631" \
+                and rate < MIN_SAMPLE_RATE:
+            raise cfg.error(loc + ("metric",), f"{spec.metric} needs signals sampled at "
+                            f"{MIN_SAMPLE_RATE:g} Hz or more; simulation.output_dt gives "
+                            f"{rate:.4g} Hz")
+
+
+def full_network(model, attachments) -> Network:
+    """The vehicle's network with its attachments (seat and passenger) mounted."""
+    network = model.network
+    for att in attachments:
+        network = network.attach(att.network, model.point_map(*att.point), att.coupled)
+    return network
+
+
+def _rk4_radius(direction: np.ndarray) -> np.ndarray:
+    """For unit complex numbers ``direction`` in the closed left half-plane, the largest
+    ``r`` with ``|R(r d)| <= 1`` on the whole segment from 0, ``R(z) = 1 + z + z^2/2 + z^3/6
+    + z^4/24`` RK4's amplification factor (2.785 on the negative real axis, 2 sqrt 2 on the
+    imaginary one)."""
+    def grows(r):
+        z = r * direction
+        return np.abs(1 + z * (1 + z * (1 / 2 + z * (1 / 6 + z / 24)))) > 1 + 1e-12
+
+    grid = np.linspace(0.0, 3.0, 301)[1:, None]
+    first = np.argmax(grows(grid), axis=0)                 # the first radius that grows
+    low, high = np.where(first > 0, grid[first - 1, 0], 0.0), grid[first, 0]
+    for _ in range(40):
+        mid = 0.5 * (low + high)
+        up = grows(mid)
+        low, high = np.where(up, low, mid), np.where(up, mid, high)
+    return low
+
+
+def stability_limit(network: Network, damping_rows: dict[str, np.ndarray] | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The largest RK4 step [s] of each design of ``network`` linearised about rest, with the
+    frequency [Hz] and the index of the mode that sets it: ``(dt_max (P,), f (P,), dof (P,))``
+    (``dof`` the DOF with most of that mode's kinetic energy).
+
+    The eigenvalues ``λ`` of ``[[0, I], [-M^-1 K, -M^-1 C]]`` must satisfy ``|R(λ dt)| <= 1``
+    (Hairer & Wanner, Solving ODEs II, Sec IV.2). Modes that grow by themselves (a real part
+    above rounding) are the physics, not the step, and are left out. ``damping_rows`` maps a
+    group's name to coefficients (m, P, 1) that replace its damping (a semi-active damper at
+    ``c_max``). Non-linear parts enter by their slope at rest only: a hardening Duffing
+    spring at large travel, or a tyre in the air, moves the limit.
+    """
+    if damping_rows:
+        network = replace(network, groups=tuple(
+            replace(g, damping=damping_rows[g.name]) if g.name in damping_rows else g
+            for g in network.groups))
+    lin = network.linear_model()
+    P, n = lin.mass.shape
+    inverse = 1.0 / lin.mass
+    A = np.zeros((P, 2 * n, 2 * n))
+    A[:, :n, n:] = np.eye(n)
+    A[:, n:, :n] = -inverse[:, :, None] * lin.stiffness
+    A[:, n:, n:] = -inverse[:, :, None] * lin.damping
+    # a design without a static equilibrium (an infeasible seat geometry: NaN) has no modes;
+    # the optimiser's constraints deal with it
+    sound = np.isfinite(A).all(axis=(1, 2))
+    A[~sound] = 0.0
+    with np.errstate(all="ignore"):
+        lam, vectors = np.linalg.eig(A)
+        lam[~sound] = 0.0
+        size = np.abs(lam)
+        decaying = (lam.real <= 1e-9 * size) & (size > 0)
+        direction = np.where(decaying, lam / np.where(size > 0, size, 1.0), -1.0)
+        direction = np.where(direction.real > 0, 1j * np.sign(direction.imag), direction)
+        limit = np.where(decaying, _rk4_radius(direction.reshape(-1)).reshape(lam.shape)
+                         / np.where(size > 0, size, 1.0), np.inf)
+    worst = np.argmin(limit, axis=1)
+    rows = np.arange(P)
+    energy = lin.mass * np.abs(vectors[rows, :n, worst]) ** 2
+    return (limit[rows, worst], np.abs(lam[rows, worst].imag) / (2 * math.pi),
+            np.argmax(energy, axis=1))
+
+
+def check_stability(cfg: Config, pv, model, attachments, loc: tuple = ("simulation", "dt"),
+                    what: str = "") -> None:
+    """ConfigError when ``simulation.dt`` exceeds RK4's stability limit for some design of the
+    assembled model (:func:`stability_limit`; semi-active dampers at ``c_min`` and at
+    ``c_max``). ``pv`` holds the designs; ``what`` says which designs they are."""
+    from .network import parameter_rows
+
+    network = full_network(model, attachments)
+    cases = [None]
+    corners = cfg.vehicle.corners
+    if any(corners[c].damper.kind == "semi_active" for c in model.corners):
+        stiff = np.stack([pv.get(f"vehicle.corners.{c}.damper."
+                                 f"{'c_max' if corners[c].damper.kind == 'semi_active' else 'c'}")
+                          for c in model.corners], axis=1)
+        cases.append({"suspension": parameter_rows(stiff)})
+    dt = cfg.simulation.dt
+    for case in cases:
+        limit, frequency, dof = stability_limit(network, case)
+        bad = np.flatnonzero(limit < dt)
+        if bad.size:
+            p = bad[np.argmin(limit[bad])]
+            state = " with the dampers at c_max" if case else ""
+            raise cfg.error(loc, f"{dt:g} s exceeds classical RK4's stability limit "
+                            f"{limit[p]:.3g} s for the fastest mode of the linearised model"
+                            f"{state} ({network.dof_names[dof[p]]}, {frequency[p]:.4g} Hz"
+                            f"{what}); use dt <= {0.9 * limit[p]:.2g} s")
+
+
+#: Most corners of the design variables' box whose stability is checked: all of them up to
+#: ten variables, else this many drawn with a fixed seed (the same ones every time).
+_CORNERS = 1024
+
+
+def bound_corners(cfg: Config) -> dict[str, np.ndarray]:
+    """Designs at the corners of the design variables' bounds, as ``params``."""
+    import itertools
+
+    variables = cfg.design_variables
+    n = len(variables)
+    if 2 ** n <= _CORNERS:
+        upper = np.array(list(itertools.product((False, True), repeat=n)), dtype=bool)
+    else:
+        upper = np.random.default_rng(0).integers(0, 2, (_CORNERS, n)).astype(bool)
+    return {v.path: np.where(upper[:, j], v.upper, v.lower) for j, v in enumerate(variables)}
+
+
+def check_config(cfg: Config, optimisation: bool = True) -> None:
+    """Everything about ``cfg`` that a run would reject, without running it: what
+    :func:`suspopt.simulate.prepare` checks, RK4's stability limit for the configured design
+    and, with ``optimisation`` and an optimisation section, the problem
+    (:meth:`suspopt.Problem.from_config`), the stability limit at the corners of the design
+    variables' bounds and the optimiser with its options. ``suspopt validate`` runs all of
+    it; the commands that simulate run what they use."""
+    from .params import ParamView
+    from .seat import build_attachments
+    from .simulate import prepare
+    from .vehicle import build_vehicle
+
+    pv, model, _, attachments = prepare(cfg)
+    check_stability(cfg, pv, model, attachments)
+    if not optimisation or not (cfg.design_variables or cfg.objectives or cfg.optimiser):
+        return
+    from .optimise import Problem, build_optimiser
+
+    problem = Problem.from_config(cfg)
+    pv = ParamView(cfg, bound_corners(cfg))
+    check_stability(cfg, pv, build_vehicle(cfg, pv), build_attachments(cfg, pv),
+                    what=" at a corner of the design variables' bounds")
+    if cfg.optimiser is not None:
+        build_optimiser(cfg, problem)
