@@ -192,6 +192,15 @@ def test_narrowed():
     assert report.narrowed([20.0, 40.0], [10.0, 50.0]).startswith("narrows some")
 
 
-def test_spread():
+def test_reproduced_and_late_gain():
+    assert "reproduce the stored ones" in report.reproduced(3e-12)
+    assert "differ from the stored ones" in report.reproduced(2e-6)
+    assert "had stopped improving" in report.late_gain_sentence([0.2, 0.9, float("nan")])
+    assert "still improving" in report.late_gain_sentence([0.2, 1.5])
+
+
+def test_spread_and_bounds_text():
     assert report.spread([100.0, 110.0, 105.0]) == pytest.approx(10.0)
     assert np.isnan(report.spread([3.0]))
+    text = report.bounds_text({"C_F1": "lower", "C_R1": "lower", "K_nlF1": "upper"})
+    assert text == "C_F1, C_R1 at the lower bound; K_nlF1 at the upper bound"
