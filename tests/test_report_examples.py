@@ -76,13 +76,20 @@ def _models_file(path: Path, labels: list[str], metrics: set[str], rng) -> None:
                 g.create_dataset(m, data=rng.uniform(0.5, 1.5, len(labels))).attrs["units"] = "SI"
 
 
-def _metrics_file(path: Path, metrics: set[str], rng) -> None:
+def _metrics_file(path: Path, metrics: set[str], rng, config: Path | None = None) -> None:
+    """A `simulate` file's metrics; with ``config`` also its text and a 3 s body.heave_acc."""
     with h5py.File(path, "w") as h5:
         for m in metrics:
             h5.create_dataset(f"metrics/{m}", data=rng.uniform(0.5, 1.5, 1))
+        if config is not None:
+            h5.attrs["config"] = config.read_text()
+            h5["time"] = np.arange(3001) * 1e-3
+            h5["signals/body.heave_acc"] = rng.normal(size=(1, 3001))
+            h5["metrics/peak_time.body.heave_acc"] = [2.025]
 
 
-def test_chapter3_tables_from_synthetic_files(tmp_path):
+def _chapter3_files(tmp_path: Path) -> None:
+    """Every file chapter3 reads, with random values."""
     rng = np.random.default_rng(0)
     d = tmp_path / "ch3"
     (d / "checks").mkdir(parents=True)
@@ -95,13 +102,19 @@ def test_chapter3_tables_from_synthetic_files(tmp_path):
                      [f"{part}_{m}_{road}" for m in models[part]], metrics, rng)
     transient = {"peak.body.heave_acc"}
     random_road = {"RC", "max_body_acc", "VST.F1", "MST.F1", "VTD.F1", "MTD.F1"}
-    _metrics_file(d / "part1a_qc_bump.h5", transient, rng)
+    configs = Path(__file__).resolve().parents[1] / "configs" / "ch3"
+    _metrics_file(d / "part1a_qc_bump.h5", transient, rng, configs / "part1a_qc_bump.yaml")
+    _metrics_file(d / "part2a_fc_arb_bump.h5", set(), rng, configs / "part2a_fc_arb_bump.yaml")
     _metrics_file(d / "checks" / "part1a_qc_bump_dt_half.h5", transient, rng)
     _metrics_file(d / "checks" / "part1a_qc_class_b_double_length.h5", random_road, rng)
     for m in ("qc", "fc"):                 # seed 1 is the config's own run
         _metrics_file(d / f"part1a_{m}_class_b.h5", random_road, rng)
         for seed in range(2, 6):
             _metrics_file(d / "checks" / f"part1a_{m}_class_b_seed_{seed}.h5", random_road, rng)
+
+
+def test_chapter3_tables_from_synthetic_files(tmp_path):
+    _chapter3_files(tmp_path)
     doc = report.Doc(tmp_path / "report")
     headline = report.chapter3(tmp_path, doc)
     text = doc.text()
@@ -109,3 +122,85 @@ def test_chapter3_tables_from_synthetic_files(tmp_path):
         assert f"**Table {number}:" in text
     assert "| Peak, M_p | m/s^2 | QC |" in text and "thesis inside?" in text
     assert headline and headline[0].startswith("Ch. 3:")
+
+
+# --- the conclusions follow their measurements (thresholds: report.CONVERGED, AGREE, ...) ----
+
+@pytest.mark.parametrize("factor, verdict", [(1.003, "the peak is converged in the step size"),
+                                             (1.086, "the peak is not converged")])
+def test_chapter3_step_size_conclusion_follows_the_dt_check(tmp_path, factor, verdict):
+    _chapter3_files(tmp_path)
+    d = tmp_path / "ch3"
+    with h5py.File(d / "part1a_qc_bump.h5", "r") as h5:
+        base = float(h5["metrics/peak.body.heave_acc"][0])
+    with h5py.File(d / "checks" / "part1a_qc_bump_dt_half.h5", "w") as h5:
+        h5["metrics/peak.body.heave_acc"] = [base * factor]
+    doc = report.Doc(tmp_path / "report")
+    report.chapter3(tmp_path, doc)
+    text = doc.text()
+    assert verdict in text
+    assert ("not converged" in text) == (factor > 1.01)
+    assert f"moves QC's peak z̈_s by {md.pct(100 * (factor - 1))}" in text
+
+
+def test_dt_sentence_turns_at_the_threshold():
+    assert report.CONVERGED == 1.0
+    ok = report.dt_sentence(0.3, -12.0, "7.92 m/s²")
+    assert "converged in the step size (0.3 % < 1 %)" in ok and "no integration error" in ok
+    assert "within 1 % of the thesis's" in report.dt_sentence(-0.3, 0.5, "7.92 m/s²")
+    bad = report.dt_sentence(8.6, -12.0, "7.92 m/s²")
+    assert "not converged in the step size (8.6 % ≥ 1 %)" in bad
+    assert "integration error may be part of" in bad and "no integration error" not in bad
+    assert "not converged" in report.dt_sentence(-1.0, -12.0, "x")   # the threshold itself
+
+
+def test_side_and_placed():
+    assert report.side([1.0, -4.9], 5.0) == "within"
+    assert report.side([1.0, 6.0], 5.0) == "above"
+    assert report.side([-1.0, -6.0], 5.0) == "below"
+    assert report.side([-6.0, 6.0], 5.0) == "both"
+    assert report.side([float("nan"), None], 5.0) == "none"
+    assert report.placed([2.0, -3.0]) == "within 5 % of the thesis's"
+    assert report.placed([2.0, 30.0]) == "above the thesis's"
+    assert report.placed([-20.0], "it", 1.0) == "below it"
+
+
+def test_seed_sentence():
+    inside = report.seed_sentence("The maxima", 12.0, [], 6)
+    assert "inside our five seeds for all 6" in inside and "can account" in inside
+    outside = report.seed_sentence("The maxima", 12.0, ["QC MST_1"], 6)
+    assert "outside our five seeds for QC MST_1 (1 of 6)" in outside
+    assert "no realisation of ours explains those" in outside
+
+
+def test_grid_sentence():
+    assert "moves the peak toward" in report.grid_sentence(0.5, 1.4)
+    assert "does not explain" in report.grid_sentence(-2.6, 1.4)
+
+
+def test_share_sentence():
+    t = 0.27
+    assert "softens them" in report.share_sentence("SH-2", np.array([0.5, 0.6]), t)
+    assert "stiffens them" in report.share_sentence("SH-2", np.array([0.1, 0.2]), t)
+    assert "changes them little" in report.share_sentence("SH-2", np.array([0.26, 0.285]), t)
+
+
+def test_narrowed():
+    assert report.narrowed([20.0, 40.0], [1.0, -4.0]).startswith("closes the gap")
+    assert report.narrowed([20.0, 40.0], [10.0, 30.0]) == "accounts for part of the gap"
+    assert report.narrowed([20.0, 40.0], [25.0, 40.0]) == "does not explain the gap"
+    assert report.narrowed([20.0, 40.0], [10.0, 50.0]).startswith("narrows some")
+
+
+def test_reproduced_and_late_gain():
+    assert "reproduce the stored ones" in report.reproduced(3e-12)
+    assert "differ from the stored ones" in report.reproduced(2e-6)
+    assert "had stopped improving" in report.late_gain_sentence([0.2, 0.9, float("nan")])
+    assert "still improving" in report.late_gain_sentence([0.2, 1.5])
+
+
+def test_spread_and_bounds_text():
+    assert report.spread([100.0, 110.0, 105.0]) == pytest.approx(10.0)
+    assert np.isnan(report.spread([3.0]))
+    text = report.bounds_text({"C_F1": "lower", "C_R1": "lower", "K_nlF1": "upper"})
+    assert text == "C_F1, C_R1 at the lower bound; K_nlF1 at the upper bound"
