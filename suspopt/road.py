@@ -19,7 +19,7 @@ from typing import NamedTuple, Sequence
 import numpy as np
 
 from .config.road import (
-    BumpHalfSine, BumpStep, FileRoad, Iso8608Road, RoadConfig, resolve_road_file,
+    BumpHalfSine, BumpStep, FileRoad, Iso8608Road, RoadConfig, read_profile, resolve_road_file,
 )
 
 __all__ = [
@@ -217,7 +217,7 @@ def _spatial_profile(road: Iso8608Road | FileRoad, positions: np.ndarray, sides:
     Flat sides are not zeroed here (the callers do).
     """
     if isinstance(road, FileRoad):
-        distance, height = _read_profile(resolve_road_file(road, base_dir))
+        distance, height = read_profile(resolve_road_file(road, base_dir))
         return _interpolate(distance, road.scale * height, positions)
     length = float(np.ptp(positions)) if positions.size else 0.0
     z = np.empty_like(positions)
@@ -272,37 +272,6 @@ def _hermite(values: np.ndarray, steps: np.ndarray, index: np.ndarray,
     u3 = u2 * fraction
     return ((2 * u3 - 3 * u2 + 1) * values[index] + (u3 - 2 * u2 + fraction) * steps[index]
             + (3 * u2 - 2 * u3) * values[following] + (u3 - u2) * steps[following])
-
-
-def _read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """Distance [m] and height [m] columns of a CSV profile with an optional header line."""
-    if not path.is_file():
-        raise FileNotFoundError(f"road.path: road profile file not found: {path}")
-    with path.open(encoding="utf-8") as stream:
-        first = stream.readline()
-    header = 0 if _is_numeric_row(first) else 1
-    try:
-        table = np.loadtxt(path, delimiter=",", skiprows=header, ndmin=2)
-    except ValueError as error:
-        raise ValueError(f"road profile {path}: {error}") from None
-    if table.shape[1] != 2 or table.shape[0] < 2:
-        raise ValueError(f"road profile {path}: need two columns (distance [m], height [m]) and "
-                         f"at least two rows, got shape {table.shape}")
-    distance, height = table.T
-    if not np.all(np.isfinite(table)) or np.any(np.diff(distance) <= 0):
-        raise ValueError(f"road profile {path}: values must be finite and distances strictly "
-                         "increasing")
-    return distance, height
-
-
-def _is_numeric_row(line: str) -> bool:
-    """True if every comma-separated field of ``line`` is a number."""
-    try:
-        for field in line.split(","):
-            float(field)
-    except ValueError:
-        return False
-    return True
 
 
 def _interpolate(distance: np.ndarray, height: np.ndarray,

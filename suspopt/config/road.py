@@ -19,7 +19,10 @@ is checked when the road is generated (:func:`suspopt.road.road_inputs` raises
 
 from __future__ import annotations
 
+import os
+import stat
 from pathlib import Path
+import math
 from typing import Annotated, Literal, Union
 
 from pydantic import Field, ValidationInfo, field_validator, model_validator
@@ -28,7 +31,7 @@ from .base import RoadHeight, RoadLength, Seed, Section, Speed, quantity
 
 __all__ = [
     "Tracks", "BumpStep", "BumpHalfSine", "Iso8608Road", "FileRoad", "RoadConfig",
-    "resolve_road_file",
+    "resolve_road_file", "read_profile", "MAX_PROFILE_BYTES",
 ]
 
 Tracks = Literal["identical", "independent", "right_only", "left_only"]
@@ -156,13 +159,14 @@ class FileRoad(_DeterministicRoad):
 
     @field_validator("path")
     @classmethod
-    def _file_exists(cls, path: Path, info: ValidationInfo) -> Path:
+    def _file_readable(cls, path: Path, info: ValidationInfo) -> Path:
         base_dir = (info.context or {}).get("base_dir")
         if not path.is_absolute() and base_dir is None:
             return path
-        resolved = _resolve(path, base_dir)
-        if not resolved.is_file():
-            raise ValueError(f"road profile file not found: {resolved}")
+        try:
+            read_profile(_resolve(path, base_dir))
+        except FileNotFoundError as exc:
+            raise ValueError(str(exc)) from None
         return path
 
 
@@ -180,3 +184,71 @@ def resolve_road_file(cfg: FileRoad, base_dir: Path | str | None) -> Path:
     file's directory), or to the current directory when ``base_dir`` is None. Existence is not
     checked here."""
     return _resolve(cfg.path, base_dir)
+
+
+#: Largest road profile read [bytes]: 100 km at 1 cm spacing.
+MAX_PROFILE_BYTES = 256 << 20
+
+
+def read_profile(path: Path) -> tuple:
+    """Distance [m] and height [m] columns ``(ndarray, ndarray)`` of a CSV road profile.
+
+    The file is a regular UTF-8 text file of at most :data:`MAX_PROFILE_BYTES`, with an
+    optional header line, then rows ``distance,height``: two finite numbers each, at least two
+    rows, distances strictly increasing. ValueError (FileNotFoundError for a missing file)
+    names the file and the line, never the line's content: the file may be anything.
+    """
+    import numpy as np
+
+    if not path.exists():
+        raise FileNotFoundError(f"road profile file not found: {path}")
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError as exc:
+        raise ValueError(f"road profile {path}: cannot open it "
+                         f"({exc.strerror or exc.__class__.__name__})") from None
+    with os.fdopen(fd, "rb") as stream:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise ValueError(f"road profile {path}: not a regular file")
+        data = stream.read(MAX_PROFILE_BYTES + 1)
+    if len(data) > MAX_PROFILE_BYTES:
+        raise ValueError(f"road profile {path}: larger than {MAX_PROFILE_BYTES >> 20} MB")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise ValueError(f"road profile {path}:{line}: not UTF-8 text") from None
+    lines = text.splitlines()
+    header = 1 if lines and _row(lines[0]) is None else 0
+    rows, numbers = [], []
+    for number, line in enumerate(lines[header:], start=header + 1):
+        if not line.strip():
+            continue
+        row = _row(line)
+        if row is None:
+            raise ValueError(f"road profile {path}:{number}: expected two numbers "
+                             f"'distance,height' separated by a comma")
+        if not (math.isfinite(row[0]) and math.isfinite(row[1])):
+            raise ValueError(f"road profile {path}:{number}: values must be finite")
+        rows.append(row)
+        numbers.append(number)
+    if len(rows) < 2:
+        raise ValueError(f"road profile {path}: needs at least two rows of "
+                         f"'distance,height', found {len(rows)}")
+    table = np.array(rows)
+    steps = np.diff(table[:, 0])
+    if (steps <= 0).any():
+        line = numbers[int(np.argmax(steps <= 0)) + 1]
+        raise ValueError(f"road profile {path}:{line}: distances must increase strictly")
+    return table[:, 0], table[:, 1]
+
+
+def _row(line: str) -> tuple[float, float] | None:
+    """The two numbers of a CSV row, or None if it is not two numbers."""
+    fields = line.split(",")
+    if len(fields) != 2:
+        return None
+    try:
+        return float(fields[0]), float(fields[1])
+    except ValueError:
+        return None
