@@ -110,6 +110,8 @@ def iso8608_level(road: Iso8608Road) -> float:
     ``Phi(Omega) = G_d(n) / (2 pi)``, ``dOmega = 2 pi dn``: ``A_i^2 = G_d(n_i) dn / pi``, hence
     ``G(n_i) = G_d(n_i) / (2 pi)``; the ``iso8608`` amplitudes ``A_i^2 = 2 G_d(n_i) dn`` give
     ``G(n_i) = G_d(n_i)``. The amplitude ratio is ``1/sqrt(2 pi)`` (about 0.40).
+    :func:`iso8608_harmonics` puts the integral of this PSD over each harmonic's cell for
+    ``G(n_i) dn``, so ``G(n_i)`` is the cell's mean of it.
     """
     nominal = _nominal_level(road)
     return nominal if road.convention == "iso8608" else nominal / (2.0 * math.pi)
@@ -118,33 +120,72 @@ def iso8608_level(road: Iso8608Road) -> float:
 def iso8608_harmonics(road: Iso8608Road, length_m: float, side: str = "right") -> Harmonics:
     """Harmonics of the ISO 8608 track under ``side`` for a road of ``length_m`` [m].
 
-    Frequencies ``n_i`` are uniformly spaced from ``n_min`` to ``n_max`` inclusive, so
-    ``dOmega = (Omega_N - Omega_1)/(N - 1)`` (Eq 2.100); ``Omega_i = 2 pi n_i``. ``N`` is
-    ``n_waves`` or, by default, the smallest N with ``dn <= 1 / length_m``:
-    ``N = ceil((n_max - n_min) length_m) + 1`` (at least 2), so the sum's period ``1/dn`` covers
-    the road and it does not repeat. The PSD is Eq 2.93, ``G_d(n) = G_d(n0) (n / n0)^-w``, and the
-    amplitudes follow ``road.convention`` (see :func:`iso8608_level`):
-    ``iso8608`` ``A_i = sqrt(2 G_d(n_i) dn)``; ``thesis`` ``A_i = sqrt(Phi(Omega_i) dOmega / pi)``
-    (Eq 2.99) with ``Phi(Omega) = G_d(Omega / 2 pi) / (2 pi)``. Phases are uniform in
+    The band ``[n_min, n_max]`` is cut into ``N`` cells of width ``dn = (n_max - n_min) / N``;
+    harmonic ``i`` sits at the centre ``n_i`` of cell ``i`` (``Omega_i = 2 pi n_i``, uniformly
+    spaced) and carries the PSD's integral over its cell, ``A_i^2 / 2 = int_cell G(n) dn``, with
+    ``G(n) = G(n0) (n / n0)^-w`` (Eq 2.93) at the level :func:`iso8608_level` gives for
+    ``road.convention``: ``iso8608`` ``A_i^2 = 2 int G_d dn`` (ISO 8608's ``2 G_d(n_i) dn``
+    with the cell's integral for ``G_d(n_i) dn``), ``thesis`` ``A_i^2 = int G_d dn / pi`` (Eq 2.99
+    ``Phi(Omega_i) dOmega / pi`` likewise), ``1/sqrt(2 pi)`` times the ``iso8608`` amplitude.
+    ``N`` is ``n_waves`` or, by default, the smallest ``N >= 2`` with ``dn <= 1 / length_m``, so
+    the sum's period ``1/dn`` covers the road and it does not repeat. Phases are uniform in
     ``[0, 2 pi)`` from ``np.random.default_rng`` on ``SeedSequence(seed).spawn(2)[k]``: ``k = 0``
     for the common (or right) track, ``k = 1`` for an ``independent`` left track. A flat side
     (``right_only`` / ``left_only``) is not reflected here: these are the harmonics of the random
     track, which :func:`profile` and :func:`road_inputs` then zero on the flat side.
 
+    Deviation from the thesis: Eq 2.99-2.100 space the ``N`` frequencies from ``Omega_1`` to
+    ``Omega_N`` inclusive, ``dOmega = (Omega_N - Omega_1)/(N - 1)``, and give each
+    ``Phi(Omega_i) dOmega``; the cells of the end harmonics then overhang the band by ``dn/2``
+    where the PSD is steepest, and the profile's variance exceeds the PSD's band integral
+    (class B, ISO band, default N: by 1.1 % for 4 km, 4.7 % for 1 km, 58 % for 100 m). Tiling
+    the band and integrating over each cell makes the ensemble variance ``sum A_i^2 / 2`` (the
+    expected ``z(s)^2`` at every ``s``) equal the band integral to rounding, for any N and w.
+
+    Remaining error for a given length: the variance realised over a finite road differs from
+    the ensemble variance by the random-phase error of the harmonics' cross terms. Measured for
+    class B, ISO band, w = 2, seeds 0-299, on ``profile`` over ``s = 0 .. L`` in 0.05 m steps
+    (harmonics from that span), as ratio - 1 to the band integral, mean / standard deviation /
+    worst seeds:
+
+    =====  ===================================  ====================================
+    L      mean square of z                     variance of z about the road's mean
+    =====  ===================================  ====================================
+    100 m  -0.5 % / 3.3 % / -10.6 %, +8.1 %     -2.8 % / 5.4 % / -20.6 %, +7.9 %
+    1 km   -0.0004 % / 0.006 % / +0.03 %        -0.03 % / 0.05 % / -0.28 %
+    4 km   -0.0001 % / 0.002 % / +0.010 %       -0.002 % / 0.003 % / -0.017 %
+    =====  ===================================  ====================================
+
+    Both conventions give the same ratios. The mean square is unbiased (3000 seeds at 100 m:
+    -0.06 % +- 0.06 %). The variance about the road's own mean is biased low by the expected
+    square of that mean: 2.8 % at 100 m, where the lowest harmonic (62.5 m wavelength; its
+    cell, 0.011-0.021 cycles/m, carries 48 % of the variance) is not much shorter than the road.
+
     The thesis writes Eq 2.97-2.98 in time (``omega_0 = V dOmega``); here the sum is spatial and
     the wheels sample it at ``V t - d``, which is the same thing (Eq 2.96, ERRATA Sec 2.5.1).
     """
-    n = np.linspace(road.n_min, road.n_max, _n_waves(road, length_m))
-    dn = n[1] - n[0]
-    psd = _nominal_level(road) * (n / _N0) ** -road.waviness
-    if road.convention == "iso8608":
-        amplitude = np.sqrt(2.0 * psd * dn)
-    else:
-        phi = psd / (2.0 * math.pi)
-        amplitude = np.sqrt(phi * (2.0 * math.pi * dn) / math.pi)
+    count = _n_waves(road, length_m)
+    edges = np.linspace(road.n_min, road.n_max, count + 1)
+    dn = (road.n_max - road.n_min) / count
+    variance = _psd_integral(iso8608_level(road), road.waviness, edges[:-1], edges[1:])
     stream = np.random.SeedSequence(road.seed).spawn(2)[_stream(road, side)]
-    phase = np.random.default_rng(stream).uniform(0.0, 2.0 * math.pi, n.size)
-    return Harmonics(2.0 * math.pi * n, amplitude, phase)
+    phase = np.random.default_rng(stream).uniform(0.0, 2.0 * math.pi, count)
+    n = road.n_min + (np.arange(count) + 0.5) * dn
+    return Harmonics(2.0 * math.pi * n, np.sqrt(2.0 * variance), phase)
+
+
+def _psd_integral(level: float, waviness: float, lower: np.ndarray,
+                  upper: np.ndarray) -> np.ndarray:
+    """``int_lower^upper level (n / n0)^-w dn`` [m^2] in closed form, any ``w`` > 0.
+
+    ``level n0 (a/n0)^(1-w) r E((1 - w) r)`` with ``r = ln(b/a)`` and ``E(x) = (e^x - 1)/x``
+    (``E = 1`` at ``w = 1``: ``level n0 ln(b/a)``); written with ``log1p``/``expm1`` so that narrow
+    cells and ``w`` near 1 keep full precision.
+    """
+    log_ratio = np.log1p((upper - lower) / lower)
+    x = (1.0 - waviness) * log_ratio
+    growth = np.ones_like(x) if waviness == 1.0 else np.expm1(x) / x
+    return level * _N0 * (lower / _N0) ** (1.0 - waviness) * log_ratio * growth
 
 
 def _nominal_level(road: Iso8608Road) -> float:
@@ -153,11 +194,11 @@ def _nominal_level(road: Iso8608Road) -> float:
 
 
 def _n_waves(road: Iso8608Road, length_m: float) -> int:
-    """``n_waves`` if given, else the smallest N >= 2 with (n_max - n_min)/(N - 1) <= 1/length."""
+    """``n_waves`` if given, else the smallest N >= 2 with (n_max - n_min)/N <= 1/length."""
     if road.n_waves is not None:
         return road.n_waves
     # the tolerance keeps a product that should be a whole number from rounding up by one
-    return max(2, math.ceil((road.n_max - road.n_min) * length_m - 1e-9) + 1)
+    return max(2, math.ceil((road.n_max - road.n_min) * length_m - 1e-9))
 
 
 def _check_wheels(offsets, sides, t) -> tuple[np.ndarray, np.ndarray]:

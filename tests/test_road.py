@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 from pydantic import BaseModel, TypeAdapter, ValidationError
-from scipy.integrate import trapezoid
+from scipy.integrate import quad, trapezoid
 from scipy.signal import welch
 
 from suspopt.config.road import RoadConfig
@@ -138,25 +138,64 @@ def test_convention_levels_and_amplitudes():
     np.testing.assert_array_equal(thesis.phase, standard.phase)
 
 
-def test_iso8608_variance_is_the_integral_of_the_psd():
-    road = iso(road_class="C")
-    harmonics = iso8608_harmonics(road, 2000.0)
-    half_step = (harmonics.omega[1] - harmonics.omega[0]) / (4 * math.pi)
-    # each harmonic carries G_d dn around it (midpoint rule): integrate G0 (n/n0)^-2 over the
-    # band widened by dn/2 at either end
-    expected = 256e-6 * 0.1 ** 2 * (1 / (road.n_min - half_step) - 1 / (road.n_max + half_step))
-    assert np.sum(harmonics.amplitude ** 2 / 2) == pytest.approx(expected, rel=1e-3)
+def band_integral(road) -> float:
+    """Integral of the generated profile's one-sided PSD over [n_min, n_max] [m^2], by quad."""
+    level = iso8608_level(road)
+    value, error = quad(lambda n: level * (n / 0.1) ** -road.waviness, road.n_min, road.n_max,
+                        epsabs=0.0, epsrel=1e-13, limit=200)
+    assert error < 1e-12 * value
+    return value
+
+
+@pytest.mark.parametrize("length", [100.0, 1000.0, 4000.0])
+@pytest.mark.parametrize("convention", ["iso8608", "thesis"])
+@pytest.mark.parametrize("changes", [{}, dict(waviness=3.0, road_class="C"),
+                                     dict(waviness=1.0, n_waves=37, n_min=0.05, n_max=10.0)])
+def test_iso8608_variance_is_the_integral_of_the_psd(length, convention, changes):
+    road = iso(convention=convention, **changes)
+    harmonics = iso8608_harmonics(road, length)
+    assert np.sum(harmonics.amplitude ** 2 / 2) == pytest.approx(band_integral(road), rel=1e-10)
+
+
+# Realised mean square of z over s = 0..L / band integral - 1, class B, ISO band, seeds
+# 0-299 (the figures in iso8608_harmonics' docstring): standard deviation per seed.
+REALISED_SPREAD = {100.0: 3.3e-2, 1000.0: 6.1e-5, 4000.0: 1.7e-5}
+
+
+@pytest.mark.parametrize("length", [100.0, 1000.0, 4000.0])
+def test_iso8608_realised_variance_over_the_road_is_the_integral_of_the_psd(length):
+    # the inclusive grid of Eq 2.100 overshoots by 58 %, 4.7 % and 1.1 % here
+    s = np.linspace(0.0, length, round(length / 0.05) + 1)
+    seeds = range(20)
+    mean_squares = [np.mean(profile(iso(seed=seed), s) ** 2) for seed in seeds]
+    tolerance = 4 * REALISED_SPREAD[length] / math.sqrt(len(seeds))
+    assert np.mean(mean_squares) / band_integral(iso()) == pytest.approx(1.0, abs=tolerance)
 
 
 def test_default_number_of_waves_spacing_and_band():
     road = iso()
     harmonics = iso8608_harmonics(road, 1000.0)
     n = harmonics.omega / (2 * math.pi)
-    assert n[0] == pytest.approx(road.n_min) and n[-1] == pytest.approx(road.n_max)
     spacing = np.diff(n)
     np.testing.assert_allclose(spacing, spacing[0])
-    assert spacing[0] <= 1 / 1000.0 * (1 + 1e-12) < (road.n_max - road.n_min) / (n.size - 2)
+    # N cells of width dn tile the band, one harmonic at each cell's centre
+    assert n[0] - spacing[0] / 2 == pytest.approx(road.n_min)
+    assert n[-1] + spacing[0] / 2 == pytest.approx(road.n_max)
+    assert n.size * spacing[0] == pytest.approx(road.n_max - road.n_min)
+    # the fewest harmonics whose spacing is at most 1/L
+    assert spacing[0] <= 1 / 1000.0 * (1 + 1e-12) < (road.n_max - road.n_min) / (n.size - 1)
     assert iso8608_harmonics(iso(n_waves=50), 1000.0).omega.size == 50
+    # a band that is a whole number of 1/L wide: N = (n_max - n_min) L, not one more
+    assert iso8608_harmonics(iso(n_min=0.01, n_max=2.01), 1000.0).omega.size == 2000
+
+
+def test_phases_do_not_depend_on_the_grid():
+    # the phase stream is the same SeedSequence draw, so a longer road extends it
+    short, long = (iso8608_harmonics(iso(seed=5), length) for length in (100.0, 1000.0))
+    np.testing.assert_array_equal(short.phase, long.phase[:short.phase.size])
+    expected = np.random.default_rng(np.random.SeedSequence(5).spawn(2)[0]).uniform(
+        0.0, 2 * math.pi, short.phase.size)
+    np.testing.assert_array_equal(short.phase, expected)
 
 
 def test_harmonic_sum_matches_the_direct_sum():

@@ -115,15 +115,20 @@ class Iso8608Road(_Road):
     convention: Literal["iso8608", "thesis"] = Field(
         description="amplitude convention: 'iso8608' A_i = sqrt(2 G_d(n_i) dn) (one-sided PSD, "
         "the standard's meaning) or 'thesis' A_i = sqrt(Phi(Omega_i) dOmega / pi) (Eq 2.99; "
-        "1/sqrt(2 pi) times smaller)")
-    waviness: quantity(0.1, 10.0) = Field(2.0, description="waviness w, the PSD slope exponent (Eq 2.93) [-]")
-    n_min: _SpatialFrequency = Field(0.011, description="lowest spatial frequency generated [cycles/m]")
+        "1/sqrt(2 pi) times smaller); G_d(n_i) dn and Phi(Omega_i) dOmega stand for the PSD's "
+        "integral over harmonic i's cell")
+    waviness: quantity(0.1, 10.0) = Field(2.0, description="waviness w, the PSD slope "
+                                          "exponent (Eq 2.93) [-]")
+    n_min: _SpatialFrequency = Field(0.011, description="lower edge of the generated band "
+                                     "[cycles/m]")
     n_max: _SpatialFrequency = Field(2.83, validate_default=True,
-                             description="highest spatial frequency generated [cycles/m]")
+                                     description="upper edge of the generated band [cycles/m]")
     n_waves: int | None = Field(
-        None, ge=2, le=10_000_000, description="number of harmonics N, uniformly spaced from n_min to n_max "
-        "inclusive (Eq 2.100); default: the smallest N whose spacing (n_max - n_min)/(N - 1) is "
-        "at most 1/L, L the length of road the wheels travel [m], so the road does not repeat")
+        None, ge=2, le=10_000_000, description="number of harmonics N, at the centres of N "
+        "equal cells tiling n_min..n_max (not Eq 2.100's inclusive grid, see "
+        "suspopt.road.iso8608_harmonics); default: the smallest N whose spacing "
+        "(n_max - n_min)/N is at most 1/L, L the length of road the wheels travel [m], so the "
+        "road does not repeat")
     seed: Seed = Field(0, description="seed of the random phases; the same seed gives the "
                       "same road bit for bit (default 0)")
 
