@@ -1,26 +1,56 @@
-"""HDF5 output, written atomically: a temporary file in the target folder, then a rename.
+"""Output files: checked targets, one writer at a time, written atomically.
 
-Root attributes of every file: ``suspopt_version``, ``created`` (UTC ISO 8601), ``command``,
-``config`` (the YAML text) and ``seed`` (the config's random seed, -1 when it draws nothing).
-Every dataset carries a ``units`` attribute.
+**Targets** (:func:`check_target`): an output is a regular file or a new name in an existing
+folder. An empty name, a directory, a device (``/dev/null``), a FIFO, a socket or a symbolic
+link is bad input, and so is an existing file that suspopt did not write (an HDF5 file without
+the root attribute ``suspopt_version``, or another file without the word ``suspopt`` in its
+first 4 kB: suspopt writes it into every figure and text it makes) unless ``force``.
+
+**One writer** (:func:`claim`): a writer holds an exclusive ``flock`` on ``.NAME.suspopt-lock``
+beside the target for as long as it writes (``suspopt optimise``: the whole run), so a second
+run on the same output fails at once with the first one's process id. Holding the lock, it
+removes the temporary files ``.NAME.*.suspopt-tmp`` that a killed run left behind: no live
+writer can own them.
+
+**Atomic writes** (:func:`atomic_file`, :func:`atomic_h5`): the file is written to a temporary
+file created exclusively, with an unpredictable name, in the target's folder, through the
+descriptor it was created with (a link planted at that name is never followed), flushed to
+disk (``fsync``), then renamed over the target, and the folder synced. A killed or failed
+write leaves the target as it was.
+
+Root attributes of every HDF5 file: ``suspopt_version``, ``created`` (UTC ISO 8601),
+``command``, ``config`` (the YAML text) and ``seed`` (the config's random seed, -1 when it
+draws nothing). Every dataset carries a ``units`` attribute.
 """
 
 from __future__ import annotations
 
+import errno
+import fcntl
 import os
+import stat
 import sys
-from collections.abc import Iterable
+import tempfile
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
 
-import h5py
 import numpy as np
 
 from . import __version__
-from .config import Config
+from .config import Config, ConfigError
 
-__all__ = ["atomic_h5", "write_dataset", "write_simulation", "read_simulation_signals"]
+__all__ = ["OUTPUT_MARKER", "check_target", "claim", "atomic_file", "atomic_h5",
+           "write_dataset", "write_simulation", "read_simulation_signals", "is_suspopt_output"]
+
+#: Written into every non-HDF5 file suspopt makes (figure metadata, a comment), so that it
+#: can tell its own outputs from other files.
+OUTPUT_MARKER = "suspopt"
+_LOCK, _TMP = ".suspopt-lock", ".suspopt-tmp"
+_HEAD = 4096
+#: Locks this process holds: resolved target -> [descriptor, depth, force].
+_held: dict[Path, list] = {}
 
 
 def _seed_of(cfg: Config) -> int:
@@ -28,30 +58,169 @@ def _seed_of(cfg: Config) -> int:
     return -1 if seed is None else int(seed)
 
 
-@contextmanager
-def atomic_h5(path: str | Path, cfg: Config, command: str | None = None):
-    """Open a new HDF5 file for writing under a temporary name; rename it on success.
+def is_suspopt_output(path: Path) -> bool:
+    """Whether the regular file ``path`` was written by suspopt (module docstring)."""
+    with open(path, "rb") as stream:
+        head = stream.read(_HEAD)
+    if head.startswith(b"\x89HDF\r\n\x1a\n"):
+        import h5py
+        try:
+            with h5py.File(path, "r") as h5:
+                return "suspopt_version" in h5.attrs
+        except (OSError, ValueError):
+            return False
+    return OUTPUT_MARKER.encode() in head
 
-    On any exception the temporary file is removed and ``path`` is left untouched.
-    """
+
+def check_target(path: str | Path, force: bool = False, option: str = "-o") -> Path:
+    """``path`` if suspopt may write it (module docstring), else ConfigError naming
+    ``option``."""
+    text = str(path)
+    if not text.strip():
+        raise ConfigError(f"{option}: an empty file name")
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    if text.endswith(os.sep) or path.name in ("", ".", ".."):
+        raise ConfigError(f"{option} {path}: names a folder, not a file")
+    folder = path.parent
+    if not folder.is_dir():
+        raise ConfigError(f"{option} {path}: folder {folder} does not exist")
     try:
-        with h5py.File(tmp, "w") as h5:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return path
+    except OSError as exc:
+        raise ConfigError(f"{option} {path}: cannot inspect it ({exc.strerror})") from None
+    kind = ("a directory" if stat.S_ISDIR(mode) else "a symbolic link" if stat.S_ISLNK(mode)
+            else "a FIFO" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode)
+            else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else None)
+    if kind is not None:
+        raise ConfigError(f"{option} {path}: is {kind}; an output must be a regular file or "
+                          f"a new name")
+    if not force:
+        try:
+            ours = is_suspopt_output(path)
+        except OSError as exc:
+            raise ConfigError(f"{option} {path}: cannot read it ({exc.strerror})") from None
+        if not ours:
+            raise ConfigError(f"{option} {path}: exists and was not written by suspopt; "
+                              f"give --force to replace it")
+    return path
+
+
+def _lock_path(path: Path) -> Path:
+    return path.with_name(f".{path.name}{_LOCK}")
+
+
+def _key(path: Path) -> Path:
+    return path.parent.resolve() / path.name
+
+
+@contextmanager
+def claim(path: str | Path, force: bool = False, option: str = "-o") -> Iterator[Path]:
+    """Check ``path`` (:func:`check_target`), hold the writer's lock of it (module docstring)
+    and clear the temporary files of dead writers; ConfigError when another process writes
+    it. Re-entrant in one process; a write inside the block may replace the file when
+    ``force`` was given here."""
+    path = check_target(path, force, option)
+    key = _key(path)
+    if key in _held:
+        _held[key][1] += 1
+        try:
+            yield path
+        finally:
+            _held[key][1] -= 1
+        return
+    lock = _lock_path(path)
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+        except OSError as exc:
+            raise ConfigError(f"{path}: cannot write in {path.parent} "
+                              f"({exc.strerror})") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            owner = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
+            os.close(fd)
+            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                raise ConfigError(f"{path}: another suspopt run (process {owner}) is writing "
+                                  f"it; wait for it to finish or choose another output") from None
+            raise
+        try:                       # the lock file may have been removed and made anew
+            same = os.stat(lock, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(fd)
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    for stale in path.parent.glob(f".{_glob_escape(path.name)}.*{_TMP}"):
+        stale.unlink(missing_ok=True)
+    _held[key] = [fd, 1, force]
+    try:
+        yield path
+    finally:
+        del _held[key]
+        try:
+            lock.unlink(missing_ok=True)
+        finally:
+            os.close(fd)
+
+
+def _glob_escape(name: str) -> str:
+    return "".join(f"[{c}]" if c in "*?[" else c for c in name)
+
+
+@contextmanager
+def atomic_file(path: str | Path, force: bool = False) -> Iterator:
+    """A binary file object that becomes ``path`` when the block ends without an exception
+    (module docstring); ``path`` is checked with :func:`check_target` first (with the
+    ``force`` of an enclosing :func:`claim`)."""
+    path = Path(path)
+    held = _held.get(_key(path)) if path.parent.is_dir() else None
+    force = force or (held is not None and held[2])
+    with claim(path, force):
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=_TMP, dir=path.parent)
+        try:
+            with os.fdopen(fd, "w+b") as stream:
+                yield stream
+                stream.flush()
+                os.fsync(stream.fileno())
+            check_target(path, force=True)        # nothing took its place meanwhile
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        try:
+            folder = os.open(path.parent, os.O_RDONLY | os.O_DIRECTORY)
+        except OSError:
+            return
+        try:
+            os.fsync(folder)
+        except OSError:
+            pass
+        finally:
+            os.close(folder)
+
+
+@contextmanager
+def atomic_h5(path: str | Path, cfg: Config, command: str | None = None, force: bool = False):
+    """A new HDF5 file written atomically (:func:`atomic_file`) with the root attributes of
+    every suspopt file. On any exception ``path`` is left untouched."""
+    import h5py
+
+    with atomic_file(path, force) as stream:
+        with h5py.File(stream, "w") as h5:
             h5.attrs["suspopt_version"] = __version__
             h5.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
             h5.attrs["command"] = command if command is not None else " ".join(sys.argv)
             h5.attrs["config"] = cfg.text
             h5.attrs["seed"] = _seed_of(cfg)
             yield h5
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
-def write_dataset(group: h5py.Group, name: str, data, units: str | list[str],
-                  **attrs) -> h5py.Dataset:
+def write_dataset(group, name: str, data, units: str | list[str], **attrs):
     """Create ``group[name]`` with its ``units`` attribute (one string, or one per column) and
     any other attributes."""
     ds = group.create_dataset(name, data=data)
@@ -95,5 +264,7 @@ def write_simulation(path: str | Path, result, signals: Iterable[str] | None = N
 
 def read_simulation_signals(path: str | Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Read ``/time`` and every ``/signals/<name>`` back from a simulate output file."""
+    import h5py
+
     with h5py.File(path, "r") as h5:
         return h5["time"][()], {k: v[()] for k, v in h5["signals"].items()}

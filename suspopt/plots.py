@@ -22,7 +22,6 @@ Figures of the thesis they correspond to:
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -68,16 +67,18 @@ def new_figure(panels: int, columns: int = 2, panel_size: tuple[float, float] = 
 
 
 def save(fig, path: str | Path, dpi: int = 120) -> Path:
-    """Write ``fig`` to ``path`` (format from the suffix) under a temporary name, then rename
-    it, so a failed write never leaves a broken figure."""
+    """Write ``fig`` to ``path`` (format from the suffix) atomically
+    (:func:`suspopt.io.atomic_file`: a failed write never leaves a broken figure), marked as
+    suspopt's in its metadata."""
+    from . import __version__
+    from .io import OUTPUT_MARKER, atomic_file
+
     path = check_path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        fig.savefig(tmp, format=FORMATS[path.suffix.lower()], dpi=dpi)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    kind = FORMATS[path.suffix.lower()]
+    mark = f"{OUTPUT_MARKER} {__version__}"
+    metadata = {"Software": mark} if kind == "png" else {"Creator": mark}
+    with atomic_file(path) as stream:
+        fig.savefig(stream, format=kind, dpi=dpi, metadata=metadata)
     return path
 
 

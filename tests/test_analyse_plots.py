@@ -14,14 +14,13 @@ def test_a_figure_that_fails_to_write_leaves_nothing(tmp_path):
     path = tmp_path / "fig.png"
 
     def broken(target, **kwargs):
-        with open(target, "wb") as handle:
-            handle.write(b"half a figure")
+        target.write(b"half a figure")
         raise OSError("disk full")
 
     fig.savefig = broken
     with pytest.raises(OSError, match="disk full"):
         plots.save(fig, path)
-    assert list(tmp_path.iterdir()) == []
+    assert list(tmp_path.iterdir()) == []       # no figure, no temporary file, no lock
 
 
 def test_the_suffix_chooses_the_format(tmp_path):
