@@ -138,6 +138,21 @@ def test_error_falls_at_rk4_order_across_bump_edges(name, preset, start, length,
     assert np.all(err[0] < 1e-2), err
 
 
+def test_edges_at_the_first_and_last_instants():
+    """A step met at t = 0 and left at the run's last instant: both impulses are applied (the
+    samples there hold the state just after them, with the road's right limit)."""
+    err = []
+    for dt in DTS[1:3]:
+        res = suspopt.simulate(config("quarter", "bump_step", 0.0, SPEED * DURATION, dt,
+                                      c_t=300.0))
+        times = np.arange(res.time.size) * DTS[0]
+        reference = exact("quarter", "bump_step", 0.0, SPEED * DURATION, 300.0, times)
+        scale = np.abs(reference).max(axis=1, keepdims=True)
+        err.append(np.max(np.abs(res.states[:, 0] - reference) / scale))
+        assert res.signals["road.F1"][0, 0] == HEIGHT and res.signals["road.F1"][0, -1] == 0.0
+    assert err[0] / err[1] > 11.0, err
+
+
 def test_reference_is_the_simulators_model():
     """The hand-written linear matrices are the simulator's (so the comparison above compares
     integrations, not models)."""
