@@ -23,7 +23,7 @@ import suspopt
 
 from conftest import corner, make_config
 
-M_S, M_U, K_T, K, C = 300.0, 40.0, 1.5e5, 1.5e4, 1200.0    # body (corner) / wheel [kg], [N/m]
+M_S, M_U, K_T, K, C = 300.0, 40.0, 1.5e5, 1.5e4, 1200.0  # [kg] body/corner, wheel; [N/m]; [N s/m]
 A_F, A_R, PITCH_INERTIA = 1.2, 1.4, 650.0                     # half car [m], [kg m^2]
 HEIGHT, SPEED = 0.05, 10.0
 DTS = 2.0 ** -np.arange(8, 12)          # 3.9 ms ... 0.49 ms, output every 3.9 ms
