@@ -23,8 +23,8 @@ from .config.road import (
 )
 
 __all__ = [
-    "ISO8608_CLASS_LEVELS", "Harmonics", "road_inputs", "profile", "iso8608_harmonics",
-    "iso8608_level",
+    "ISO8608_CLASS_LEVELS", "Harmonics", "road_inputs", "road_edges", "profile",
+    "iso8608_harmonics", "iso8608_level",
 ]
 
 #: Geometric-mean displacement PSD level G_d(n0) of each ISO 8608 class [m^3], n0 = 0.1 cycles/m
@@ -49,7 +49,7 @@ class Harmonics(NamedTuple):
 
 
 def road_inputs(road: RoadConfig, offsets: np.ndarray, sides: Sequence[str], t: np.ndarray,
-                base_dir: Path | None = None) -> tuple[np.ndarray, np.ndarray]:
+                base_dir: Path | None = None, left: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Vertical road height and its time derivative under each wheel.
 
     offsets (N,) [m]: distance of each wheel behind the front axle (0 for front wheels,
@@ -59,11 +59,14 @@ def road_inputs(road: RoadConfig, offsets: np.ndarray, sides: Sequence[str], t: 
     Returns z (N, T) [m] and zdot (N, T) [m/s].
 
     ``zdot`` is analytic for the half-sine bump, ISO 8608 roads and CSV profiles (for a CSV, the
-    slope of the linear interpolation times V). The step bump's derivative is a Dirac; here it is
-    the backward difference of ``z`` on the sorted distinct times of ``t``: a spike of height
-    ``h / dt_k`` at the first time on the plateau (and ``-h / dt_k`` at the first time past it),
-    so that ``sum_k zdot_k (t_k - t_{k-1})`` reproduces the step exactly at every grid time (on a
-    uniform grid the trapezoidal integral reaches ``h`` one step after the edge).
+    slope of the linear interpolation times V). A bump (Eq 2.101-2.104) is a function of time
+    with edges - instants where ``z`` (step) or ``zdot`` (half-sine) jumps, listed by
+    :func:`road_edges`: at an edge the value returned is the right limit (the road from that
+    instant on, as the equations' ``t_0 <= t < t_0 + L/V`` say), or with ``left=True`` the left
+    limit (the road just before it; ``left`` changes nothing elsewhere). The step bump's
+    derivative is a Dirac ``±h δ(t - t_edge)`` at its edges and 0 between them: ``zdot`` is
+    that regular part, 0 everywhere, and the simulator integrates the Dirac exactly as an
+    impulse at the edge (:func:`suspopt.simulate.simulate`).
 
     For an ``iso8608`` road without ``n_waves`` the number of harmonics follows from the span of
     road positions the wheels cover, ``V (max t - min t) + (max d - min d)``
@@ -71,13 +74,39 @@ def road_inputs(road: RoadConfig, offsets: np.ndarray, sides: Sequence[str], t: 
     """
     offsets, t = _check_wheels(offsets, sides, t)
     if isinstance(road, (BumpStep, BumpHalfSine)):
-        z, zdot = _bump_inputs(road, offsets, t)
+        z, zdot = _bump_inputs(road, offsets, t, left)
     else:
         positions = road.speed * t[None, :] - offsets[:, None]
         z, slope = _spatial_profile(road, positions, sides, base_dir)
         zdot = road.speed * slope
     on_road = np.array([not _is_flat(road, side) for side in sides])[:, None]
     return np.where(on_road, z, 0.0), np.where(on_road, zdot, 0.0)
+
+
+def road_edges(road: RoadConfig, offsets: np.ndarray,
+               sides: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+    """The instants where a bump's ``z`` or ``zdot`` is discontinuous, and the steps in ``z``.
+
+    A wheel ``d`` behind the front axle meets the bump at ``t_0 + d/V`` and leaves it
+    ``L/V`` later (Eq 2.101-2.104, ERRATA Eq 2.104); wheels on a flat side have no edges.
+    Returns the distinct edge times ``(E,)`` [s], ascending, and the jump of ``z`` under each
+    wheel at each of them ``(N, E)`` [m]: ``+h`` where a wheel climbs a step bump, ``-h`` where it
+    comes down, 0 for the half-sine bump (``z`` continuous, ``zdot`` jumping by ``± h pi V/L``)
+    and for the wheels without an edge at that instant. Roads other than bumps have no edges
+    (``E = 0``).
+    """
+    offsets = np.asarray(offsets, dtype=float)
+    if not isinstance(road, (BumpStep, BumpHalfSine)):
+        return np.zeros(0), np.zeros((offsets.size, 0))
+    on_road = np.array([not _is_flat(road, side) for side in sides])
+    up, down = _bump_window(road, offsets)
+    times = np.unique(np.concatenate([up[on_road], down[on_road]]))
+    jumps = np.zeros((offsets.size, times.size))
+    if isinstance(road, BumpStep):
+        wheels = np.flatnonzero(on_road)
+        jumps[wheels, np.searchsorted(times, up[wheels])] += road.height
+        jumps[wheels, np.searchsorted(times, down[wheels])] -= road.height
+    return times, jumps
 
 
 def profile(road: Iso8608Road | FileRoad, s: np.ndarray, side: str = "right",
@@ -225,30 +254,33 @@ def _is_flat(road: RoadConfig, side: str) -> bool:
     return (road.tracks, side) in {("right_only", "left"), ("left_only", "right")}
 
 
-def _bump_inputs(road: BumpStep | BumpHalfSine, offsets: np.ndarray,
-                 t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Bump under each wheel, Eq 2.101-2.104: the front wheels' input delayed by d/V."""
-    since_start = t[None, :] - offsets[:, None] / road.speed - road.start
-    on_bump = (since_start >= 0.0) & (since_start < road.length / road.speed)
+def _bump_window(road: BumpStep | BumpHalfSine,
+                 offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """When each wheel meets and leaves the bump (N,) [s]: ``t_0 + d/V`` and ``L/V`` later
+    (Eq 2.102/2.104 with ``t_distance = d/V``; ERRATA Eq 2.104 for the rear duration)."""
+    up = road.start + offsets / road.speed
+    return up, up + road.length / road.speed
+
+
+def _bump_inputs(road: BumpStep | BumpHalfSine, offsets: np.ndarray, t: np.ndarray,
+                 left: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Bump under each wheel, Eq 2.101-2.104: the front wheels' input delayed by d/V.
+
+    On the bump is ``up <= t < down`` (the right limits at the edges), or with ``left``
+    ``up < t <= down`` (the left limits). The step's ``zdot`` is its regular part, 0 (see
+    :func:`road_inputs`).
+    """
+    up, down = (w[:, None] for w in _bump_window(road, offsets))
+    t = t[None, :]
+    on_bump = (t > up) & (t <= down) if left else (t >= up) & (t < down)
     if isinstance(road, BumpStep):
         z = np.where(on_bump, road.height, 0.0)
-        return z, _grid_derivative(z, t)
+        return z, np.zeros_like(z)
     rate = math.pi * road.speed / road.length  # [rad/s]: half a period over length/speed
-    z = np.where(on_bump, road.height * np.sin(rate * since_start), 0.0)
-    zdot = np.where(on_bump, road.height * rate * np.cos(rate * since_start), 0.0)
+    phase = rate * (t - up)
+    z = np.where(on_bump, road.height * np.sin(phase), 0.0)
+    zdot = np.where(on_bump, road.height * rate * np.cos(phase), 0.0)
     return z, zdot
-
-
-def _grid_derivative(z: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Backward difference of ``z`` (N, T) on the sorted distinct times of ``t``, 0 at the first.
-
-    Repeated times share a value; ``t`` may come in any order (integrator stage times).
-    """
-    times, first, where = np.unique(t, return_index=True, return_inverse=True)
-    z_sorted = z[:, first]
-    rate = np.zeros_like(z_sorted)
-    rate[:, 1:] = np.diff(z_sorted, axis=1) / np.diff(times)
-    return rate[:, where.reshape(-1)]
 
 
 def _spatial_profile(road: Iso8608Road | FileRoad, positions: np.ndarray, sides: Sequence[str],

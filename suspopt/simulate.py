@@ -3,10 +3,11 @@
 The equations of motion are the vehicle's :class:`~suspopt.network.Network` with the seat (if
 any) mounted on it, packed by :class:`_Assembled`. The integrator is the classical 4th-order
 Runge-Kutta method with a fixed step ``dt``; the road is sampled on the half-step grid the
-stages need, so a bump edge that falls on a step boundary is seen exactly. All P designs
-advance together: states are ``(2n, P, 1)`` - DOF by DOF, each a contiguous row over the
-designs - and each stage is two small matrix products and the element forces on whole rows,
-in preallocated buffers. There is no Python loop over designs.
+stages need, and a step that meets a bump's edge is split there, the step bump's Dirac in the
+road's rate entering as an exact impulse (:func:`_integrate`), so every edge is seen at its
+instant. All P designs advance together: states are ``(2n, P, 1)`` - DOF by DOF, each a
+contiguous row over the designs - and each stage is two small matrix products and the element
+forces on whole rows, in preallocated buffers. There is no Python loop over designs.
 
 A design whose state becomes non-finite or exceeds ``DIVERGENCE_LIMIT`` is marked in
 ``Result.diverged`` (with the time in ``Result.diverged_at``); its samples from then on are NaN,
@@ -17,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import difflib
 
@@ -29,7 +30,7 @@ from .control import build_controller
 from .network import Network, widen
 from .params import ParamView
 from .specs import evaluate_spec, spec_signals
-from .road import road_inputs
+from .road import road_edges, road_inputs
 from .seat import SIGNAL_HEADS as _SEAT_HEADS, build_attachments
 from .seat import signal_units as _seat_signal_units
 from .vehicle import VehicleModel, build_vehicle
@@ -290,10 +291,39 @@ def _stacked(arrays: list[np.ndarray]) -> np.ndarray:
     return np.concatenate(arrays).reshape((len(arrays),) + arrays[0].shape)
 
 
+class _Edges(NamedTuple):
+    """The road's edges (:func:`suspopt.road.road_edges`) as :func:`_integrate` takes them."""
+
+    times: np.ndarray      #: (E,) ascending [s]
+    jumps: np.ndarray      #: (E, n_u) the step in the inputs u at each edge [m]
+    #: ``inputs(t, left)``: the inputs' part of the deformations (T, 2R, 1, 1) at times ``t``
+    #: (T,), their left limits if ``left``, else the right ones
+    inputs: Callable[[np.ndarray, bool], np.ndarray]
+    #: (R,) element rows that cannot pull (a tyre that may lift off), or None
+    no_pull: np.ndarray | None
+
+
 def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, n_steps: int,
-               every: int, controller: Controller | None = None) -> _Trajectory:
+               every: int, controller: Controller | None = None,
+               edges: _Edges | None = None) -> _Trajectory:
     """Classical RK4 over ``n_steps``; ``offsets`` (2 n_steps + 1, 2R, 1, 1) are the inputs'
-    part of the deformations on the half-step grid. Samples are kept every ``every``-th step.
+    part of the deformations on the half-step grid ``t = j dt/2`` (their right limits at a
+    road edge). Samples are kept every ``every``-th step.
+
+    Road edges (``edges``; the bumps' jumps in z or its rate, Eq 2.101-2.104) are seen at their
+    instants. A step whose interior holds edges is split at them into RK4 sub-steps; each
+    sub-step's last stage takes the road's left limit at its end and the next one's first stage
+    the right limit, so a step ending on an edge uses the left limit in its last stage and one
+    starting on it (the grid) the right limit. Where the inputs jump by ``Δu`` their rate
+    holds a Dirac ``Δu δ(t - t_e)``, integrated exactly: an impulse ``c D_u Δu`` [N s] of the
+    viscous elements that see the road (the tyre damping c_T, Eq 2.29), so the velocities
+    jump by ``M^-1 (-D_qᵀ) (c D_u Δu)`` at the edge (the elastic forces stay bounded and give
+    no impulse). A tyre that may lift off cannot pull: its force is capped at the static load,
+    so its impulse at an edge where it would pull (the road dropping away) is not applied; one
+    that pushes is. A split step still makes one output sample, its controller sample (at the
+    step's start) and one actuator-lag update; the sample's accelerations are the first stage
+    of the step, as for any step. Only the few split steps allocate and call the road again;
+    the others pay one dictionary look-up.
 
     Every array lives in preallocated buffers (states ``(2n, P, 1)``) and each stage is a few
     whole-population operations: two small matrix products and the element forces. A sample
@@ -399,8 +429,57 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
             changes.append(j)
             last_samples[0] = controller.samples
 
+    # the steps k with road edges in (t_k, t_k+1] (the grid as _run's, t_k = 2k dt/2), by step
+    split: dict[int, list[int]] = {}
+    if edges is not None:
+        bounds = np.arange(2 * n_steps + 1)[::2] * half
+        for e, k in enumerate(np.searchsorted(bounds, edges.times) - 1):
+            if edges.times[e] >= 0.0 and k < n_steps:
+                split.setdefault(int(k), []).append(e)
+        R = asm.R
+        rate_forces = asm.G2[..., R:2 * R]      # q'' per unit viscous force, times M
+
+    def derivative(state: np.ndarray, offset: np.ndarray | None) -> np.ndarray:
+        """[q'; q''] at ``state`` (2n, width, 1), in a new array (split steps only)."""
+        out = np.empty_like(state)
+        out[:n] = state[n:]
+        evaluate(state.reshape(n2, width), offset, coef, unscaled_mass,
+                 out[n:].reshape(n, width), out[n:])
+        return out
+
+    def impulse(e: int) -> None:
+        """The velocity jump M^-1 G (c D_u Δu) of the inputs' jump Δu at edge e."""
+        force = coef[R:2 * R] * (asm.input_map @ edges.jumps[e])[:, None, None]   # [N s]
+        if edges.no_pull is not None:   # a tyre that cannot pull takes no pulling impulse
+            force[edges.no_pull] = np.minimum(force[edges.no_pull], 0.0)
+        force2 = force.reshape(R, width)
+        jump = rate_forces @ force2 if rate_forces.ndim == 2 \
+            else np.einsum("prc,cp->rp", rate_forces, force2)
+        y[n:] += jump[:, :, None] * unscaled_mass
+
+    def split_step(k: int, found: list[int]) -> None:
+        """Step k in RK4 sub-steps between the edges ``found`` inside it, each edge's impulse
+        applied at its instant (the first stage, at t_k, is the step's as always)."""
+        times, end = edges.times[found], bounds[k + 1]
+        ends = np.append(times[times < end], end)
+        starts = np.insert(ends[:-1], 0, bounds[k])
+        h = ends - starts
+        rights, middles = edges.inputs(starts, False), edges.inputs(starts + 0.5 * h, False)
+        lefts = edges.inputs(ends, True)
+        for j, step in enumerate(h):
+            k1 = derivative(y, offsets[2 * k] if j == 0 else rights[j])
+            k2 = derivative(y + 0.5 * step * k1, middles[j])
+            k3 = derivative(y + 0.5 * step * k2, middles[j])
+            k4 = derivative(y + step * k3, lefts[j])
+            y[...] += step / 6.0 * (k1 + 2.0 * (k2 + k3) + k4)
+            if j < len(found) and edges.jumps[found[j]].any():
+                impulse(found[j])
+
     q_rate1, v1 = first[5], first[6]
     with np.errstate(over="ignore", invalid="ignore"):
+        for e in split.pop(-1, []):                     # edges at t = 0: before the first sample
+            if edges.jumps[e].any():
+                impulse(e)
         for k in range(n_steps):
             i = 2 * k
             if controller is not None and (decay is not None or k % sample_every == 0):
@@ -408,20 +487,23 @@ def _integrate(asm: _Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, 
             evaluate(y2, offsets[i], coef, unscaled_mass, acc2, acc)
             if k % every == 0:
                 keep(k // every)
-            acc *= half
-            multiply(v1, half, out=q_rate1)
-            add(y, s1, out=ys)
-            for state2, shift, inverse_mass, out2, out, q_rate, v, h, slope, target in stages:
-                evaluate(state2, offsets[i + shift], coef, inverse_mass, out2, out)
-                multiply(v, h, out=q_rate)
-                if target is not None:
-                    add(y, slope, out=target)
-            s1 += s3
-            s2 *= 2.0
-            s1 += s2
-            s1 *= third
-            s1 += s4
-            y += s1
+            if k in split:
+                split_step(k, split[k])
+            else:
+                acc *= half
+                multiply(v1, half, out=q_rate1)
+                add(y, s1, out=ys)
+                for state2, shift, inverse_mass, out2, out, q_rate, v, h, slope, target in stages:
+                    evaluate(state2, offsets[i + shift], coef, inverse_mass, out2, out)
+                    multiply(v, h, out=q_rate)
+                    if target is not None:
+                        add(y, slope, out=target)
+                s1 += s3
+                s2 *= 2.0
+                s1 += s2
+                s1 *= third
+                s1 += s4
+                y += s1
             if (k + 1) % _CHECK_EVERY == 0 or k + 1 == n_steps:
                 bad = ~(np.abs(flat[id(y)][:, :P]) < DIVERGENCE_LIMIT).all(axis=0)
                 new_bad = bad & np.isnan(diverged_at)
@@ -495,8 +577,19 @@ def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller
     n_steps, every = sim.n_steps, sim.output_every
     t_grid = np.arange(2 * n_steps + 1) * (0.5 * sim.dt)
     z, zd = road_inputs(cfg.road, model.offsets, model.sides, t_grid, base_dir=cfg.base_dir)
-    asm = _Assembled(full_network(model, attachments), pv.P, controlled="suspension" if controller else None)
-    traj = _integrate(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller)
+    network = full_network(model, attachments)
+    asm = _Assembled(network, pv.P, controlled="suspension" if controller else None)
+    times, jumps = road_edges(cfg.road, model.offsets, model.sides)
+    edges = None
+    if times.size:
+        def inputs(t: np.ndarray, left: bool) -> np.ndarray:
+            return asm.offsets(*road_inputs(cfg.road, model.offsets, model.sides, t,
+                                            base_dir=cfg.base_dir, left=left))
+        no_pull = np.concatenate([np.full(g.size, g.name == "tyre") for g in network.groups]) \
+            if cfg.vehicle.tyre_lift_off else None
+        edges = _Edges(times, jumps.T, inputs, no_pull)
+    traj = _integrate(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller,
+                      edges)
     out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
     return Result(config=cfg, model=model, time=t_grid[out_idx], states=traj.states,
                   accelerations=traj.accelerations, road=z[:, None, out_idx],

@@ -7,11 +7,12 @@ import math
 import numpy as np
 import pytest
 from pydantic import BaseModel, TypeAdapter, ValidationError
-from scipy.integrate import quad, trapezoid
+from scipy.integrate import quad
 from scipy.signal import welch
 
 from suspopt.config.road import RoadConfig
-from suspopt.road import iso8608_harmonics, iso8608_level, profile, road_inputs
+from suspopt.road import (iso8608_harmonics, iso8608_level, profile, road_edges,
+                          road_inputs)
 
 ROAD = TypeAdapter(RoadConfig)
 # dyadic numbers keep the bump edges exactly on grid points
@@ -56,22 +57,39 @@ def test_step_bump_can_be_a_pothole():
     assert z.min() == -0.03 and z.max() == 0.0
 
 
-def test_step_derivative_integrates_to_the_step():
-    z, zdot = road_inputs(bump("bump_step"), *FOUR_WHEELS, T)
-    integral = np.concatenate([np.zeros((4, 1)), np.cumsum(zdot[:, 1:] * np.diff(T), axis=1)],
-                              axis=1)
-    np.testing.assert_allclose(integral, z, atol=1e-12)
-    mid_plateau = np.searchsorted(T, START + 0.1)
-    assert trapezoid(zdot[0, :mid_plateau], T[:mid_plateau]) == pytest.approx(HEIGHT)
-
-
-def test_step_derivative_on_unsorted_stage_times_matches_the_sorted_grid():
-    stages = np.concatenate([T, T + DT / 2, T + DT / 2, T + DT])    # RK4 stage times
-    _, zdot = road_inputs(bump("bump_step"), np.zeros(1), ["right"], stages)
-    grid = np.unique(stages)
-    _, zdot_grid = road_inputs(bump("bump_step"), np.zeros(1), ["right"], grid)
-    np.testing.assert_array_equal(zdot[0], zdot_grid[0, np.searchsorted(grid, stages)])
-    assert zdot_grid.max() == pytest.approx(HEIGHT / (DT / 2))
+@pytest.mark.parametrize("kind", ["bump_step", "bump_half_sine"])
+def test_bump_edges_are_where_the_road_jumps(kind):
+    """road_edges lists every instant the road (or its rate) jumps; between them the left and
+    right limits agree, at them they differ by the listed jump (step) or the slope's jump."""
+    offsets, sides = FOUR_WHEELS
+    times, jumps = road_edges(bump(kind), offsets, sides)
+    delay = WHEELBASE / SPEED
+    duration = LENGTH / SPEED
+    np.testing.assert_array_equal(times, np.unique([START, START + duration, START + delay,
+                                                    START + delay + duration]))
+    right, right_rate = road_inputs(bump(kind), offsets, sides, times)
+    left, left_rate = road_inputs(bump(kind), offsets, sides, times, left=True)
+    if kind == "bump_step":
+        np.testing.assert_array_equal(right - left, jumps)
+        # the edges' jumps add up to the road at every time; the rate is the Dirac's regular part
+        z, zdot = road_inputs(bump(kind), offsets, sides, T)
+        passed = times[None, :] <= T[:, None]
+        np.testing.assert_allclose(passed @ jumps.T, z.T, atol=1e-15)
+        assert not zdot.any()
+        assert jumps[0, 0] == HEIGHT and jumps[2, -1] == -HEIGHT
+    else:
+        assert not jumps.any()
+        np.testing.assert_allclose(right, left, atol=1e-15)
+        slope = HEIGHT * math.pi * SPEED / LENGTH
+        np.testing.assert_allclose(np.abs(right_rate - left_rate).max(axis=1), slope)
+    between = 0.5 * (times[1:] + times[:-1])
+    np.testing.assert_array_equal(road_inputs(bump(kind), offsets, sides, between, left=True),
+                                  road_inputs(bump(kind), offsets, sides, between))
+    # a flat side has no edges; a road other than a bump has none at all
+    assert road_edges(bump(kind, tracks="right_only"), offsets, ["left"] * 4)[0].size == 0
+    np.testing.assert_array_equal(road_edges(bump(kind, tracks="right_only"), offsets, sides)[0],
+                                  times)
+    assert road_edges(iso(), offsets, sides)[0].size == 0
 
 
 def test_half_sine_shape_and_rear_delay():
