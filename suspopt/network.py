@@ -29,7 +29,7 @@ S samples (1 while integrating, T afterwards); parameters are ``(rows, P, 1)``; 
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np

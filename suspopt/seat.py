@@ -496,7 +496,6 @@ def build_seat(cfg: Config, pv: ParamView | None = None) -> SeatModel:
     if pv.varies("seat.position"):
         raise ConfigError("params: seat.position cannot be a design parameter: the seat's "
                           "point on the body is one per run")
-    P = pv.P
 
     def get(key: str) -> np.ndarray:
         return pv.get(f"seat.{key}")
