@@ -2,17 +2,69 @@
 
 A library first (``load_config``, ``simulate``, ...); the ``suspopt`` command is a thin layer
 over it. Nothing in the library prints.
+
+The names below are imported when first used (PEP 562), so that ``import suspopt`` and the
+command's start-up do not pay for numpy, scipy and pymoo until something needs them.
 """
+
+from __future__ import annotations
+
+import importlib
+import sys
+import types
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-from .config import Config, ConfigError, config_schema, load_config  # noqa: E402
-from .simulate import Result, simulate  # noqa: E402
-from .vehicle import build_vehicle, frequency_response, modal_analysis  # noqa: E402
-from .optimise import Problem  # noqa: E402
-from .kesort import KEpsilonSort, kesort, pareto_picks  # noqa: E402
-from .memory import reuse_memory  # noqa: E402
+#: Public name -> the module that defines it.
+_EXPORTS = {
+    "Config": "config", "ConfigError": "config", "config_schema": "config",
+    "load_config": "config", "Result": "simulate", "simulate": "simulate",
+    "build_vehicle": "vehicle", "modal_analysis": "vehicle", "frequency_response": "vehicle",
+    "Problem": "optimise", "kesort": "kesort", "KEpsilonSort": "kesort",
+    "pareto_picks": "kesort", "reuse_memory": "memory",
+}
 
-__all__ = ["__version__", "Config", "ConfigError", "config_schema", "load_config", "Result",
-           "simulate", "build_vehicle", "modal_analysis", "frequency_response", "Problem",
-           "kesort", "KEpsilonSort", "pareto_picks", "reuse_memory"]
+__all__ = ["__version__", *_EXPORTS]
+
+
+class _Package(types.ModuleType):
+    """The package's module type: ``simulate`` and ``kesort`` are functions that share their
+    names with their modules, so importing ``suspopt.simulate`` (which sets the module as an
+    attribute of the package) must not hide the function."""
+
+    def _function(name: str) -> property:
+        def get(self):
+            return getattr(importlib.import_module(f"suspopt.{name}"), name)
+
+        def keep(self, module):          # the import system's setattr: the function stays
+            pass
+        return property(get, keep)
+
+    simulate = _function("simulate")
+    kesort = _function("kesort")
+    del _function
+
+
+sys.modules[__name__].__class__ = _Package
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'suspopt' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)
+
+
+if TYPE_CHECKING:
+    from .config import Config, ConfigError, config_schema, load_config
+    from .kesort import KEpsilonSort, kesort, pareto_picks
+    from .memory import reuse_memory
+    from .optimise import Problem
+    from .simulate import Result, simulate
+    from .vehicle import build_vehicle, frequency_response, modal_analysis

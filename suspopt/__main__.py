@@ -1,5 +1,5 @@
 """``python -m suspopt`` runs the command-line interface."""
 
-from .cli import app
+from ._entry import run
 
-app(prog_name="suspopt")
+run()

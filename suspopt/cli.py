@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import shlex
 import sys
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Optional
 
@@ -21,8 +22,17 @@ from .config import ConfigError, config_schema, load_config
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Simulate, optimise and select vehicle and seat suspensions from YAML.")
-out = Console()
-err = Console(stderr=True)
+# text from files and arguments is printed as it is: no rich markup, no emoji codes
+# (":x:" in a file name), no highlighting
+out = Console(markup=False, emoji=False, highlight=False)
+err = Console(stderr=True, markup=False, emoji=False, highlight=False)
+
+#: Exit code of a run that finished but whose every design failed to simulate.
+EXIT_ALL_FAILED = 3
+
+_FORCE_HELP = "replace an existing output that suspopt did not write"
+_MEMORY_HELP = ("most memory a run may take, e.g. 4G (default: what the machine has free); "
+                "evaluations of many designs run in batches of at most half of it")
 
 
 @app.callback()
@@ -35,8 +45,31 @@ def _main() -> None:
 
 def _fail(message: str) -> None:
     """Report bad input in one line and exit with code 2."""
-    err.print(f"error: {message}", markup=False, highlight=False, soft_wrap=True)
+    err.print("error: " + " ".join(str(message).split()), soft_wrap=True)
     raise typer.Exit(code=2)
+
+
+def _memory(max_memory: str | None) -> None:
+    """Apply ``--max-memory``."""
+    from .memory import parse_size, set_limit
+
+    try:
+        set_limit(None if max_memory is None else parse_size(max_memory))
+    except ValueError as exc:
+        _fail(f"--max-memory: {exc}")
+
+
+def _claim(stack: ExitStack, path: Path | None, force: bool, option: str = "-o") -> None:
+    """Check an output and hold its writer's lock for the rest of the command
+    (:func:`suspopt.io.claim`)."""
+    from .io import claim
+
+    if path is None:
+        return
+    try:
+        stack.enter_context(claim(path, force, option))
+    except ConfigError as exc:
+        _fail(str(exc))
 
 
 def _load(path: Path):
@@ -51,10 +84,14 @@ def _command() -> str:
 
 
 @app.command()
-def validate(config: Path = typer.Argument(..., help="YAML config file")) -> None:
-    """Check a config file and report the first problem with its line."""
+def validate(config: Path = typer.Argument(..., help="YAML config file"),
+             max_memory: Optional[str] = typer.Option(None, "--max-memory",
+                                                      help=_MEMORY_HELP)) -> None:
+    """Check a config and report its first problem with its line (what any command would
+    reject about it)."""
     from .checks import check_config
 
+    _memory(max_memory)
     cfg = _load(config)
     try:
         check_config(cfg)
@@ -113,33 +150,36 @@ def _metrics_table(result) -> Table:
 @app.command()
 def simulate(config: Path = typer.Argument(..., help="YAML config file"),
              output: Optional[Path] = typer.Option(None, "-o", "--output",
-                                                   help="HDF5 file to write")) -> None:
+                                                   help="HDF5 file to write"),
+             force: bool = typer.Option(False, "--force", help=_FORCE_HELP),
+             max_memory: Optional[str] = typer.Option(None, "--max-memory",
+                                                      help=_MEMORY_HELP)) -> None:
     """Simulate the configured vehicle over its road; write signals to HDF5."""
+    from .checks import check_config
     from .io import write_simulation
     from .simulate import simulate as run
 
-    cfg = _load(config)
-    if output is not None and not output.parent.exists():
-        _fail(f"-o {output}: folder {output.parent} does not exist")
-    try:
-        result = run(cfg)
-    except (ConfigError, FileNotFoundError) as exc:
-        _fail(str(exc))
-    if result.diverged.any():
-        err.print(f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
-                  f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
-                  f"try a smaller simulation.dt", markup=False)
-    out.print(_summary_table(result))
-    if result.metrics:
-        out.print(_metrics_table(result))
-    if output is not None:
-        signals = None if cfg.output.signals == "all" else cfg.output.signals
+    _memory(max_memory)
+    with ExitStack() as stack:
+        _claim(stack, output, force)
+        cfg = _load(config)
         try:
+            check_config(cfg, optimisation=False)
+            result = run(cfg)
+        except ConfigError as exc:
+            _fail(str(exc))
+        if result.diverged.any():
+            err.print(f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
+                      f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
+                      f"try a smaller simulation.dt")
+        out.print(_summary_table(result))
+        if result.metrics:
+            out.print(_metrics_table(result))
+        if output is not None:
+            signals = None if cfg.output.signals == "all" else cfg.output.signals
             write_simulation(output, result, signals=signals, float32=cfg.output.float32,
                              command=_command())
-        except KeyError as exc:
-            _fail(f"output.signals: {exc.args[0]}")
-        out.print(f"wrote {output}")
+            out.print(f"wrote {output}")
 
 
 #: Options of ``analyse`` that only some kinds take: keyword -> flag.
@@ -166,7 +206,10 @@ def analyse(kind: str = typer.Argument(..., help="analysis kind"),
                 "replace the stored ones; repeatable"),
             mass_change: Optional[list[float]] = typer.Option(
                 None, "--mass-change", help="masses: change of the load on the seat, in kg; "
-                "repeatable (default -20 and +20)")) -> None:
+                "repeatable (default -20 and +20)"),
+            force: bool = typer.Option(False, "--force", help=_FORCE_HELP),
+            max_memory: Optional[str] = typer.Option(None, "--max-memory",
+                                                     help=_MEMORY_HELP)) -> None:
     """Run an analysis (see the README for the kinds) and print its table."""
     from .analyse import analysis_kinds
     from .plots import check_path
@@ -186,28 +229,30 @@ def analyse(kind: str = typer.Argument(..., help="analysis kind"),
     wrong = [_ANALYSE_OPTIONS[key] for key in options if key not in spec.options]
     if wrong:
         _fail(f"analyse {kind} does not take {', '.join(wrong)}")
-    for path in (output, plot):
-        if path is not None and not path.parent.exists():
-            _fail(f"{path}: folder {path.parent} does not exist")
-    try:
-        if plot is not None:
-            check_path(plot)
-        report = spec.run(sources if spec.many else sources[0], output, plot, **options)
-    except (ConfigError, FileNotFoundError, ValueError) as exc:
-        _fail(str(exc))
-    from rich.markup import escape
-
-    table = Table(title=escape(report.title))
-    for col in report.columns:           # units in brackets are text, not rich markup
-        table.add_column(escape(col))
+    _memory(max_memory)
+    with ExitStack() as stack:
+        try:
+            if plot is not None:
+                check_path(plot)
+        except ValueError as exc:
+            _fail(str(exc))
+        _claim(stack, output, force)
+        _claim(stack, plot, force, "--plot")
+        try:
+            report = spec.run(sources if spec.many else sources[0], output, plot, **options)
+        except (ConfigError, FileNotFoundError, ValueError) as exc:
+            _fail(str(exc))
+    table = Table(title=report.title)
+    for col in report.columns:
+        table.add_column(col)
     for row in report.rows:
-        table.add_row(*(escape(cell) for cell in row))
+        table.add_row(*row)
     out.print(table)
     for note in report.notes:
-        out.print(note, markup=False)
+        out.print(note)
     for path in (output, plot):
         if path is not None:
-            out.print(f"wrote {path}", markup=False)
+            out.print(f"wrote {path}")
 
 
 def _progress_line(p) -> str:
@@ -225,8 +270,6 @@ def _progress_line(p) -> str:
 def _optimum_table(result, rows: int = 12) -> Table:
     """The best design (one column), or up to ``rows`` designs spread along the Pareto front
     (one row each)."""
-    from rich.markup import escape
-
     N = len(result.X)
     names = result.obj_names + result.var_names
     units = result.obj_units + result.var_units
@@ -245,7 +288,7 @@ def _optimum_table(result, rows: int = 12) -> Table:
     table = Table(title=f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
     table.add_column("#", justify="right")
     for name, unit in zip(names, units):
-        table.add_column(escape(f"{name} [{unit}]"), justify="right")
+        table.add_column(f"{name} [{unit}]", justify="right")
     table.add_column("feasible")
     for i in pick:
         table.add_row(str(i), *(f"{v:.4g}" for v in values[i]), feasible[i])
@@ -258,16 +301,29 @@ def optimise(config: Path = typer.Argument(..., help="YAML config file"),
                  None, "-o", "--output", help="HDF5 file (default CONFIG's name with .h5 in "
                  "the current folder), rewritten every generation"),
              resume: bool = typer.Option(False, "--resume",
-                                         help="continue from the checkpoint in OUT.h5")) -> None:
+                                         help="continue from the checkpoint in OUT.h5"),
+             force: bool = typer.Option(False, "--force", help=_FORCE_HELP),
+             max_memory: Optional[str] = typer.Option(None, "--max-memory",
+                                                      help=_MEMORY_HELP)) -> None:
     """Optimise the config's design variables; write the optimum or Pareto set to HDF5."""
+    with ExitStack() as stack:
+        output = output if output is not None else Path(config.stem + ".h5")
+        _memory(max_memory)
+        _claim(stack, output, force)
+        _optimise(config, output, resume)
+
+
+def _optimise(config: Path, output: Path, resume: bool) -> None:
     from rich.progress import BarColumn, Progress, TextColumn
 
+    from .checks import check_config
     from .optimise import optimise as run
 
     cfg = _load(config)
-    output = output if output is not None else Path(config.stem + ".h5")
-    if not output.parent.exists():
-        _fail(f"-o {output}: folder {output.parent} does not exist")
+    try:
+        check_config(cfg)
+    except ConfigError as exc:
+        _fail(str(exc))
     total = cfg.optimiser.generations if cfg.optimiser is not None else None
     bar = Progress(TextColumn("{task.description}"), BarColumn(), console=err,
                    disable=not err.is_terminal)
@@ -276,7 +332,7 @@ def optimise(config: Path = typer.Argument(..., help="YAML config file"),
     def report(p) -> None:
         bar.update(task, completed=p.generation, description=_progress_line(p))
         if not err.is_terminal:
-            err.print(_progress_line(p), markup=False, highlight=False)
+            err.print(_progress_line(p))
 
     try:
         with bar:
@@ -292,10 +348,15 @@ def optimise(config: Path = typer.Argument(..., help="YAML config file"),
             f"{w:.4g} {name}" for w, name in zip(result.weights, result.obj_names)))
     if result.status == "interrupted":
         err.print(f"interrupted: wrote the designs found so far to {output}; continue with "
-                  f"suspopt optimise {config} -o {output} --resume", markup=False,
+                  f"suspopt optimise {config} -o {output} --resume",
                   soft_wrap=True)
         raise typer.Exit(code=130)
     out.print(f"wrote {output}")
+    if result.status == "failed":
+        err.print(f"error: every design of the optimum failed to simulate (diverged or gave "
+                  f"NaN); {output} holds them with the penalty values and status 'failed'",
+                  soft_wrap=True)
+        raise typer.Exit(code=EXIT_ALL_FAILED)
 
 
 def _floats(option: str, text: str) -> list[float]:
@@ -309,8 +370,6 @@ def _floats(option: str, text: str) -> list[float]:
 def _kesort_tables(sel) -> list[Table]:
     """The optimum of each case and of the pool (the form of Tables 6.2-6.3, 7.5-7.6), then
     the Pareto picks of the pool."""
-    from rich.markup import escape
-
     columns = [(f"{label} optimum", cs.chosen) for label, cs in sel.case_sorts.items()]
     columns.append(("optimum among all" if sel.case_sorts else "k-ε optimum", sel.chosen))
     columns += [(f"tie {n}", int(i)) for n, i in enumerate(sel.sort.ties[1:], start=2)]
@@ -320,9 +379,9 @@ def _kesort_tables(sel) -> list[Table]:
     table.add_column("unit")
     rows = [i for _, i in columns]
     for title, _ in columns:
-        table.add_column(escape(title), justify="right")
+        table.add_column(title, justify="right")
     table.add_row("design #", "", *(str(i) for i in rows))
-    table.add_row("case", "", *(escape(str(sel.case[i])) for i in rows))
+    table.add_row("case", "", *(str(sel.case[i]) for i in rows))
     if sel.case_sorts:
         table.add_row("k-ε level in its case", "1",
                       *(f"{sel.level_in_case(i):.3f}" for i in rows))
@@ -331,18 +390,18 @@ def _kesort_tables(sel) -> list[Table]:
     table.add_row("k level among all" if sel.case_sorts else "k level", "1",
                   *(f"{sel.sort.k[i]:.0f}" for i in rows))
     for j, (name, unit) in enumerate(zip(sel.names, sel.units)):
-        table.add_row(escape(name), escape(unit), *(f"{sel.F[i, j]:.4g}" for i in rows))
+        table.add_row(name, unit, *(f"{sel.F[i, j]:.4g}" for i in rows))
     for j, (name, unit) in enumerate(zip(sel.var_names, sel.var_units)):
-        table.add_row(escape(name), escape(unit), *(
+        table.add_row(name, unit, *(
             "-" if np.isnan(sel.X[i, j]) else f"{sel.X[i, j]:.5g}" for i in rows))
     table.add_row("feasible", "", *("yes" if sel.feasible[i] else "no" for i in rows))
     picks = Table(title="Pareto picks among all (Fig. 8.21: edges and knee)")
     for col in ("pick", "design #", "case", "k-ε level"):
         picks.add_column(col, justify="left" if col in ("pick", "case") else "right")
     for name, unit in zip(sel.names, sel.units):
-        picks.add_column(escape(f"{name} [{unit}]"), justify="right")
+        picks.add_column(f"{name} [{unit}]", justify="right")
     for key, i in sel.picks.items():
-        picks.add_row(key, str(i), escape(str(sel.case[i])), f"{sel.sort.k_eps[i]:.3f}",
+        picks.add_row(key, str(i), str(sel.case[i]), f"{sel.sort.k_eps[i]:.3f}",
                       *(f"{v:.4g}" for v in sel.F[i]))
     return [table, picks]
 
@@ -381,17 +440,27 @@ def kesort(pareto: list[Path] = typer.Argument(..., help="Pareto HDF5 file(s) wr
            output: Optional[Path] = typer.Option(None, "-o", "--output",
                                                  help="HDF5 file for /kesort"),
            plot: Optional[Path] = typer.Option(None, "--plot", help="figure of the k-ε "
-                                               "levels over the front (.png or .svg)")) -> None:
-    """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12), with the
-    supplementary objectives re-simulated in one batch."""
+                                               "levels over the front (.png or .svg)"),
+           force: bool = typer.Option(False, "--force", help=_FORCE_HELP),
+           max_memory: Optional[str] = typer.Option(None, "--max-memory",
+                                                    help=_MEMORY_HELP)) -> None:
+    """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12); supplementary
+    objectives are re-simulated in one batch."""
+    _memory(max_memory)
+    with ExitStack() as stack:
+        _claim(stack, output, force)
+        _claim(stack, plot, force, "--plot")
+        _kesort(pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible,
+                output, plot)
+
+
+def _kesort(pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output,
+            plot) -> None:
     import importlib.util
 
     from .kesort import check_options
     from .selection import load_design_sets, select, write_selection
 
-    for path in (output, plot):
-        if path is not None and not path.parent.exists():
-            _fail(f"{path}: folder {path.parent} does not exist")
     if plot is not None:
         if plot.suffix.lower() not in (".png", ".svg"):
             _fail(f"--plot {plot}: give a .png or .svg file")
@@ -421,12 +490,11 @@ def kesort(pareto: list[Path] = typer.Argument(..., help="Pareto HDF5 file(s) wr
     for table in _kesort_tables(selection):
         out.print(table)
     for label_, cs in selection.case_sorts.items():
-        out.print(_threshold_line(cs.sort, label_), markup=False, highlight=False)
+        out.print(_threshold_line(cs.sort, label_))
     out.print(_threshold_line(selection.sort, "all" if selection.case_sorts
-                              else selection.cases[0]),
-              markup=False, highlight=False)
+                              else selection.cases[0]))
     for note in selection.notes:
-        out.print(f"note: {note}", markup=False, highlight=False)
+        out.print(f"note: {note}")
     for path in (output, plot):
         if path is not None:
             out.print(f"wrote {path}")

@@ -168,6 +168,12 @@ def claim(path: str | Path, force: bool = False, option: str = "-o") -> Iterator
             os.close(fd)
 
 
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def _glob_escape(name: str) -> str:
     return "".join(f"[{c}]" if c in "*?[" else c for c in name)
 
@@ -183,6 +189,7 @@ def atomic_file(path: str | Path, force: bool = False) -> Iterator:
     with claim(path, force):
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=_TMP, dir=path.parent)
         try:
+            os.fchmod(fd, 0o666 & ~_umask())         # mkstemp's 0600 is for the temp name only
             with os.fdopen(fd, "w+b") as stream:
                 yield stream
                 stream.flush()

@@ -17,7 +17,7 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 
-__all__ = ["reuse_memory"]
+__all__ = ["reuse_memory", "parse_size", "set_limit", "available", "limit", "describe", "check"]
 
 #: mallopt parameters of glibc's malloc.h.
 _M_TRIM_THRESHOLD, _M_MMAP_MAX = -1, -4
@@ -41,3 +41,80 @@ def reuse_memory() -> bool:
         return False
     mallopt.argtypes, mallopt.restype = (ctypes.c_int, ctypes.c_int), ctypes.c_int
     return bool(mallopt(_M_MMAP_MAX, 0)) and bool(mallopt(_M_TRIM_THRESHOLD, _KEEP))
+
+
+# --- how much a run may allocate ---------------------------------------------------------------
+
+#: The limit set by ``--max-memory`` (bytes), or None for the memory the machine has free.
+_limit: int | None = None
+_UNITS = {"": 1, "k": 1 << 10, "m": 1 << 20, "g": 1 << 30, "t": 1 << 40}
+
+
+def parse_size(text: str) -> int:
+    """Bytes of a size such as ``4G``, ``512M``, ``2.5g`` or ``1000000`` (binary units);
+    ValueError for anything else."""
+    import re
+
+    match = re.fullmatch(r"\s*([0-9]+(?:\.[0-9]*)?)\s*([kKmMgGtT]?)[bB]?\s*", text)
+    if match is None:
+        raise ValueError(f"{text!r} is not a size (give e.g. 4G, 512M)")
+    size = float(match.group(1)) * _UNITS[match.group(2).lower()]
+    if not 1 <= size < 1 << 60:
+        raise ValueError(f"{text!r} is not a size of memory")
+    return int(size)
+
+
+def set_limit(size: int | None) -> None:
+    """Cap what a run may allocate (``--max-memory``); None: the machine's free memory."""
+    global _limit
+    _limit = size
+
+
+def available() -> int:
+    """Memory this process may still allocate [bytes]: the kernel's ``MemAvailable``, cut by
+    an address-space limit (``ulimit -v``) if one is set."""
+    import os
+    import resource
+
+    free = None
+    try:
+        with open("/proc/meminfo") as info:
+            for line in info:
+                if line.startswith("MemAvailable:"):
+                    free = int(line.split()[1]) * 1024
+                    break
+    except OSError:
+        pass
+    if free is None:
+        try:
+            free = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        except (ValueError, OSError):
+            free = 1 << 62
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    return free if soft == resource.RLIM_INFINITY else min(free, soft)
+
+
+def limit() -> tuple[int, str]:
+    """The allocation limit [bytes] and where it comes from."""
+    if _limit is not None:
+        return _limit, "the --max-memory limit"
+    return available(), "the memory this machine has available"
+
+
+def describe(size: float) -> str:
+    """``size`` bytes for a message: 512 MB, 3.2 GB, 44 TB."""
+    for unit, scale in (("TB", 1 << 40), ("GB", 1 << 30), ("MB", 1 << 20)):
+        if size >= scale:
+            return f"{size / scale:.3g} {unit}"
+    return f"{size / 1024:.3g} kB"
+
+
+def check(need: float, what: str, advice: str) -> None:
+    """ConfigError when ``need`` bytes exceed the limit (:func:`limit`): the message gives
+    the estimate, the limit and ``advice``."""
+    from .config import ConfigError
+
+    cap, source = limit()
+    if need > cap:
+        raise ConfigError(f"{what} needs about {describe(need)}, more than {source} "
+                          f"({describe(cap)}); {advice}")

@@ -23,7 +23,7 @@ from .config.road import (
 )
 
 __all__ = [
-    "ISO8608_CLASS_LEVELS", "Harmonics", "road_inputs", "road_edges", "profile",
+    "ISO8608_CLASS_LEVELS", "Harmonics", "road_inputs", "road_memory", "road_edges", "profile",
     "iso8608_harmonics", "iso8608_level",
 ]
 
@@ -107,6 +107,19 @@ def road_edges(road: RoadConfig, offsets: np.ndarray,
         jumps[wheels, np.searchsorted(times, up[wheels])] += road.height
         jumps[wheels, np.searchsorted(times, down[wheels])] -= road.height
     return times, jumps
+
+
+def road_memory(road: RoadConfig, wheels: int, times: int, span: float) -> float:
+    """Bytes :func:`road_inputs` allocates at its peak for ``wheels`` wheels at ``times``
+    instants covering ``span`` metres of road: about 20 arrays of one value per wheel and
+    instant (the heights, rates and the harmonic sum's interpolation), and for an ISO 8608
+    road the harmonics' FFT grid (:func:`_harmonic_sum`)."""
+    size = 20.0 * 8 * wheels * times
+    if isinstance(road, Iso8608Road):
+        count = _n_waves(road, span)
+        grid = max(4096, 1 << math.ceil(math.log2(_OVERSAMPLING * count)))
+        size += 2 * 3 * 16 * grid + 4 * 8 * count          # coefficients, transforms, cells
+    return size
 
 
 def profile(road: Iso8608Road | FileRoad, s: np.ndarray, side: str = "right",

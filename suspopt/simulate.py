@@ -24,13 +24,14 @@ import difflib
 
 import numpy as np
 
+from . import memory
 from .checks import check_steps, full_network
 from .config import Config
 from .control import build_controller
 from .network import Network, widen
 from .params import ParamView
 from .specs import evaluate_spec, spec_signals
-from .road import road_edges, road_inputs
+from .road import road_edges, road_inputs, road_memory
 from .seat import SIGNAL_HEADS as _SEAT_HEADS, build_attachments
 from .seat import signal_units as _seat_signal_units
 from .vehicle import VehicleModel, build_vehicle
@@ -563,12 +564,47 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> "Result":
     the config's ``metrics:`` specs as (P,) arrays.
     """
     pv, model, controller, attachments = prepare(cfg, params)
+    check_memory(cfg, model, attachments, pv.P, signals=len(cfg.metrics))
     result = _run(cfg, pv, model, controller, attachments)
     for spec in cfg.metrics:
         for name, values, unit in evaluate_spec(spec, result, result.signal_unit):
             result.metrics[name] = values
             result.metric_units[name] = unit
     return result
+
+
+def run_memory(cfg: Config, model: VehicleModel, attachments: Sequence[Attachment], P: int,
+               signals: int = 0) -> tuple[float, float]:
+    """Peak bytes of a run of P designs, ``(shared, per_design)``: what does not grow with P
+    (the road's inputs on the half-step grid, their part of the element deformations) and
+    what each design adds (its states and accelerations at every output sample, the
+    controller's records, the caches behind its signals, ``signals`` signals computed from
+    them, the ISO 2631 weighting's transforms). An estimate from the arrays the integrator and
+    :class:`Result` allocate, rounded up."""
+    sim, road = cfg.simulation, cfg.road
+    n = model.n_dof + sum(len(att.dof_names) for att in attachments)
+    rows = sum(g.size for g in model.network.groups) + sum(
+        g.size for att in attachments for g in att.network.groups)
+    corners = len(model.corners)
+    half_steps = 2 * sim.n_steps + 1
+    samples = sim.n_steps // sim.output_every + 1
+    span = road.speed * sim.duration + float(np.max(model.offsets, initial=0.0))
+    shared = road_memory(road, corners, half_steps, span) + 8.0 * half_steps * 2 * rows
+    # states, accelerations, deformation and force caches, held records, signals, transforms
+    per_design = 8.0 * samples * (3 * n + 8 * corners + 4 * corners + signals + 6)
+    return shared, per_design
+
+
+def check_memory(cfg: Config, model: VehicleModel, attachments: Sequence[Attachment], P: int,
+                 signals: int = 0) -> None:
+    """ConfigError when a run of P designs (:func:`run_memory`) needs more memory than the
+    limit (:func:`suspopt.memory.check`)."""
+    shared, per_design = run_memory(cfg, model, attachments, P, signals)
+    memory.check(shared + P * per_design, f"simulating {P} design{'s' if P > 1 else ''} for "
+                 f"{cfg.simulation.duration:g} s at dt = {cfg.simulation.dt:g} s",
+                 "shorten simulation.duration, raise simulation.dt or output_dt, store fewer "
+                 "output.signals" + (", lower road.n_max or set road.n_waves"
+                                     if cfg.road.kind == "iso8608" else ""))
 
 
 def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller | None,

@@ -35,10 +35,14 @@ from ..simulate import signal_names, signal_units, simulate
 from ..specs import evaluate_spec, metric_unit, spec_signals
 from ..vehicle import build_vehicle
 
-__all__ = ["Problem", "PENALTY"]
+__all__ = ["Problem", "PENALTY", "BATCH_BYTES"]
 
 #: Objective and constraint value given to a failed (diverged, NaN) design.
 PENALTY = 1.0e10
+#: Memory one batch of an evaluation may take [bytes] (:meth:`Problem.batch_width`): a
+#: population larger than that (a Ch. 8 seat on 1000 m of road takes about 11 MB per design)
+#: is simulated in batches of equal width, one after the other.
+BATCH_BYTES = 2 << 30
 
 #: Config sections and fields that are one per run: the simulator never reads them per design.
 _ONE_PER_RUN = {
@@ -61,6 +65,7 @@ class _Term:
     names: tuple[str, ...]
     units: tuple[str, ...]
     keys: tuple[str, ...] = ()      # seat.geometry: the seat_constraints keys, in order
+    signals: tuple[str, ...] = ()   # the signals a metric reads
 
 
 class Problem(_PymooProblem):
@@ -80,6 +85,7 @@ class Problem(_PymooProblem):
         self._objectives, self._constraints = list(objectives), list(constraints)
         self._supplementary = list(supplementary)
         self._sim_cfg = cfg.model_copy(update={"metrics": []})
+        self._width: int | None = None
         self._simulates = any(t.spec.metric for t in self._all_terms())
         self._log = np.array([v.scale == "log" for v in self.variables])
         self._integer = np.array([v.integer for v in self.variables])
@@ -153,7 +159,36 @@ class Problem(_PymooProblem):
     def _all_terms(self) -> list[_Term]:
         return self._objectives + self._constraints + self._supplementary
 
+    def batch_width(self) -> int:
+        """Designs simulated in one batch: as many as fit in :data:`BATCH_BYTES` (or half of
+        ``--max-memory`` when that is smaller) by :func:`suspopt.simulate.run_memory`, at
+        least one. It depends on the config (and an explicit memory limit) only, never on the
+        memory free at the moment, so that a run repeats bit for bit."""
+        if self._width is None:
+            from .. import memory
+            from ..simulate import prepare, run_memory
+
+            _, model, _, attachments = prepare(self._sim_cfg)
+            signals = len({n for t in self._all_terms() if t.spec.metric
+                           for n in t.signals})
+            _, per_design = run_memory(self._sim_cfg, model, attachments, 1, signals)
+            budget = BATCH_BYTES if memory._limit is None else min(BATCH_BYTES,
+                                                                   memory._limit // 2)
+            self._width = max(1, int(budget // per_design))
+        return self._width
+
     def _evaluate(self, X, out, *args, **kwargs):
+        width = self.batch_width() if self._simulates else max(len(X), 1)
+        parts = [self._evaluate_batch(X[i:i + width], "S" in out)
+                 for i in range(0, len(X), width)]
+        for j, key in enumerate(("F", "G", "S")):
+            if key in out or key != "S":
+                out[key] = np.concatenate([p[j] for p in parts]) if parts else \
+                    np.empty((0, (self.n_obj, self.n_ieq_constr,
+                                  len(self.supplementary_names))[j]))
+
+    def _evaluate_batch(self, X, supplementary: bool):
+        """F, G (and S, or None) of one batch of designs, in one simulation."""
         params = self.params(X)
         with np.errstate(all="ignore"):      # failed designs are flagged below, not warned about
             result = simulate(self._sim_cfg, params) if self._simulates else None
@@ -162,11 +197,11 @@ class Problem(_PymooProblem):
             failed = ~(np.isfinite(F).all(axis=1) & np.isfinite(G).all(axis=1))
             if result is not None:
                 failed |= result.diverged
-            out["F"] = np.where(failed[:, None], PENALTY, F)
-            out["G"] = np.column_stack([np.where(np.isfinite(G), G, PENALTY),
-                                        np.where(failed, PENALTY, -1.0)])
-            if "S" in out:
-                out["S"] = _stack(self._supplementary, self.cfg, result, params, len(X))
+            S = _stack(self._supplementary, self.cfg, result, params, len(X)) \
+                if supplementary else None
+            return (np.where(failed[:, None], PENALTY, F),
+                    np.column_stack([np.where(np.isfinite(G), G, PENALTY),
+                                     np.where(failed, PENALTY, -1.0)]), S)
 
     def _constraint_values(self, result, params, P: int) -> np.ndarray:
         """``g = min - value`` and ``g = value - max`` of every constraint column, (P, k)."""
@@ -273,14 +308,14 @@ def _compile(cfg: Config, spec: Objective, loc: tuple, available: list[str], uni
         raise cfg.error(loc + ("signal",), str(exc)) from None
     unit = metric_unit(spec, unit_of(signals[0]))
     if (len(signals) == 1 and spec.signal in available) or spec.reduce != "none":
-        return _Term(spec, (spec.label,), (unit,))
+        return _Term(spec, (spec.label,), (unit,), signals=tuple(signals))
     if objective:
         corner_list = ", ".join(s.rsplit(".", 1)[1] for s in signals)
         raise cfg.error(loc + ("reduce",), f"{spec.label} gives one value per corner "
                         f"({corner_list}); an objective is one number per design: add "
                         f"reduce: mean (or max, min, sum)")
     return _Term(spec, tuple(f"{spec.label}.{s.rsplit('.', 1)[1]}" for s in signals),
-                 (unit,) * len(signals))
+                 (unit,) * len(signals), signals=tuple(signals))
 
 
 _UNIT = re.compile(r"\[([^\],]+)\]")

@@ -22,7 +22,7 @@ and best):
   ``evaluations``, ``time`` [s], ``feasible`` (share of the generation's designs).
 - ``/checkpoint/state``: the pickled run (optimiser with its random Generator, history);
   ``--resume`` unpickles it, so resume only files you wrote.
-- root attributes: those of ``atomic_h5`` plus ``status`` (running, finished, interrupted),
+- root attributes: those of ``atomic_h5`` plus ``status`` (running, finished, interrupted, or failed: every design of the optimum failed to simulate),
   ``algorithm``, ``optimiser_seed``, ``generations``, ``evaluations``.
 """
 
@@ -47,7 +47,7 @@ from ..config.optimise import ALGORITHMS, Hybrid as HybridSettings
 from ..io import atomic_h5
 from .algorithms import (Gradient, Hybrid, Optimiser, PymooOptimiser, Solutions, WeightedSum,
                          balanced_weights, pymoo_algorithm, termination)
-from .problem import Problem
+from .problem import PENALTY, Problem
 
 __all__ = ["optimise", "build_optimiser", "Progress", "OptimisationResult"]
 
@@ -146,6 +146,8 @@ def optimise(cfg: Config, output: str | Path, resume: bool = False,
         status = "interrupted"
     if snapshot is None:                 # resumed a finished run, or nothing to do
         snapshot = _snapshot(run, problem)
+    if status == "finished" and (snapshot.optimum.F >= PENALTY).all():
+        status = "failed"                # every design of the optimum failed to simulate
     return _write(output, cfg, problem, snapshot, run.weights, status, command)
 
 

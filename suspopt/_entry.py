@@ -1,0 +1,65 @@
+"""The ``suspopt`` command's entry point: runs the CLI and turns what escapes it into exit
+codes, with no traceback for anything but a bug.
+
+- bad input (a usage error, a config, a file): one line ``error: ...``, exit 2;
+- Ctrl-C at any moment, start-up included: ``interrupted``, exit 130 (an output being written
+  is left as it was; ``suspopt optimise`` keeps what it found, see its help);
+- a numpy floating-point warning: one line ``warning: ...`` per place, not a stack of them;
+- anything else is a bug: its traceback and exit 1.
+
+This module imports nothing heavy, so that even an interrupt during the imports lands here.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import warnings
+
+#: Exit code of an interrupted command (128 + SIGINT, as shells report it).
+EXIT_INTERRUPTED = 130
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    text = " ".join(str(message).split())
+    place = filename.rsplit("/", 2)[-2:]
+    sys.stderr.write(f"warning: {text} (at {'/'.join(place)}:{lineno})\n")
+
+
+def _interrupted() -> int:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)       # a second Ctrl-C while leaving
+    sys.stderr.write("interrupted\n")
+    return EXIT_INTERRUPTED
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run ``suspopt`` with ``argv`` (default the process's arguments); return its exit
+    code."""
+    try:
+        warnings.showwarning = _one_line_warning
+        warnings.simplefilter("default")           # each place once
+        import typer
+
+        from .cli import app
+        try:
+            code = app(args=argv, prog_name="suspopt", standalone_mode=False)
+        except typer.Abort:                          # click's form of a KeyboardInterrupt
+            return _interrupted()
+        except Exception as exc:
+            if not (hasattr(exc, "format_message") and hasattr(exc, "exit_code")):
+                raise                                # a bug: its traceback
+            # a usage error (click's, vendored by newer typer)
+            message = " ".join(exc.format_message().split())
+            if message:                              # (no message: the help was shown)
+                ctx = getattr(exc, "ctx", None)
+                hint = f" (see {ctx.command_path} --help)" if ctx is not None else ""
+                sys.stderr.write(f"error: {message}{hint}\n")
+            return exc.exit_code
+        return code if isinstance(code, int) else 0
+    except KeyboardInterrupt:
+        return _interrupted()
+
+
+def run() -> None:
+    """Console-script entry point."""
+    sys.exit(main())
