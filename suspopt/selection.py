@@ -43,7 +43,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-import h5py
 import numpy as np
 
 from .config import Config, ConfigError, load_config
@@ -158,51 +157,31 @@ class Selection:
         return float(cs.sort.k_eps[np.flatnonzero(cs.rows == i)[0]])
 
 
-def _text(value) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
-def _labels(ds: h5py.Dataset, key: str, path: Path, columns: int) -> list[str]:
-    names = [_text(n) for n in np.atleast_1d(ds.attrs.get(key, []))]
-    if len(names) != columns:
-        raise ConfigError(f"{path}: {ds.name}: attribute {key!r} has {len(names)} entries for "
-                          f"{columns} columns")
-    return names
-
-
 def read_pareto(path: str | Path) -> ParetoSet:
-    """Read a ``suspopt optimise`` output; ConfigError naming the file and key if it is not
-    one."""
+    """Read a ``suspopt optimise`` output; ConfigError naming the file and the dataset or
+    attribute if it is not one (:class:`suspopt.h5read.H5Reader`)."""
+    from .h5read import H5Reader
+
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"{path}: no such file")
-    try:
-        h5 = h5py.File(path, "r")
-    except OSError:
-        raise ConfigError(f"{path}: not an HDF5 file") from None
-    with h5:
-        data = {}
+    data = {}
+    with H5Reader(path) as h5:
         for key in ("X", "F", "G"):
-            ds = h5.get(f"pareto/{key}")
-            if not isinstance(ds, h5py.Dataset):
-                raise ConfigError(f"{path}: /pareto/{key}: missing (is this a suspopt optimise "
-                                  f"file?)")
-            values = np.array(ds[()], dtype=float)
-            if values.ndim != 2:
-                raise ConfigError(f"{path}: /pareto/{key}: expected a 2-D dataset, got shape "
-                                  f"{values.shape}")
-            data[key] = (values, _labels(ds, "names", path, values.shape[1]),
-                         _labels(ds, "units", path, values.shape[1]))
+            name = f"pareto/{key}"
+            values = h5.array(name, ndim=2)
+            data[key] = (values, h5.labels(name, "names", values.shape[1]),
+                         h5.labels(name, "units", values.shape[1]))
         rows = {key: value[0].shape[0] for key, value in data.items()}
         if len(set(rows.values())) != 1:
             raise ConfigError(f"{path}: /pareto: X, F and G have {rows['X']}, {rows['F']} and "
                               f"{rows['G']} rows")
         if rows["X"] == 0:
             raise ConfigError(f"{path}: /pareto/X: the set is empty")
-        if "config" not in h5.attrs:
+        if not np.isfinite(data["X"][0]).all():
+            raise ConfigError(f"{path}: /pareto/X: values must be finite")
+        if "config" not in h5.file.attrs:
             raise ConfigError(f"{path}: attribute 'config' (the YAML text) is missing; give "
                               f"--config")
-        text = _text(h5.attrs["config"])
+        text = h5.text_attr("config")
     (X, var_names, var_units), (F, obj_names, _), (G, constraint_names, _) = \
         data["X"], data["F"], data["G"]
     return ParetoSet(path, X, var_names, var_units, F, obj_names, G, constraint_names, text)
@@ -373,7 +352,7 @@ def _columns(X: np.ndarray, have: list[str], want: list[str]) -> np.ndarray:
     return out
 
 
-def _write_sort(group: h5py.Group, sort: KEpsilonSort, rows: np.ndarray | None,
+def _write_sort(group, sort: KEpsilonSort, rows: np.ndarray | None,
                 picks: dict[str, int]) -> None:
     """k_eps, k, chosen, ties and picks of one sort; indices in the pool (``rows`` maps a
     case's own indices to the pool's)."""
@@ -407,6 +386,8 @@ def write_selection(path: str | Path, selection: Selection, command: str | None 
         _write_sort(grp, s.sort, None, s.picks)
         grp.attrs["cases"] = np.array(s.cases, dtype="S")
         sets = grp.create_group("sets")
+        import h5py
+
         text = h5py.string_dtype()
         write_dataset(sets, "file", np.array([str(d.source) for d in s.sets], dtype=text), "1")
         write_dataset(sets, "label", np.array([d.label for d in s.sets], dtype=text), "1")

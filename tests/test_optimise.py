@@ -162,34 +162,42 @@ class Mixed(PymooProblem):
 
 
 @pytest.mark.parametrize("name", [k for k in ALGORITHMS if k not in ("gradient", "hybrid")])
-def test_every_registered_pymoo_algorithm_is_seeded_and_resumes_from_its_pickle(name,
-                                                                                 monkeypatch):
-    import io
-
-    from suspopt.optimise.run import _Pickler, _Unpickler
+def test_every_registered_pymoo_algorithm_is_seeded_and_resumes_by_replay(name, monkeypatch):
+    """Each algorithm draws only from the run's Generator, and replaying its evaluated batches
+    (the data-only checkpoint) rebuilds it exactly: no design is evaluated again."""
+    from suspopt.optimise.run import _Recorder
 
     n_obj = 3 if ".moo." in ALGORITHMS[name] else 1
     problem = Mixed(n_obj)
-    optimiser = PymooOptimiser(pymoo_algorithm(ALGORITHMS[name], {}, 12, n_obj),
-                               termination(n_obj, 8, None, 1e-12, 30))
-    optimiser.setup(problem, np.random.default_rng(1))
+
+    def optimiser():
+        return PymooOptimiser(pymoo_algorithm(ALGORITHMS[name], {}, 12, n_obj),
+                              termination(n_obj, 8, None, 1e-12, 30))
     default_rng = np.random.default_rng
 
     def seeded_only(seed=None, *args):            # pymoo's fallback for a missing random_state
         assert seed is not None, f"{name} draws from an unseeded Generator"
         return default_rng(seed, *args)
 
+    first, recorder = optimiser(), _Recorder(problem)
+    resumed, replay = optimiser(), _Recorder(problem)
+    first.setup(recorder, default_rng(1))          # (pymoo's setup makes a Generator of its
+    resumed.setup(replay, default_rng(1))          # own, which the run's replaces)
     monkeypatch.setattr(np.random, "default_rng", seeded_only)
     for _ in range(3):
-        optimiser.next()
-    buffer = io.BytesIO()
-    _Pickler(buffer, problem).dump(optimiser)
-    resumed = _Unpickler(io.BytesIO(buffer.getvalue()), problem).load()
-    while optimiser.has_next():
-        optimiser.next()
+        first.next()
+    replay._stored.extend(recorder.batches)       # what the checkpoint holds
+    evaluated = []
+    monkeypatch.setattr(problem, "_evaluate", lambda X, out, *a, **k: evaluated.append(X))
+    for _ in range(3):
+        resumed.next()
+    assert not replay.replaying and evaluated == []
+    monkeypatch.undo()
+    while first.has_next():
+        first.next()
         resumed.next()
     assert not resumed.has_next()
-    np.testing.assert_array_equal(optimiser.optimum().F, resumed.optimum().F)
+    np.testing.assert_array_equal(first.optimum().F, resumed.optimum().F)
 
 
 # --- the YAML problem on a tiny Chapter 5 half car -----------------------------------------------
@@ -357,7 +365,13 @@ def test_cli_optimise_writes_the_design_md_layout(tmp_path):
         for key in ("best", "hypervolume", "evaluations", "time", "generation", "feasible"):
             assert h5[f"history/{key}"].shape[0] == 2 and "units" in h5[f"history/{key}"].attrs
         assert h5["history/evaluations"][-1] == 16
-        assert "units" in h5["checkpoint/state"].attrs
+        checkpoint = h5["checkpoint"]                   # data only: every evaluated batch
+        assert checkpoint.attrs["format"] == "replay-1" and checkpoint.attrs["generations"] == 2
+        assert checkpoint["batches"][()].tolist() == [8, 8]
+        assert checkpoint["X"].shape == (16, 3) and checkpoint["F"].shape == (16, 2)
+        assert checkpoint["G"].shape == (16, 6)
+        assert [u.decode() for u in checkpoint["X"].attrs["units"]][2] == "log10(N/m^3)"
+        assert "state" not in checkpoint
 
 
 @pytest.mark.parametrize("change, needle", [

@@ -135,6 +135,11 @@ class Problem(_PymooProblem):
                    compile_all(cfg.objectives.supplementary, ("objectives", "supplementary"),
                                True))
 
+    @property
+    def search_units(self) -> list[str]:
+        """Units of the search coordinates ``X``: ``log10(unit)`` on a log scale."""
+        return [f"log10({u})" if log else u for u, log in zip(self.var_units, self._log)]
+
     def to_physical(self, X) -> np.ndarray:
         """Values of the design variables (N, n_var) in SI units: ``10**X`` on a log scale,
         rounded for integer variables."""

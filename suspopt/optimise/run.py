@@ -20,31 +20,34 @@ and best):
   weights), ``hypervolume`` (of the feasible optimum, objectives normalised by the first
   feasible generation's ideal and nadir points, reference point 1.1; NaN for one objective),
   ``evaluations``, ``time`` [s], ``feasible`` (share of the generation's designs).
-- ``/checkpoint/state``: the pickled run (optimiser with its random Generator, history);
-  ``--resume`` unpickles it, so resume only files you wrote.
-- root attributes: those of ``atomic_h5`` plus ``status`` (running, finished, interrupted, or failed: every design of the optimum failed to simulate),
-  ``algorithm``, ``optimiser_seed``, ``generations``, ``evaluations``.
+- ``/checkpoint``: every batch of designs the optimiser had evaluated when the file was
+  written, as data: ``X (E, n)`` search coordinates, ``F (E, m)``, ``G (E, k)`` (the problem's
+  objectives and constraints, before any weighted sum) and ``batches (B,)`` their sizes in
+  order; attributes ``format`` and ``generations``. ``--resume`` rebuilds the run by running
+  the optimiser again from the seed for that many generations with each batch answered from
+  the file (no simulation), checks that it asks for exactly the stored designs and arrives at
+  the stored history, then goes on; so it continues bit for bit, and nothing read from the
+  file is ever executed (there is no pickle).
+- root attributes: those of ``atomic_h5`` plus ``status`` (running, finished, interrupted,
+  or failed: every design of the optimum failed to simulate), ``algorithm``,
+  ``optimiser_seed``, ``generations``, ``evaluations``.
 """
 
 from __future__ import annotations
 
-import importlib
-import io
-import pickle
-import sys
 import time
-import types
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import h5py
 import numpy as np
+from pymoo.core.problem import Problem as _PymooProblem
 from pymoo.indicators.hv import HV
 
 from ..config import Config, ConfigError
 from ..config.optimise import ALGORITHMS, Hybrid as HybridSettings
-from ..io import atomic_h5
+from ..io import atomic_h5, write_dataset
 from .algorithms import (Gradient, Hybrid, Optimiser, PymooOptimiser, Solutions, WeightedSum,
                          balanced_weights, pymoo_algorithm, termination)
 from .problem import PENALTY, Problem
@@ -90,11 +93,48 @@ class OptimisationResult:
     weights: np.ndarray | None = None
 
 
+#: ``/checkpoint`` attribute ``format`` of the data-only checkpoint.
+CHECKPOINT_FORMAT = "replay-1"
+
+
+class _Recorder(_PymooProblem):
+    """The problem as the optimiser sees it: every batch it evaluates is kept (the
+    checkpoint); on a resume the stored batches answer, in order, for as long as they last,
+    each checked to be the batch the optimiser asks for."""
+
+    def __init__(self, problem: Problem, stored: list[tuple] | None = None,
+                 source: Path | None = None):
+        super().__init__(n_var=problem.n_var, n_obj=problem.n_obj,
+                         n_ieq_constr=problem.n_ieq_constr, xl=problem.xl, xu=problem.xu)
+        self.problem, self.source = problem, source
+        self.batches: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        self._stored = deque(stored or [])
+
+    @property
+    def replaying(self) -> bool:
+        return bool(self._stored)
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        X = np.array(X, dtype=float)
+        if self._stored:
+            stored_X, F, G = self._stored.popleft()
+            if stored_X.shape != X.shape or not np.array_equal(stored_X, X):
+                raise ConfigError(f"--resume: {self.source}: /checkpoint/X: batch "
+                                  f"{len(self.batches)} holds other designs than the run asks "
+                                  f"for (the file was written by another version of suspopt "
+                                  f"or pymoo, or was changed); run without --resume")
+        else:
+            F, G = self.problem.evaluate(X, return_values_of=["F", "G"])
+        self.batches.append((X, np.asarray(F, float), np.asarray(G, float)))
+        out["F"], out["G"] = self.batches[-1][1:]
+
+
 @dataclass
 class _Run:
-    """Everything a checkpoint holds."""
+    """A run: the optimiser, the recorder it evaluates through, and what is reported."""
 
     optimiser: Optimiser
+    recorder: _Recorder
     weights: np.ndarray | None
     history: dict[str, list] = field(default_factory=lambda: {
         k: [] for k in ("generation", "best", "hypervolume", "evaluations", "time",
@@ -108,7 +148,7 @@ class _Run:
 class _Snapshot:
     """The run after a completed generation, ready to write."""
 
-    state: bytes
+    batches: int                    # the recorder's batches so far
     optimum: Solutions              # X physical, F main objectives
     history: dict[str, np.ndarray]
     generation: int
@@ -127,7 +167,8 @@ def optimise(cfg: Config, output: str | Path, resume: bool = False,
     output = Path(output)
     problem = Problem.from_config(cfg)
     optimiser = build_optimiser(cfg, problem)
-    run = _load(output, cfg, problem) if resume else _start(cfg, problem, optimiser)
+    run = _resume(output, cfg, problem, optimiser) if resume else \
+        _start(cfg, _Recorder(problem), optimiser)
     snapshot = None
     status = "finished"
     try:
@@ -137,7 +178,7 @@ def optimise(cfg: Config, output: str | Path, resume: bool = False,
             run.elapsed = time.perf_counter() - start
             progress = _record(run, cfg)
             snapshot = _snapshot(run, problem)
-            _write(output, cfg, problem, snapshot, run.weights, "running", command)
+            _write(output, cfg, problem, snapshot, run, "running", command)
             if callback is not None:
                 callback(progress)
     except KeyboardInterrupt:
@@ -148,7 +189,7 @@ def optimise(cfg: Config, output: str | Path, resume: bool = False,
         snapshot = _snapshot(run, problem)
     if status == "finished" and (snapshot.optimum.F >= PENALTY).all():
         status = "failed"                # every design of the optimum failed to simulate
-    return _write(output, cfg, problem, snapshot, run.weights, status, command)
+    return _write(output, cfg, problem, snapshot, run, status, command)
 
 
 def build_optimiser(cfg: Config, problem: Problem) -> Optimiser:
@@ -209,27 +250,27 @@ def _check_objectives(cfg: Config, problem: Problem) -> None:
                         f"{', '.join(problem.obj_names)}")
 
 
-def _start(cfg: Config, problem: Problem, optimiser: Optimiser) -> _Run:
-    """A new run: the Generator of the seed balances the weights (if asked), then drives the
-    optimiser."""
+def _start(cfg: Config, recorder: _Recorder, optimiser: Optimiser) -> _Run:
+    """A run from the start: the Generator of the seed balances the weights (if asked), then
+    drives the optimiser; every evaluation goes through ``recorder``."""
     opt = cfg.optimiser
     rng = np.random.default_rng(opt.seed)
-    weights, working = None, problem
+    weights, working = None, recorder
     if opt.weighted_sum is not None:
         ws = opt.weighted_sum
         if ws.weights is not None:
             weights = np.array(ws.weights, dtype=float)
         else:
             dominant = None if ws.balance.dominant is None else \
-                problem.obj_names.index(ws.balance.dominant)
+                recorder.problem.obj_names.index(ws.balance.dominant)
             try:
-                weights = balanced_weights(problem, ws.balance.samples, rng, dominant,
+                weights = balanced_weights(recorder, ws.balance.samples, rng, dominant,
                                            ws.balance.factor)
             except ValueError as exc:
                 raise cfg.error(("optimiser", "weighted_sum", "balance"), str(exc)) from None
-        working = WeightedSum(problem, weights)
+        working = WeightedSum(recorder, weights)
     optimiser.setup(working, rng)
-    return _Run(optimiser=optimiser, weights=weights)
+    return _Run(optimiser=optimiser, recorder=recorder, weights=weights)
 
 
 def _record(run: _Run, cfg: Config) -> Progress:
@@ -271,7 +312,7 @@ def _time_left(run: _Run, opt) -> float | None:
 
 
 def _snapshot(run: _Run, problem: Problem) -> _Snapshot:
-    """Pickle the run and take its optimum (re-evaluating the main objectives of a weighted
+    """The run's optimum and history now (re-evaluating the main objectives of a weighted
     sum's best design: F is the sum there)."""
     optimum = run.optimiser.optimum()
     order = np.argsort(optimum.F[:, 0], kind="stable")
@@ -281,81 +322,80 @@ def _snapshot(run: _Run, problem: Problem) -> _Snapshot:
         if run.weighted_optimum is None or run.weighted_optimum[0] != key:
             run.weighted_optimum = (key, *problem.evaluate(X, return_values_of=["F", "G"]))
         F, G = run.weighted_optimum[1:]
-    buffer = io.BytesIO()
-    _Pickler(buffer, problem).dump(run)
-    return _Snapshot(state=buffer.getvalue(), optimum=Solutions(problem.to_physical(X), F, G),
+    return _Snapshot(batches=len(run.recorder.batches),
+                     optimum=Solutions(problem.to_physical(X), F, G),
                      history={k: np.array(v, dtype=float) for k, v in run.history.items()},
                      generation=run.optimiser.n_gen, evaluations=run.optimiser.n_eval)
 
 
-class _Pickler(pickle.Pickler):
-    """Pickles a run without its Problem (rebuilt from the config on resume)."""
+def _read_checkpoint(output: Path, cfg: Config, problem: Problem):
+    """The stored batches ``[(X, F, G), ...]``, generations and history of ``output``;
+    ConfigError naming the file and the dataset for anything missing or malformed."""
+    from ..h5read import H5Reader
 
-    def __init__(self, file, problem: Problem):
-        super().__init__(file, protocol=pickle.HIGHEST_PROTOCOL)
-        self._problem = problem
-
-    def persistent_id(self, obj):
-        return "problem" if obj is self._problem else None
-
-    def reducer_override(self, obj):
-        """pymoo's ``@default_random_state`` wraps module-level functions (GA's tournament
-        comparison) without ``functools.wraps``, so pickle cannot find them by name: store
-        them as the module attribute they are."""
-        if not isinstance(obj, types.FunctionType) or "<locals>" not in obj.__qualname__:
-            return NotImplemented
-        for cell in obj.__closure__ or ():
-            inner = cell.cell_contents
-            if isinstance(inner, types.FunctionType) and \
-                    getattr(sys.modules.get(inner.__module__), inner.__name__, None) is obj:
-                return _module_attribute, (inner.__module__, inner.__name__)
-        return NotImplemented
-
-
-def _module_attribute(module: str, name: str):
-    return getattr(importlib.import_module(module), name)
-
-
-class _Unpickler(pickle.Unpickler):
-    def __init__(self, file, problem: Problem):
-        super().__init__(file)
-        self._problem = problem
-
-    def persistent_load(self, pid):
-        return self._problem
-
-
-def _load(output: Path, cfg: Config, problem: Problem) -> _Run:
-    """The run checkpointed in ``output``; ConfigError if there is none or the config
-    differs."""
+    where = f"--resume: {output}"
     if not output.exists():
-        raise ConfigError(f"--resume: {output} does not exist (run without --resume to start)")
-    try:
-        with h5py.File(output, "r") as h5:
-            text, state = h5.attrs["config"], h5["checkpoint/state"][()]
-    except (OSError, KeyError):
-        raise ConfigError(f"--resume: {output} is not a suspopt optimise file with a "
-                          f"checkpoint") from None
-    if text != cfg.text:
-        raise ConfigError(f"--resume: {output} was written for another config (its YAML "
-                          f"text differs); use the same config or run without --resume")
-    return _Unpickler(io.BytesIO(state.tobytes()), problem).load()
+        raise ConfigError(f"{where}: does not exist (run without --resume to start)")
+    with H5Reader(output, where) as h5:
+        if h5.text_attr("config") != cfg.text:
+            raise ConfigError(f"{where}: was written for another config (its YAML text "
+                              f"differs); use the same config or run without --resume")
+        if "checkpoint/state" in h5.file:
+            raise ConfigError(f"{where}: /checkpoint/state: an old checkpoint (a pickle), "
+                              f"which suspopt no longer loads: a file must never run code; "
+                              f"run without --resume")
+        group = h5.group("checkpoint")
+        if group.attrs.get("format") != CHECKPOINT_FORMAT:
+            raise ConfigError(f"{where}: /checkpoint: not a suspopt checkpoint of format "
+                              f"{CHECKPOINT_FORMAT}")
+        generations = h5.int_attr("checkpoint", "generations", 0, 10 ** 7)
+        sizes = h5.array("checkpoint/batches", ndim=1, integer=True)
+        X = h5.array("checkpoint/X", ndim=2, columns=problem.n_var)
+        F = h5.array("checkpoint/F", ndim=2, columns=problem.n_obj)
+        G = h5.array("checkpoint/G", ndim=2, columns=problem.n_ieq_constr)
+        history = {key: h5.array(f"history/{key}", ndim=2 if key == "best" else 1)
+                   for key in ("generation", "best", "hypervolume", "evaluations", "time",
+                               "feasible")}
+    if (sizes < 1).any() or sizes.sum() != len(X) or not len(X) == len(F) == len(G):
+        raise ConfigError(f"{where}: /checkpoint: batches of {int(sizes.sum())} designs, "
+                          f"X, F, G of {len(X)}, {len(F)}, {len(G)}")
+    if not np.isfinite(X).all():
+        raise ConfigError(f"{where}: /checkpoint/X: values must be finite")
+    if len(history["time"]) != generations:
+        raise ConfigError(f"{where}: /history/time: {len(history['time'])} generations, the "
+                          f"checkpoint {generations}")
+    edges = np.concatenate([[0], np.cumsum(sizes)])
+    batches = [(X[a:b], F[a:b], G[a:b]) for a, b in zip(edges[:-1], edges[1:])]
+    return batches, generations, history
 
 
-def _dataset(group, name: str, data, units, **attrs) -> None:
-    ds = group.create_dataset(name, data=data)
-    ds.attrs["units"] = np.array(units, dtype="S") if isinstance(units, list) else units
-    for key, value in attrs.items():
-        ds.attrs[key] = value
+def _resume(output: Path, cfg: Config, problem: Problem, optimiser: Optimiser) -> _Run:
+    """The run checkpointed in ``output`` (module docstring), rebuilt by replaying it."""
+    batches, generations, stored = _read_checkpoint(output, cfg, problem)
+    run = _start(cfg, _Recorder(problem, batches, output), optimiser)
+    for generation in range(generations):
+        if not run.optimiser.has_next():
+            break
+        run.optimiser.next()
+        run.elapsed = float(stored["time"][generation])
+        _record(run, cfg)
+    rebuilt = {k: np.array(v, dtype=float) for k, v in run.history.items()}
+    same = all(np.array_equal(rebuilt[k].reshape(stored[k].shape), stored[k], equal_nan=True)
+               if rebuilt[k].size == stored[k].size else False for k in stored)
+    if run.recorder.replaying or not same:
+        raise ConfigError(f"--resume: {output}: /history: replaying the checkpoint does not "
+                          f"give the stored run (the file was written by another version "
+                          f"of suspopt or pymoo, or was changed); run without --resume")
+    return run
 
 
 def _names(names: list[str]) -> np.ndarray:
     return np.array(names, dtype="S")
 
 
-def _write(output: Path, cfg: Config, problem: Problem, snap: _Snapshot,
-           weights: np.ndarray | None, status: str, command: str | None
-           ) -> OptimisationResult:
+def _write(output: Path, cfg: Config, problem: Problem, snap: _Snapshot, run: _Run,
+           status: str, command: str | None) -> OptimisationResult:
+    weights, run_batches = run.weights, run.recorder.batches
     opt = cfg.optimiser
     best_names = problem.obj_names if weights is None else ["weighted_sum"]
     best_units = problem.obj_units if weights is None else ["1"]
@@ -366,20 +406,31 @@ def _write(output: Path, cfg: Config, problem: Problem, snap: _Snapshot,
         if weights is not None:
             pareto.attrs["weights"] = weights
         o = snap.optimum
-        _dataset(pareto, "X", o.X, problem.var_units, names=_names(problem.var_names))
-        _dataset(pareto, "F", o.F, problem.obj_units, names=_names(problem.obj_names))
-        _dataset(pareto, "G", o.G, problem.constraint_units,
+        write_dataset(pareto, "X", o.X, problem.var_units, names=_names(problem.var_names))
+        write_dataset(pareto, "F", o.F, problem.obj_units, names=_names(problem.obj_names))
+        write_dataset(pareto, "G", o.G, problem.constraint_units,
                  names=_names(problem.constraint_names))
         hist = h5.create_group("history")
         units = {"generation": "1", "hypervolume": "1", "evaluations": "1", "time": "s",
                  "feasible": "1"}
         for key, values in snap.history.items():
             if key == "best":
-                _dataset(hist, key, values.reshape(len(values), -1), best_units,
+                write_dataset(hist, key, values.reshape(len(values), -1), best_units,
                          names=_names(best_names))
             else:
-                _dataset(hist, key, values, units[key])
-        _dataset(h5.create_group("checkpoint"), "state", np.void(snap.state), "pickle")
+                write_dataset(hist, key, values, units[key])
+        batches = run_batches[:snap.batches]
+        checkpoint = h5.create_group("checkpoint")
+        checkpoint.attrs.update(format=CHECKPOINT_FORMAT, generations=snap.generation)
+        for j, (key, columns, units) in enumerate((
+                ("X", problem.n_var, problem.search_units),
+                ("F", problem.n_obj, problem.obj_units),
+                ("G", problem.n_ieq_constr, problem.constraint_units))):
+            data = np.concatenate([b[j] for b in batches]) if batches else \
+                np.empty((0, columns))
+            write_dataset(checkpoint, key, data, units)
+        write_dataset(checkpoint, "batches", np.array([len(b[0]) for b in batches],
+                                                      dtype=np.int64), "1")
     return OptimisationResult(X=o.X, F=o.F, G=o.G, var_names=problem.var_names,
                               var_units=problem.var_units, obj_names=problem.obj_names,
                               obj_units=problem.obj_units,
