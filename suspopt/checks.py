@@ -204,8 +204,8 @@ def bound_corners(cfg: Config) -> dict[str, np.ndarray]:
 
 def check_config(cfg: Config, optimisation: bool = True) -> None:
     """Everything about ``cfg`` that a run would reject, without running it: what
-    :func:`suspopt.simulate.prepare` checks, RK4's stability limit for the configured design
-    and, with ``optimisation`` and an optimisation section, the problem
+    :func:`suspopt.simulate.prepare` checks, RK4's stability limit for the configured design,
+    the memory ``suspopt simulate`` needs to write every output signal and, with ``optimisation`` and an optimisation section, the problem
     (:meth:`suspopt.Problem.from_config`), the stability limit at the corners of the design
     variables' bounds and the optimiser with its options. ``suspopt validate`` runs all of
     it; the commands that simulate run what they use."""
@@ -214,8 +214,13 @@ def check_config(cfg: Config, optimisation: bool = True) -> None:
     from .simulate import prepare
     from .vehicle import build_vehicle
 
-    pv, model, _, attachments = prepare(cfg)
+    from .simulate import check_memory, signal_names
+
+    pv, model, controller, attachments = prepare(cfg)
     check_stability(cfg, pv, model, attachments)
+    written = cfg.output.signals if cfg.output.signals != "all" else signal_names(
+        model, getattr(controller, "units", {}), attachments)
+    check_memory(cfg, model, attachments, 1, signals=len(written) + len(cfg.metrics))
     if not optimisation or not (cfg.design_variables or cfg.objectives or cfg.optimiser):
         return
     from .optimise import Problem, build_optimiser

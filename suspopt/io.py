@@ -243,8 +243,13 @@ def write_simulation(path: str | Path, result, signals: Iterable[str] | None = N
 
     ``/time (T,)``, ``/signals/<name> (P, T)``, ``/metrics/<name> (P,)``, ``/diverged_at (P,)``
     (NaN where the design did not diverge), ``/designs/X (P, n)`` with attr ``names`` when
-    design parameters were given, and ``/modal/frequency (P, n)`` with attr ``dominant``.
+    design parameters were given, ``/modal/frequency (P, n)`` with attr ``dominant`` (design
+    0's DOF of most energy per mode), ``/modal/label (P, n)`` (what each mode is) and
+    ``/modal/energy_share (P, n, n)`` (each DOF's share of each mode's kinetic energy, attr
+    ``dofs``): :func:`suspopt.vehicle.modal_analysis`.
     """
+    import h5py
+
     from .vehicle import modal_analysis
 
     names = list(result.signals) if signals is None else list(signals)
@@ -264,8 +269,12 @@ def write_simulation(path: str | Path, result, signals: Iterable[str] | None = N
             write_dataset(h5.create_group("designs"), "X", X, "SI",
                      names=np.array(list(result.designs), dtype="S"))
         modes = modal_analysis(result.model)
-        write_dataset(h5.create_group("modal"), "frequency", modes.frequency, "Hz",
-                 dominant=np.array(modes.dominant[0], dtype="S"))
+        modal = h5.create_group("modal")
+        write_dataset(modal, "frequency", modes.frequency, "Hz",
+                      dominant=np.array(modes.dominant[0], dtype="S"))
+        write_dataset(modal, "label", np.array(modes.label, dtype=h5py.string_dtype()), "1")
+        write_dataset(modal, "energy_share", modes.energy, "1",
+                      dofs=np.array(modes.dof_names, dtype="S"))
     return Path(path)
 
 

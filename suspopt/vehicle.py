@@ -268,22 +268,63 @@ def _static_tyre_load(mass, K, nb, N, kt, body_dofs, g) -> np.ndarray:
     return -kt * q0[:, nb:]
 
 
+#: A mode is named after one DOF when that DOF holds at least this share of its kinetic
+#: energy (three quarters: a half car's two wheels share their hop modes 58/42); otherwise
+#: after every DOF holding at least :data:`MODE_PART` of it.
+MODE_DOMINANCE = 0.75
+MODE_PART = 0.15
+
+
 @dataclass
 class ModalResult:
     """Undamped modes: ``frequency (P, n)`` [Hz] ascending, ``shape (P, n, n)`` (columns,
-    normalised to unit max |entry|), ``dominant (P, n)`` DOF name with most kinetic energy."""
+    normalised to unit max |entry|), ``energy (P, n, n)`` each DOF's share of each mode's
+    kinetic energy (rows DOFs, columns modes; columns sum to 1), ``dominant (P, n)`` the DOF
+    with the largest share, and ``label (P, n)`` what the mode is: that DOF when it holds at
+    least :data:`MODE_DOMINANCE` of the energy, else the DOFs holding at least
+    :data:`MODE_PART` of it joined by ``+`` (in phase with the largest) or ``-`` (against
+    it), e.g. ``wheel.F1 - wheel.F2`` for a half car's wheels hopping in antiphase. Modes of
+    (nearly) equal frequency, such as a full car's four wheel hops within 0.01 Hz, may come
+    out as any combination of each other, and so may their labels."""
 
     frequency: np.ndarray
     shape: np.ndarray
+    energy: np.ndarray
     dominant: np.ndarray
+    label: np.ndarray
     dof_names: tuple[str, ...]
+
+
+def _mode_labels(shape: np.ndarray, energy: np.ndarray, names: np.ndarray) -> np.ndarray:
+    """:attr:`ModalResult.label` from the shapes and energy shares (P, n, n)."""
+    P, n, _ = shape.shape
+    labels = np.empty((P, n), dtype=object)
+    for p in range(P):                   # labels are text: a loop over designs and modes
+        for k in range(n):
+            share = energy[p, :, k]
+            order = np.argsort(-share, kind="stable")
+            lead = order[0]
+            if share[lead] >= MODE_DOMINANCE:
+                labels[p, k] = str(names[lead])
+                continue
+            parts = [str(names[lead])]
+            for j in order[1:]:
+                if share[j] < MODE_PART:
+                    break
+                same = np.sign(shape[p, j, k]) == np.sign(shape[p, lead, k])
+                parts.append(("+ " if same else "- ") + str(names[j]))
+            labels[p, k] = " ".join(parts)
+    return labels.astype(str)
 
 
 def modal_analysis(model: VehicleModel) -> ModalResult:
     """Undamped natural frequencies and mode shapes of the linearised model (K φ = ω² M φ).
 
     Solved as the symmetric problem M^-1/2 K M^-1/2 (M diagonal), batched over designs. The
-    Duffing term has zero stiffness at equilibrium and does not enter.
+    Duffing term has zero stiffness at equilibrium and does not enter. Each mode is labelled
+    by the DOFs that carry its kinetic energy (:class:`ModalResult`): on a full car the wheel
+    hop modes are collective (a pair of wheels in or against phase), so no single wheel names
+    them.
     """
     m = np.broadcast_to(model.mass[:, 0, :], (model.P, model.n_dof))
     K = np.broadcast_to(model.stiffness, (model.P, model.n_dof, model.n_dof))
@@ -292,9 +333,11 @@ def modal_analysis(model: VehicleModel) -> ModalResult:
     shape = s[:, :, None] * vec
     shape = shape / np.max(np.abs(shape), axis=1, keepdims=True)
     energy = m[:, :, None] * shape ** 2
+    energy = energy / energy.sum(axis=1, keepdims=True)
     names = np.array(model.dof_names)
     return ModalResult(frequency=np.sqrt(np.clip(lam, 0, None)) / (2 * np.pi), shape=shape,
-                       dominant=names[np.argmax(energy, axis=1)], dof_names=model.dof_names)
+                       energy=energy, dominant=names[np.argmax(energy, axis=1)],
+                       label=_mode_labels(shape, energy, names), dof_names=model.dof_names)
 
 
 def frequency_response(model: VehicleModel, f: np.ndarray, speed: float | None = None,

@@ -31,7 +31,7 @@ config files' names) and ``reference``):
 
 - ``/models/<label>/``: attributes ``source``, ``config`` (YAML text), ``preset``, ``road``;
   ``time (T,)`` [s], ``signals/<name> (T,)``, ``psd/frequency (F,)`` [Hz], ``psd/<name> (F,)``
-  [(unit)^2/Hz], ``modal/frequency (n,)`` [Hz] with attribute ``dominant``;
+  [(unit)^2/Hz], ``modal/frequency (n,)`` [Hz] with attributes ``dominant`` and ``label``;
 - ``/comparison/value/<metric> (M,)`` in the metric's unit and
   ``/comparison/difference/<metric> (M,)`` [%], over the models in the order of ``models``
   (NaN where a model lacks the metric).
@@ -88,7 +88,8 @@ _RIDE_ROLL = ({"metric": "var", "signal": "body.roll"},
 class ModelResponse:
     """One model's run: ``time (T,)`` [s], ``signals`` (name -> (T,)), ``psd`` (name ->
     (F,)) over ``psd_frequency`` [Hz], ``metrics`` (name -> value), ``natural_frequency (n,)``
-    [Hz] with each mode's ``dominant`` DOF; ``units`` of every signal, PSD and metric."""
+    [Hz] with each mode's ``dominant`` DOF and ``mode_label`` (what the mode is,
+    :class:`suspopt.vehicle.ModalResult`); ``units`` of every signal, PSD and metric."""
 
     label: str
     source: Path
@@ -100,6 +101,7 @@ class ModelResponse:
     metrics: dict[str, float]
     natural_frequency: np.ndarray
     dominant: list[str]
+    mode_label: list[str]
     units: dict[str, str]
     diverged: bool
     corners: tuple[str, ...]
@@ -177,7 +179,8 @@ def _response(label: str, source: Path, cfg: Config, result: Result,
     return ModelResponse(label=label, source=source, config=cfg, time=result.time,
                          signals={n: sig[n][0] for n in TIME_SIGNALS if n in sig},
                          psd_frequency=frequency, psd=spectra, metrics=metrics,
-                         natural_frequency=modes.frequency[0], dominant=dominant, units=units,
+                         natural_frequency=modes.frequency[0], dominant=dominant,
+                         mode_label=[str(x) for x in modes.label[0]], units=units,
                          diverged=bool(result.diverged[0]), corners=result.model.corners,
                          order=order)
 
@@ -251,7 +254,8 @@ def write_models(path: str | Path, comparison: ModelComparison,
             for name, values in m.psd.items():
                 write_dataset(spectra, name, values, m.units[f"PSD of {name}"])
             write_dataset(g.create_group("modal"), "frequency", m.natural_frequency, "Hz",
-                          dominant=np.array(m.dominant, dtype="S"))
+                          dominant=np.array(m.dominant, dtype="S"),
+                          label=np.array(m.mode_label, dtype="S"))
         value = h5.create_group("comparison/value")
         difference = h5.create_group("comparison/difference")
         for name in comparison.metric_names:

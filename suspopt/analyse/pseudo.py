@@ -121,15 +121,15 @@ class PseudoFronts:
 
 def read_sections(path: Path, option: str) -> dict:
     """The YAML mapping of config sections in ``path``; ConfigError naming ``option``."""
-    import yaml
+    from ..config.yamlio import YamlError, parse_yaml, read_text
 
     try:
-        data = yaml.safe_load(path.read_text())
+        data, _ = parse_yaml(read_text(path))
     except FileNotFoundError:
         raise ConfigError(f"{option} {path}: no such file") from None
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-        raise ConfigError(f"{option} {path}: cannot read it as YAML "
-                          f"({exc.__class__.__name__})") from None
+    except YamlError as exc:
+        raise ConfigError(f"{option} {path}{f':{exc.line}' if exc.line else ''}: "
+                          f"{exc}") from None
     if not isinstance(data, dict):
         raise ConfigError(f"{option} {path}: must be a YAML mapping of config sections")
     return data
@@ -143,7 +143,15 @@ def config_with(pareto: ParetoSet, edit: Callable[[dict], None], what: str) -> C
     then refer to the lines of that text (written to the analysis's HDF5 as ``config``)."""
     import yaml
 
-    data = yaml.safe_load(pareto.config_text)
+    from ..config.yamlio import YamlError, parse_yaml
+
+    try:
+        data, _ = parse_yaml(pareto.config_text)
+    except YamlError as exc:
+        raise ConfigError(f"{pareto.path}:config{f':{exc.line}' if exc.line else ''}: "
+                          f"{exc}") from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{pareto.path}:config: not a mapping of config sections")
     edit(data)
     text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
     try:
