@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import signal
 import sys
+import threading
 import warnings
 
 #: Exit code of an interrupted command (128 + SIGINT, as shells report it).
@@ -27,14 +28,30 @@ def _one_line_warning(message, category, filename, lineno, file=None, line=None)
 
 
 def _interrupted() -> int:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)       # a second Ctrl-C while leaving
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)   # a second Ctrl-C while leaving
     sys.stderr.write("interrupted\n")
     return EXIT_INTERRUPTED
+
+
+class _Interrupts:
+    """Notes that Ctrl-C was pressed (typer turns the KeyboardInterrupt into exit code 130
+    without a word)."""
+
+    seen = False
+
+    @classmethod
+    def handler(cls, signum, frame):
+        cls.seen = True
+        raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run ``suspopt`` with ``argv`` (default the process's arguments); return its exit
     code."""
+    _Interrupts.seen = False
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _Interrupts.handler)
     try:
         warnings.showwarning = _one_line_warning
         warnings.simplefilter("default")           # each place once
@@ -55,9 +72,14 @@ def main(argv: list[str] | None = None) -> int:
                 hint = f" (see {ctx.command_path} --help)" if ctx is not None else ""
                 sys.stderr.write(f"error: {message}{hint}\n")
             return exc.exit_code
+        if _Interrupts.seen:
+            return _interrupted()
         return code if isinstance(code, int) else 0
     except KeyboardInterrupt:
         return _interrupted()
+    finally:
+        from .memory import set_limit
+        set_limit(None)                  # --max-memory holds for one command
 
 
 def run() -> None:

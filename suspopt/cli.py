@@ -340,16 +340,15 @@ def _optimise(config: Path, output: Path, resume: bool) -> None:
     except ConfigError as exc:
         _fail(str(exc))
     except KeyboardInterrupt:
-        err.print("interrupted before the first generation completed; nothing written")
+        err.print("the first generation had not completed: nothing written")
         raise typer.Exit(code=130)
     out.print(_optimum_table(result))
     if result.weights is not None:
         out.print("weighted sum (Eq 5.7): " + " + ".join(
             f"{w:.4g} {name}" for w, name in zip(result.weights, result.obj_names)))
     if result.status == "interrupted":
-        err.print(f"interrupted: wrote the designs found so far to {output}; continue with "
-                  f"suspopt optimise {config} -o {output} --resume",
-                  soft_wrap=True)
+        err.print(f"wrote the designs found so far to {output}; continue with "
+                  f"suspopt optimise {config} -o {output} --resume", soft_wrap=True)
         raise typer.Exit(code=130)
     out.print(f"wrote {output}")
     if result.status == "failed":

@@ -212,9 +212,10 @@ def read_profile(path: Path) -> tuple:
     except OSError as exc:
         raise ValueError(f"road profile {path}: cannot open it "
                          f"({exc.strerror or exc.__class__.__name__})") from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise ValueError(f"road profile {path}: not a regular file")
     with os.fdopen(fd, "rb") as stream:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise ValueError(f"road profile {path}: not a regular file")
         data = stream.read(MAX_PROFILE_BYTES + 1)
     if len(data) > MAX_PROFILE_BYTES:
         raise ValueError(f"road profile {path}: larger than {MAX_PROFILE_BYTES >> 20} MB")

@@ -70,13 +70,14 @@ def read_text(path: str | Path, limit: int = MAX_CONFIG_BYTES, what: str = "conf
         raise YamlError(f"is a directory, not a {what} file") from None
     except OSError as exc:
         raise YamlError(f"cannot open it ({exc.strerror or exc.__class__.__name__})") from None
+    mode = os.fstat(fd).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        kind = ("a directory" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode)
+                else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+                else "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
+        raise YamlError(f"is {kind}, not a regular {what} file")
     with os.fdopen(fd, "rb") as stream:
-        mode = os.fstat(fd).st_mode
-        if not stat.S_ISREG(mode):
-            kind = ("a directory" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode)
-                    else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
-                    else "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
-            raise YamlError(f"is {kind}, not a regular {what} file")
         data = stream.read(limit + 1)
     if len(data) > limit:
         raise YamlError(f"is larger than {limit // 1024} kB: not a {what} file")
@@ -140,6 +141,13 @@ class _Loader(Reader, Scanner, Parser, Composer, _Constructor, _CoreResolver):
         _Constructor.__init__(self)
         _CoreResolver.__init__(self)
         self._depth = 0
+
+    def fetch_flow_collection_start(self, TokenClass):
+        # the scanner's cost grows with the square of the flow nesting: stop it early
+        if self.flow_level >= MAX_DEPTH:
+            raise YamlError(f"nested more than {MAX_DEPTH} levels deep",
+                            self.get_mark().line + 1)
+        super().fetch_flow_collection_start(TokenClass)
 
     def compose_node(self, parent, index):
         self._depth += 1
