@@ -20,7 +20,7 @@ from rich.table import Table
 
 from .config import ConfigError, config_schema, load_config
 
-app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+app = typer.Typer(add_completion=True, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Simulate, optimise and select vehicle and seat suspensions from YAML.")
 # text from files and arguments is printed as it is: no rich markup, no emoji codes
 # (":x:" in a file name), no highlighting
@@ -35,12 +35,48 @@ _MEMORY_HELP = ("most memory a run may take, e.g. 4G (default: what the machine 
                 "evaluations of many designs run in batches of at most half of it")
 
 
+#: ``-v``: what each step did and how long it took, on stderr.
+_verbose = [False]
+
+
+def _info(message: str) -> None:
+    if _verbose[0]:
+        err.print(f"info: {message}", soft_wrap=True)
+
+
+def _show_version(value: bool) -> None:
+    if value:
+        from . import __version__
+        out.print(f"suspopt {__version__}")
+        raise typer.Exit()
+
+
 @app.callback()
-def _main() -> None:
+def _main(version: bool = typer.Option(False, "--version", callback=_show_version,
+                                       is_eager=True, help="print the version and exit"),
+          quiet: bool = typer.Option(False, "-q", "--quiet", help="print nothing but warnings "
+                                     "and errors (no tables, no progress)"),
+          verbose: bool = typer.Option(False, "-v", "--verbose", help="also print, on stderr, "
+                                       "what each step did and how long it took")) -> None:
     """Simulate, optimise and select vehicle and seat suspensions from YAML."""
     from .memory import reuse_memory
 
+    out.quiet = quiet
+    _verbose[0] = verbose and not quiet
     reuse_memory()          # a command's repeated batches reuse their memory (suspopt.memory)
+
+
+class _FoldingTable(Table):
+    """A table whose cells fold onto further lines when the terminal is narrow (a CI log's
+    80 columns) instead of being cut to "…"."""
+
+    def add_column(self, *args, **kwargs) -> None:
+        kwargs.setdefault("overflow", "fold")
+        super().add_column(*args, **kwargs)
+
+
+def _table(title: str | None = None) -> Table:
+    return _FoldingTable(title=title)
 
 
 def _fail(message: str) -> None:
@@ -109,7 +145,7 @@ def schema() -> None:
 def _summary_table(result) -> Table:
     """Peak and RMS body acceleration, max travel and tyre deflection per corner."""
     P = min(result.P, 5)
-    table = Table(title=f"{result.model.preset} - key results"
+    table = _table(f"{result.model.preset} - key results"
                   + (f" (first {P} of {result.P} designs)" if result.P > P else ""))
     table.add_column("quantity")
     table.add_column("unit")
@@ -137,7 +173,7 @@ def _summary_table(result) -> Table:
 def _metrics_table(result) -> Table:
     """The config's metrics (``metrics:`` section), one row each."""
     P = min(result.P, 5)
-    table = Table(title="metrics")
+    table = _table("metrics")
     table.add_column("metric")
     table.add_column("unit")
     for p in range(P):
@@ -147,39 +183,150 @@ def _metrics_table(result) -> Table:
     return table
 
 
+def _is_hdf5(path: Path) -> bool:
+    """Whether ``path`` is an HDF5 file (by its signature), not a YAML config."""
+    try:
+        with open(path, "rb") as stream:
+            return stream.read(8) == b"\x89HDF\r\n\x1a\n"
+    except OSError:
+        return False
+
+
+_PICK_HELP = ("designs of a result file to simulate: knee, best_<objective>, chosen (the k-ε "
+              "optimum of a kesort file) or a row number; repeatable, or separated by commas")
+
+
 @app.command()
-def simulate(config: Path = typer.Argument(..., help="YAML config file"),
+def simulate(source: Path = typer.Argument(..., help="YAML config, or a result file of "
+                                           "optimise, kesort or analyse with --pick"),
              output: Optional[Path] = typer.Option(None, "-o", "--output",
                                                    help="HDF5 file to write"),
+             pick: list[str] = typer.Option([], "--pick", help=_PICK_HELP),
+             set_: list[str] = typer.Option([], "--set", help="PATH=VALUE: override a "
+                                            "numeric field of the config; repeatable"),
+             sweep_: list[str] = typer.Option([], "--sweep", help="PATH=START:STOP:N: N "
+                                              "designs from START to STOP; several sweeps "
+                                              "make a grid (all combinations) or, with "
+                                              "--zip, go side by side"),
+             zipped: bool = typer.Option(False, "--zip", help="pair the --sweep values "
+                                         "instead of taking every combination"),
+             plot: Optional[Path] = typer.Option(None, "--plot", help="figure of the signals "
+                                                 "over time, their PSD and the ISO 2631 "
+                                                 "comfort levels (.png or .svg)"),
              force: bool = typer.Option(False, "--force", help=_FORCE_HELP),
              max_memory: Optional[str] = typer.Option(None, "--max-memory",
                                                       help=_MEMORY_HELP)) -> None:
-    """Simulate the configured vehicle over its road; write signals to HDF5."""
-    from .checks import check_config
-    from .io import write_simulation
-    from .simulate import simulate as run
-
+    """Simulate a config (or designs picked from a result file) and write signals to HDF5."""
     _memory(max_memory)
     with ExitStack() as stack:
         _claim(stack, output, force)
-        cfg = _load(config)
+        _claim(stack, plot, force, "--plot")
         try:
-            check_config(cfg, optimisation=False)
-            result = run(cfg)
-        except ConfigError as exc:
+            _simulate(source, output, pick, set_, sweep_, zipped, plot)
+        except (ConfigError, ValueError) as exc:
             _fail(str(exc))
-        if result.diverged.any():
-            err.print(f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
-                      f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
-                      f"try a smaller simulation.dt")
-        out.print(_summary_table(result))
-        if result.metrics:
-            out.print(_metrics_table(result))
-        if output is not None:
-            signals = None if cfg.output.signals == "all" else cfg.output.signals
-            write_simulation(output, result, signals=signals, float32=cfg.output.float32,
-                             command=_command())
-            out.print(f"wrote {output}")
+
+
+def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
+    from .checks import check_config, check_stability
+    from .io import write_dataset, write_simulation
+    from .params import apply_sets, sweep
+    from .simulate import check_memory, prepare, signal_names
+    from .simulate import simulate as run
+
+    if plot is not None:
+        from .plots import check_path
+        check_path(plot)
+    picked = None
+    if _is_hdf5(source):
+        from .picks import read_picks, split_picks
+        if not pick:
+            _fail(f"{source} is a result file: name the designs to simulate with --pick "
+                  f"(knee, best_<objective>, chosen or a row number)")
+        if sweeps:
+            _fail("--sweep takes a config; with --pick the designs are the picked ones")
+        picked = read_picks(source, split_picks(pick))
+        cfg = apply_sets(picked.config, sets)
+        params = picked.params()
+    else:
+        if pick:
+            _fail(f"--pick takes a result file (optimise, kesort, analyse); {source} is a "
+                  f"config")
+        cfg = apply_sets(_load(source), sets)
+        params = sweep(cfg, sweeps, zipped) or None
+    check_config(cfg, optimisation=False)
+    pv, model, controller, attachments = prepare(cfg, params)
+    if params:
+        check_stability(cfg, pv, model, attachments,
+                        what=" for a picked design" if picked else " for a swept design")
+    written = cfg.output.signals if cfg.output.signals != "all" else signal_names(
+        model, getattr(controller, "units", {}), attachments)
+    check_memory(cfg, model, attachments, pv.P, signals=len(written) + len(cfg.metrics))
+    result = run(cfg, params)
+    if result.diverged.any():
+        err.print(f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
+                  f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
+                  f"try a smaller simulation.dt")
+    out.print(_summary_table(result))
+    if result.metrics:
+        out.print(_metrics_table(result))
+    extra = None
+    if picked is not None:
+        objectives = _pick_objectives(picked, cfg, result)
+        out.print(_picks_table(picked, *objectives))
+
+        def extra(h5) -> None:
+            F, names, units = objectives
+            designs = h5.require_group("designs")
+            designs.attrs["source"] = str(picked.source)
+            write_dataset(designs, "pick", np.array(picked.names, dtype=_text_dtype()), "1")
+            write_dataset(designs, "row", picked.rows, "1")
+            group = h5.create_group("objectives")
+            write_dataset(group, "F", F, units, names=np.array(names, dtype="S"))
+            write_dataset(group, "stored_F", picked.F, picked.obj_units,
+                          names=np.array(picked.obj_names, dtype="S"))
+    if output is not None:
+        write_simulation(output, result, signals=None if cfg.output.signals == "all"
+                         else cfg.output.signals, float32=cfg.output.float32,
+                         command=_command(), extra=extra)
+        out.print(f"wrote {output}")
+    if plot is not None:
+        from .plots import plot_simulation
+        plot_simulation(result, plot)
+        out.print(f"wrote {plot}")
+
+
+def _text_dtype():
+    import h5py
+    return h5py.string_dtype()
+
+
+def _pick_objectives(picked, cfg, result):
+    """The picked designs' main and supplementary objectives from their new simulation:
+    ``(F (P, m + s), names, units)``."""
+    from .optimise import Problem
+
+    problem = Problem.from_config(cfg)
+    F, _, S = problem.values(result, picked.params(), len(picked.rows), supplementary=True)
+    return (np.hstack([F, S]), problem.obj_names + problem.supplementary_names,
+            problem.obj_units + problem.supplementary_units)
+
+
+def _picks_table(picked, F, names, units) -> Table:
+    """Each pick's objectives as the file stored them and as simulated now."""
+    table = _table(f"{picked.source.name}: the picked designs' objectives")
+    for col in ("pick", "row", "objective", "stored", "simulated", "change"):
+        table.add_column(col, justify="left" if col in ("pick", "objective") else "right")
+    for i, name in enumerate(picked.names):
+        for j, (objective, unit) in enumerate(zip(names, units)):
+            stored = picked.F[i, picked.obj_names.index(objective)] \
+                if objective in picked.obj_names else np.nan
+            change = "" if not np.isfinite(stored) or stored == 0 else \
+                f"{(F[i, j] - stored) / abs(stored):+.1e}"
+            table.add_row(name if j == 0 else "", str(int(picked.rows[i])) if j == 0 else "",
+                          f"{objective} [{unit}]", "" if np.isnan(stored) else f"{stored:.6g}",
+                          f"{F[i, j]:.6g}", change)
+    return table
 
 
 #: Options of ``analyse`` that only some kinds take: keyword -> flag.
@@ -242,7 +389,7 @@ def analyse(kind: str = typer.Argument(..., help="analysis kind"),
             report = spec.run(sources if spec.many else sources[0], output, plot, **options)
         except (ConfigError, FileNotFoundError, ValueError) as exc:
             _fail(str(exc))
-    table = Table(title=report.title)
+    table = _table(report.title)
     for col in report.columns:
         table.add_column(col)
     for row in report.rows:
@@ -277,7 +424,7 @@ def _optimum_table(result, rows: int = 12) -> Table:
     feasible = ["yes" if ok else "no" for ok in (result.G <= 0).all(axis=1)]
     suffix = "" if result.status == "finished" else " (interrupted)"
     if N == 1:
-        table = Table(title="best design" + suffix)
+        table = _table("best design" + suffix)
         for col in ("quantity", "unit", "value"):
             table.add_column(col, justify="right" if col == "value" else "left")
         for name, unit, value in zip(names, units, values[0]):
@@ -285,7 +432,7 @@ def _optimum_table(result, rows: int = 12) -> Table:
         table.add_row("feasible", "", feasible[0])
         return table
     pick = np.unique(np.linspace(0, N - 1, min(rows, N)).round().astype(int))
-    table = Table(title=f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
+    table = _table(f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
     table.add_column("#", justify="right")
     for name, unit in zip(names, units):
         table.add_column(f"{name} [{unit}]", justify="right")
@@ -326,12 +473,12 @@ def _optimise(config: Path, output: Path, resume: bool) -> None:
         _fail(str(exc))
     total = cfg.optimiser.generations if cfg.optimiser is not None else None
     bar = Progress(TextColumn("{task.description}"), BarColumn(), console=err,
-                   disable=not err.is_terminal)
+                   disable=not err.is_terminal or out.quiet)
     task = bar.add_task("starting", total=total)
 
     def report(p) -> None:
         bar.update(task, completed=p.generation, description=_progress_line(p))
-        if not err.is_terminal:
+        if not err.is_terminal and not out.quiet:
             err.print(_progress_line(p))
 
     try:
@@ -372,7 +519,7 @@ def _kesort_tables(sel) -> list[Table]:
     columns = [(f"{label} optimum", cs.chosen) for label, cs in sel.case_sorts.items()]
     columns.append(("optimum among all" if sel.case_sorts else "k-ε optimum", sel.chosen))
     columns += [(f"tie {n}", int(i)) for n, i in enumerate(sel.sort.ties[1:], start=2)]
-    table = Table(title="k-ε optimum" + (" of each case and among all" if sel.case_sorts
+    table = _table("k-ε optimum" + (" of each case and among all" if sel.case_sorts
                                          else ""))
     table.add_column("quantity")
     table.add_column("unit")
@@ -394,7 +541,7 @@ def _kesort_tables(sel) -> list[Table]:
         table.add_row(name, unit, *(
             "-" if np.isnan(sel.X[i, j]) else f"{sel.X[i, j]:.5g}" for i in rows))
     table.add_row("feasible", "", *("yes" if sel.feasible[i] else "no" for i in rows))
-    picks = Table(title="Pareto picks among all (Fig. 8.21: edges and knee)")
+    picks = _table("Pareto picks among all (Fig. 8.21: edges and knee)")
     for col in ("pick", "design #", "case", "k-ε level"):
         picks.add_column(col, justify="left" if col in ("pick", "case") else "right")
     for name, unit in zip(sel.names, sel.units):

@@ -238,7 +238,8 @@ def write_dataset(group, name: str, data, units: str | list[str], **attrs):
 
 
 def write_simulation(path: str | Path, result, signals: Iterable[str] | None = None,
-                     float32: bool = False, command: str | None = None) -> Path:
+                     float32: bool = False, command: str | None = None,
+                     extra=None) -> Path:
     """Write a simulation ``Result`` with the layout of DESIGN.md.
 
     ``/time (T,)``, ``/signals/<name> (P, T)``, ``/metrics/<name> (P,)``, ``/diverged_at (P,)``
@@ -268,6 +269,8 @@ def write_simulation(path: str | Path, result, signals: Iterable[str] | None = N
             X = np.column_stack([result.designs[k] for k in result.designs])
             write_dataset(h5.create_group("designs"), "X", X, "SI",
                      names=np.array(list(result.designs), dtype="S"))
+        if extra is not None:                    # what the caller adds (e.g. the picks)
+            extra(h5)
         modes = modal_analysis(result.model)
         modal = h5.create_group("modal")
         write_dataset(modal, "frequency", modes.frequency, "Hz",

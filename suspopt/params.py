@@ -16,7 +16,26 @@ import numpy as np
 
 from .config import Config, ConfigError
 
-__all__ = ["ParamView", "numeric_paths", "field_range"]
+__all__ = ["ParamView", "numeric_paths", "field_range", "one_per_run", "ONE_PER_RUN"]
+
+#: Config sections and fields that are one per run: the simulator never reads them per design.
+ONE_PER_RUN = {
+    "simulation": "the simulation settings are one per run",
+    "road": "the road is one per run",
+    "output": "the output settings are one per run",
+    "optimiser": "the optimiser settings are one per run",
+    "vehicle.gravity": "gravity is one per run",
+    "vehicle.corner_defaults": "corner_defaults are merged into the corners when the config "
+                               "loads; vary vehicle.corners.<corner>... instead",
+}
+
+
+def one_per_run(path: str) -> str | None:
+    """Why the dotted ``path`` cannot vary between the designs of one batch, or None."""
+    for prefix, why in ONE_PER_RUN.items():
+        if path == prefix or path.startswith(prefix + "."):
+            return why
+    return None
 
 
 def _walk(node: Any, prefix: str, out: dict[str, float]) -> None:
@@ -124,3 +143,93 @@ class ParamView:
         if bad.size:
             raise ConfigError(f"params: {path}: must be > 0 (designs {bad[:5].tolist()})")
         return value
+
+
+# --- batches from the command line ---------------------------------------------------------
+
+#: Most designs a sweep makes (a grid of several sweeps multiplies quickly).
+MAX_SWEEP_DESIGNS = 1_000_000
+
+
+def _split(item: str, option: str) -> tuple[str, str]:
+    path, sep, value = item.partition("=")
+    if not sep or not path.strip() or not value.strip():
+        raise ConfigError(f"{option} {item!r}: expected PATH=VALUE")
+    return path.strip(), value.strip()
+
+
+def _numeric_path(cfg: Config, path: str, option: str) -> None:
+    paths = numeric_paths(cfg)
+    if path not in paths:
+        close = difflib.get_close_matches(path, list(paths), n=3)
+        raise ConfigError(f"{option} {path}: not a numeric field of this config" + (
+            f"; did you mean {', '.join(close)}?" if close else ""))
+
+
+def apply_sets(cfg: Config, items: list[str]) -> Config:
+    """``cfg`` with each ``PATH=VALUE`` of ``--set`` written into it: any numeric field,
+    checked as if the YAML said so (the result's text is the edited YAML)."""
+    from .config.loader import edit_config, set_path
+    from .config.yamlio import YamlError, parse_yaml
+
+    values = {}
+    for item in items:
+        path, text = _split(item, "--set")
+        _numeric_path(cfg, path, "--set")
+        try:
+            value, _ = parse_yaml(text)
+        except YamlError:
+            value = None
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            raise ConfigError(f"--set {item}: {text!r} is not a number")
+        values[path] = value
+    if not values:
+        return cfg
+
+    def put(data: dict) -> None:
+        for path, value in values.items():
+            set_path(data, path, value)
+    described = ", ".join(f"{p} = {v!r}" for p, v in values.items())
+    return edit_config(cfg.text, put, cfg.source, f"--set {described}")
+
+
+def sweep(cfg: Config, items: list[str], zipped: bool = False) -> dict[str, np.ndarray]:
+    """``params`` of ``--sweep PATH=START:STOP:N`` (each N values evenly spaced, ends
+    included): the grid of all sweeps (every combination, the last sweep varying fastest),
+    or with ``zipped`` their values side by side (every sweep the same N)."""
+    ranges = {}
+    for item in items:
+        path, text = _split(item, "--sweep")
+        _numeric_path(cfg, path, "--sweep")
+        why = one_per_run(path)
+        if why is not None:
+            raise ConfigError(f"--sweep {path}: cannot vary between the designs of one run: "
+                              f"{why}; use --set")
+        parts = text.split(":")
+        try:
+            start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
+            if len(parts) != 3:
+                raise ValueError
+        except (ValueError, IndexError):
+            raise ConfigError(f"--sweep {item}: expected PATH=START:STOP:N") from None
+        if not (np.isfinite(start) and np.isfinite(stop)) or not 1 <= count <= \
+                MAX_SWEEP_DESIGNS:
+            raise ConfigError(f"--sweep {item}: START and STOP must be finite and N from 1 "
+                              f"to {MAX_SWEEP_DESIGNS}")
+        if path in ranges:
+            raise ConfigError(f"--sweep {path}: given twice")
+        ranges[path] = np.linspace(start, stop, count)
+    if not ranges:
+        return {}
+    if zipped:
+        sizes = {len(v) for v in ranges.values()}
+        if len(sizes) > 1:
+            raise ConfigError(f"--zip: the sweeps have {sorted(sizes)} values; zipped sweeps "
+                              f"need the same N")
+        return ranges
+    total = int(np.prod([len(v) for v in ranges.values()], dtype=float))
+    if total > MAX_SWEEP_DESIGNS:
+        raise ConfigError(f"--sweep: the grid has {total} designs, more than "
+                          f"{MAX_SWEEP_DESIGNS}; use fewer values or --zip")
+    grid = np.meshgrid(*ranges.values(), indexing="ij")
+    return {path: g.reshape(-1) for path, g in zip(ranges, grid)}

@@ -53,7 +53,7 @@ import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError
-from ..config.loader import load_config_text
+from ..config.loader import edit_config, set_path
 from ..io import atomic_h5, write_dataset
 from ..kesort import pareto_picks
 from ..seat import build_seat, passenger_mass_change
@@ -138,36 +138,13 @@ def read_sections(path: Path, option: str) -> dict:
 # --- changes -------------------------------------------------------------------------------
 
 def config_with(pareto: ParetoSet, edit: Callable[[dict], None], what: str) -> Config:
-    """The stored config with ``edit`` applied to its YAML data (a dict, edited in place);
-    the result's text is the edited YAML. ``what`` names the edit in error messages, which
-    then refer to the lines of that text (written to the analysis's HDF5 as ``config``)."""
-    import yaml
+    """The stored config with ``edit`` applied to its YAML data
+    (:func:`suspopt.config.loader.edit_config`); errors refer to the lines of the edited
+    text, written to the analysis's HDF5 as ``config``."""
+    return edit_config(pareto.config_text, edit,
+                       pareto.path.with_name(pareto.path.name + ":config"),
+                       f"{what}; the config of {pareto.path.name}")
 
-    from ..config.yamlio import YamlError, parse_yaml
-
-    try:
-        data, _ = parse_yaml(pareto.config_text)
-    except YamlError as exc:
-        raise ConfigError(f"{pareto.path}:config{f':{exc.line}' if exc.line else ''}: "
-                          f"{exc}") from None
-    if not isinstance(data, dict):
-        raise ConfigError(f"{pareto.path}:config: not a mapping of config sections")
-    edit(data)
-    text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
-    try:
-        return load_config_text(text, pareto.path.with_name(pareto.path.name + ":config"))
-    except ConfigError as exc:
-        raise ConfigError(f"{exc} (the config of {pareto.path.name} with {what})") from None
-
-
-def _set_path(data: dict, path: str, value: float) -> None:
-    """``data[a][b][c] = value`` for the dotted ``path`` ``a.b.c``, making missing levels."""
-    *parents, key = path.split(".")
-    for part in parents:
-        if not isinstance(data.get(part), dict):
-            data[part] = {}
-        data = data[part]
-    data[key] = value
 
 def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
     """One variant per road: an ISO 8608 class letter (A-E: the stored road with that class)
@@ -250,7 +227,7 @@ def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) ->
 
         def seat_passenger(data, changed=changed):
             for path, value in changed.items():
-                _set_path(data, path, value)
+                set_path(data, path, value)
 
         variants.append(Variant(f"{new:g} kg",
                                 config_with(pareto, seat_passenger, f"a {new:g} kg load"),

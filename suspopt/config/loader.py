@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import difflib
 from pathlib import Path
+from collections.abc import Callable
 from typing import Any, get_args, get_origin
 
 import yaml
@@ -24,7 +25,8 @@ from .simulation import Output, Simulation
 from .vehicle import Vehicle
 from .yamlio import YamlError, parse_yaml, read_text
 
-__all__ = ["Config", "ConfigError", "load_config", "load_config_text", "config_schema"]
+__all__ = ["Config", "ConfigError", "load_config", "load_config_text", "config_schema",
+           "edit_config", "set_path"]
 
 
 class ConfigError(ValueError):
@@ -244,6 +246,38 @@ def load_config(path: str | Path) -> Config:
     except YamlError as exc:
         raise ConfigError(f"{path}{f':{exc.line}' if exc.line else ''}: {exc}") from None
     return load_config_text(text, path)
+
+
+def set_path(data: dict, path: str, value: Any) -> None:
+    """``data[a][b][c] = value`` for the dotted ``path`` ``a.b.c``, making missing levels (a
+    corner given only by ``corner_defaults`` gets its own entry, which overrides them)."""
+    *parents, key = path.split(".")
+    for part in parents:
+        if not isinstance(data.get(part), dict):
+            data[part] = {}
+        data = data[part]
+    data[key] = value
+
+
+def edit_config(text: str, edit: Callable[[dict], None], source: Path | None = None,
+                what: str = "the change") -> Config:
+    """The config of the YAML ``text`` with ``edit`` applied to its data (a dict, edited in
+    place); the result's text is the edited YAML (comments are not kept) and its errors refer
+    to the lines of that text under the name ``source``. ``what`` names the edit in messages.
+    """
+    name = str(source) if source is not None else "<config>"
+    try:
+        data, _ = parse_yaml(text)
+    except YamlError as exc:
+        raise ConfigError(f"{name}{f':{exc.line}' if exc.line else ''}: {exc}") from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{name}: not a mapping of config sections")
+    edit(data)
+    edited = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+    try:
+        return load_config_text(edited, source)
+    except ConfigError as exc:
+        raise ConfigError(f"{exc} (with {what})") from None
 
 
 def config_schema() -> dict:

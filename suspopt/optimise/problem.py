@@ -29,7 +29,7 @@ from pymoo.core.problem import Problem as _PymooProblem
 from ..config import Config, ConfigError
 from ..config.optimise import DesignVariable, Objective
 from ..control import build_controller
-from ..params import ParamView, numeric_paths
+from ..params import ParamView, numeric_paths, one_per_run
 from ..seat import CONSTRAINT_UNITS, build_attachments, seat_constraints, seat_static_deflection
 from ..simulate import signal_names, signal_units, simulate
 from ..specs import evaluate_spec, metric_unit, spec_signals
@@ -44,16 +44,6 @@ PENALTY = 1.0e10
 #: is simulated in batches of equal width, one after the other.
 BATCH_BYTES = 2 << 30
 
-#: Config sections and fields that are one per run: the simulator never reads them per design.
-_ONE_PER_RUN = {
-    "simulation": "the simulation settings are one per run",
-    "road": "the road is one per run",
-    "output": "the output settings are one per run",
-    "optimiser": "the optimiser settings are one per run",
-    "vehicle.gravity": "gravity is one per run",
-    "vehicle.corner_defaults": "corner_defaults are merged into the corners when the config "
-                               "loads; vary vehicle.corners.<corner>... instead",
-}
 _FAILED = "simulation_failed"
 
 
@@ -195,14 +185,23 @@ class Problem(_PymooProblem):
     def _evaluate_batch(self, X, supplementary: bool):
         """F, G (and S, or None) of one batch of designs, in one simulation."""
         params = self.params(X)
-        with np.errstate(all="ignore"):      # failed designs are flagged below, not warned about
+        with np.errstate(all="ignore"):      # failed designs are flagged, not warned about
             result = simulate(self._sim_cfg, params) if self._simulates else None
-            F = _stack(self._objectives, self.cfg, result, params, len(X))
-            G = self._constraint_values(result, params, len(X))
+        return self.values(result, params, len(X), supplementary)
+
+    def values(self, result, params: dict[str, np.ndarray], P: int,
+               supplementary: bool = False):
+        """``(F, G, S)`` of P designs from their simulation ``result`` (None when no term
+        needs one) and ``params`` (dotted path -> (P,) physical values): the objectives, the
+        constraints with ``simulation_failed`` last, and the supplementary objectives (None
+        unless asked), failed designs penalised (module docstring)."""
+        with np.errstate(all="ignore"):      # failed designs are flagged below, not warned about
+            F = _stack(self._objectives, self.cfg, result, params, P)
+            G = self._constraint_values(result, params, P)
             failed = ~(np.isfinite(F).all(axis=1) & np.isfinite(G).all(axis=1))
             if result is not None:
                 failed |= result.diverged
-            S = _stack(self._supplementary, self.cfg, result, params, len(X)) \
+            S = _stack(self._supplementary, self.cfg, result, params, P) \
                 if supplementary else None
             return (np.where(failed[:, None], PENALTY, F),
                     np.column_stack([np.where(np.isfinite(G), G, PENALTY),
@@ -252,9 +251,9 @@ def _check_paths(cfg: Config) -> None:
             raise cfg.error(loc, f"{var.path!r} is not a numeric field of this config" + (
                 f"; did you mean {', '.join(close)}?" if close else
                 " (derived quantities such as a seat's K_v stay derived)"))
-        for prefix, why in _ONE_PER_RUN.items():
-            if var.path == prefix or var.path.startswith(prefix + "."):
-                raise cfg.error(loc, f"{var.path} cannot vary between designs: {why}")
+        why = one_per_run(var.path)
+        if why is not None:
+            raise cfg.error(loc, f"{var.path} cannot vary between designs: {why}")
         if var.path in seen:
             raise cfg.error(loc, f"{var.path} is already design_variables[{seen[var.path]}]")
         seen[var.path] = i

@@ -1,0 +1,228 @@
+"""Designs picked from a result file, taken onward: re-simulated, or written as a config.
+
+A *design table* is the table of designs a result file holds, with their variables ``X``
+(physical values) and objectives ``F``:
+
+- ``suspopt optimise`` output: ``/pareto`` (the optimum or the Pareto set);
+- ``suspopt kesort`` output: ``/kesort`` (the pooled sets; each design keeps the config of
+  its set, ``/kesort/sets/config``);
+- ``suspopt analyse roads|masses|controllers`` output: ``/pareto`` (the stored front);
+- ``suspopt analyse transmissibility`` of a front: ``/designs`` (its edges and knee).
+
+A *pick* names one row of it: ``knee``, ``best_<objective>`` (the edges of the front,
+:func:`suspopt.kesort.pareto_picks`, or the ones the file stored), ``chosen`` (the k-ε
+optimum of a kesort file) or a row number. :func:`read_picks` resolves picks into
+:class:`Picked` designs; :meth:`Picked.params` gives them to :func:`suspopt.simulate` in one
+batch, and :func:`design_config` writes one of them into its config as a standalone YAML.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .config import Config, ConfigError
+from .config.loader import edit_config, load_config_text, set_path
+from .config.road import FileRoad, resolve_road_file
+
+__all__ = ["Picked", "DesignTable", "read_table", "read_picks", "design_config",
+           "split_picks"]
+
+
+@dataclass
+class DesignTable:
+    """The designs of a result file: ``X (N, n)`` physical values, ``F (N, m)``, their names
+    and units; ``picks`` by name (row indices); ``configs`` the YAML text of each row's
+    config and ``config_of (N,)`` which one; ``table`` the group (``pareto``, ``kesort``,
+    ``designs``)."""
+
+    path: Path
+    table: str
+    X: np.ndarray
+    var_names: list[str]
+    var_units: list[str]
+    F: np.ndarray
+    obj_names: list[str]
+    obj_units: list[str]
+    picks: dict[str, int]
+    configs: list[str]
+    config_of: np.ndarray
+
+    def resolve(self, pick: str) -> int:
+        """The row of ``pick`` (a name or a row number); ConfigError listing the choices."""
+        if pick in self.picks:
+            return self.picks[pick]
+        try:
+            row = int(pick)
+        except ValueError:
+            known = ", ".join(list(self.picks) + ["a row number"])
+            raise ConfigError(f"--pick {pick}: {self.path} has no such pick; it has "
+                              f"{known}") from None
+        if not 0 <= row < len(self.X):
+            raise ConfigError(f"--pick {pick}: {self.path}: /{self.table} has rows 0 to "
+                              f"{len(self.X) - 1}")
+        return row
+
+
+@dataclass
+class Picked:
+    """Designs picked from one table, all of one config: ``names`` (the picks as given),
+    ``rows`` in the table, ``X (P, n)`` physical values of ``var_names`` at ``paths``,
+    ``F (P, m)`` their stored objectives, and ``config`` (resolving relative paths from the
+    file's folder)."""
+
+    source: Path
+    table: str
+    names: list[str]
+    rows: np.ndarray
+    X: np.ndarray
+    var_names: list[str]
+    var_units: list[str]
+    paths: list[str]
+    F: np.ndarray
+    obj_names: list[str]
+    obj_units: list[str]
+    config: Config
+
+    def params(self) -> dict[str, np.ndarray]:
+        """``simulate``'s params: dotted path -> (P,) values."""
+        return {path: self.X[:, j] for j, path in enumerate(self.paths)}
+
+
+def split_picks(given: list[str]) -> list[str]:
+    """``--pick`` values as given (repeatable, each may list several separated by commas)."""
+    picks = [p.strip() for item in given for p in item.split(",") if p.strip()]
+    if not picks:
+        raise ConfigError("--pick: name a design: knee, best_<objective>, chosen or a row "
+                          "number")
+    return picks
+
+
+def read_table(path: str | Path) -> DesignTable:
+    """The design table of an optimise, kesort or analyse file (module docstring);
+    ConfigError naming the file and the dataset for anything else."""
+    from .h5read import H5Reader
+    from .kesort import pareto_picks
+
+    path = Path(path)
+    with H5Reader(path) as h5:
+        groups = set(h5.file.keys())
+        if "kesort" in groups:
+            table = "kesort"
+        elif "pareto" in groups:
+            table = "pareto"
+        elif "designs" in groups and "F" in h5.file["designs"]:
+            table = "designs"
+        else:
+            raise ConfigError(f"{path}: holds no designs to pick (/pareto, /kesort or "
+                              f"/designs): give a file of suspopt optimise, kesort or analyse")
+        X = h5.array(f"{table}/X", ndim=2)
+        F = h5.array(f"{table}/F", ndim=2)
+        if len(X) != len(F) or len(X) == 0:
+            raise ConfigError(f"{path}: /{table}: X and F have {len(X)} and {len(F)} rows")
+        var_names = h5.labels(f"{table}/X", "names", X.shape[1])
+        var_units = h5.labels(f"{table}/X", "units", X.shape[1])
+        obj_names = h5.labels(f"{table}/F", "names", F.shape[1])
+        obj_units = h5.labels(f"{table}/F", "units", F.shape[1])
+        picks: dict[str, int] = {}
+        if table == "kesort":
+            sets = h5.group("kesort/sets")
+            configs = [h5.text(v, "/kesort/sets/config")
+                       for v in np.atleast_1d(h5.dataset("kesort/sets/config")[()])]
+            config_of = h5.array("kesort/source", ndim=1, integer=True)
+            del sets
+            picks["chosen"] = _index(h5, "kesort/chosen", len(X))
+            picks.update(_stored_picks(h5, "kesort/picks", len(X)))
+        else:
+            configs = [h5.text_attr("config")]
+            config_of = np.zeros(len(X), dtype=np.int64)
+            if table == "designs":
+                entries = h5.labels("designs/F", "picks", len(X)) if "picks" in \
+                    h5.dataset("designs/F").attrs else []
+                if not entries and "picks" in h5.dataset("designs/X").attrs:
+                    entries = h5.labels("designs/X", "picks", len(X))
+                for row, entry in enumerate(entries):
+                    for name in entry.split(","):
+                        picks.setdefault(name.strip(), row)
+            elif "pareto/picks" in h5.file:
+                picks.update(_stored_picks(h5, "pareto/picks", len(X)))
+        if ((config_of < 0) | (config_of >= len(configs))).any():
+            raise ConfigError(f"{path}: /kesort/source: indices beyond /kesort/sets")
+    if not picks and np.isfinite(F).all():
+        picks = pareto_picks(F, obj_names)
+    return DesignTable(path, table, X, var_names, var_units, F, obj_names, obj_units, picks,
+                       configs, config_of)
+
+
+def _index(h5, name: str, rows: int) -> int:
+    value = h5.array(name, ndim=0, integer=True)
+    if not 0 <= int(value) < rows:
+        raise ConfigError(f"{h5.where}: /{name}: {int(value)} is not a row of the table")
+    return int(value)
+
+
+def _stored_picks(h5, group: str, rows: int) -> dict[str, int]:
+    return {name: _index(h5, f"{group}/{name}", rows) for name in h5.group(group)}
+
+
+def read_picks(path: str | Path, picks: list[str]) -> Picked:
+    """The designs ``picks`` of the file ``path`` (module docstring), with their config."""
+    table = read_table(path)
+    rows = np.array([table.resolve(p) for p in picks])
+    which = sorted({int(table.config_of[r]) for r in rows})
+    if len(which) > 1:
+        raise ConfigError(f"--pick: {', '.join(picks)} come from sets of {table.path} with "
+                          f"different configs; pick designs of one set at a time")
+    cfg = load_config_text(table.configs[which[0]],
+                           table.path.with_name(table.path.name + ":config"))
+    path_of = {v.label: v.path for v in cfg.design_variables}
+    missing = [n for n in table.var_names if n not in path_of]
+    X = table.X[rows]
+    keep = [j for j, n in enumerate(table.var_names) if n in path_of]
+    if missing and not np.isnan(X[:, [j for j, n in enumerate(table.var_names)
+                                       if n in missing]]).all():
+        raise ConfigError(f"{table.path}: /{table.table}/X holds {', '.join(missing)}, which "
+                          f"the stored config's design_variables do not have")
+    X = X[:, keep]
+    if not np.isfinite(X).all():
+        raise ConfigError(f"{table.path}: /{table.table}/X: the picked designs have no value "
+                          f"for some variable")
+    names = [table.var_names[j] for j in keep]
+    return Picked(source=table.path, table=table.table, names=list(picks), rows=rows, X=X,
+                  var_names=names, var_units=[table.var_units[j] for j in keep],
+                  paths=[path_of[n] for n in names], F=table.F[rows],
+                  obj_names=table.obj_names, obj_units=table.obj_units, config=cfg)
+
+
+def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
+    """Design ``i`` of ``picked`` written into its config: the values in place, a road file
+    made absolute (the config leaves the file's folder), and a comment block saying where
+    it came from. Returns the config and its YAML text."""
+    from . import __version__
+
+    cfg = picked.config
+    values = {path: float(picked.X[i, j]) for j, path in enumerate(picked.paths)}
+
+    def put(data: dict) -> None:
+        for path, value in values.items():
+            set_path(data, path, value)
+        if isinstance(cfg.road, FileRoad) and isinstance(data.get("road"), dict):
+            data["road"]["path"] = str(resolve_road_file(cfg.road, cfg.base_dir).resolve())
+
+    edited = edit_config(cfg.text, put, cfg.source, "the picked design's values")
+    objectives = ", ".join(f"{n} = {v:.6g} {u}".rstrip()
+                           for n, v, u in zip(picked.obj_names, picked.F[i], picked.obj_units))
+    variables = ", ".join(f"{n} = {v:.6g} {u}".rstrip()
+                          for n, v, u in zip(picked.var_names, picked.X[i], picked.var_units))
+    header = "\n".join([
+        f"# Design {picked.names[i]!r} (row {int(picked.rows[i])} of /{picked.table}) of "
+        f"{picked.source}",
+        f"# written by suspopt {__version__}: the stored config with the design's values in "
+        f"place.",
+        f"# stored objectives: {objectives}",
+        f"# design variables: {variables}",
+    ])
+    text = header + "\n" + edited.text
+    return load_config_text(text, cfg.source), text
