@@ -475,7 +475,7 @@ def test_names_are_printed_as_they_are(tmp_path, capsys):
 
 def test_usage_errors_are_one_line(capsys):
     assert one_error(capsys, "simulate") == \
-        "error: Missing argument 'config'. (see suspopt simulate --help)"
+        "error: Missing argument 'source'. (see suspopt simulate --help)"
     assert "No such command 'simulat'" in one_error(capsys, "simulat")
 
 
