@@ -12,6 +12,7 @@ This module imports nothing heavy, so that even an interrupt during the imports 
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -84,4 +85,12 @@ def main(argv: list[str] | None = None) -> int:
 
 def run() -> None:
     """Console-script entry point."""
-    sys.exit(main())
+    code = main()
+    if code == EXIT_INTERRUPTED:
+        # CPython may remember an interrupt it saw inside C code even though it was caught,
+        # and then end the process by SIGINT (status -2) instead of the code given: leave at
+        # once, every output already cleaned up
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)

@@ -185,11 +185,17 @@ def _metrics_table(result) -> Table:
 
 def _is_hdf5(path: Path) -> bool:
     """Whether ``path`` is an HDF5 file (by its signature), not a YAML config."""
+    import os
+    import stat
+
     try:
-        with open(path, "rb") as stream:
-            return stream.read(8) == b"\x89HDF\r\n\x1a\n"
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     except OSError:
         return False
+    try:                                 # (a FIFO or a device is no HDF5 file: never read it)
+        return stat.S_ISREG(os.fstat(fd).st_mode) and os.read(fd, 8) == b"\x89HDF\r\n\x1a\n"
+    finally:
+        os.close(fd)
 
 
 _PICK_HELP = ("designs of a result file to simulate: knee, best_<objective>, chosen (the k-ε "

@@ -123,15 +123,24 @@ class H5Reader:
             raise ConfigError(f"{self.where}: {name}: longer than {MAX_CONFIG_BYTES >> 10} kB")
         return value
 
+    def has_attr(self, key: str, node: str = "") -> bool:
+        """Whether ``/node`` (the root by default) has the attribute ``key``."""
+        obj = self.file if not node else self._node(node)
+        try:
+            return obj is not None and key in obj.attrs
+        except (OSError, ValueError, TypeError, RuntimeError, KeyError):
+            raise ConfigError(f"{self.where}: attributes of /{node}: damaged, cannot be "
+                              f"read") from None
+
     def text_attr(self, key: str, node: str = "") -> str:
         """The text attribute ``key`` of ``/node`` (the root by default)."""
         obj = self.file if not node else self._node(node)
         label = f"attribute {key!r}" + (f" of /{node}" if node else "")
+        if not self.has_attr(key, node):
+            raise ConfigError(f"{self.where}: {label}: missing")
         try:
-            if obj is None or key not in obj.attrs:
-                raise ConfigError(f"{self.where}: {label}: missing")
             value = obj.attrs[key]
-        except (OSError, ValueError, TypeError, RuntimeError):
+        except (OSError, ValueError, TypeError, RuntimeError, KeyError):
             raise ConfigError(f"{self.where}: {label}: damaged, cannot be read") from None
         return self.text(value, label)
 
@@ -141,7 +150,7 @@ class H5Reader:
         label = f"/{node}: attribute {key!r}"
         try:
             value = obj.attrs[key] if obj is not None and key in obj.attrs else None
-        except (OSError, ValueError, TypeError, RuntimeError):
+        except (OSError, ValueError, TypeError, RuntimeError, KeyError):
             value = None
         if isinstance(value, np.ndarray) and value.ndim == 0:
             value = value[()]
@@ -158,8 +167,8 @@ class H5Reader:
         label = f"/{name}: attribute {key!r}"
         try:
             raw = ds.attrs[key] if key in ds.attrs else None
-        except (OSError, ValueError, TypeError, RuntimeError):
-            raw = None
+        except (OSError, ValueError, TypeError, RuntimeError, KeyError):
+            raise ConfigError(f"{self.where}: {label}: damaged, cannot be read") from None
         if raw is None:
             raise ConfigError(f"{self.where}: {label}: missing")
         entries = [self.text(v, label) for v in np.atleast_1d(raw)]

@@ -176,9 +176,11 @@ def read_pareto(path: str | Path) -> ParetoSet:
                               f"{rows['G']} rows")
         if rows["X"] == 0:
             raise ConfigError(f"{path}: /pareto/X: the set is empty")
-        if not np.isfinite(data["X"][0]).all():
-            raise ConfigError(f"{path}: /pareto/X: values must be finite")
-        if "config" not in h5.file.attrs:
+        for key in ("X", "F", "G"):
+            if not np.isfinite(data[key][0]).all():
+                raise ConfigError(f"{path}: /pareto/{key}: values must be finite (a failed "
+                                  f"design has the penalty values, never NaN)")
+        if not h5.has_attr("config"):
             raise ConfigError(f"{path}: attribute 'config' (the YAML text) is missing; give "
                               f"--config")
         text = h5.text_attr("config")
@@ -208,7 +210,10 @@ def evaluate_pareto(pareto: ParetoSet, cfg: Config | None = None,
                           f"its config's main objectives are {', '.join(problem.obj_names)}")
     resimulate = not own or bool(problem.supplementary_names)
     if resimulate:
-        F, G, S = problem.evaluate(problem.to_search(X), return_values_of=["F", "G", "S"])
+        try:
+            F, G, S = problem.evaluate(problem.to_search(X), return_values_of=["F", "G", "S"])
+        except ConfigError as exc:           # a stored value the config's field cannot take
+            raise ConfigError(f"{pareto.path}: /pareto/X: {exc}") from None
         if own:
             gap = _relative_gap(F, pareto.F)
             if gap > _AGREE:

@@ -160,6 +160,10 @@ def front_designs(pareto: ParetoSet) -> FrontDesigns:
         picks.setdefault(row, []).append(name)
     rows = np.array(list(picks))
     path_of = {v.label: v.path for v in cfg.design_variables}
+    if sorted(path_of) != sorted(pareto.var_names):
+        raise ConfigError(f"{pareto.path}: /pareto/X holds {', '.join(pareto.var_names)}; its "
+                          f"config varies {', '.join(path_of)}: the designs do not fit its "
+                          f"design_variables")
     return FrontDesigns(rows=rows, picks=list(picks.values()), X=pareto.X[rows],
                         F=pareto.F[rows], var_names=pareto.var_names,
                         var_units=pareto.var_units, obj_names=pareto.obj_names,
@@ -289,7 +293,12 @@ def _run_front(source: Path, output: Path | None, plot: Path | None,
     pareto = read_pareto(source)
     cfg = with_passenger(pareto, with_[0]) if with_ else pareto.config()
     designs = front_designs(pareto)
-    data = seat_transmissibility(cfg, params=designs.params())
+    try:
+        data = seat_transmissibility(cfg, params=designs.params())
+    except ConfigError as exc:               # a stored value the config's field cannot take
+        if not str(exc).startswith("params:"):
+            raise
+        raise ConfigError(f"{pareto.path}: /pareto/X: {exc}") from None
     title = f"{data.kind.upper()} front of {pareto.path.name}"
     if output is not None:
         write_transmissibility(output, data, cfg, designs=designs)

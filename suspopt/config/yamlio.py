@@ -208,8 +208,9 @@ def parse_yaml(text: str) -> tuple[Any, Node | None]:
     YamlError with the line for malformed, unsafe or oversized input."""
     if len(text) > MAX_CONFIG_BYTES:
         raise YamlError(f"is larger than {MAX_CONFIG_BYTES // 1024} kB: not a config")
-    loader = _Loader(text)
+    loader = None
     try:
+        loader = _Loader(text)
         node = loader.get_single_node()
         if node is None:
             return None, None
@@ -225,7 +226,11 @@ def parse_yaml(text: str) -> tuple[Any, Node | None]:
         problem = getattr(exc, "problem", None) or getattr(exc, "reason", None) \
             or str(exc).splitlines()[0]
         raise YamlError(f"malformed YAML: {problem}", line) from None
-    except (ValueError, OverflowError) as exc:       # a number Python cannot hold
-        raise YamlError(f"malformed YAML: {exc}") from None
+    except (ValueError, OverflowError, TypeError, AttributeError) as exc:
+        # a number Python cannot hold, an explicit tag (!!timestamp, !!binary) of a value
+        # its constructor cannot read
+        raise YamlError(f"malformed YAML: a value that cannot be read "
+                        f"({exc.__class__.__name__})") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
