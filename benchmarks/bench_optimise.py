@@ -44,8 +44,8 @@ REPEATS = 3
 
 
 def bump(road, offsets: np.ndarray, t) -> tuple[np.ndarray, np.ndarray]:
-    """Half-sine bump height and rate under each wheel, (..., N) at times t (...,) (ERRATA
-    Eq 2.101)."""
+    """Half-sine bump height and rate under each wheel, (..., N) at times t (...,) (slip:
+    docs/thesis-slips.md#eq-2101)."""
     t = np.asarray(t)[..., None]
     t0 = road.start + offsets / road.speed
     duration = road.length / road.speed

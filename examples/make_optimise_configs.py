@@ -33,7 +33,7 @@ vehicle:
 road:
   kind: bump_half_sine
   height: 0.05           # h [m]
-  length: 1.0            # base length on the road [m]: the thesis's L/2 with L = 2 m (ERRATA Eq 2.101)
+  length: 1.0            # base length on the road [m]: the thesis's L/2 with L = 2 m (slip: docs/thesis-slips.md#eq-2101)
   speed: 11.111          # 40 km/h
   start: 0.5             # front wheel reaches the bump [s]
 simulation: {duration: 3.0, dt: 2.0e-3}   # RK4 and the sample grid: f1-f3 within 0.06 % of dt -> 0 (configs/README.md)
@@ -45,7 +45,7 @@ design_variables:        # Eq 5.1, bounds of Table 5.2
   - {name: C_F1, path: vehicle.corners.F1.damper.c, lower: 2.0e3, upper: 1.0e4}
   - {name: K_lR1, path: vehicle.corners.R1.spring.linear, lower: 3.2e4, upper: 1.5e5}
   - {name: C_R1, path: vehicle.corners.R1.damper.c, lower: 2.0e3, upper: 1.0e4}
-  # Table 5.2 prints 3.0e8 as the K_nl upper bound; Tables 5.4-5.15 use 0.5-30e6 (ERRATA)
+  # Table 5.2 prints 3.0e8 as the K_nl upper bound; Tables 5.4-5.15 use 0.5-30e6 (slip: docs/thesis-slips.md#table-52)
   - {name: K_nlF1, path: vehicle.corners.F1.spring.cubic, lower: 5.0e5, upper: 3.0e7}
   - {name: K_nlR1, path: vehicle.corners.R1.spring.cubic, lower: 5.0e5, upper: 3.0e7}
 """
@@ -136,7 +136,7 @@ seat:                    # Sec 6.1.2: PS seat at the centre of the vehicle, driv
   stiffness: 3.0e4       # K_v [N/m]; Ch. 6 prints none: the PS seat of Table 7.1
   damping: 1200          # C_v [N s/m] (Table 7.1)
   mass: 13.6             # seat alone [kg] (Sec 8.2); the passenger rides on it
-  passenger: {}          # Table 2.3 passenger (82.21 kg, ERRATA)
+  passenger: {}          # Table 2.3 passenger (82.21 kg; slip: docs/thesis-slips.md#table-23)
   position: {x: 0.0, y: 0.0}
   coupling: one_way
 """

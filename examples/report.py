@@ -594,7 +594,8 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
            f"not both within {SAME:g} %: the bar changes the steady roll, or the roll has not"
            " reached h/(b1 + b2)")
     s2a = ["- **Part 2a's anti-roll bar.** Our bar is a torsional spring between the body and",
-           "the axle (ERRATA), so with one side raised by h the car rolls by h/(b1 + b2) =",
+           "the axle (slip: docs/thesis-slips.md#eq-211), so with one side raised by h the car",
+           "rolls by h/(b1 + b2) =",
            f"{md.num(rolled, 3)} rad at rest: ours {md.num(arb, 3)} rad with bars and",
            f"{md.num(no_arb, 3)} without (the bar: {md.pct(bar_effect)}; with bars"
            f" {md.pct(geometric)} from h/(b1 + b2)), {bar}. The thesis's",
@@ -907,7 +908,8 @@ def chapter5(out: Path, doc: Doc) -> list[str]:
     doc("# Chapter 5: optimisation methods and fitness functions (Tables 5.4-5.14)", "")
     doc("## What was run", "")
     doc.para("The HC2 of Table 5.1 over the 0.05 m half-sine bump at 40 km/h (3 s, dt = 2 ms),",
-             "six design variables (Eq 5.1, Table 5.2 with the ERRATA's K_nl bound), RC_s < 0.8",
+             "six design variables (Eq 5.1, Table 5.2 with the K_nl bound of",
+             "docs/thesis-slips.md#table-52), RC_s < 0.8",
              "m/s² and 10-30 % spring usage (Eq 5.2-5.3); Cases 1-5 (f1, f2, f3, the balanced",
              "sum, the f1-dominated sum; Eq 5.4-5.7) × scenarios S1-S5 (GA population 200 and",
              "1000, hybrid GA 10 generations + SLSQP, SLSQP; Table 5.3), seed 1:")
@@ -1113,7 +1115,8 @@ def chapter5(out: Path, doc: Doc) -> list[str]:
              f"the dynamic tyre force {span(ours_ft, lambda v: md.num(v, 3))} N against",
              f"{span(t_ft, md.printed)} N, while RC_s lies {span(rc_diff)} from the thesis's.",
              "The configs read the thesis's L = 2 m as the full sine period, a",
-             f"{md.num(bump, 2)} m half-sine on the road (ERRATA Eq 2.101). Simulated again",
+             f"{md.num(bump, 2)} m half-sine on the road (slip: docs/thesis-slips.md#eq-2101).",
+             "Simulated again",
              f"over a {md.num(2 * bump, 2)} m half-sine, the Case 1/S1 optimum gives MST_F1",
              f"{md.num(longer[1, 1]['MST.F1'][0] * 1e3, 3)} mm, tyre forces",
              f"{md.num(longer[1, 1]['F_T.F1'][0], 3)} /",
@@ -1134,8 +1137,9 @@ def chapter5(out: Path, doc: Doc) -> list[str]:
              f"{md.num(100 * usage.min, 2)}-{md.num(100 * usage.max, 2)} %).",
              f"Of the thesis's {len(thesis_knl)} printed K_nl optima {over} exceed the",
              f"{md.num(knl_upper, 3)}·10⁶ N/m³ upper bound its own tables state" + (
-                 ", so its runs searched a wider K_nl range than the ERRATA bound the configs"
-                 " use (new slip, listed in the notes below)." if over else "."))
+                 ", so its runs searched a wider K_nl range than the bound the configs use"
+                 " (docs/thesis-slips.md#table-52; new slip, listed in the notes below)."
+                 if over else "."))
     s2_gens = [runs[c, 2].generations for c in range(1, 6)]
     time_share = [100 * runs[c, s].seconds / ref["cases"][c]["time"][s - 1] for c, s in runs]
     stops = {}

@@ -28,7 +28,8 @@ hybrid      ṠT (β σ_sky + (1 - β) σ_gnd)             X > T               c
 ==========  =======================================  ==================  =========================
 
 ``S = z̈_s² - α_c² ż_s²`` is the frequency-range selector with the crossover ``α_c`` in rad/s
-(``crossover_frequency``; ERRATA: the thesis prints ``ż_s²`` for ``z̈_s²`` in places).
+(``crossover_frequency``; the thesis prints ``ż_s²`` for ``z̈_s²`` in places, slip:
+docs/thesis-slips.md#eq-237).
 
 - **SH-L** (Eq 2.35) with ``α`` = ``linear_weight``: the printed coefficient is unbounded as
   ``ṠT -> 0``; a damper cannot exceed its range, so it is clipped to ``[C_min, C_max]`` (as in
@@ -115,7 +116,7 @@ def _ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
 
 
 def _frequency_selector(body_vel, body_acc, crossover):
-    """``S = z̈_s² - α_c² ż_s²`` (Eq 2.37-2.39 with ERRATA) [m²/s⁴]."""
+    """``S = z̈_s² - α_c² ż_s²`` (Eq 2.37-2.39; slip: docs/thesis-slips.md#eq-237) [m²/s⁴]."""
     return body_acc * body_acc - crossover * crossover * (body_vel * body_vel)
 
 
@@ -445,7 +446,8 @@ def distribution_quantile(samples: np.ndarray, level: np.ndarray | float,
     """Quantile at ``level`` (0-1, broadcast over the non-fitted axes) of the distribution
     fitted to ``samples`` along ``axis``: ``student_t`` (:func:`fit_student_t`, then
     ``μ + s t_ν⁻¹(level)``), ``normal`` (``μ + σ Φ⁻¹(level)`` with the sample mean and standard
-    deviation: ERRATA Eq 4.7, ``T = μ + Z σ``) or ``empirical`` (the sample quantile).
+    deviation: ``T = μ + Z σ``, slip: docs/thesis-slips.md#eq-47) or ``empirical`` (the
+    sample quantile).
     Vectorised: no loop over the other axes."""
     x = np.moveaxis(np.asarray(samples, dtype=float), axis, 0)
     level = np.broadcast_to(np.asarray(level, dtype=float), x.shape[1:])
@@ -462,7 +464,8 @@ def distribution_quantile(samples: np.ndarray, level: np.ndarray | float,
 def threshold_for_share(condition: np.ndarray, c_max_share: np.ndarray | float, law: str,
                         distribution: str = "student_t", axis: int = -1) -> np.ndarray:
     """Threshold ``T`` that leaves the share ``c_max_share`` of the samples at ``C_max``
-    (Eq 4.5-4.7 with ERRATA Eq 4.7: the quantile of the distribution fitted to ``condition``).
+    (Eq 4.5-4.7 as mended: the quantile of the distribution fitted to ``condition``; slip:
+    docs/thesis-slips.md#eq-47).
 
     ``c_max_share`` is the thesis's ``1 - N%`` (0-1). The quantile level is ``1 - c_max_share``
     for laws that stiffen above ``T`` (Eq 4.6: ``P(X < T_A) = N%``) and ``c_max_share`` for

@@ -240,7 +240,7 @@ def write_dataset(group, name: str, data, units: str | list[str], **attrs):
 def write_simulation(path: str | Path, result, signals: Iterable[str] | None = None,
                      float32: bool = False, command: str | None = None,
                      extra=None) -> Path:
-    """Write a simulation ``Result`` with the layout of DESIGN.md.
+    """Write a simulation ``Result`` with the layout of docs/architecture.md#public-contract.
 
     ``/time (T,)``, ``/signals/<name> (P, T)``, ``/metrics/<name> (P,)``, ``/diverged_at (P,)``
     (NaN where the design did not diverge), ``/designs/X (P, n)`` with attr ``names`` when

@@ -10,8 +10,9 @@ counts the objectives in which ``i`` is not worse than ``j``, and the level is t
 the least favourable ``j``, minus 1. So ``k = m - 1`` for a solution better than every other in
 every objective (the utopia point), ``k >= 0`` for a Pareto-optimal solution and ``k = -1``
 where some solution is better in every objective. k-ε optimality (Gobbi et al.) softens the
-merit with an indifference threshold ``ε_l`` per objective (Eq 6.12 as reference/ERRATA.md
-mends it): ``Γ = 1`` if ``Δ <= 0``, ``1 - Δ/ε`` if ``0 < Δ < ε``, ``0`` if ``Δ >= ε``. The
+merit with an indifference threshold ``ε_l`` per objective (Eq 6.12 as mended, slip:
+docs/thesis-slips.md#eq-612): ``Γ = 1`` if ``Δ <= 0``, ``1 - Δ/ε`` if ``0 < Δ < ε``,
+``0`` if ``Δ >= ε``. The
 level becomes continuous in ``[-1, m - 1]``; it is never below the k-optimality level and
 tends to it as ``ε -> 0`` (``ε_l = 0`` *is* Eq 6.11 for that objective).
 
@@ -140,7 +141,8 @@ def normalise_objectives(F, how: str = "max", names: Sequence[str] | None = None
 
 
 def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
-    """k-ε levels (Eq 6.10, Γ of Eq 6.12 with the ERRATA) of the rows of ``F (N, m)``.
+    """k-ε levels (Eq 6.10, Γ of Eq 6.12 as mended, slip: docs/thesis-slips.md#eq-612) of the
+    rows of ``F (N, m)``.
 
     ``eps``: one threshold or one per objective, in the units of ``F``; ``eps_l = 0`` gives the
     crisp merit of Eq 6.11 for that objective, so ``eps = 0`` returns the k-optimality levels.

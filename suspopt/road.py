@@ -3,7 +3,8 @@
 Every road is a height ``z`` [m] under a wheel and its time derivative ``zdot`` [m/s]. A wheel at
 distance ``d`` behind the front axle, driving at constant speed ``V``, sees the road the front
 wheels saw ``d / V`` earlier: ``z(V t - d)`` for spatial profiles, a bump delayed by ``d / V``
-(thesis Eq 2.102/2.104 ``t_distance = (a_F + a_R)/V``; ERRATA Eq 2.104 for the rear duration).
+(thesis Eq 2.102/2.104 ``t_distance = (a_F + a_R)/V``; the rear duration as mended, slip:
+docs/thesis-slips.md#eq-2104).
 
 The ``tracks`` setting of the road decides what each side sees (see
 :mod:`suspopt.config.road`): the same profile, an independent realisation for the left side
@@ -28,7 +29,7 @@ __all__ = [
 ]
 
 #: Geometric-mean displacement PSD level G_d(n0) of each ISO 8608 class [m^3], n0 = 0.1 cycles/m
-#: (ISO 8608:1995, reference/standards.md). Thesis Table 2.4 lists the same roads as
+#: (ISO 8608:1995, docs/iso-facts.md#classes-a-e). Thesis Table 2.4 lists the same roads as
 #: Phi(Omega0) = G_d(n0) (2 pi n0)^2 / (2 pi), about G_d(n0)/16, for w = 2.
 ISO8608_CLASS_LEVELS: dict[str, float] = {
     "A": 16e-6, "B": 64e-6, "C": 256e-6, "D": 1024e-6, "E": 4096e-6,
@@ -88,7 +89,8 @@ def road_edges(road: RoadConfig, offsets: np.ndarray,
     """The instants where a bump's ``z`` or ``zdot`` is discontinuous, and the steps in ``z``.
 
     A wheel ``d`` behind the front axle meets the bump at ``t_0 + d/V`` and leaves it
-    ``L/V`` later (Eq 2.101-2.104, ERRATA Eq 2.104); wheels on a flat side have no edges.
+    ``L/V`` later (Eq 2.101-2.104; slip: docs/thesis-slips.md#eq-2104); wheels on a flat side
+    have no edges.
     Returns the distinct edge times ``(E,)`` [s], ascending, and the jump of ``z`` under each
     wheel at each of them ``(N, E)`` [m]: ``+h`` where a wheel climbs a step bump, ``-h`` where it
     comes down, 0 for the half-sine bump (``z`` continuous, ``zdot`` jumping by ``± h pi V/L``)
@@ -145,7 +147,8 @@ def iso8608_level(road: Iso8608Road) -> float:
 
     ``iso8608`` convention: the nominal level (``level``, else the class's geometric mean).
 
-    ``thesis`` convention: nominal / (2 pi). Derivation (reference/standards.md): a harmonic
+    ``thesis`` convention: nominal / (2 pi). Derivation (docs/iso-facts.md#amplitude-conventions):
+    a harmonic
     ``A_i sin(Omega_i s - phi_i)`` carries variance ``A_i^2 / 2``, spread over its spacing
     ``dn = dOmega / (2 pi)`` in cycles/m, so the profile's one-sided PSD is
     ``G(n_i) = A_i^2 / (2 dn)``. With Eq 2.99 ``A_i^2 = Phi(Omega_i) dOmega / pi`` and
@@ -204,7 +207,8 @@ def iso8608_harmonics(road: Iso8608Road, length_m: float, side: str = "right") -
     cell, 0.011-0.021 cycles/m, carries 48 % of the variance) is not much shorter than the road.
 
     The thesis writes Eq 2.97-2.98 in time (``omega_0 = V dOmega``); here the sum is spatial and
-    the wheels sample it at ``V t - d``, which is the same thing (Eq 2.96, ERRATA Sec 2.5.1).
+    the wheels sample it at ``V t - d``, which is the same thing (Eq 2.96; slip:
+    docs/thesis-slips.md#sec-251).
     """
     count = _n_waves(road, length_m)
     edges = np.linspace(road.n_min, road.n_max, count + 1)
@@ -270,7 +274,8 @@ def _is_flat(road: RoadConfig, side: str) -> bool:
 def _bump_window(road: BumpStep | BumpHalfSine,
                  offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """When each wheel meets and leaves the bump (N,) [s]: ``t_0 + d/V`` and ``L/V`` later
-    (Eq 2.102/2.104 with ``t_distance = d/V``; ERRATA Eq 2.104 for the rear duration)."""
+    (Eq 2.102/2.104 with ``t_distance = d/V``; the rear duration as mended, slip:
+    docs/thesis-slips.md#eq-2104)."""
     up = road.start + offsets / road.speed
     return up, up + road.length / road.speed
 

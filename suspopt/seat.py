@@ -3,8 +3,9 @@
 Coordinates and signs. Displacements are vertical, upward +, and measured from static
 equilibrium: ``z_s`` is the floor (the body at the seat's point), ``x`` the seat mass, ``y`` the
 inner mass of NSS4. The mechanisms stand on the floor, so their forces act on the isolator
-travel ``u = x - z_s`` (NSS4: ``u_0 + y - z_s``), as Eq 2.45, 2.52 and 2.58 do (ERRATA for
-Eq 2.43/2.44 and 2.49/2.51, which print ``x``). The ``*_force`` functions return the force of a
+travel ``u = x - z_s`` (NSS4: ``u_0 + y - z_s``), as Eq 2.45, 2.52 and 2.58 do (Eq 2.43/2.44
+and 2.49/2.51 print ``x``; slip: docs/thesis-slips.md#eq-243). The ``*_force`` functions return
+the force of a
 mechanism on the mass it carries, upward +: a positive slope is a negative stiffness.
 
 Static equilibrium. Each isolator carries its load ``m g`` at ``u = 0`` (NSS4: ``u = u_0``):
@@ -15,13 +16,15 @@ and ``m`` here is the whole load on the isolator, seat plus passenger.
 
 Equations of motion (``u = x - z_s``; the passenger's pelvis link acts on the seat too):
 
-- PS: ``m ẍ + C_v u̇ + K_v u = 0`` (Eq 2.40 with the seat's ``ẍ``, ERRATA);
+- PS: ``m ẍ + C_v u̇ + K_v u = 0`` (Eq 2.40 with the seat's ``ẍ``; slip:
+  docs/thesis-slips.md#eq-240);
 - NSS1-NSS3: ``m ẍ + C_v u̇ + K_v u - f_N(u) = 0`` (Eq 2.44, 2.51, 2.57), ``f_N`` exact
   (Eq 2.43, 2.49, 2.56) or its 3rd-order series (Eq 2.45, 2.52; NSS3 derived here);
 - NSS4: ``m ẍ + C_v (ẋ - ẏ) + K_S u + K_v (x - y) = 0`` and
   ``m_d ÿ - C_v (ẋ - ẏ) - K_v (x - y) - [F(u_0 + y - z_s) - F(u_0)] = 0`` (Eq 2.59-2.69,
   ``F = -f_N`` the mechanism's upward force, :func:`nss4_force`);
-- passenger: Eq 2.70-2.77 rebuilt from the topology (ERRATA): seat - pelvis - abdomen -
+- passenger: Eq 2.70-2.77 rebuilt from the topology (slip: docs/thesis-slips.md#eq-270):
+  seat - pelvis - abdomen -
   diaphragm - thorax - torso, back tied to pelvis and torso, head on back. Besides the index
   slips, Eq 2.75 prints the torso-back term with the wrong sign (``-k_4 (z_3 - z_2)`` would be
   a negative stiffness) and Eq 2.76 lacks the head's reaction ``-c_1 (ż_1 - ż_2) -
@@ -63,7 +66,7 @@ __all__ = [
 
 #: Body parts of the passenger, bottom to top (Fig. 2.14, Table 2.3).
 PASSENGER_PARTS = ("pelvis", "abdomen", "diaphragm", "thorax", "torso", "back", "head")
-#: The part (or the seat) each part's own k_i, c_i join it to (ERRATA for Eq 2.70-2.77).
+#: The part (or the seat) each part's own k_i, c_i join it to (slip: docs/thesis-slips.md#eq-270).
 _BELOW = {"pelvis": "seat", "abdomen": "pelvis", "diaphragm": "abdomen", "thorax": "diaphragm",
           "torso": "thorax", "back": "pelvis", "head": "back"}
 #: First part of the names of seat and passenger signals.
@@ -164,7 +167,7 @@ def _link_series(rest, stiffness, offset, length):
 
 def nss1_force(u, horizontal_stiffness, wall_distance, spring_free_length):
     """NSS1 (Carrella) mechanism force on the seat, ``f_N = 2 K_h (L_o / sqrt(u² + a_o²) - 1) u``
-    [N] (Eq 2.41-2.43 in the travel ``u``, ERRATA).
+    [N] (Eq 2.41-2.43 in the travel ``u``; slip: docs/thesis-slips.md#eq-243).
 
     Each inclined spring runs from an anchor at horizontal distance ``a_o`` to the seat; its
     length is ``sqrt(u² + a_o²)``, its compression ``L_o`` minus that, and the vertical share of
@@ -185,14 +188,15 @@ def nss1_taylor(horizontal_stiffness, wall_distance, spring_free_length):
 
 def nss2_force(u, horizontal_stiffness, wall_distance, spring_free_length, bar_length):
     """NSS2 (Le) mechanism force on the seat, ``f_N = 2 K_h (1 + (L_o - a_o)/sqrt(b² - u²)) u``
-    [N] (Eq 2.49 in the travel ``u``, ERRATA).
+    [N] (Eq 2.49 in the travel ``u``; slip: docs/thesis-slips.md#eq-243).
 
     A bar of length ``b`` from the seat reaches a slider at ``sqrt(b² - u²)`` from the seat's
     axis; the horizontal spring between slider and its anchor at ``a_o`` has length
     ``a_o - sqrt(b² - u²)`` and potential ``½ K_h (L_o - a_o + sqrt(b² - u²))²``; the force is
     minus its derivative, times two springs. It is zero at ``u = 0`` and at ``u = X_ST``.
 
-    Eq 2.50 (ERRATA) in the ratios ``γ1 = b/L_o``, ``γ2 = a_o/L_o``: dividing Eq 2.49's
+    Eq 2.50 (slip: docs/thesis-slips.md#eq-250) in the ratios ``γ1 = b/L_o``, ``γ2 = a_o/L_o``:
+    dividing Eq 2.49's
     fraction by ``L_o`` gives ``f_N = 2 K_h (1 + (1 - γ2) / sqrt(γ1² - (u/L_o)²)) u`` — the
     printed ``sqrt(γ1² - x²)`` lacks the ``1/L_o`` on ``x``.
     """
@@ -413,7 +417,8 @@ class SeatModel:
 
 
 def _passive(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form: str):
-    """PS, Eq 2.40 (ERRATA: ``m ẍ + C_v (ẋ - ż_s) + K_v (x - z_s) = 0``)."""
+    """PS, Eq 2.40 as ``m ẍ + C_v (ẋ - ż_s) + K_v (x - z_s) = 0`` (slip:
+    docs/thesis-slips.md#eq-240)."""
     k_v = get("stiffness")
     return [(0, 1, k_v, get("damping"))], None, {
         "static_deflection": ps_static_deflection(load, k_v, g), "vertical_stiffness": k_v}

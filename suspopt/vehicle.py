@@ -4,7 +4,8 @@ The body has a subset of the degrees of freedom {heave, roll, pitch}; corner ``i
 ``(x_i, y_i)`` (``x = +a_F`` front, ``-a_R`` rear; ``y = +b_1`` right, ``-b_2`` left) and carries
 an unsprung mass on a tyre, joined to the body by a spring and a damper. The suspension travel
 is ``ST_i = z_s + y_i φ - x_i θ - z_ui`` (Eq 2.3, 2.9, 2.17 and Eq 2.26 with the rear roll sign
-mended per ERRATA) and the tyre deflection ``TD_i = z_ui - z_road,i`` (Eq 2.4, 2.10, 2.18, 2.27).
+mended, slip: docs/thesis-slips.md#eq-226) and the tyre deflection ``TD_i = z_ui - z_road,i``
+(Eq 2.4, 2.10, 2.18, 2.27).
 The vehicle is a :class:`suspopt.network.Network` over ``q = [body DOFs, wheel heaves]``
 (measured from static equilibrium) with the road heights under the wheels as inputs, and three
 element groups (:func:`vehicle_network`):
@@ -15,7 +16,7 @@ element groups (:func:`vehicle_network`):
 - ``tyre``: along ``TD = z_u - z_road``, ``F_T = k_T TD + c_T dTD/dt`` (Eq 2.28-2.29); with
   ``tyre_lift_off`` the tyre cannot pull, so ``F_T`` never exceeds the static load;
 - ``anti_roll_bar``: torsional springs between the body roll and the axle roll
-  ``(z_right - z_left)/(b_1 + b_2)`` (ERRATA for Eq 2.11-2.12 and 2.25).
+  ``(z_right - z_left)/(b_1 + b_2)`` (slip: docs/thesis-slips.md#eq-211).
 
 By virtual work these give the equations of motion of every preset (Eq 2.1-2.2, 2.5-2.8,
 2.13-2.16, 2.19-2.25) as ``M q'' = -J^T (F_K + F_C) - F_T - ...``; the linear matrices ``K``,
@@ -236,7 +237,7 @@ def _anti_roll_bars(pv: ParamView, corners, body_dofs):
     """Twist map (P, B, n) and stiffness (P, B) of the axles' bars, or (None, None).
 
     A bar is a torsional spring between the body roll φ and the axle roll (z_R - z_L)/w,
-    w = b_1 + b_2: twist = φ - (z_R - z_L)/w (ERRATA for Eq 2.11-2.12 and 2.25).
+    w = b_1 + b_2: twist = φ - (z_R - z_L)/w (slip: docs/thesis-slips.md#eq-211).
     """
     if "roll" not in body_dofs:
         return None, None

@@ -40,7 +40,8 @@ def test_k_eps_levels_of_a_hand_made_set():
     levels = k_eps_levels(HAND, 2.0)
     np.testing.assert_allclose(levels, [1.0, 1.0, 0.5, 1.5])
     assert kesort(HAND, 2.0).chosen == 3
-    # eps = 1: Δ = 1 is no longer inside the band (Γ = 0 for Δ >= ε, ERRATA Eq 6.12)
+    # eps = 1: Δ = 1 is no longer inside the band (Γ = 0 for Δ >= ε;
+    # slip: docs/thesis-slips.md#eq-612)
     np.testing.assert_allclose(k_eps_levels(HAND, 1.0), [1, 1, 0, 1])
 
 

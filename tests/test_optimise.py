@@ -308,7 +308,7 @@ def test_bad_optimisation_input_names_key_and_line(case):
     assert needle in message and message.startswith(f"case.yaml:{line}:"), message
 
 
-# --- runs: reproducible, resumable, written as DESIGN.md says -----------------------------------
+# --- runs: reproducible, resumable, written as docs/architecture.md#public-contract says --------
 
 @pytest.mark.parametrize("variant", ["nsga2", "hybrid_weighted"])
 def test_resume_equals_an_uninterrupted_run(tmp_path, variant):

@@ -48,7 +48,7 @@ def test_step_bump_height_start_duration_and_rear_delay():
     delay = WHEELBASE / SPEED
     for row, d in zip(z, [0.0, 0.0, delay, delay]):
         np.testing.assert_array_equal(row, np.where(window(d), HEIGHT, 0.0))
-    # ERRATA Eq 2.104: the rear plateau lasts as long as the front one
+    # the rear plateau lasts as long as the front one (slip: docs/thesis-slips.md#eq-2104)
     assert np.count_nonzero(z[2]) == np.count_nonzero(z[0]) == round(LENGTH / SPEED / DT)
 
 

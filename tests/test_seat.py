@@ -112,7 +112,8 @@ def test_taylor_forms_of_nss1_and_nss2_are_eq_2_45_and_2_52():
 
 
 def test_eq_2_50_in_ratios_needs_the_travel_over_l_o():
-    """ERRATA Eq 2.50: f_N = 2 K_h (1 + (1 - γ2)/sqrt(γ1² - (u/L_o)²)) u equals Eq 2.49."""
+    """Eq 2.50 as mended, f_N = 2 K_h (1 + (1 - γ2)/sqrt(γ1² - (u/L_o)²)) u, equals Eq 2.49
+    (slip: docs/thesis-slips.md#eq-250)."""
     k_h, a_o, l_o, b = 3e3, 0.16, 0.15, 0.06
     u = np.linspace(-0.05, 0.05, 11)
     g1, g2 = b / l_o, a_o / l_o
@@ -121,7 +122,8 @@ def test_eq_2_50_in_ratios_needs_the_travel_over_l_o():
 
 
 def test_mechanism_forces_are_the_printed_equations_in_the_travel():
-    """Eq 2.43, 2.56 and 2.65 as printed (with x -> u, ERRATA), against the library's forms."""
+    """Eq 2.43, 2.56 and 2.65 as printed (with x -> u; slip: docs/thesis-slips.md#eq-243),
+    against the library's forms."""
     u = np.linspace(-0.03, 0.03, 13)
     k_h = 4e3
     a_o, x_st = 0.1, 0.05
@@ -164,8 +166,9 @@ def test_nss4_without_horizontal_springs_is_the_linear_two_mass_system():
 
 
 def _hand_passenger_matrices(k_seat: float, c_seat: float, m_seat: float):
-    """M, K, C of seat + passenger written row by row from Eq 2.70-2.77 as mended in ERRATA
-    (Eq 2.71: x -> z_9; Eq 2.75: the torso-back term restores, +c_4, +k_4; Eq 2.76: the
+    """M, K, C of seat + passenger written row by row from Eq 2.70-2.77 as mended (slip:
+    docs/thesis-slips.md#eq-270; Eq 2.71: x -> z_9; Eq 2.75: the torso-back term restores,
+    +c_4, +k_4; Eq 2.76: the
     head's reaction -c_1(ż_1 - ż_2) - k_1(z_1 - z_2) on the back, missing in print).
     DOFs [seat 9, pelvis 8, abdomen 7, diaphragm 6, thorax 5, torso 3, back 2, head 1]."""
     m = {9: m_seat, 8: 27.70, 7: 6.20, 6: 0.46, 5: 1.38, 3: 33.33, 2: 6.94, 1: 6.20}
@@ -205,7 +208,8 @@ def test_passenger_chain_matrices_frequencies_and_statics():
     assert np.allclose(lin.stiffness[0], K, rtol=1e-12, atol=1e-9)
     assert np.allclose(lin.damping[0], C, rtol=1e-12, atol=1e-9)
     assert np.allclose(np.diag(lin.mass[0]), M)
-    assert lin.mass[0, 1:].sum() == pytest.approx(82.21)      # Table 2.3 (ERRATA: not 81.4)
+    # Table 2.3 sums to 82.21 kg, not 81.4 (slip: docs/thesis-slips.md#table-23)
+    assert lin.mass[0, 1:].sum() == pytest.approx(82.21)
     assert np.allclose(lin.input_stiffness[0], [5.0e4] + [0] * 7)
     # the passenger alone on a rigid seat: frequencies from the assembled matrices ...
     p = slice(1, None)

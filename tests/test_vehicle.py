@@ -94,7 +94,8 @@ def test_static_tyre_loads_carry_the_weight(load):
 
 
 def test_travel_sign_convention(load):
-    """ST_i = z_s + y_i φ - x_i θ - z_ui (DESIGN.md; Eq 2.26 with ERRATA)."""
+    """ST_i = z_s + y_i φ - x_i θ - z_ui (docs/architecture.md#conventions; Eq 2.26 as mended,
+    slip: docs/thesis-slips.md#eq-226)."""
     model = build_vehicle(load("ch3/part1a_fc_bump.yaml"))
     q = np.zeros((model.n_dof, 1, 1))
     q[1] = 0.01  # roll

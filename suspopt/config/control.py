@@ -28,8 +28,8 @@ class Threshold(Section):
     base law runs (``T = 0``) until ``t >= learn_time``; then, and every
     ``refit_factor * learn_time`` seconds, the condition history of each corner (every sample
     since ``t = 0``) is fitted with ``distribution`` and ``T`` is set to the quantile that leaves
-    the share ``c_max_share`` of the samples at ``C_max`` (Eq 4.5-4.7 with ERRATA:
-    ``T = μ + Z σ``, the quantile of the fitted distribution).
+    the share ``c_max_share`` of the samples at ``C_max`` (Eq 4.5-4.7 as mended, ``T = μ + Z σ``,
+    the quantile of the fitted distribution; slip: docs/thesis-slips.md#eq-47).
 
     ``c_max_share`` is the thesis's ``1 - N%`` (Tables 4.2-4.3 use 27 %); the quantile level is
     ``1 - c_max_share`` for laws that stiffen above the threshold and ``c_max_share`` for SH-ADD-2,

@@ -72,8 +72,8 @@ class BumpStep(_DeterministicRoad):
     """Rectangular bump (step up, plateau, step down), Eq 2.103-2.104.
 
     A wheel is raised by ``height`` from ``start`` for ``length / speed`` seconds; the rear wheels
-    see the same plateau delayed by the wheelbase over the speed (ERRATA Eq 2.104: the printed
-    rear duration ``L/(2V)`` is a slip).
+    see the same plateau delayed by the wheelbase over the speed (the printed rear duration
+    ``L/(2V)`` is a slip: docs/thesis-slips.md#eq-2104).
     """
 
     kind: Literal["bump_step"] = Field(description="rectangular bump, Eq 2.103-2.104")
@@ -84,7 +84,7 @@ class BumpStep(_DeterministicRoad):
 
 
 class BumpHalfSine(_DeterministicRoad):
-    """Half-sine bump, Eq 2.101-2.102 as corrected in ERRATA.
+    """Half-sine bump, Eq 2.101-2.102 as corrected (slip: docs/thesis-slips.md#eq-2101).
 
     ``z = height sin(pi (t - start) V / length)`` for ``start <= t < start + length / V``,
     0 otherwise. ``length`` is the base length of the bump on the road, the thesis's ``L/2``.
@@ -93,7 +93,8 @@ class BumpHalfSine(_DeterministicRoad):
     kind: Literal["bump_half_sine"] = Field(description="half-sine bump, Eq 2.101-2.102")
     height: RoadHeight = Field(description="crest height h [m]; negative for a dip")
     length: RoadLength = Field(description="base length of the half-sine on the road L_b [m] "
-                              "(the thesis's L/2, ERRATA Eq 2.101); crossing lasts length/speed s")
+                              "(the thesis's L/2, slip: docs/thesis-slips.md#eq-2101); crossing "
+                              "lasts length/speed s")
     start: _Start = Field(description="time at which the front wheels reach the bump t0 [s]")
 
 
@@ -101,7 +102,8 @@ class Iso8608Road(_Road):
     """Random road of ISO 8608 roughness by harmonic superposition, Eq 2.93, 2.97-2.100.
 
     ``convention`` is required on purpose: the two amplitude conventions differ by a factor
-    ``sqrt(2 pi)`` (reference/standards.md) and must never be mixed silently. Use ``thesis`` in
+    ``sqrt(2 pi)`` (docs/iso-facts.md#amplitude-conventions) and must never be mixed silently.
+    Use ``thesis`` in
     configs that reproduce the thesis's tables, ``iso8608`` for roads of the standard's roughness.
     """
 

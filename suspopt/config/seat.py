@@ -41,7 +41,8 @@ _BodyPoint = quantity(-100.0, 100.0)
 
 
 class Position(Section):
-    """Where the seat stands on the body (DESIGN.md: x + forward, y + right of the CG)."""
+    """Where the seat stands on the body (x + forward, y + right of the CG:
+    docs/architecture.md#conventions)."""
 
     x: _BodyPoint = Field(0.0, description="longitudinal distance ahead of the body's centre of "
                        "gravity [m] (Ch. 7: e = 0.4)")
@@ -86,14 +87,15 @@ def _segment(part: str):
 
 
 class Passenger(Section):
-    """The seated passenger of Sec 2.3 (Fig. 2.14, Table 2.3), as mended in ERRATA (Eq 2.70-2.77).
+    """The seated passenger of Sec 2.3 (Fig. 2.14, Table 2.3), Eq 2.70-2.77 as mended (slip:
+    docs/thesis-slips.md#eq-270).
 
     Chain: seat - pelvis - abdomen - diaphragm - thorax - torso; the back is tied to the pelvis
     and to the torso; the head sits on the back. Each part's ``stiffness`` and ``damping`` join
     it to the part below it; ``torso_back`` is the torso-back link (k_4, c_4, the "Torso (3-4)"
     row of Table 2.3). A part given with some keys keeps the table's values for the others
     (``head: {mass: 7}``). The Table 2.3 masses sum to 82.21 kg, not the printed 81.4 kg; the
-    table's masses are kept (ERRATA).
+    table's masses are kept (slip: docs/thesis-slips.md#table-23).
     """
 
     pelvis: Segment = _segment("pelvis")
@@ -150,7 +152,8 @@ class _NegativeStiffnessSeat(_Seat):
 
 
 class PassiveSeat(_Seat):
-    """PS: linear spring and damper, Eq 2.40 (ERRATA: the seat mass accelerates, x'')."""
+    """PS: linear spring and damper, Eq 2.40 with the seat mass accelerating, x'' (slip:
+    docs/thesis-slips.md#eq-240)."""
 
     kind: Literal["ps"] = Field(description="passive seat, Eq 2.40")
     stiffness: Stiffness = Field(description="spring K_v [N/m] (Table 8.2: 1e4-1.5e5)")
@@ -214,7 +217,7 @@ class YanSeat(_NegativeStiffnessSeat):
                                          "(Table 8.8: 0-0.25)")
     precompression: SeatLength = Field(
         description="u_2, precompression of the horizontal springs [m]; no default on purpose: "
-        "Sec 2.2.4 uses 0.01, Ch. 8 (Sec 8.2.2) 0.001 (ERRATA)")
+        "Sec 2.2.4 uses 0.01, Ch. 8 (Sec 8.2.2) 0.001 (slip: docs/thesis-slips.md#sec-224)")
 
     @model_validator(mode="after")
     def _static_deflection_exists(self) -> "YanSeat":

@@ -155,7 +155,8 @@ class Corner(Section):
 class Body(Section):
     """Sprung mass of the model and the corner geometry.
 
-    Corner positions follow DESIGN.md: ``x = +a_front`` (front) / ``-a_rear`` (rear),
+    Corner positions follow docs/architecture.md#conventions: ``x = +a_front`` (front) /
+    ``-a_rear`` (rear),
     ``y = +b_right`` (right, F1/R1) / ``-b_left`` (left, F2/R2).
     """
 
@@ -172,7 +173,7 @@ class AntiRollBars(Section):
     """Torsional anti-roll bar stiffness per axle [N m/rad].
 
     Modelled as a torsional spring between the body roll angle and the axle's wheel-pair roll
-    angle ``(z_right - z_left)/(b_right + b_left)`` (ERRATA for Eq 2.11-2.12, 2.25).
+    angle ``(z_right - z_left)/(b_right + b_left)`` (slip: docs/thesis-slips.md#eq-211).
     """
 
     front: TorsionalStiffness = Field(0.0, description="front bar k_AR,F [N m/rad]")
@@ -193,7 +194,8 @@ def _deep_merge(base: dict, over: dict) -> dict:
 
 
 class Vehicle(Section):
-    """A rigid body on corners; the four thesis models are presets (DESIGN.md)."""
+    """A rigid body on corners; the four thesis models are presets
+    (docs/architecture.md#conventions)."""
 
     preset: Literal["quarter", "half_roll", "half_pitch", "full"] = Field(
         description="quarter (QC) | half_roll (HC1) | half_pitch (HC2) | full (FC)")

@@ -5,7 +5,8 @@ return a scalar or ``(P,)``. ``weighting`` is one of ``"Wk", "Wd", "Wf", "Wc", "
 (case-insensitive) or ``None`` / ``"none"`` for the unweighted signal.
 
 Method of weighting: the analogue response ``H(j2πf)`` of ISO 2631-1 Annex A (parameters in
-``reference/standards.md``) is applied in the frequency domain: the record is zero padded,
+``docs/iso-facts.md#filter-structure-annex-a``) is applied in the frequency domain: the record
+is zero padded,
 transformed with ``rfft``, multiplied by ``H`` at the bin frequencies and transformed back.
 A bilinear (IIR) realisation misses the analogue magnitude near 80 Hz at fs = 1 kHz (Wk: 3.3 %
 low without pre-warping; pre-warping corrects one frequency per section only); the
@@ -59,7 +60,8 @@ class WeightingParameters:
     """Corner frequencies (Hz) and quality factors of one ISO 2631-1 Annex A weighting.
 
     ``math.inf`` for ``f3`` drops the numerator of the acceleration-velocity transition, for
-    ``f4`` the whole transition, for ``f5``/``f6`` the upward step (standards.md table); the Q of
+    ``f4`` the whole transition, for ``f5``/``f6`` the upward step (the table in
+    docs/iso-facts.md#filter-structure-annex-a); the Q of
     an absent stage is unused and set to 1.
     """
 
@@ -83,7 +85,8 @@ WEIGHTINGS: dict[str, WeightingParameters] = {
     "We": WeightingParameters(0.4, 100.0, 1.0, 1.0, 0.63, _INF, 1.0, _INF, 1.0),
     "Wj": WeightingParameters(0.4, 100.0, _INF, _INF, 1.0, 3.75, 0.91, 5.32, 0.91),
 }
-"""ISO 2631-1:1997 Annex A parameters of the six weightings (reference/standards.md)."""
+"""ISO 2631-1:1997 Annex A parameters of the six weightings
+(docs/iso-facts.md#filter-structure-annex-a)."""
 _BY_LOWER_NAME = {name.lower(): name for name in WEIGHTINGS}
 
 COMFORT_REACTIONS: tuple[tuple[float, float, str], ...] = (

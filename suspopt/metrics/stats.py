@@ -86,7 +86,8 @@ STATISTICS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "peak_to_peak": peak_to_peak,
 }
 """Statistic name -> function of a signal ``(..., T)`` returning ``(...)``; objectives use these
-names (ERRATA: objectives must be configurable as var / std / rms / max of a signal). The
+names (objectives must be configurable as var / std / rms / max of a signal, slip:
+docs/thesis-slips.md#variance-units). The
 functions are named ``maximum`` / ``minimum`` so that they do not shadow the builtins."""
 
 

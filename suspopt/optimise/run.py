@@ -8,8 +8,8 @@ uninterrupted run. Ctrl-C (KeyboardInterrupt) stops the run and rewrites the fil
 last completed generation with ``status = "interrupted"``. Nothing here prints: progress goes
 to ``callback(Progress)``.
 
-HDF5 layout (DESIGN.md), every dataset with a ``units`` attribute (one per column for X, F, G
-and best):
+HDF5 layout (the public contract, docs/architecture.md#public-contract), every dataset with a
+``units`` attribute (one per column for X, F, G and best):
 
 - ``/pareto/X (N, n)`` physical values, ``/pareto/F (N, m)``, ``/pareto/G (N, k)`` (G <= 0
   feasible), each with ``names``: the best design (one objective) or the non-dominated set,
