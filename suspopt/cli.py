@@ -13,12 +13,11 @@ from contextlib import ExitStack
 from pathlib import Path
 from typing import Optional
 
-import numpy as np
 import typer
 from rich.console import Console
 from rich.table import Table
 
-from .config import ConfigError, config_schema, load_config
+from .errors import ConfigError
 
 app = typer.Typer(add_completion=True, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Simulate, optimise and select vehicle and seat suspensions from YAML.")
@@ -109,6 +108,8 @@ def _claim(stack: ExitStack, path: Path | None, force: bool, option: str = "-o")
 
 
 def _load(path: Path):
+    from .config import load_config
+
     try:
         return load_config(path)
     except ConfigError as exc:
@@ -139,11 +140,55 @@ def validate(config: Path = typer.Argument(..., help="YAML config file"),
 @app.command()
 def schema() -> None:
     """Print the JSON Schema of the config (for editor completion)."""
+    from .config import config_schema
+
     sys.stdout.write(json.dumps(config_schema(), indent=2) + "\n")
+
+
+@app.command()
+def export(source: Path = typer.Argument(..., help="result file of optimise, kesort or "
+                                         "analyse"),
+           pick: list[str] = typer.Option([], "--pick", help="the design to write as a config: "
+                                          "knee, best_<objective>, chosen or a row number"),
+           output: Optional[Path] = typer.Option(None, "-o", "--output",
+                                                 help="YAML file for the picked design"),
+           csv: Optional[Path] = typer.Option(None, "--csv", help="folder for the file's "
+                                              "tables as CSV, units in the headers"),
+           force: bool = typer.Option(False, "--force", help=_FORCE_HELP)) -> None:
+    """Write a picked design as a standalone config (-o design.yaml), or a result file's
+    tables as CSV (--csv DIR)."""
+    if (output is None) == (csv is None):
+        _fail("export: give -o FILE.yaml (with --pick) or --csv DIR")
+    with ExitStack() as stack:
+        try:
+            if csv is not None:
+                from .export import write_csv
+                if pick:
+                    _fail("--csv writes every table of the file; --pick is for -o")
+                for path in write_csv(source, csv, force=force):
+                    out.print(f"wrote {path}")
+                return
+            from .io import atomic_file
+            from .picks import design_config, read_picks, split_picks
+
+            _claim(stack, output, force)
+            names = split_picks(pick)
+            if len(names) != 1:
+                _fail(f"--pick: -o writes one design; got {len(names)} ({', '.join(names)})")
+            picked = read_picks(source, names)
+            _, text = design_config(picked)
+            with atomic_file(output) as stream:
+                stream.write(text.encode())
+        except ConfigError as exc:
+            _fail(str(exc))
+    out.print(f"wrote {output} (design {names[0]!r}, row {int(picked.rows[0])} of "
+              f"{source})")
 
 
 def _summary_table(result) -> Table:
     """Peak and RMS body acceleration, max travel and tyre deflection per corner."""
+    import numpy as np
+
     P = min(result.P, 5)
     table = _table(f"{result.model.preset} - key results"
                   + (f" (first {P} of {result.P} designs)" if result.P > P else ""))
@@ -234,6 +279,8 @@ def simulate(source: Path = typer.Argument(..., help="YAML config, or a result f
 
 
 def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
+    import numpy as np
+
     from .checks import check_config, check_stability
     from .io import write_dataset, write_simulation
     from .params import apply_sets, sweep
@@ -310,6 +357,8 @@ def _text_dtype():
 def _pick_objectives(picked, cfg, result):
     """The picked designs' main and supplementary objectives from their new simulation:
     ``(F (P, m + s), names, units)``."""
+    import numpy as np
+
     from .optimise import Problem
 
     problem = Problem.from_config(cfg)
@@ -320,6 +369,8 @@ def _pick_objectives(picked, cfg, result):
 
 def _picks_table(picked, F, names, units) -> Table:
     """Each pick's objectives as the file stored them and as simulated now."""
+    import numpy as np
+
     table = _table(f"{picked.source.name}: the picked designs' objectives")
     for col in ("pick", "row", "objective", "stored", "simulated", "change"):
         table.add_column(col, justify="left" if col in ("pick", "objective") else "right")
@@ -340,8 +391,21 @@ _ANALYSE_OPTIONS = {"reference": "--reference", "road": "--road", "with_": "--wi
                     "mass_change": "--mass-change"}
 
 
+def _analysis_help() -> str:
+    from .analyse import SUMMARIES
+
+    return "analysis kind: " + "; ".join(f"{k}: {v}" for k, v in SUMMARIES.items())
+
+
+def _analysis_kinds(incomplete: str) -> list[str]:
+    from .analyse import SUMMARIES
+
+    return [k for k in SUMMARIES if k.startswith(incomplete)]
+
+
 @app.command()
-def analyse(kind: str = typer.Argument(..., help="analysis kind"),
+def analyse(kind: str = typer.Argument(..., help=_analysis_help(),
+                                       autocompletion=_analysis_kinds),
             sources: list[Path] = typer.Argument(
                 ..., help="YAML config, or Pareto HDF5 file; models takes several configs"),
             output: Optional[Path] = typer.Option(None, "-o", "--output",
@@ -363,7 +427,8 @@ def analyse(kind: str = typer.Argument(..., help="analysis kind"),
             force: bool = typer.Option(False, "--force", help=_FORCE_HELP),
             max_memory: Optional[str] = typer.Option(None, "--max-memory",
                                                      help=_MEMORY_HELP)) -> None:
-    """Run an analysis (see the README for the kinds) and print its table."""
+    """Run an analysis of configs or of a Pareto file and print its table: models, roads,
+    masses, controllers, transmissibility or cdf-sensitivity (see KIND below)."""
     from .analyse import analysis_kinds
     from .plots import check_path
 
@@ -410,6 +475,8 @@ def analyse(kind: str = typer.Argument(..., help="analysis kind"),
 
 def _progress_line(p) -> str:
     """One generation's report: budget, evaluations, best or hypervolume, feasible share."""
+    import numpy as np
+
     gen = f"gen {p.generation}" + (f"/{p.max_generations}" if p.max_generations else "")
     if not np.isfinite(p.best).any():
         score = "none feasible yet"
@@ -423,6 +490,8 @@ def _progress_line(p) -> str:
 def _optimum_table(result, rows: int = 12) -> Table:
     """The best design (one column), or up to ``rows`` designs spread along the Pareto front
     (one row each)."""
+    import numpy as np
+
     N = len(result.X)
     names = result.obj_names + result.var_names
     units = result.obj_units + result.var_units
@@ -458,7 +527,11 @@ def optimise(config: Path = typer.Argument(..., help="YAML config file"),
              force: bool = typer.Option(False, "--force", help=_FORCE_HELP),
              max_memory: Optional[str] = typer.Option(None, "--max-memory",
                                                       help=_MEMORY_HELP)) -> None:
-    """Optimise the config's design variables; write the optimum or Pareto set to HDF5."""
+    """Optimise the config's design variables; write the optimum or Pareto set to HDF5.
+
+    The progress line's HV is the hypervolume of every feasible non-dominated design found so
+    far, objectives scaled by the first feasible generation's range (reference point 1.1):
+    it never falls."""
     with ExitStack() as stack:
         output = output if output is not None else Path(config.stem + ".h5")
         _memory(max_memory)
@@ -522,6 +595,8 @@ def _floats(option: str, text: str) -> list[float]:
 def _kesort_tables(sel) -> list[Table]:
     """The optimum of each case and of the pool (the form of Tables 6.2-6.3, 7.5-7.6), then
     the Pareto picks of the pool."""
+    import numpy as np
+
     columns = [(f"{label} optimum", cs.chosen) for label, cs in sel.case_sorts.items()]
     columns.append(("optimum among all" if sel.case_sorts else "k-ε optimum", sel.chosen))
     columns += [(f"tie {n}", int(i)) for n, i in enumerate(sel.sort.ties[1:], start=2)]

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .metrics import energy, iso2631, springs, stats, transient
 
 __all__ = ["METRICS", "MetricDef", "evaluate_spec", "spec_signals", "metric_unit"]
 
@@ -72,9 +71,9 @@ METRICS: dict[str, MetricDef] = {
                                    "std of dynamic tyre load over static load"),
 }
 
-_STAT = {"var": stats.var, "std": stats.std, "rms": stats.rms, "max": stats.maximum,
-         "min": stats.minimum, "max_abs": stats.max_abs, "mean": stats.mean,
-         "peak_to_peak": stats.peak_to_peak}
+#: The statistics by metric name: functions of :mod:`suspopt.metrics.stats`.
+_STAT = {"var": "var", "std": "std", "rms": "rms", "max": "maximum", "min": "minimum",
+         "max_abs": "max_abs", "mean": "mean", "peak_to_peak": "peak_to_peak"}
 _REDUCE = {"mean": np.mean, "max": np.max, "min": np.min, "sum": np.sum}
 
 
@@ -112,6 +111,9 @@ def metric_unit(spec, signal_unit: str) -> str:
 
 def _one(spec, result, name: str) -> np.ndarray:
     """The metric of one signal, (P,)."""
+    # the metrics (scipy) load when a metric is first computed, not when a config is read
+    from .metrics import energy, iso2631, springs, stats, transient
+
     kind = METRICS[spec.metric].kind
     if kind == "derived":
         corner = name.rsplit(".", 1)[1]
@@ -127,7 +129,7 @@ def _one(spec, result, name: str) -> np.ndarray:
                                              result.model.static_tyre_load[:, 0, c])
     x = result.signals[name]
     if kind == "statistic":
-        return _STAT[spec.metric](x)
+        return getattr(stats, _STAT[spec.metric])(x)
     fs = 1.0 / (result.time[1] - result.time[0])
     if kind == "iso2631":
         if spec.metric == "mtvv":

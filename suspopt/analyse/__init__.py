@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Report", "Kind", "KINDS", "analysis_kinds", "relative_change"]
+__all__ = ["Report", "Kind", "KINDS", "SUMMARIES", "analysis_kinds", "relative_change"]
 
 
 @dataclass
@@ -57,6 +57,18 @@ def relative_change(value, reference) -> np.ndarray:
 
 #: kind name -> Kind
 KINDS: dict[str, Kind] = {}
+#: What each kind does, for ``suspopt analyse --help`` (which must not import the kinds'
+#: modules to say so; a test checks that it lists every kind of :data:`KINDS`).
+SUMMARIES = {
+    "models": "configs side by side, as Ch. 3 does (transient or random-road metrics, modes)",
+    "roads": "a Pareto file's designs on other roads (Sec 8.4.2, Table 8.12)",
+    "masses": "a Pareto file's designs with another passenger mass (Sec 8.4.3, Table 8.13)",
+    "controllers": "a Pareto file's designs with another controller (Fig. 7.4b)",
+    "transmissibility": "seat-to-head and seat transmissibility of a config or of a front's "
+                        "edges and knee (Eq 2.86, Fig. 8.26)",
+    "cdf-sensitivity": "the C_max share of an adaptive CDF threshold swept from 20 to 70 % "
+                       "(Figs. 4.7, 4.10)",
+}
 
 
 def analysis_kinds() -> dict[str, Kind]:

@@ -15,6 +15,7 @@ from typing import Any, get_args, get_origin
 import yaml
 from pydantic import Field, PrivateAttr, ValidationError
 
+from ..errors import ConfigError
 from .base import Section
 from .control import Control
 from .metrics import MetricSpec
@@ -27,10 +28,6 @@ from .yamlio import YamlError, parse_yaml, read_text
 
 __all__ = ["Config", "ConfigError", "load_config", "load_config_text", "config_schema",
            "edit_config", "set_path"]
-
-
-class ConfigError(ValueError):
-    """Bad input: the message is one line naming the file, line and key path."""
 
 
 class Config(Section):

@@ -17,8 +17,9 @@ HDF5 layout (the public contract, docs/architecture.md#public-contract), every d
   sum) and ``/pareto`` has the attribute ``weights``.
 - ``/history/<name> (generations,)``: ``generation``, ``best`` (generations, m: the lowest
   feasible value of each objective, NaN while none is feasible; the weighted sum with
-  weights), ``hypervolume`` (of the feasible optimum, objectives normalised by the first
-  feasible generation's ideal and nadir points, reference point 1.1; NaN for one objective),
+  weights), ``hypervolume`` (of the non-dominated feasible designs among all evaluated so
+  far, so it never falls; objectives normalised by the first feasible generation's ideal
+  and nadir points, reference point 1.1 in each; NaN for one objective),
   ``evaluations``, ``time`` [s], ``feasible`` (share of the generation's designs).
 - ``/checkpoint``: every batch of designs the optimiser had evaluated when the file was
   written, as data: ``X (E, n)`` search coordinates, ``F (E, m)``, ``G (E, k)`` (the problem's
@@ -141,6 +142,8 @@ class _Run:
                         "feasible")})
     elapsed: float = 0.0
     normalisation: tuple[np.ndarray, np.ndarray] | None = None
+    archive: np.ndarray | None = None        # non-dominated feasible F found so far
+    archived: int = 0                        # the recorder's batches in the archive
     weighted_optimum: tuple[bytes, np.ndarray, np.ndarray] | None = None   # X key, F, G
 
 
@@ -280,13 +283,13 @@ def _record(run: _Run, cfg: Config) -> Progress:
     feasible_f = optimum.F[optimum.feasible]
     best = feasible_f.min(axis=0) if len(feasible_f) else np.full(optimum.F.shape[1], np.nan)
     hv = np.nan
-    if optimum.F.shape[1] > 1 and len(feasible_f):
+    if optimum.F.shape[1] > 1 and _archive(run).size:
         if run.normalisation is None:
             ideal, nadir = feasible_f.min(axis=0), feasible_f.max(axis=0)
             run.normalisation = (ideal, np.where(nadir > ideal, nadir, ideal + 1.0))
         ideal, nadir = run.normalisation
         hv = float(HV(ref_point=np.full(len(ideal), _HV_REFERENCE))(
-            (feasible_f - ideal) / (nadir - ideal)))
+            (run.archive - ideal) / (nadir - ideal)))
     h = run.history
     h["generation"].append(optimiser.n_gen)
     h["best"].append(best)
@@ -298,6 +301,23 @@ def _record(run: _Run, cfg: Config) -> Progress:
                     evaluations=optimiser.n_eval, max_evaluations=opt.max_evaluations,
                     best=best, hypervolume=hv, feasible=h["feasible"][-1],
                     elapsed=run.elapsed, time_left=_time_left(run, opt), phase=optimiser.phase)
+
+
+def _archive(run: _Run) -> np.ndarray:
+    """The non-dominated feasible designs among all evaluated so far (their main objectives),
+    updated with the batches since the last call: the set whose hypervolume the history
+    reports, so that it never falls (an algorithm's own front can lose a design)."""
+    from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+    batches = run.recorder.batches[run.archived:]
+    run.archived = len(run.recorder.batches)
+    found = [F[(G <= 0).all(axis=1)] for _, F, G in batches]
+    pool = np.vstack([run.archive] + found) if run.archive is not None else \
+        np.vstack(found) if found else np.empty((0, 0))
+    if len(pool) > 1:
+        pool = pool[NonDominatedSorting().do(pool, only_non_dominated_front=True)]
+    run.archive = pool
+    return pool
 
 
 def _time_left(run: _Run, opt) -> float | None:
