@@ -13,6 +13,7 @@ import pytest
 import xarray as xr
 
 import suspopt
+from suspopt.analyse import models, transmissibility
 from suspopt.analyse.pseudo import pseudo_fronts, road_variants, write_pseudo_fronts
 from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
@@ -28,7 +29,7 @@ K = [4.0e4, 6.0e4]                     # two designs: the design axis is not a s
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     """A simulate file of two designs with metrics, a tiny Pareto front, a kesort file of two
-    cases and an ``analyse roads`` file."""
+    cases, and ``analyse roads``, ``transmissibility`` and ``models`` files."""
     d = tmp_path_factory.mktemp("layout")
     text = (CONFIGS / "quickstart.yaml").read_text().replace("duration: 3.0", "duration: 1.0")
     text += ("metrics:\n  - {name: RC, metric: rms_weighted, signal: body.heave_acc, "
@@ -43,7 +44,11 @@ def files(tmp_path_factory):
     pareto = read_pareto(front)
     roads = write_pseudo_fronts(d / "roads.h5",
                                 pseudo_fronts("roads", pareto, road_variants(pareto, ["B"])))
-    return {"sim": sim, "front": front, "ke": ke, "roads": roads}
+    transmissibility.run(front, output=d / "stht.h5")
+    models.run([CONFIGS / "ch3/part1a_qc_bump.yaml", CONFIGS / "ch3/part1a_hc1_bump.yaml"],
+               output=d / "models.h5")
+    return {"sim": sim, "front": front, "ke": ke, "roads": roads, "stht": d / "stht.h5",
+            "models": d / "models.h5"}
 
 
 def groups(path) -> list[str | None]:
@@ -71,7 +76,7 @@ def datasets(path) -> list[tuple[str, tuple, dict]]:
     return out
 
 
-@pytest.mark.parametrize("kind", ["sim", "front", "ke", "roads"])
+@pytest.mark.parametrize("kind", ["sim", "front", "ke", "roads", "stht", "models"])
 def test_every_group_opens_in_xarray_with_named_dimensions(files, kind):
     """No phony_dim anywhere; the whole file is one DataTree (one length per name)."""
     path = files[kind]
