@@ -21,6 +21,16 @@ write leaves the target as it was.
 Root attributes of every HDF5 file: ``suspopt_version``, ``created`` (UTC ISO 8601),
 ``command``, ``config`` (the YAML text) and ``seed`` (the config's random seed, -1 when it
 draws nothing). Every dataset carries a ``units`` attribute.
+
+**Dimensions** (:func:`write_dataset`, the one writer of every dataset): each axis of a dataset
+is attached to an HDF5 dimension scale, the netCDF-4 way, so that xarray (engine
+``h5netcdf``), netCDF tools and pandas see named dimensions with coordinates: ``time`` [s],
+``design`` (row numbers), ``objective``, ``variable``, ``constraint`` (names, as text) and the
+like (README, "Signals and HDF5 layout"). A dimension's scale is a 1-D dataset of that name in
+the dataset's group or a group above it; one name means one length along every path of groups,
+so the whole file also opens as an ``xarray.DataTree``. Names, text data and text attributes
+are variable-length UTF-8 strings. :func:`open_dataset` reads a group back as an
+``xarray.Dataset``.
 """
 
 from __future__ import annotations
@@ -31,7 +41,7 @@ import os
 import stat
 import sys
 import tempfile
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
@@ -42,7 +52,8 @@ from . import __version__
 from .config import Config, ConfigError
 
 __all__ = ["OUTPUT_MARKER", "check_target", "claim", "atomic_file", "atomic_h5",
-           "write_dataset", "write_simulation", "read_simulation_signals", "is_suspopt_output"]
+           "write_dataset", "write_attrs", "text_array", "write_simulation",
+           "read_simulation_signals", "open_dataset", "is_suspopt_output"]
 
 #: Written into every non-HDF5 file suspopt makes (figure metadata, a comment), so that it
 #: can tell its own outputs from other files.
@@ -227,57 +238,149 @@ def atomic_h5(path: str | Path, cfg: Config, command: str | None = None, force: 
             yield h5
 
 
-def write_dataset(group, name: str, data, units: str | list[str], **attrs):
-    """Create ``group[name]`` with its ``units`` attribute (one string, or one per column) and
-    any other attributes."""
-    ds = group.create_dataset(name, data=data)
-    ds.attrs["units"] = np.array(units, dtype="S") if isinstance(units, list) else units
+def text_array(values) -> np.ndarray:
+    """``values`` (strings or bytes, any shape) as an array of variable-length UTF-8 strings."""
+    import h5py
+
+    items = np.asarray(values, dtype=object)
+    flat = [v.decode("utf-8") if isinstance(v, (bytes, np.bytes_)) else str(v)
+            for v in items.ravel()]
+    return np.array(flat, dtype=h5py.string_dtype()).reshape(items.shape)
+
+
+def _is_text(value) -> bool:
+    """Whether ``value`` is an array or sequence of strings (not one string)."""
+    if isinstance(value, np.ndarray) and value.dtype.kind != "O":
+        return value.dtype.kind in "US"
+    if not isinstance(value, (list, tuple, np.ndarray)):
+        return False
+    items = np.asarray(value, dtype=object).ravel()
+    return items.size > 0 and all(isinstance(v, (str, bytes)) for v in items)
+
+
+def write_attrs(obj, **attrs) -> None:
+    """Set the attributes of ``obj`` (a file, group or dataset): sequences of strings as
+    variable-length UTF-8 strings, anything else as given (h5py writes ``str`` as UTF-8)."""
     for key, value in attrs.items():
-        ds.attrs[key] = value
+        obj.attrs[key] = text_array(value) if _is_text(value) else value
+
+
+def _text_values(ds) -> list:
+    """The values of the 1-D dataset ``ds``, text decoded."""
+    values = ds[()]
+    return [v.decode("utf-8") if isinstance(v, bytes) else v for v in values.tolist()]
+
+
+def _find_scale(group, dim: str):
+    """The dimension scale ``dim`` in ``group`` or the nearest group above it, or None."""
+    node = group
+    while True:
+        found = node.get(dim)
+        if found is not None and getattr(found, "is_scale", False):
+            return found
+        if node.name == "/":
+            return None
+        node = node.parent
+
+
+def _scale(group, dim: str, size: int, values=None):
+    """The scale of dimension ``dim`` for an axis of length ``size`` in ``group``
+    (:func:`_find_scale`), else a new one in ``group`` holding ``values`` (default the row
+    numbers 0 ... size-1)."""
+    found = _find_scale(group, dim)
+    if found is None:
+        return write_dataset(group, dim, np.arange(size) if values is None else values, "1",
+                             dims=(dim,))
+    if found.shape != (size,):
+        raise ValueError(f"{group.name}: dimension {dim!r} of length {size}, but {found.name} "
+                         f"has {found.shape[0]}")
+    if values is not None and _text_values(found) != list(values):
+        raise ValueError(f"{group.name}: dimension {dim!r}: {list(values)} are not the "
+                         f"values of {found.name}")
+    return found
+
+
+def write_dataset(group, name: str, data, units: str | Sequence[str],
+                  dims: Sequence[str] = (), coords: dict | None = None,
+                  names: Sequence[str] | None = None, **attrs):
+    """Create ``group[name]`` holding ``data``, with its ``units`` attribute (one string, or
+    one per column) and its dimensions (module docstring); return the dataset.
+
+    ``dims`` names every axis (``()`` for a scalar). Each is attached to the dimension scale
+    of that name in ``group`` or the nearest group above it; where there is none, one is made
+    in ``group`` holding ``coords[dim]`` (names as text, units ``1``) or, without, the row
+    numbers 0 ... n-1 (``design``, ``mode``, ...). A 1-D dataset whose dimension is its own
+    name is that dimension's scale (``time``). ``names``, the columns' names, is written as
+    the attribute ``names`` and is the coordinate of the last dimension. Text data, ``names``,
+    per-column ``units`` and text attributes are written as variable-length UTF-8 strings.
+    """
+    data = text_array(data) if _is_text(data) else np.asarray(data)
+    dims = tuple(dims)
+    if len(dims) != data.ndim:
+        raise ValueError(f"{group.name}/{name}: {data.ndim} axes, dimensions {dims}")
+    coords = dict(coords or {})
+    if names is not None:
+        attrs["names"] = text_array(list(names))
+        coords.setdefault(dims[-1], list(names))
+    above = _find_scale(group.parent, name) if dims == (name,) and group.name != "/" else None
+    if above is not None and above.shape != data.shape:     # one length along every path
+        raise ValueError(f"{group.name}/{name}: dimension {name!r} of length "
+                         f"{data.shape[0]}, but {above.name} has {above.shape[0]}")
+    ds = group.create_dataset(name, data=data)
+    ds.attrs["units"] = text_array(list(units)) if isinstance(units, (list, tuple)) else units
+    write_attrs(ds, **attrs)
+    if dims == (name,):
+        ds.make_scale(name)
+        return ds
+    for axis, dim in enumerate(dims):
+        ds.dims[axis].attach_scale(_scale(group, dim, data.shape[axis], coords.get(dim)))
     return ds
 
 
 def write_simulation(path: str | Path, result, signals: Iterable[str] | None = None,
                      float32: bool = False, command: str | None = None,
                      extra=None) -> Path:
-    """Write a simulation ``Result`` with the layout of docs/architecture.md#public-contract.
+    """Write a simulation ``Result`` (README, "Signals and HDF5 layout").
 
-    ``/time (T,)``, ``/signals/<name> (P, T)``, ``/metrics/<name> (P,)``, ``/diverged_at (P,)``
-    (NaN where the design did not diverge), ``/designs/X (P, n)`` with attr ``names`` when
-    design parameters were given, ``/modal/frequency (P, n)`` with attr ``dominant`` (design
-    0's DOF of most energy per mode), ``/modal/label (P, n)`` (what each mode is) and
-    ``/modal/energy_share (P, n, n)`` (each DOF's share of each mode's kinetic energy, attr
-    ``dofs``): :func:`suspopt.vehicle.modal_analysis`.
+    ``/time (T,)`` [s] and ``/design (P,)`` (row numbers) are the dimension scales ``time``
+    and ``design``; ``/signals/<name> (design, time)``, ``/metrics/<name> (design,)``,
+    ``/diverged_at (design,)`` [s] (NaN where the design did not diverge), ``/designs/X
+    (design, variable)`` with attr ``names`` (also the scale ``/designs/variable``) when design
+    parameters were given, ``/modal/frequency (design, mode)`` [Hz] with attr ``dominant``
+    (design 0's DOF of most energy per mode), ``/modal/label (design, mode)`` (what each mode
+    is) and ``/modal/energy_share (design, mode, dof)`` (each DOF's share of each mode's
+    kinetic energy, attr ``dofs``, scale ``/modal/dof``): :func:`suspopt.vehicle.modal_analysis`.
+    ``/modal/mode`` numbers the modes.
     """
-    import h5py
-
     from .vehicle import modal_analysis
 
     names = list(result.signals) if signals is None else list(signals)
     dtype = np.float32 if float32 else np.float64
     with atomic_h5(path, result.config, command) as h5:
-        write_dataset(h5, "time", result.time, "s")
+        write_dataset(h5, "time", result.time, "s", dims=("time",))
+        write_dataset(h5, "design", np.arange(len(result.diverged_at)), "1", dims=("design",))
         grp = h5.create_group("signals")
         for name in names:
             write_dataset(grp, name, np.asarray(result.signals[name], dtype=dtype),
-                     result.signal_unit(name))
+                          result.signal_unit(name), dims=("design", "time"))
         met = h5.create_group("metrics")
         for name, value in result.metrics.items():
-            write_dataset(met, name, np.asarray(value), result.metric_units[name])
-        write_dataset(h5, "diverged_at", result.diverged_at, "s")
+            write_dataset(met, name, np.asarray(value), result.metric_units[name],
+                          dims=("design",))
+        write_dataset(h5, "diverged_at", result.diverged_at, "s", dims=("design",))
         if result.designs:
             X = np.column_stack([result.designs[k] for k in result.designs])
-            write_dataset(h5.create_group("designs"), "X", X, "SI",
-                     names=np.array(list(result.designs), dtype="S"))
+            write_dataset(h5.create_group("designs"), "X", X, "SI", dims=("design", "variable"),
+                          names=list(result.designs))
         if extra is not None:                    # what the caller adds (e.g. the picks)
             extra(h5)
         modes = modal_analysis(result.model)
         modal = h5.create_group("modal")
-        write_dataset(modal, "frequency", modes.frequency, "Hz",
-                      dominant=np.array(modes.dominant[0], dtype="S"))
-        write_dataset(modal, "label", np.array(modes.label, dtype=h5py.string_dtype()), "1")
-        write_dataset(modal, "energy_share", modes.energy, "1",
-                      dofs=np.array(modes.dof_names, dtype="S"))
+        write_dataset(modal, "frequency", modes.frequency, "Hz", dims=("design", "mode"),
+                      dominant=list(modes.dominant[0]))
+        write_dataset(modal, "label", modes.label, "1", dims=("design", "mode"))
+        write_dataset(modal, "energy_share", modes.energy, "1", dims=("design", "mode", "dof"),
+                      coords={"dof": list(modes.dof_names)}, dofs=list(modes.dof_names))
     return Path(path)
 
 
@@ -287,3 +390,35 @@ def read_simulation_signals(path: str | Path) -> tuple[np.ndarray, dict[str, np.
 
     with h5py.File(path, "r") as h5:
         return h5["time"][()], {k: v[()] for k, v in h5["signals"].items()}
+
+
+def open_dataset(path: str | Path, group: str | None = None):
+    """The datasets of ``group`` (default the root; ``"pareto"``, ``"kesort/cases/A"``) of a
+    suspopt HDF5 file as an ``xarray.Dataset`` (lazy, through xarray's ``h5netcdf`` engine):
+    named dimensions with their coordinates, those held by the groups above included (``time``
+    and ``design`` for ``/signals``), and each variable's attributes (``units``, ``names``).
+    ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
+    pandas DataFrame. Needs ``pip install 'suspopt[xarray]'`` (ModuleNotFoundError naming it
+    otherwise)."""
+    try:
+        import h5netcdf  # noqa: F401
+        import xarray
+    except ImportError:
+        raise ModuleNotFoundError("suspopt.io.open_dataset needs xarray and h5netcdf: "
+                                  "pip install 'suspopt[xarray]'") from None
+
+    def load(name: str | None):
+        return xarray.open_dataset(path, engine="h5netcdf", group=name, phony_dims="sort",
+                                   decode_times=False, decode_timedelta=False)
+
+    ds = load(group)
+    parts = [p for p in (group or "").split("/") if p]
+    for depth in range(len(parts) - 1, -1, -1):         # the nearest group above first
+        missing = [d for d in ds.sizes if d not in ds.coords]
+        if not missing:
+            break
+        with load("/".join(parts[:depth]) or None) as above:
+            found = {d: above[d].load() for d in missing
+                     if d in above.coords and above.sizes[d] == ds.sizes[d]}
+        ds = ds.assign_coords(found)
+    return ds

@@ -35,6 +35,9 @@ HDF5 layout, every dataset with a ``units`` attribute (one per column for F and 
   ``rows`` (its designs' indices in ``/kesort``), ``k_eps``, ``k`` (over ``rows``),
   ``chosen`` and ``ties`` (indices in ``/kesort``), ``picks/<key>``, with the same attributes.
 - root attributes: those of :func:`~suspopt.io.atomic_h5`, with the first set's config.
+- dimensions (:func:`suspopt.io.write_dataset`): ``/kesort/design`` (row numbers: the pool's
+  index), ``/kesort/objective`` and ``/kesort/variable`` (the names of the columns of F and
+  X), ``/kesort/tie``, ``/kesort/sets/set``; in a case, ``rows`` itself and ``case_tie``.
 """
 
 from __future__ import annotations
@@ -47,7 +50,7 @@ import numpy as np
 
 from .config import Config, ConfigError, load_config
 from .config.loader import load_config_text
-from .io import atomic_h5, write_dataset
+from .io import atomic_h5, write_attrs, write_dataset
 from .kesort import KEpsilonSort, kesort, pareto_picks
 from .optimise.problem import PENALTY, Problem
 
@@ -360,20 +363,20 @@ def _columns(X: np.ndarray, have: list[str], want: list[str]) -> np.ndarray:
 def _write_sort(group, sort: KEpsilonSort, rows: np.ndarray | None,
                 picks: dict[str, int]) -> None:
     """k_eps, k, chosen, ties and picks of one sort; indices in the pool (``rows`` maps a
-    case's own indices to the pool's)."""
+    case's own indices to the pool's and is the dimension of its k_eps and k)."""
     index = (lambda i: i) if rows is None else (lambda i: rows[i])
+    design, tie = ("design", "tie") if rows is None else ("rows", "case_tie")
     if rows is not None:
-        write_dataset(group, "rows", rows, "1")
-    write_dataset(group, "k_eps", sort.k_eps, "1")
-    write_dataset(group, "k", sort.k, "1")
+        write_dataset(group, "rows", rows, "1", dims=("rows",))
+    write_dataset(group, "k_eps", sort.k_eps, "1", dims=(design,))
+    write_dataset(group, "k", sort.k, "1", dims=(design,))
     write_dataset(group, "chosen", int(index(sort.chosen)), "1")
-    write_dataset(group, "ties", np.asarray(index(sort.ties), dtype=int), "1")
+    write_dataset(group, "ties", np.asarray(index(sort.ties), dtype=int), "1", dims=(tie,))
     grp = group.create_group("picks")
     for key, value in picks.items():
         write_dataset(grp, key, int(value), "1")
-    group.attrs.update(epsilon=sort.epsilon, P=np.nan if sort.P is None else sort.P,
-                       P_auto=sort.P_auto, normalisation=sort.normalisation,
-                       unique=sort.unique)
+    write_attrs(group, epsilon=sort.epsilon, P=np.nan if sort.P is None else sort.P,
+                P_auto=sort.P_auto, normalisation=sort.normalisation, unique=sort.unique)
 
 
 def write_selection(path: str | Path, selection: Selection, command: str | None = None
@@ -382,21 +385,20 @@ def write_selection(path: str | Path, selection: Selection, command: str | None 
     s = selection
     with atomic_h5(path, s.sets[0].config, command) as h5:
         grp = h5.create_group("kesort")
-        write_dataset(grp, "F", s.F, s.units, names=np.array(s.names, dtype="S"))
-        write_dataset(grp, "X", s.X, s.var_units, names=np.array(s.var_names, dtype="S"))
-        write_dataset(grp, "case", np.array(list(s.case), dtype="S"), "1")
-        write_dataset(grp, "source", s.source, "1")
-        write_dataset(grp, "row", s.row, "1")
-        write_dataset(grp, "feasible", s.feasible, "1")
+        write_dataset(grp, "F", s.F, s.units, dims=("design", "objective"), names=s.names)
+        write_dataset(grp, "X", s.X, s.var_units, dims=("design", "variable"),
+                      names=s.var_names)
+        write_dataset(grp, "case", list(s.case), "1", dims=("design",))
+        write_dataset(grp, "source", s.source, "1", dims=("design",))
+        write_dataset(grp, "row", s.row, "1", dims=("design",))
+        write_dataset(grp, "feasible", s.feasible, "1", dims=("design",))
         _write_sort(grp, s.sort, None, s.picks)
-        grp.attrs["cases"] = np.array(s.cases, dtype="S")
+        write_attrs(grp, cases=list(s.cases))
         sets = grp.create_group("sets")
-        import h5py
-
-        text = h5py.string_dtype()
-        write_dataset(sets, "file", np.array([str(d.source) for d in s.sets], dtype=text), "1")
-        write_dataset(sets, "label", np.array([d.label for d in s.sets], dtype=text), "1")
-        write_dataset(sets, "config", np.array([d.config.text for d in s.sets], dtype=text), "1")
+        for key, values in (("file", [str(d.source) for d in s.sets]),
+                            ("label", [d.label for d in s.sets]),
+                            ("config", [d.config.text for d in s.sets])):
+            write_dataset(sets, key, values, "1", dims=("set",))
         if s.case_sorts:
             cases = grp.create_group("cases")
             for label, cs in s.case_sorts.items():

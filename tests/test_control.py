@@ -474,7 +474,7 @@ def test_cdf_sensitivity_writes_hdf5_and_plot(tmp_path):
         datasets = []
         grp.visititems(lambda name, obj: datasets.append(obj)
                        if isinstance(obj, h5py.Dataset) else None)
-        assert all("units" in d.attrs for d in datasets) and len(datasets) == 19
+        assert all("units" in d.attrs for d in datasets) and len(datasets) == 20  # + corner
         achieved = grp["achieved_share"][()]       # a short run: far from converged
         assert np.all(np.diff(achieved) > 0) and achieved[0] < grp["base_share"][()]
         assert grp["reduction/SW"].attrs["units"] == "%"

@@ -12,6 +12,11 @@ semi-active corners), RC the ISO 2631-1 Wk-weighted r.m.s. of the body heave acc
 the mean power the dampers dissipate (Eq 2.92, summed over corners). Each is reported as the
 thesis's reduction ``(X_base - X_CDF) / X_base * 100 %`` (Sec 4.3): positive means smaller
 with the CDF strategy. The share achieved is counted after the first fit (``t >= learn_time``).
+
+HDF5 (``output``): ``/cdf_sensitivity/c_max_share (S,)`` (the dimension scale of the sweep),
+``achieved_share``, ``base_share``, ``final_threshold (c_max_share, corner)`` (scale
+``corner``: the semi-active corners), ``base/<M>`` (one value), ``cdf/<M>`` and
+``reduction/<M>`` [%] over ``c_max_share``; every dataset with ``units``.
 """
 
 from __future__ import annotations
@@ -116,17 +121,20 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
             grp.attrs["distribution"] = spec.distribution
             grp.attrs["corners"] = ",".join(active)
 
-            write_dataset(grp, "c_max_share", SHARES, "1")
-            write_dataset(grp, "achieved_share", values["share"][1:], "1")
+            share = ("c_max_share",)
+            write_dataset(grp, "c_max_share", SHARES, "1", dims=share)
+            write_dataset(grp, "achieved_share", values["share"][1:], "1", dims=share)
             write_dataset(grp, "base_share", values["share"][0], "1")
-            write_dataset(grp, "final_threshold", threshold, unit)
+            write_dataset(grp, "final_threshold", threshold, unit,
+                          dims=("c_max_share", "corner"), coords={"corner": active})
             for key, group in (("base", grp.create_group("base")),
                                ("cdf", grp.create_group("cdf")),
                                ("reduction", grp.create_group("reduction"))):
                 for name, m_unit in METRIC_UNITS.items():
                     data = {"base": base[name], "cdf": values[name][1:],
                             "reduction": reduction[name]}[key]
-                    write_dataset(group, name, data, "%" if key == "reduction" else m_unit)
+                    write_dataset(group, name, data, "%" if key == "reduction" else m_unit,
+                                  dims=() if key == "base" else share)
     if plot is not None:
         plots.sensitivity(plot, title, 100 * SHARES, "C_max share requested (1 - N) [%]",
                           [{"SW": reduction["SW"]},

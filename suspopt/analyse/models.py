@@ -35,6 +35,9 @@ config files' names) and ``reference``):
 - ``/comparison/value/<metric> (M,)`` in the metric's unit and
   ``/comparison/difference/<metric> (M,)`` [%], over the models in the order of ``models``
   (NaN where a model lacks the metric).
+- dimensions (:func:`suspopt.io.write_dataset`): each model's ``time`` and
+  ``psd/frequency``, ``modal/mode`` (numbering its modes), and ``/comparison/model`` (the
+  labels, as the attribute ``models``).
 """
 
 from __future__ import annotations
@@ -48,7 +51,7 @@ import numpy as np
 from .. import plots
 from ..config import Config, ConfigError, load_config
 from ..config.metrics import MetricSpec
-from ..io import atomic_h5, write_dataset
+from ..io import atomic_h5, write_attrs, write_dataset
 from ..metrics import psd
 from ..simulate import Result, simulate
 from ..specs import METRICS, evaluate_spec
@@ -237,31 +240,34 @@ def write_models(path: str | Path, comparison: ModelComparison,
     """Write ``comparison`` with the layout of the module docstring (atomically)."""
     models = comparison.models
     ref = models[comparison.reference]
-    labels = np.array([m.label for m in models], dtype="S")
+    labels = [m.label for m in models]
     with atomic_h5(path, ref.config, command) as h5:
-        h5.attrs.update(analysis="models", models=labels, reference=ref.label)
+        write_attrs(h5, analysis="models", models=labels, reference=ref.label)
         top = h5.create_group("models")
         for m in models:
             g = top.create_group(m.label.replace("/", "_"))
-            g.attrs.update(source=str(m.source), config=m.config.text,
-                           preset=m.config.vehicle.preset, road=m.config.road.kind)
-            write_dataset(g, "time", m.time, "s")
+            write_attrs(g, source=str(m.source), config=m.config.text,
+                        preset=m.config.vehicle.preset, road=m.config.road.kind)
+            write_dataset(g, "time", m.time, "s", dims=("time",))
             sig = g.create_group("signals")
             for name, values in m.signals.items():
-                write_dataset(sig, name, values, m.units[name])
+                write_dataset(sig, name, values, m.units[name], dims=("time",))
             spectra = g.create_group("psd")
-            write_dataset(spectra, "frequency", m.psd_frequency, "Hz")
+            write_dataset(spectra, "frequency", m.psd_frequency, "Hz", dims=("frequency",))
             for name, values in m.psd.items():
-                write_dataset(spectra, name, values, m.units[f"PSD of {name}"])
+                write_dataset(spectra, name, values, m.units[f"PSD of {name}"],
+                              dims=("frequency",))
             write_dataset(g.create_group("modal"), "frequency", m.natural_frequency, "Hz",
-                          dominant=np.array(m.dominant, dtype="S"),
-                          label=np.array(m.mode_label, dtype="S"))
-        value = h5.create_group("comparison/value")
-        difference = h5.create_group("comparison/difference")
+                          dims=("mode",), dominant=list(m.dominant), label=list(m.mode_label))
+        comparison_group = h5.create_group("comparison")
+        write_dataset(comparison_group, "model", labels, "1", dims=("model",))
+        value = comparison_group.create_group("value")
+        difference = comparison_group.create_group("difference")
         for name in comparison.metric_names:
             write_dataset(value, name, comparison.value[name],
-                          comparison.metric_units[name], models=labels)
-            write_dataset(difference, name, comparison.difference[name], "%", models=labels)
+                          comparison.metric_units[name], dims=("model",), models=labels)
+            write_dataset(difference, name, comparison.difference[name], "%", dims=("model",),
+                          models=labels)
     return Path(path)
 
 

@@ -41,6 +41,10 @@ column for X, F, S, as ``suspopt optimise`` writes them; X, F, S also ``names``)
   attributes ``label``, ``config`` (the changed config's YAML text) and the change
   (``road_class`` or ``road_source``; ``load_mass`` [kg] and ``mass_change`` [kg];
   ``controller_source``).
+- dimensions (:func:`suspopt.io.write_dataset`), in ``/pareto`` and in each
+  ``/pseudo/<label>``: ``design`` (row numbers of the stored front), ``variable``,
+  ``objective`` and ``supplementary`` (the names of the columns of X, F and change, S and
+  S_change).
 """
 
 from __future__ import annotations
@@ -54,7 +58,7 @@ import numpy as np
 from .. import plots
 from ..config import Config, ConfigError
 from ..config.loader import edit_config, set_path
-from ..io import atomic_h5, write_dataset
+from ..io import atomic_h5, write_attrs, write_dataset
 from ..kesort import pareto_picks
 from ..seat import build_seat, passenger_mass_change
 from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
@@ -299,8 +303,9 @@ def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> 
                         sets=sets)
 
 
-def _columns(group, name: str, data, names, units) -> None:
-    write_dataset(group, name, data, list(units), names=np.array(names, dtype="S"))
+def _columns(group, name: str, data, dim: str, names, units) -> None:
+    """``data (N, len(names))`` over the dimensions ``design`` and ``dim`` (the names)."""
+    write_dataset(group, name, data, list(units), dims=("design", dim), names=names)
 
 
 def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
@@ -312,29 +317,31 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
         h5.attrs["analysis"] = fronts.kind
         h5.attrs["source"] = str(p.path)
         grp = h5.create_group("pareto")
-        _columns(grp, "X", p.X, p.var_names, p.var_units)
-        _columns(grp, "F", p.F, names[:m], units[:m])
-        write_dataset(grp, "feasible", fronts.stored.feasible.astype(np.int8), "1")
+        _columns(grp, "X", p.X, "variable", p.var_names, p.var_units)
+        _columns(grp, "F", p.F, "objective", names[:m], units[:m])
+        write_dataset(grp, "feasible", fronts.stored.feasible.astype(np.int8), "1",
+                      dims=("design",))
         picks = grp.create_group("picks")
         for key, row in fronts.picks.items():
             write_dataset(picks, key, row, "1")
         if len(names) > m:
-            _columns(grp, "S", fronts.reference[:, m:], names[m:], units[m:])
+            _columns(grp, "S", fronts.reference[:, m:], "supplementary", names[m:], units[m:])
         pseudo = h5.create_group("pseudo")
-        pseudo.attrs["labels"] = np.array([v.label for v in fronts.variants], dtype="S")
+        write_attrs(pseudo, labels=[v.label for v in fronts.variants])
         for i, (variant, s) in enumerate(zip(fronts.variants, fronts.sets)):
             g = pseudo.create_group(variant.label.replace("/", "_"))
-            g.attrs.update(label=variant.label, config=variant.config.text, **variant.attrs)
+            write_attrs(g, label=variant.label, config=variant.config.text, **variant.attrs)
             values, change = fronts.values(i), fronts.change(i)
-            _columns(g, "F", values[:, :m], names[:m], units[:m])
-            _columns(g, "change", change[:, :m], names[:m], ["%"] * m)
+            _columns(g, "F", values[:, :m], "objective", names[:m], units[:m])
+            _columns(g, "change", change[:, :m], "objective", names[:m], ["%"] * m)
             if len(names) > m:
-                _columns(g, "S", values[:, m:], names[m:], units[m:])
-                _columns(g, "S_change", change[:, m:], names[m:], ["%"] * (len(names) - m))
+                _columns(g, "S", values[:, m:], "supplementary", names[m:], units[m:])
+                _columns(g, "S_change", change[:, m:], "supplementary", names[m:],
+                         ["%"] * (len(names) - m))
             if variant.X is not None:
-                _columns(g, "X", variant.X, p.var_names, p.var_units)
-            write_dataset(g, "feasible", s.feasible.astype(np.int8), "1")
-            write_dataset(g, "failed", s.failed.astype(np.int8), "1")
+                _columns(g, "X", variant.X, "variable", p.var_names, p.var_units)
+            write_dataset(g, "feasible", s.feasible.astype(np.int8), "1", dims=("design",))
+            write_dataset(g, "failed", s.failed.astype(np.int8), "1", dims=("design",))
     return Path(path)
 
 

@@ -38,6 +38,9 @@ HDF5 layout (every dataset has a ``units`` attribute; root attributes as every s
 - for a Pareto file, ``/designs/X (P, n)`` and ``/designs/F (P, m)`` (with ``names``, one unit
   per column), ``/designs/row (P,)`` [1] (the rows of the file's ``/pareto``) and the attribute
   ``picks`` of ``/designs`` (each design's pick names, e.g. ``best_X_ST``, ``knee``).
+- dimensions (:func:`suspopt.io.write_dataset`): ``/design (P,)`` (row numbers), the
+  ``frequency`` of ``/linear`` and of ``/simulated``, ``/modal/mode`` (numbering the modes),
+  ``/designs/variable`` and ``/designs/objective`` (the names of the columns of X and F).
 """
 
 from __future__ import annotations
@@ -51,7 +54,7 @@ import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError, load_config
-from ..io import atomic_h5, write_dataset
+from ..io import atomic_h5, write_attrs, write_dataset
 from ..kesort import pareto_picks
 from ..metrics import transmissibility, coherence, weighted_rms
 from ..optimise import Problem
@@ -203,31 +206,35 @@ def write_transmissibility(path: str | Path, data: SeatTransmissibility, cfg: Co
     they were picked from a front."""
     with atomic_h5(path, cfg, command) as h5:
         h5.attrs["seat_kind"] = data.kind
+        write_dataset(h5, "design", np.arange(len(data.static_deflection)), "1",
+                      dims=("design",))
         lin, sim = h5.create_group("linear"), h5.create_group("simulated")
-        write_dataset(lin, "frequency", data.linear_frequency, "Hz")
-        write_dataset(sim, "frequency", data.simulated_frequency, "Hz")
+        write_dataset(lin, "frequency", data.linear_frequency, "Hz", dims=("frequency",))
+        write_dataset(sim, "frequency", data.simulated_frequency, "Hz", dims=("frequency",))
         coh = sim.create_group("coherence")
+        spectrum = ("design", "frequency")
         for j, name in enumerate(data.dof_names):
-            write_dataset(lin, name, data.linear[..., j], "-")
-            write_dataset(sim, name, data.simulated[..., j], "-")
-            write_dataset(coh, name, data.coherence[..., j], "-")
-        write_dataset(h5.create_group("statics"), "static_deflection", data.static_deflection, "m")
+            write_dataset(lin, name, data.linear[..., j], "-", dims=spectrum)
+            write_dataset(sim, name, data.simulated[..., j], "-", dims=spectrum)
+            write_dataset(coh, name, data.coherence[..., j], "-", dims=spectrum)
+        write_dataset(h5.create_group("statics"), "static_deflection", data.static_deflection,
+                      "m", dims=("design",))
         write_dataset(h5.create_group("modal"), "frequency", data.natural_frequency, "Hz",
-                      dof_names=np.array(data.dof_names, dtype="S"))
+                      dims=("design", "mode"), dof_names=list(data.dof_names))
         con = h5.create_group("constraints")
         for name, values in data.constraints.items():
-            write_dataset(con, name, values, CONSTRAINT_UNITS[name])
+            write_dataset(con, name, values, CONSTRAINT_UNITS[name], dims=("design",))
         rms = h5.create_group("weighted_rms")
         for name, values in data.weighted_rms.items():
-            write_dataset(rms, name, values, "m/s^2")
+            write_dataset(rms, name, values, "m/s^2", dims=("design",))
         if designs is not None:
             grp = h5.create_group("designs")
-            grp.attrs["picks"] = np.array([", ".join(p) for p in designs.picks], dtype="S")
-            write_dataset(grp, "row", designs.rows, "1")
+            write_attrs(grp, picks=[", ".join(p) for p in designs.picks])
+            write_dataset(grp, "row", designs.rows, "1", dims=("design",))
             write_dataset(grp, "X", designs.X, list(designs.var_units),
-                          names=np.array(designs.var_names, dtype="S"))
+                          dims=("design", "variable"), names=designs.var_names)
             write_dataset(grp, "F", designs.F, list(designs.obj_units),
-                          names=np.array(designs.obj_names, dtype="S"))
+                          dims=("design", "objective"), names=designs.obj_names)
     return Path(path)
 
 

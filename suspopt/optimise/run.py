@@ -29,6 +29,10 @@ HDF5 layout (the public contract, docs/architecture.md#public-contract), every d
   the file (no simulation), checks that it asks for exactly the stored designs and arrives at
   the stored history, then goes on; so it continues bit for bit, and nothing read from the
   file is ever executed (there is no pickle).
+- dimensions (:func:`suspopt.io.write_dataset`): ``/pareto/{design, variable, objective,
+  constraint}`` (row numbers; the names of the columns of X, F, G), ``/history/generation``
+  and ``/history/objective`` (the columns of ``best``), ``/checkpoint/{evaluation, variable,
+  objective, constraint, batch}``.
 - root attributes: those of ``atomic_h5`` plus ``status`` (running, finished, interrupted,
   or failed: every design of the optimum failed to simulate), ``algorithm``,
   ``optimiser_seed``, ``generations``, ``evaluations``.
@@ -409,10 +413,6 @@ def _resume(output: Path, cfg: Config, problem: Problem, optimiser: Optimiser) -
     return run
 
 
-def _names(names: list[str]) -> np.ndarray:
-    return np.array(names, dtype="S")
-
-
 def _write(output: Path, cfg: Config, problem: Problem, snap: _Snapshot, run: _Run,
            status: str, command: str | None) -> OptimisationResult:
     weights, run_batches = run.weights, run.recorder.batches
@@ -426,31 +426,36 @@ def _write(output: Path, cfg: Config, problem: Problem, snap: _Snapshot, run: _R
         if weights is not None:
             pareto.attrs["weights"] = weights
         o = snap.optimum
-        write_dataset(pareto, "X", o.X, problem.var_units, names=_names(problem.var_names))
-        write_dataset(pareto, "F", o.F, problem.obj_units, names=_names(problem.obj_names))
+        write_dataset(pareto, "X", o.X, problem.var_units, dims=("design", "variable"),
+                      names=problem.var_names)
+        write_dataset(pareto, "F", o.F, problem.obj_units, dims=("design", "objective"),
+                      names=problem.obj_names)
         write_dataset(pareto, "G", o.G, problem.constraint_units,
-                 names=_names(problem.constraint_names))
+                      dims=("design", "constraint"), names=problem.constraint_names)
         hist = h5.create_group("history")
         units = {"generation": "1", "hypervolume": "1", "evaluations": "1", "time": "s",
                  "feasible": "1"}
+        write_dataset(hist, "generation", snap.history["generation"], "1", dims=("generation",))
         for key, values in snap.history.items():
             if key == "best":
                 write_dataset(hist, key, values.reshape(len(values), -1), best_units,
-                         names=_names(best_names))
-            else:
-                write_dataset(hist, key, values, units[key])
+                              dims=("generation", "objective"), names=best_names)
+            elif key != "generation":
+                write_dataset(hist, key, values, units[key], dims=("generation",))
         batches = run_batches[:snap.batches]
         checkpoint = h5.create_group("checkpoint")
         checkpoint.attrs.update(format=CHECKPOINT_FORMAT, generations=snap.generation)
-        for j, (key, columns, units) in enumerate((
-                ("X", problem.n_var, problem.search_units),
-                ("F", problem.n_obj, problem.obj_units),
-                ("G", problem.n_ieq_constr, problem.constraint_units))):
+        for j, (key, columns, units, dim, names) in enumerate((
+                ("X", problem.n_var, problem.search_units, "variable", problem.var_names),
+                ("F", problem.n_obj, problem.obj_units, "objective", problem.obj_names),
+                ("G", problem.n_ieq_constr, problem.constraint_units, "constraint",
+                 problem.constraint_names))):
             data = np.concatenate([b[j] for b in batches]) if batches else \
                 np.empty((0, columns))
-            write_dataset(checkpoint, key, data, units)
+            write_dataset(checkpoint, key, data, units, dims=("evaluation", dim),
+                          coords={dim: names})
         write_dataset(checkpoint, "batches", np.array([len(b[0]) for b in batches],
-                                                      dtype=np.int64), "1")
+                                                      dtype=np.int64), "1", dims=("batch",))
     return OptimisationResult(X=o.X, F=o.F, G=o.G, var_names=problem.var_names,
                               var_units=problem.var_units, obj_names=problem.obj_names,
                               obj_units=problem.obj_units,
