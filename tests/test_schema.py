@@ -11,6 +11,7 @@ import pytest
 from suspopt.config import ConfigError, config_schema
 from suspopt.config.loader import SCHEMA_ID, load_config_text
 from suspopt.config.yamlio import parse_yaml
+from suspopt.templates import template_names, template_text
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 BUNDLED = sorted(CONFIGS.rglob("*.yaml"))
@@ -41,6 +42,11 @@ def test_the_bundled_configs_are_all_there():
 @pytest.mark.parametrize("path", BUNDLED, ids=lambda p: str(p.relative_to(CONFIGS)))
 def test_every_bundled_config_matches_the_schema(validator, path):
     assert _errors(validator, path.read_text()) == []
+
+
+@pytest.mark.parametrize("name", template_names())
+def test_every_template_matches_the_schema(validator, name):
+    assert _errors(validator, template_text(name)) == []
 
 
 WRONG = {
