@@ -23,11 +23,17 @@ from .optimise import Constraint, DesignVariable, Objectives, Optimiser
 from .road import RoadConfig
 from .seat import SeatConfig
 from .simulation import Output, Simulation
-from .vehicle import Vehicle
+from .vehicle import Vehicle, corner_defaults_schema
 from .yamlio import YamlError, parse_yaml, read_text
 
 __all__ = ["Config", "ConfigError", "load_config", "load_config_text", "config_schema",
-           "edit_config", "set_path"]
+           "edit_config", "set_path", "SCHEMA_DIALECT", "SCHEMA_ID"]
+
+#: The JSON Schema dialect of :func:`config_schema` (pydantic writes draft 2020-12).
+SCHEMA_DIALECT = "https://json-schema.org/draft/2020-12/schema"
+#: The schema's ``$id``: a name, not an address (``suspopt schema`` prints the schema and no
+#: server holds it), so a URN, which no tool tries to download.
+SCHEMA_ID = "urn:suspopt:schema:config"
 
 
 class Config(Section):
@@ -278,5 +284,13 @@ def edit_config(text: str, edit: Callable[[dict], None], source: Path | None = N
 
 
 def config_schema() -> dict:
-    """JSON Schema of the config, for editors' completion and validation."""
-    return Config.model_json_schema()
+    """JSON Schema (draft 2020-12) of the config, for editors' completion and validation.
+
+    It is pydantic's schema of :class:`Config` with one change, made here on the finished
+    dict: the corners' keys that ``vehicle.corner_defaults`` may give are optional
+    (:func:`~suspopt.config.vehicle.corner_defaults_schema`). The schema checks keys, types
+    and ranges; rules between keys (``c_max >= c_min``, a preset's body fields, RK4
+    stability, ...) are the loader's and ``suspopt validate``'s."""
+    schema = Config.model_json_schema()
+    corner_defaults_schema(schema["$defs"])
+    return {"$schema": SCHEMA_DIALECT, "$id": SCHEMA_ID, **schema}

@@ -11,6 +11,7 @@ the ``control:`` section (:mod:`suspopt.config.control`).
 
 from __future__ import annotations
 
+import copy
 from typing import Annotated, Any, ClassVar, Literal, Union
 
 from pydantic import Discriminator, Field, Tag, model_validator
@@ -21,7 +22,7 @@ from .base import (CubicStiffness, Damping, Inertia, Mass, Section, Stiffness,
 __all__ = [
     "PRESET_CORNERS", "PRESET_BODY_DOFS", "DAMPER_LAWS", "LAW_PARAMETERS", "Spring", "Tyre",
     "PassiveDamper", "SemiActiveDamper", "Damper", "Corner", "Body",
-    "AntiRollBars", "Vehicle",
+    "AntiRollBars", "Vehicle", "corner_defaults_schema",
 ]
 
 #: Corners of each preset (thesis names: F1 front right, F2 front left, R1 rear right,
@@ -243,3 +244,61 @@ class Vehicle(Section):
                 self.preset not in ("half_roll", "full"):
             raise ValueError("anti_roll_bars need a model with roll (half_roll or full)")
         return self
+
+
+def _partial(defs: dict, name: str) -> str:
+    """The name of a copy of ``defs[name]`` in which every key is optional, and so are the keys
+    of the sections it refers to (added to ``defs`` as ``<name>Partial``). A union's tag
+    (``kind: semi_active``) stays required: without it a damper is passive (``_damper_kind``)."""
+    partial = name + "Partial"
+    if partial not in defs:
+        schema = copy.deepcopy(defs[name])
+        defs[partial] = schema
+        props = schema.get("properties", {})
+        tags = [key for key in schema.pop("required", []) if "const" in props.get(key, {})]
+        if tags:
+            schema["required"] = tags
+        schema["title"] = partial
+        schema["description"] = (
+            schema.get("description", "") + " Here every key" +
+            "".join(f" but {tag}" for tag in tags) + " may be missing: a corner's own keys "
+            "and vehicle.corner_defaults together must give them.").strip()
+        _refs_to_partial(defs, props)
+    return partial
+
+
+def _refs_to_partial(defs: dict, node: Any) -> None:
+    """Point every ``$ref`` under ``node`` at the partial copy of its section."""
+    if isinstance(node, dict):
+        ref = node.get("$ref")
+        if isinstance(ref, str) and ref.startswith("#/$defs/"):
+            node["$ref"] = "#/$defs/" + _partial(defs, ref[len("#/$defs/"):])
+        for value in node.values():
+            _refs_to_partial(defs, value)
+    elif isinstance(node, list):
+        for value in node:
+            _refs_to_partial(defs, value)
+
+
+def corner_defaults_schema(defs: dict) -> None:
+    """Make the JSON schema's ``Vehicle`` say what :meth:`Vehicle._apply_corner_defaults` does.
+
+    The merge of ``corner_defaults`` into each corner happens before validation, where a JSON
+    schema cannot see it. So in the schema ``corner_defaults`` is a corner whose keys are all
+    optional; when it is given, so are a corner's (an empty corner, ``F1: {}`` or ``F1:``,
+    takes the defaults; the loader checks the merged corner), and without it every corner is
+    complete. The corners are named (F1, F2, R1, R2) so that an editor completes them.
+    ``defs`` is the schema's ``$defs``, changed in place."""
+    vehicle = defs["Vehicle"]
+    props = vehicle["properties"]
+    part = {"$ref": "#/$defs/" + _partial(defs, "Corner")}
+    names = PRESET_CORNERS["full"]
+    props["corner_defaults"]["anyOf"] = [part, {"type": "null"}]
+    props["corners"].pop("additionalProperties")
+    props["corners"]["properties"] = {name: {"anyOf": [part, {"type": "null"}]}
+                                      for name in names}
+    props["corners"]["additionalProperties"] = False
+    vehicle["if"] = {"required": ["corner_defaults"],
+                     "properties": {"corner_defaults": {"type": "object", "minProperties": 1}}}
+    vehicle["else"] = {"properties": {"corners": {"properties": {
+        name: {"$ref": "#/$defs/Corner"} for name in names}}}}
