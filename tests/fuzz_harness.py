@@ -812,7 +812,7 @@ def _root_config(value):
 
 
 def _names(ds, n_more=0):
-    names = [bytes(n) for n in ds.attrs["names"]]
+    names = [n.encode() if isinstance(n, str) else bytes(n) for n in ds.attrs["names"]]
     return np.array(names[:len(names) + n_more] if n_more < 0 else names + [b"extra"] * n_more,
                     dtype="S")
 
@@ -925,9 +925,9 @@ def h5_variants() -> list[tuple[str, object, str | None]]:
     out += [
         ("X_names_not_in_config", _attr("X", "names", np.array([b"foo", b"bar"])), "/pareto/X"),
         ("X_names_duplicated", _attr("X", "names", lambda d: np.array(
-            [d.attrs["names"][0]] * len(d.attrs["names"]))), "/pareto/X"),
+            [d.attrs["names"][0]] * len(d.attrs["names"]), dtype="S")), "/pareto/X"),
         ("X_names_swapped", _attr("X", "names", lambda d: np.array(
-            list(d.attrs["names"])[::-1])), None),
+            list(d.attrs["names"])[::-1], dtype="S")), None),
         ("F_names_not_in_config", _attr("F", "names", np.array([b"a", b"b"])), "/pareto/F"),
         ("X_outside_bounds", _replace("X", _data(lambda v: v * 1e6)), None),
         ("X_zero", _replace("X", _data(lambda v: np.zeros_like(v))), None),
