@@ -135,6 +135,12 @@ def test_yaml_1_2_numbers():
     ("simulation: {duration: 3.0, dt: 1.0e-3}",
      "simulation: {duration: 3.0, dt: 1.0e-3}\ncontrol: {sample_time: .inf}",
      "control.sample_time: Input should be a finite number", 25),
+    ("simulation: {duration: 3.0, dt: 1.0e-3}",
+     "simulation: {duration: 0.001, dt: 1.0e-3, output_dt: 2.0e-3}",
+     "simulation: output_dt (0.002) must not exceed duration (0.001)", 24),
+    ("simulation: {duration: 3.0, dt: 1.0e-3}",
+     "simulation: {duration: 3.0, dt: 1.0e-3}\nmetrics:\n  - {metric: null, signal: body.heave}",
+     "metrics[0].metric: Input should be a valid string", 26),
 ])
 def test_validate_rejects_what_simulate_would(tmp_path, capsys, old, new, needle, line):
     path = write(tmp_path, edited(old, new))

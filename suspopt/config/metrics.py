@@ -30,5 +30,5 @@ class MetricSpec(Section):
 
     @field_validator("metric")
     @classmethod
-    def _known_metric(cls, metric: str) -> str:
-        return check_known("metric", metric, METRICS)
+    def _known_metric(cls, metric: str | None) -> str | None:
+        return metric if metric is None else check_known("metric", metric, METRICS)

@@ -22,6 +22,9 @@ class Simulation(Section):
         if self.dt > self.duration:
             raise ValueError("dt must not exceed duration")
         if self.output_dt is not None:
+            if self.output_dt > self.duration:
+                raise ValueError(f"output_dt ({self.output_dt}) must not exceed duration "
+                                 f"({self.duration}): a run needs two output samples")
             ratio = self.output_dt / self.dt
             if ratio < 1 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
                 raise ValueError(f"output_dt ({self.output_dt}) must be a whole multiple of "
