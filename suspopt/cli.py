@@ -145,6 +145,40 @@ def schema() -> None:
     sys.stdout.write(json.dumps(config_schema(), indent=2) + "\n")
 
 
+def _template_help() -> str:
+    from .templates import TEMPLATES
+
+    return "the kind of study: " + "; ".join(f"{k}: {v}" for k, v in TEMPLATES.items())
+
+
+def _template_kinds(incomplete: str) -> list[str]:
+    from .templates import template_names
+
+    return [k for k in template_names() if k.startswith(incomplete)]
+
+
+@app.command()
+def init(kind: str = typer.Argument(..., help=_template_help(),
+                                    autocompletion=_template_kinds),
+         output: Path = typer.Option(..., "-o", "--output", help="the new config (YAML)"),
+         force: bool = typer.Option(False, "--force", help=_FORCE_HELP)) -> None:
+    """Write a commented starter config of one kind of study, ready to validate and run."""
+    from .io import atomic_file
+    from .templates import template_text
+
+    with ExitStack() as stack:
+        try:
+            text = template_text(kind)
+        except ValueError as exc:
+            _fail(f"init: {exc}")
+        _claim(stack, output, force)
+        with atomic_file(output) as stream:
+            stream.write(text.encode())
+    command = "optimise" if kind in ("optimise", "kesort") else "simulate"
+    out.print(f"wrote {output}; next: suspopt validate {output}, then suspopt {command} "
+              f"{output} -o {Path(output).with_suffix('.h5')}")
+
+
 @app.command()
 def export(source: Path = typer.Argument(..., help="result file of optimise, kesort or "
                                          "analyse"),
@@ -332,12 +366,12 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
             F, names, units = objectives
             designs = h5.require_group("designs")
             designs.attrs["source"] = str(picked.source)
-            write_dataset(designs, "pick", np.array(picked.names, dtype=_text_dtype()), "1")
-            write_dataset(designs, "row", picked.rows, "1")
+            write_dataset(designs, "pick", list(picked.names), "1", dims=("design",))
+            write_dataset(designs, "row", picked.rows, "1", dims=("design",))
             group = h5.create_group("objectives")
-            write_dataset(group, "F", F, units, names=np.array(names, dtype="S"))
+            write_dataset(group, "F", F, units, dims=("design", "objective"), names=names)
             write_dataset(group, "stored_F", picked.F, picked.obj_units,
-                          names=np.array(picked.obj_names, dtype="S"))
+                          dims=("design", "stored_objective"), names=picked.obj_names)
     if output is not None:
         write_simulation(output, result, signals=None if cfg.output.signals == "all"
                          else cfg.output.signals, float32=cfg.output.float32,
@@ -347,11 +381,6 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
         from .plots import plot_simulation
         plot_simulation(result, plot)
         out.print(f"wrote {plot}")
-
-
-def _text_dtype():
-    import h5py
-    return h5py.string_dtype()
 
 
 def _pick_objectives(picked, cfg, result):
@@ -524,6 +553,9 @@ def optimise(config: Path = typer.Argument(..., help="YAML config file"),
                  "the current folder), rewritten every generation"),
              resume: bool = typer.Option(False, "--resume",
                                          help="continue from the checkpoint in OUT.h5"),
+             plot: Optional[Path] = typer.Option(None, "--plot", help="figure of the front "
+                                                 "(or the best value) and the history per "
+                                                 "generation (.png or .svg)"),
              force: bool = typer.Option(False, "--force", help=_FORCE_HELP),
              max_memory: Optional[str] = typer.Option(None, "--max-memory",
                                                       help=_MEMORY_HELP)) -> None:
@@ -535,11 +567,18 @@ def optimise(config: Path = typer.Argument(..., help="YAML config file"),
     with ExitStack() as stack:
         output = output if output is not None else Path(config.stem + ".h5")
         _memory(max_memory)
+        if plot is not None:
+            from .plots import check_path
+            try:
+                check_path(plot)
+            except ValueError as exc:
+                _fail(str(exc))
         _claim(stack, output, force)
-        _optimise(config, output, resume)
+        _claim(stack, plot, force, "--plot")
+        _optimise(config, output, resume, plot)
 
 
-def _optimise(config: Path, output: Path, resume: bool) -> None:
+def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> None:
     from rich.progress import BarColumn, Progress, TextColumn
 
     from .checks import check_config
@@ -577,6 +616,13 @@ def _optimise(config: Path, output: Path, resume: bool) -> None:
                   f"suspopt optimise {config} -o {output} --resume", soft_wrap=True)
         raise typer.Exit(code=130)
     out.print(f"wrote {output}")
+    if plot is not None:
+        from .plots import plot_optimisation
+        try:
+            plot_optimisation(result, plot)
+        except ValueError as exc:
+            _fail(str(exc))
+        out.print(f"wrote {plot}")
     if result.status == "failed":
         err.print(f"error: every design of the optimum failed to simulate (diverged or gave "
                   f"NaN); {output} holds them with the penalty values and status 'failed'",
