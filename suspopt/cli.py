@@ -6,7 +6,6 @@ and line; 1 unexpected failure.
 
 from __future__ import annotations
 
-import json
 import shlex
 import sys
 from contextlib import ExitStack
@@ -23,8 +22,8 @@ app = typer.Typer(add_completion=True, no_args_is_help=True, pretty_exceptions_e
                   help="Simulate, optimise and select vehicle and seat suspensions from YAML.")
 # text from files and arguments is printed as it is: no rich markup, no emoji codes
 # (":x:" in a file name), no highlighting
-out = Console(markup=False, emoji=False, highlight=False)
-err = Console(stderr=True, markup=False, emoji=False, highlight=False)
+out = Console(markup=False, emoji=False, highlight=False, soft_wrap=True)
+err = Console(stderr=True, markup=False, emoji=False, highlight=False, soft_wrap=True)
 
 #: Exit code of a run that finished but whose every design failed to simulate.
 EXIT_ALL_FAILED = 3
@@ -140,9 +139,11 @@ def validate(config: Path = typer.Argument(..., help="YAML config file"),
 @app.command()
 def schema() -> None:
     """Print the JSON Schema of the config (for editor completion)."""
-    from .config import config_schema
+    from importlib import resources
 
-    sys.stdout.write(json.dumps(config_schema(), indent=2) + "\n")
+    # the schema as suspopt.config.config_schema() makes it, stored with the package so that
+    # printing it needs no model (tests/test_schema.py checks the two are the same)
+    sys.stdout.write(resources.files("suspopt").joinpath("schema.json").read_text())
 
 
 def _template_help() -> str:

@@ -75,7 +75,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import digamma, gammaln, ndtri, stdtrit
 
 from .config import Config, ConfigError
 from .config.control import Control
@@ -207,6 +206,8 @@ def _t_derivatives(x: np.ndarray, weights: np.ndarray | None, total, loc, scale,
     With ``d = (x - μ)/s`` and the E-step weight ``w = (ν + 1)/(ν + d²)`` everything follows
     from five sums, ``Σw, Σw², Σwd, Σw²d`` and ``L = Σ log(1 + d²/ν)``, because
     ``w d² = ν + 1 - ν w``."""
+    from scipy.special import digamma, gammaln     # (loaded by the fits that use them)
+
     def wsum(a: np.ndarray) -> np.ndarray:
         return np.sum(a, axis=0) if weights is None else np.einsum("ij,ij->j", weights, a)
 
@@ -427,6 +428,8 @@ def fit_student_t(samples: np.ndarray, axis: int = 0,
 def _t_quantile(fit: tuple[np.ndarray, np.ndarray, np.ndarray], level) -> np.ndarray:
     """Quantile of a fitted location-scale t, ``μ + s t_ν⁻¹(level)``."""
     loc, scale, df = fit
+    from scipy.special import stdtrit
+
     return loc + scale * stdtrit(df, level)
 
 
@@ -454,6 +457,8 @@ def distribution_quantile(samples: np.ndarray, level: np.ndarray | float,
     if distribution == "empirical":
         return _empirical_quantile(x, level)
     if distribution == "normal":
+        from scipy.special import ndtri
+
         return np.mean(x, axis=0) + np.std(x, axis=0) * ndtri(level)
     if distribution == "student_t":
         return _t_quantile(fit_student_t(x, axis=0), level)

@@ -19,8 +19,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["Report", "Kind", "KINDS", "SUMMARIES", "analysis_kinds", "relative_change"]
 
@@ -51,6 +53,8 @@ class Kind:
 def relative_change(value, reference) -> np.ndarray:
     """``100 (value - reference) / reference`` [%], NaN or inf where the reference is 0 or NaN
     (the percentages of Tables 3.3-3.21, 4.2-4.3, 8.12-8.13; their signs are each table's)."""
+    import numpy as np
+
     with np.errstate(divide="ignore", invalid="ignore"):
         return 100.0 * (np.asarray(value, dtype=float) - reference) / reference
 

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import difflib
-from collections.abc import Iterable
 from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field
+
+from ..errors import check_known
 
 __all__ = ["Section", "check_known", "quantity", "Mass", "Inertia", "Stiffness",
            "TorsionalStiffness", "CubicStiffness", "Damping", "VehicleLength", "SeatLength",
@@ -69,13 +69,3 @@ class Section(BaseModel):
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False,
                               strict=True)
-
-
-def check_known(what: str, name: str, known: Iterable[str]) -> str:
-    """Return ``name`` if it is in ``known``, else raise ValueError with the closest matches."""
-    known = list(known)
-    if name not in known:
-        close = difflib.get_close_matches(name, known, n=3)
-        raise ValueError(f"unknown {what} {name!r}" + (
-            f"; did you mean {', '.join(close)}?" if close else f"; known: {', '.join(known)}"))
-    return name

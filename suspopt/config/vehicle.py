@@ -182,12 +182,14 @@ class AntiRollBars(Section):
 
 
 def _deep_merge(base: dict, over: dict) -> dict:
-    """``over`` on top of ``base``; a sub-section of another ``kind`` (a semi-active damper over
-    a passive default) replaces the default's instead of mixing keys of both kinds."""
+    """``over`` on top of ``base``. A sub-section that names another ``kind`` (a semi-active
+    damper over a passive default) replaces the default's instead of mixing keys of both
+    kinds; one that names no ``kind`` is of the default's kind (``{c_max: 4000}`` over a
+    semi-active default changes its ``c_max``)."""
     out = dict(base)
     for key, value in over.items():
         if isinstance(value, dict) and isinstance(out.get(key), dict) and \
-                _damper_kind(value) == _damper_kind(out[key]):
+                value.get("kind", _damper_kind(out[key])) == _damper_kind(out[key]):
             out[key] = _deep_merge(out[key], value)
         else:
             out[key] = value
@@ -248,22 +250,23 @@ class Vehicle(Section):
 
 def _partial(defs: dict, name: str) -> str:
     """The name of a copy of ``defs[name]`` in which every key is optional, and so are the keys
-    of the sections it refers to (added to ``defs`` as ``<name>Partial``). A union's tag
-    (``kind: semi_active``) stays required: without it a damper is passive (``_damper_kind``)."""
+    of the sections it refers to (added to ``defs`` as ``<name>Partial``). A union of such
+    sections (the damper kinds) takes any of them: a part without its ``kind`` is of the
+    default's kind (``_deep_merge``), so it may fit either."""
     partial = name + "Partial"
     if partial not in defs:
         schema = copy.deepcopy(defs[name])
         defs[partial] = schema
         props = schema.get("properties", {})
-        tags = [key for key in schema.pop("required", []) if "const" in props.get(key, {})]
-        if tags:
-            schema["required"] = tags
+        schema.pop("required", None)
         schema["title"] = partial
         schema["description"] = (
-            schema.get("description", "") + " Here every key" +
-            "".join(f" but {tag}" for tag in tags) + " may be missing: a corner's own keys "
-            "and vehicle.corner_defaults together must give them.").strip()
+            schema.get("description", "") + " Here every key may be missing: a corner's own "
+            "keys and vehicle.corner_defaults together must give them.").strip()
         _refs_to_partial(defs, props)
+        for prop in props.values():
+            if "oneOf" in prop:
+                prop["anyOf"] = prop.pop("oneOf")
     return partial
 
 

@@ -12,19 +12,26 @@ signals without looping over the ``P`` designs. One topic per module:
 - :mod:`.springs`: non-linear spring usage ratio (Eq 5.3)
 """
 
-from .energy import (damper_switches, mean_dissipated_power, mean_dissipated_power_from_damping,
-                     share_at_max_damping)
-from .iso2631 import (COMFORT_REACTIONS, MTVV_RATIO_LIMIT, VDV_RATIO_LIMIT, WEIGHTINGS,
-                      comfort_reaction, crest_factor, mtvv, ratio_tests, running_rms, vdv, weight,
-                      weighted_rms, weighting_response)
-from .spectral import coherence, psd, transfer_function, transmissibility
-from .springs import nonlinear_spring_usage
-from .stats import (STATISTICS, dynamic_tyre_load_ratio, max_abs, maximum, mean, minimum,
-                    peak_dynamic_tyre_load_ratio, peak_to_peak, peak_tyre_force, pitch_variance,
-                    rms, std, suspension_travel_max, suspension_travel_max_abs,
-                    suspension_travel_variance, tyre_deflection_max, tyre_deflection_max_abs,
-                    tyre_deflection_variance, var)
-from .transient import transient_metrics
+import importlib
+
+#: Public name -> the module that defines it; imported when first used (PEP 562), so that
+#: a run that computes no metric never loads scipy.
+_MODULES = {
+    "iso2631": ("WEIGHTINGS", "MTVV_RATIO_LIMIT", "VDV_RATIO_LIMIT", "COMFORT_REACTIONS",
+                "weighting_response", "weight", "weighted_rms", "running_rms", "mtvv", "vdv",
+                "crest_factor", "ratio_tests", "comfort_reaction"),
+    "stats": ("STATISTICS", "var", "std", "rms", "maximum", "minimum", "max_abs", "mean",
+              "peak_to_peak", "suspension_travel_variance", "suspension_travel_max",
+              "suspension_travel_max_abs", "tyre_deflection_variance", "tyre_deflection_max",
+              "tyre_deflection_max_abs", "pitch_variance", "dynamic_tyre_load_ratio",
+              "peak_dynamic_tyre_load_ratio", "peak_tyre_force"),
+    "energy": ("mean_dissipated_power", "mean_dissipated_power_from_damping",
+               "damper_switches", "share_at_max_damping"),
+    "transient": ("transient_metrics",),
+    "spectral": ("psd", "transfer_function", "coherence", "transmissibility"),
+    "springs": ("nonlinear_spring_usage",),
+}
+_HOME = {name: module for module, names in _MODULES.items() for name in names}
 
 __all__ = [
     # iso2631
@@ -47,3 +54,15 @@ __all__ = [
     # springs
     "nonlinear_spring_usage",
 ]
+
+
+def __getattr__(name: str):
+    if name in _HOME:
+        value = getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

@@ -6,7 +6,6 @@ Signals have time on the last axis, ``(T,)`` or ``(P, T)``; results are a scalar
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import trapezoid
 
 __all__ = [
     "mean_dissipated_power",
@@ -26,6 +25,8 @@ def mean_dissipated_power(damper_force: np.ndarray, travel_velocity: np.ndarray,
     """
     t = np.asarray(t, dtype=float)
     power = np.asarray(damper_force, dtype=float) * np.asarray(travel_velocity, dtype=float)
+    from scipy.integrate import trapezoid
+
     return trapezoid(power, t, axis=-1) / (t[-1] - t[0])
 
 

@@ -24,7 +24,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
 
 __all__ = [
     "WEIGHTINGS",
@@ -195,6 +194,8 @@ def weight(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
         return a.copy()
     n = a.shape[-1]
     padding = math.ceil(math.log(1.0 / _WRAP_DECAY) / _slowest_decay_rate(params) * fs)
+    from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
+
     m = next_fast_len(n + padding, real=True)
     spectrum = rfft(a, m, axis=-1) * _response(rfftfreq(m, 1.0 / fs), params)
     return irfft(spectrum, m, axis=-1)[..., :n]

@@ -11,7 +11,6 @@ at most the record): about 15 averages, and a resolution of ``8/T_record`` Hz.
 from __future__ import annotations
 
 import numpy as np
-from scipy import signal
 
 __all__ = ["psd", "transfer_function", "coherence", "transmissibility"]
 
@@ -30,6 +29,8 @@ def psd(x: np.ndarray, fs: float, nperseg: int | None = None) -> tuple[np.ndarra
     Its integral over ``f`` is the variance of ``x`` (mean removed).
     """
     x = np.asarray(x, dtype=float)
+    from scipy import signal
+
     return signal.welch(x, fs, nperseg=_segment(x.shape[-1], nperseg), axis=-1)
 
 
@@ -42,6 +43,8 @@ def transfer_function(x: np.ndarray, y: np.ndarray, fs: float,
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
     segment = _segment(x.shape[-1], nperseg)
+    from scipy import signal
+
     f, p_xy = signal.csd(x, y, fs, nperseg=segment, axis=-1)
     _, p_xx = signal.welch(x, fs, nperseg=segment, axis=-1)
     return f, p_xy / p_xx
@@ -51,6 +54,8 @@ def coherence(x: np.ndarray, y: np.ndarray, fs: float,
               nperseg: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Magnitude-squared coherence ``|P_xy|²/(P_xx P_yy)`` between ``x`` and ``y`` (0-1)."""
     x = np.asarray(x, dtype=float)
+    from scipy import signal
+
     return signal.coherence(x, np.asarray(y, dtype=float), fs,
                             nperseg=_segment(x.shape[-1], nperseg), axis=-1)
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from importlib import resources
 
-from ..config.base import check_known
+from ..errors import check_known
 
 __all__ = ["TEMPLATES", "template_names", "template_description", "template_text"]
 
