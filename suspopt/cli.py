@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import shlex
 import sys
+import time
 from contextlib import ExitStack
 from pathlib import Path
 from typing import Optional
@@ -128,11 +129,16 @@ def validate(config: Path = typer.Argument(..., help="YAML config file"),
     from .checks import check_config
 
     _memory(max_memory)
+    started = time.perf_counter()
     cfg = _load(config)
+    _info(f"{config}: read and typed in {time.perf_counter() - started:.3g} s")
     try:
         check_config(cfg)
     except ConfigError as exc:
         _fail(str(exc))
+    _info(f"checked the run (steps, road, RK4 stability, memory"
+          f"{', the optimisation' if cfg.design_variables else ''}) in "
+          f"{time.perf_counter() - started:.3g} s")
     out.print(f"{config}: valid ({cfg.vehicle.preset}, road {cfg.road.kind})")
 
 
@@ -350,7 +356,17 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
     written = cfg.output.signals if cfg.output.signals != "all" else signal_names(
         model, getattr(controller, "units", {}), attachments)
     check_memory(cfg, model, attachments, pv.P, signals=len(written) + len(cfg.metrics))
+    if _verbose[0]:
+        from .memory import describe
+        from .simulate import run_memory
+        shared, per_design = run_memory(cfg, model, attachments, pv.P,
+                                        len(written) + len(cfg.metrics))
+        _info(f"{cfg.source}: checked; {pv.P} design{'s' if pv.P > 1 else ''}, "
+              f"{cfg.simulation.n_steps} steps of {cfg.simulation.dt:g} s, about "
+              f"{describe(shared + pv.P * per_design)} of memory")
+    started = time.perf_counter()
     result = run(cfg, params)
+    _info(f"simulated in {time.perf_counter() - started:.3g} s")
     if result.diverged.any():
         err.print(f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
                   f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
@@ -374,9 +390,11 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
             write_dataset(group, "stored_F", picked.F, picked.obj_units,
                           dims=("design", "stored_objective"), names=picked.obj_names)
     if output is not None:
+        started = time.perf_counter()
         write_simulation(output, result, signals=None if cfg.output.signals == "all"
                          else cfg.output.signals, float32=cfg.output.float32,
                          command=_command(), extra=extra)
+        _info(f"wrote {len(written)} signals in {time.perf_counter() - started:.3g} s")
         out.print(f"wrote {output}")
     if plot is not None:
         from .plots import plot_simulation
