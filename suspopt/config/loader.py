@@ -206,12 +206,9 @@ def _allowed_keys(loc: tuple) -> list[str]:
     return sorted(getattr(model, "model_fields", {}))
 
 
-def load_config_text(text: str, source: Path | None = None) -> Config:
-    """Parse and validate YAML text; raise ConfigError with file, line and key path.
-
-    The YAML is read by :func:`suspopt.config.yamlio.parse_yaml`: safe tags, the YAML 1.2
-    core schema, bounded depth and size, no duplicate keys."""
-    name = str(source) if source is not None else "<config>"
+def _sections(text: str, name: str):
+    """The data and node tree of a config's YAML text, a mapping of sections; ConfigError
+    naming ``name`` and the line otherwise."""
     try:
         data, node = parse_yaml(text)
     except YamlError as exc:
@@ -219,6 +216,16 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
     if not isinstance(data, dict):
         raise ConfigError(f"{name}:1: the config must be a mapping of sections "
                           f"(vehicle, road, simulation, ...)")
+    return data, node
+
+
+def load_config_text(text: str, source: Path | None = None) -> Config:
+    """Parse and validate YAML text; raise ConfigError with file, line and key path.
+
+    The YAML is read by :func:`suspopt.config.yamlio.parse_yaml`: safe tags, the YAML 1.2
+    core schema, bounded depth and size, no duplicate keys."""
+    name = str(source) if source is not None else "<config>"
+    data, node = _sections(text, name)
     lines = _line_map(node) if node is not None else {}
     try:
         base_dir = source.parent if source is not None else Path.cwd()
@@ -268,13 +275,7 @@ def edit_config(text: str, edit: Callable[[dict], None], source: Path | None = N
     place); the result's text is the edited YAML (comments are not kept) and its errors refer
     to the lines of that text under the name ``source``. ``what`` names the edit in messages.
     """
-    name = str(source) if source is not None else "<config>"
-    try:
-        data, _ = parse_yaml(text)
-    except YamlError as exc:
-        raise ConfigError(f"{name}{f':{exc.line}' if exc.line else ''}: {exc}") from None
-    if not isinstance(data, dict):
-        raise ConfigError(f"{name}: not a mapping of config sections")
+    data, _ = _sections(text, str(source) if source is not None else "<config>")
     edit(data)
     edited = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
     try:
