@@ -1,7 +1,8 @@
 """The ``suspopt`` command: a thin layer that reads arguments, calls the library and renders.
 
 Exit codes: 0 success; 2 bad input (config, file, arguments) with one line naming the YAML key
-and line; 1 unexpected failure.
+and line (or the file and dataset); 3 a run whose every optimum design failed to simulate;
+130 interrupted (suspopt._entry); 1 an unexpected failure (a bug).
 """
 
 from __future__ import annotations
