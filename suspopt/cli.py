@@ -79,6 +79,37 @@ def _table(title: str | None = None) -> Table:
     return _FoldingTable(title=title)
 
 
+def _show(table: Table, keys: int = 1) -> None:
+    """Print ``table``; when it is wider than the terminal (a CI log's 80 columns), as several
+    tables of the columns that fit, each with the first ``keys`` columns again, so that no
+    number is cut or broken across lines."""
+    def needs(column) -> int:             # its widest cell and the border and padding
+        return max(len(str(c)) for c in [column.header, *column._cells]) + 3
+
+    width = out.width
+    if 1 + sum(needs(c) for c in table.columns) <= width or len(table.columns) <= keys + 1:
+        out.print(table)
+        return
+    key, rest = table.columns[:keys], table.columns[keys:]
+    base = 1 + sum(needs(c) for c in key)
+    groups, current, used = [], [], base
+    for column in rest:
+        if current and used + needs(column) > width:
+            groups.append(current)
+            current, used = [], base
+        current.append(column)
+        used += needs(column)
+    groups.append(current)
+    title = str(table.title or "")
+    for i, group in enumerate(groups, start=1):
+        part = _table(f"{title} ({i} of {len(groups)})" if title else None)
+        for column in key + group:
+            part.add_column(column.header, justify=column.justify)
+        for row in range(table.row_count):
+            part.add_row(*(column._cells[row] for column in key + group))
+        out.print(part)
+
+
 def _fail(message: str) -> None:
     """Report bad input in one line and exit with code 2."""
     err.print("error: " + " ".join(str(message).split()), soft_wrap=True)
@@ -372,13 +403,13 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
         err.print(f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
                   f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
                   f"try a smaller simulation.dt")
-    out.print(_summary_table(result))
+    _show(_summary_table(result), keys=2)
     if result.metrics:
-        out.print(_metrics_table(result))
+        _show(_metrics_table(result), keys=2)
     extra = None
     if picked is not None:
         objectives = _pick_objectives(picked, cfg, result)
-        out.print(_picks_table(picked, *objectives))
+        _show(_picks_table(picked, *objectives), keys=3)
 
         def extra(h5) -> None:
             F, names, units = objectives
@@ -514,7 +545,7 @@ def analyse(kind: str = typer.Argument(..., help=_analysis_help(),
         table.add_column(col)
     for row in report.rows:
         table.add_row(*row)
-    out.print(table)
+    _show(table, keys=2 if report.columns[:2] == ["metric", "unit"] else 1)
     for note in report.notes:
         out.print(note)
     for path in (output, plot):
@@ -627,7 +658,7 @@ def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> No
     except KeyboardInterrupt:
         err.print("the first generation had not completed: nothing written")
         raise typer.Exit(code=130)
-    out.print(_optimum_table(result))
+    _show(_optimum_table(result))
     if result.weights is not None:
         out.print("weighted sum (Eq 5.7): " + " + ".join(
             f"{w:.4g} {name}" for w, name in zip(result.weights, result.obj_names)))
@@ -780,8 +811,8 @@ def _kesort(pareto, config, label, eps, P, P_range, P_step, normalise, keep_infe
     if plot is not None:
         from .plots import plot_kesort
         plot_kesort(selection, plot)
-    for table in _kesort_tables(selection):
-        out.print(table)
+    for table, keys in zip(_kesort_tables(selection), (2, 3)):
+        _show(table, keys=keys)
     for label_, cs in selection.case_sorts.items():
         out.print(_threshold_line(cs.sort, label_))
     out.print(_threshold_line(selection.sort, "all" if selection.case_sorts
