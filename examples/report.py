@@ -37,6 +37,7 @@ from suspopt import plots                                       # noqa: E402
 from suspopt.analyse import relative_change                     # noqa: E402
 from suspopt.analyse.cdf import c_max_share                     # noqa: E402
 from suspopt.config.metrics import MetricSpec                   # noqa: E402
+from suspopt.errors import ConfigError                          # noqa: E402
 from suspopt.selection import read_pareto                       # noqa: E402
 
 THESIS = md.thesis_values()
@@ -1900,9 +1901,18 @@ def main() -> None:
         shutil.rmtree(args.report / "figures")
     chapters = {3: chapter3, 4: chapter4, 5: chapter5, 6: chapter6, 7: chapter7, 8: chapter8}
     headlines = {}
+    missing = {}
     for number, build in chapters.items():
         doc = Doc(args.report)
-        headlines[number] = build(args.out, doc)
+        try:
+            headlines[number] = build(args.out, doc)
+        except (ConfigError, OSError) as exc:      # a partial output: say what is missing
+            missing[number] = str(exc)
+            headlines[number] = [f"Ch. {number}: not built - {exc}"]
+            doc = Doc(args.report)
+            doc(f"# Chapter {number}: {CHAPTERS[number]}", "",
+                f"Not built: the outputs of this chapter's runs are incomplete ({exc}). "
+                f"Run `examples/reproduce_thesis.sh` (or this chapter's script) to make them.")
         (args.report / f"ch{number}.md").write_text(doc.text())
     steps = read_steps(args.out)
     wall = args.wall if args.wall is not None else sum(steps.values())
@@ -1955,6 +1965,8 @@ def main() -> None:
     doc("")
     (args.report / "README.md").write_text(doc.text())
     print(f"wrote {args.report / 'README.md'} and ch3.md ... ch8.md")
+    for number, why in missing.items():
+        print(f"not built: chapter {number}: {why}", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -204,3 +204,17 @@ def test_spread_and_bounds_text():
     assert np.isnan(report.spread([3.0]))
     text = report.bounds_text({"C_F1": "lower", "C_R1": "lower", "K_nlF1": "upper"})
     assert text == "C_F1, C_R1 at the lower bound; K_nlF1 at the upper bound"
+
+
+def test_a_partial_output_names_what_is_missing(tmp_path):
+    """report.py on the outputs of a run that stopped early: each chapter it cannot build
+    says which file is missing, and the rest is written."""
+    out, folder = tmp_path / "out", tmp_path / "report"
+    (out / "ch3").mkdir(parents=True)
+    proc = subprocess.run([sys.executable, str(EXAMPLES / "report.py"), str(out),
+                           str(folder)], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr
+    assert "not built: chapter 8:" in proc.stderr and "no such file" in proc.stderr
+    readme = (folder / "README.md").read_text()
+    assert "Ch. 8: not built - " in readme
+    assert (folder / "ch8.md").read_text().startswith("# Chapter 8: Seat suspensions\n\nNot built")
