@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import csv
 import re
+from contextlib import contextmanager
 from io import TextIOWrapper
 from pathlib import Path
 
@@ -74,7 +75,12 @@ def _units(ds, columns: int) -> list[str]:
 
 
 def _dims(ds) -> list[tuple[str, object]]:
-    """(name, scale or None) of every axis of ``ds``: its dimension scale, else ``dim<k>``."""
+    """(name, scale or None) of every axis of ``ds``: its dimension scale, else ``dim<k>``.
+    The scales are looked up only when the dataset's list of them has one entry per axis
+    (libhdf5 reads past the list of a crafted file, where it has fewer)."""
+    listed = ds.attrs.get("DIMENSION_LIST")
+    if listed is None or np.shape(listed) != (ds.ndim,):
+        return [(f"dim{axis}", None) for axis in range(ds.ndim)]
     out = []
     for axis in range(ds.ndim):
         scales = ds.dims[axis]
@@ -195,10 +201,11 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
 
     h5_path, folder = Path(h5_path), Path(folder)
     with H5Reader(h5_path) as reader:
-        if "suspopt_version" not in reader.file.attrs:
+        if not reader.has_attr("suspopt_version"):
             raise ConfigError(f"{h5_path}: not a file suspopt wrote (no root attribute "
                               f"'suspopt_version')")
-        tables = _plan(reader.file)
+        with _reading(h5_path):
+            tables = _plan(reader.file)
         try:
             folder.mkdir(exist_ok=True)
         except OSError as exc:
@@ -214,9 +221,22 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
             names.add(file)
             targets.append(check_target(folder / f"{file}.csv", force, "--csv"))
         for target, (_, group, members, dims) in zip(targets, tables):
-            header, columns = _columns(members, dims)
+            with _reading(h5_path):
+                header, columns = _columns(members, dims)
             comment = (f"# written by suspopt {__version__} from "
                        f"{' '.join(str(h5_path).splitlines())} ({group})\n")
             with atomic_file(target, force) as stream:
                 _write_table(stream, comment, header, columns)
     return targets
+
+
+@contextmanager
+def _reading(h5_path: Path):
+    """Errors of libhdf5 reading a damaged file as ConfigError naming it."""
+    try:
+        yield
+    except ConfigError:
+        raise
+    except (OSError, RuntimeError, KeyError, ValueError, TypeError) as exc:
+        raise ConfigError(f"{h5_path}: damaged, cannot be read "
+                          f"({' '.join(str(exc).split())[:120]})") from None

@@ -26,6 +26,7 @@ import numpy as np
 from .config import Config, ConfigError
 from .config.loader import edit_config, load_config_text, set_path
 from .config.road import FileRoad, resolve_road_file
+from .params import ParamView
 
 __all__ = ["Picked", "DesignTable", "read_table", "read_picks", "design_config",
            "split_picks"]
@@ -190,6 +191,10 @@ def read_picks(path: str | Path, picks: list[str]) -> Picked:
         raise ConfigError(f"{table.path}: /{table.table}/X: the picked designs have no value "
                           f"for some variable")
     names = [table.var_names[j] for j in keep]
+    try:                                     # a stored value its field cannot take
+        ParamView(cfg, {path_of[n]: X[:, j] for j, n in enumerate(names)})
+    except ConfigError as exc:
+        raise ConfigError(f"{table.path}: /{table.table}/X: {exc}") from None
     return Picked(source=table.path, table=table.table, names=list(picks), rows=rows, X=X,
                   var_names=names, var_units=[table.var_units[j] for j in keep],
                   paths=[path_of[n] for n in names], F=table.F[rows],

@@ -730,7 +730,10 @@ def case_count(default: int) -> int:
 H5_RUNS = [["kesort", "{path}", "-o", "{out}"],
            ["analyse", "roads", "{path}", "--road", "B", "-o", "{out}"],
            ["analyse", "masses", "{path}", "-o", "{out}"],
-           ["analyse", "transmissibility", "{path}", "-o", "{out}"]]
+           ["analyse", "transmissibility", "{path}", "-o", "{out}"],
+           ["simulate", "{path}", "--pick", "knee,0", "-o", "{out}"],
+           ["export", "{path}", "--pick", "knee", "-o", "{out}.yaml"],
+           ["export", "{path}", "--csv", "{out}.csv"]]
 #: the bundled config of the tiny front, and its run length [s]
 FRONT = "ch8/pareto_ps_class_a"
 FRONT_DURATION = 0.3
