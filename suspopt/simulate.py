@@ -602,7 +602,8 @@ def check_memory(cfg: Config, model: VehicleModel, attachments: Sequence[Attachm
     shared, per_design = run_memory(cfg, model, attachments, P, signals)
     memory.check(shared + P * per_design, f"simulating {P} design{'s' if P > 1 else ''} for "
                  f"{cfg.simulation.duration:g} s at dt = {cfg.simulation.dt:g} s",
-                 "shorten simulation.duration, raise simulation.dt or output_dt, store fewer "
+                 ("simulate fewer designs at once, " if P > 1 else "")
+                 + "shorten simulation.duration, raise simulation.dt or output_dt, store fewer "
                  "output.signals" + (", lower road.n_max or set road.n_waves"
                                      if cfg.road.kind == "iso8608" else ""))
 
