@@ -27,7 +27,7 @@ import numpy as np
 from . import memory
 from .checks import check_steps, full_network
 from .config import Config
-from .control import build_controller
+from .control.controller import build_controller
 from .network import Network, widen
 from .params import ParamView
 from .specs import evaluate_spec, spec_signals

@@ -18,7 +18,8 @@ from typer.testing import CliRunner
 import suspopt
 from suspopt.cli import app
 from suspopt.config import ConfigError
-from suspopt.control import (LAWS, StudentTSummary, _t_quantile, _trigamma_step,
+from suspopt.control.stats import _trigamma_step
+from suspopt.control import (LAWS, StudentTSummary, t_quantile,
                              distribution_quantile, fit_student_t, law_condition,
                              threshold_for_share)
 
@@ -261,7 +262,7 @@ def _summary_errors(x: np.ndarray, block: int) -> np.ndarray:
     summary, errors = StudentTSummary(x.shape[1]), []
     for n in range(block, x.shape[0] + 1, block):
         bounded, exact = summary.fit(x[:n]), fit_student_t(x[:n])
-        errors.append([np.abs(_t_quantile(bounded, level) - _t_quantile(exact, level))
+        errors.append([np.abs(t_quantile(bounded, level) - t_quantile(exact, level))
                        / np.where(exact[1] > 0, exact[1], 1.0) for level in (0.27, 0.73)])
     return np.array(errors)
 
@@ -277,7 +278,7 @@ def test_summary_fit_follows_the_exact_fit_on_t_samples():
     x = loc + scale * rng.standard_t(df, size=(8000, 5))
     assert np.max(_summary_errors(x, 250)) < 1e-3
     true = scipy.stats.t.ppf(0.73, df, loc, scale)
-    exact = _t_quantile(fit_student_t(x), 0.73)
+    exact = t_quantile(fit_student_t(x), 0.73)
     assert np.all(np.abs(exact - true) < 0.05 * scale)
 
 

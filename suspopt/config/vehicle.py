@@ -14,7 +14,9 @@ from __future__ import annotations
 import copy
 from typing import Annotated, Any, ClassVar, Literal, Union
 
-from pydantic import Discriminator, Field, Tag, model_validator
+from pydantic import Discriminator, Field, Tag, create_model, model_validator
+
+from ..control.laws import LAWS, PARAMETERS
 
 from .base import (CubicStiffness, Damping, Inertia, Mass, Section, Stiffness,
                    TorsionalStiffness, VehicleLength, quantity)
@@ -75,24 +77,24 @@ class PassiveDamper(Section):
     soft_field: ClassVar[str] = "c"
 
 
-#: Control laws of a semi-active damper (suspopt.control has their exact definitions).
-DAMPER_LAWS = ("sh_2", "sh_l", "add", "sh_add_1", "sh_add_2", "groundhook", "hybrid")
+#: Control laws of a semi-active damper, from :data:`suspopt.control.laws.LAWS` (which has
+#: their exact definitions).
+DAMPER_LAWS = tuple(LAWS)
 #: Law parameters of SemiActiveDamper and the laws that use them.
 LAW_PARAMETERS: dict[str, tuple[str, ...]] = {
-    "linear_weight": ("sh_l",),
-    "crossover_frequency": ("sh_add_1", "sh_add_2"),
-    "skyhook_weight": ("hybrid",),
-}
+    name: tuple(law.name for law in LAWS.values() if name in law.parameters)
+    for name in PARAMETERS}
 
 
-class SemiActiveDamper(Section):
+class _SemiActiveFields(Section):
     """Controllable damper switched or varied between ``c_min`` and ``c_max`` (Sec 2.1.6).
 
-    ``law`` picks the control law: ``sh_2`` (Eq 2.34), ``sh_l`` (Eq 2.35), ``add`` (Eq 2.36),
-    ``sh_add_1`` (Eq 2.37), ``sh_add_2`` (Eq 2.39), ``groundhook`` and ``hybrid``
-    (skyhook-groundhook, named in Sec 4.4); :mod:`suspopt.control` defines each one with the
-    project's signs (``ST = z_s - z_u``, extension positive). The linear analyses (modal,
-    frequency response) see the soft state ``c_min``.
+    ``law`` picks the control law (:data:`suspopt.control.laws.LAWS`: ``sh_2`` Eq 2.34,
+    ``sh_l`` Eq 2.35, ``add`` Eq 2.36, ``sh_add_1`` Eq 2.37, ``sh_add_2`` Eq 2.39,
+    ``groundhook`` and ``hybrid``, named in Sec 4.4), each defined there with the project's
+    signs (``ST = z_s - z_u``, extension positive); the law's parameters are fields of their
+    own (:data:`suspopt.control.laws.PARAMETERS`), given exactly for the laws that take them.
+    The linear analyses (modal, frequency response) see the soft state ``c_min``.
     """
 
     kind: Literal["semi_active"] = Field(description="damper type")
@@ -100,23 +102,11 @@ class SemiActiveDamper(Section):
     c_max: Damping = Field(description="stiff damping coefficient C_max [N s/m], "
                                     "at least c_min")
     law: Literal[DAMPER_LAWS] = Field(description="control law: " + " | ".join(DAMPER_LAWS))
-    linear_weight: float | None = Field(
-        None, ge=0, le=1, allow_inf_nan=False,
-        description="SH-L tuning parameter alpha of Eq 2.35 in [0, 1] [-]; 1 gives SH-2 "
-        "(law sh_l only)")
-    crossover_frequency: quantity(1e-3, 1e5) | None = Field(
-        None,
-        description="frequency-range selector alpha of Eq 2.37-2.39 [rad/s] (the thesis uses "
-        "39 rad/s, about 6 Hz; laws sh_add_1 and sh_add_2 only)")
-    skyhook_weight: float | None = Field(
-        None, ge=0, le=1, allow_inf_nan=False,
-        description="share beta of the skyhook term in the hybrid law in [0, 1] [-]; 1 is pure "
-        "skyhook, 0 pure groundhook (law hybrid only)")
 
     soft_field: ClassVar[str] = "c_min"
 
     @model_validator(mode="after")
-    def _check(self) -> "SemiActiveDamper":
+    def _check(self) -> "_SemiActiveFields":
         if self.c_max < self.c_min:
             raise ValueError(f"c_max ({self.c_max}) must be at least c_min ({self.c_min})")
         for name, laws in LAW_PARAMETERS.items():
@@ -127,6 +117,22 @@ class SemiActiveDamper(Section):
                 raise ValueError(f"{name} is a parameter of law {' / '.join(laws)}, not of "
                                  f"{self.law!r}; remove it")
         return self
+
+
+def _parameter_field(parameter) -> tuple:
+    """The config field of a law parameter: optional, in its range, described."""
+    laws = " and ".join(LAW_PARAMETERS[parameter.name])
+    bound = {"gt" if parameter.low_open else "ge": parameter.low}
+    return (quantity(parameter.low, parameter.high) | None,
+            Field(None, **bound, le=parameter.high,
+                  description=f"{parameter.description} (law{'s' if ' and ' in laws else ''} "
+                              f"{laws} only)"))
+
+
+SemiActiveDamper = create_model(
+    "SemiActiveDamper", __base__=_SemiActiveFields, __module__=__name__,
+    __doc__=_SemiActiveFields.__doc__,
+    **{name: _parameter_field(p) for name, p in PARAMETERS.items()})
 
 
 def _damper_kind(value: Any) -> str:

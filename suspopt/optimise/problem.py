@@ -28,7 +28,7 @@ from pymoo.core.problem import Problem as _PymooProblem
 
 from ..config import Config, ConfigError
 from ..config.optimise import DesignVariable, Objective
-from ..control import build_controller
+from ..control.controller import build_controller
 from ..params import ParamView, numeric_paths, one_per_run
 from ..seat import CONSTRAINT_UNITS, build_attachments, seat_constraints, seat_static_deflection
 from ..simulate import signal_names, signal_units, simulate
