@@ -34,7 +34,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-__all__ = ["Elements", "Network", "LinearModel", "apply", "parameter_rows", "widen"]
+__all__ = ["Elements", "Network", "LinearModel", "Assembled", "apply", "parameter_rows",
+           "widen"]
 
 
 def apply(matrix: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -240,3 +241,102 @@ def _pad(matrix: np.ndarray, before: int, after: int) -> np.ndarray:
     """Zero columns around a (.., m, n) map."""
     widths = [(0, 0)] * (matrix.ndim - 1) + [(before, after)]
     return np.pad(matrix, widths)
+
+
+def _product(matrix: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
+    """``out = matrix @ x`` for a (P, r, c) matrix per design and columns ``x (c, P)``."""
+    np.einsum("prc,cp->rp", matrix, x, out=out)
+
+
+class Assembled:
+    """A network packed for fast evaluation of ``q'' = M^-1 Σ -D_qᵀ F`` (suspopt.network).
+
+    All groups' deformation rows are stacked: ``e = D2 @ [q; v] + offset`` gives the
+    displacements (rows ``:R``) and rates (rows ``R:``) of every element, ``F = coef * e`` their
+    elastic and viscous forces (``coef = [k; c]``), the groups' non-linear parts are added to
+    the elastic rows, and ``q'' = M^-1 G2 @ F`` with ``G2 = [G, G]`` (``G = -D_qᵀ``, masked
+    where a one-way seat does not push the body). ``offset`` holds the inputs' part
+    ``[D_u u; D_u u']``. A semi-active damper's coefficients are the rows ``damper_rows`` of
+    ``coef``. The deformation and force maps are shared by all designs unless a group's map
+    differs between them (``(P, ...)`` arrays, multiplied per design by :func:`_product`).
+    """
+
+    def __init__(self, network: Network, P: int, controlled: str | None = None):
+        self.network = network
+        n, groups = network.n, network.groups
+        R = sum(g.size for g in groups)
+        self.n, self.R, self.P = n, R, P
+        per_design = any(g.dof_map.ndim == 3 for g in groups)
+        dq = [np.broadcast_to(g.dof_map, (P, g.size, n)) if per_design else g.dof_map
+              for g in groups]
+        Dq = np.concatenate(dq, axis=-2)
+        D2 = np.zeros(Dq.shape[:-2] + (2 * R, 2 * n))
+        D2[..., :R, :n] = Dq
+        D2[..., R:, n:] = Dq
+        self.input_map = np.concatenate([g.input_map for g in groups])       # (R, n_u)
+        G = np.concatenate([np.broadcast_to(g.force_map, (P, n, g.size)) if per_design
+                            else g.force_map for g in groups], axis=-1)
+        # the non-linear parts are forces of their own rows of F, acting like their elements
+        extra_rows = np.concatenate([np.arange(start, start + g.size) for start, g
+                                     in zip(np.cumsum([0] + [g.size for g in groups]), groups)
+                                     if g.extra is not None] or [np.arange(0)])
+        G2 = np.concatenate([G, G, G[..., extra_rows]], axis=-1)
+        # M^-1 multiplies the accelerations even where it could be folded into G2: folding
+        # rounds differently, and a design must give the same bits whatever else varies in
+        # its batch
+        self.inverse_mass = np.ascontiguousarray(1.0 / np.broadcast_to(network.mass,
+                                                                       (n, P, 1)))
+        self.D2, self.G2 = np.ascontiguousarray(D2), np.ascontiguousarray(G2)
+        self.coef = np.ascontiguousarray(np.concatenate(
+            [np.broadcast_to(g.stiffness, (g.size, P, 1)) for g in groups]
+            + [np.broadcast_to(g.damping, (g.size, P, 1)) for g in groups]))
+        self.extras, self.damper_rows, start, out = [], None, 0, 2 * R
+        for g in groups:
+            rows = slice(start, start + g.size)
+            rates = slice(R + start, R + start + g.size)
+            if g.extra is not None:
+                self.extras.append((rows, rates, slice(out, out + g.size), g.extra,
+                                    g.extra_uses_force))
+                out += g.size
+            if g.name == controlled:
+                self.damper_rows = rates
+            start += g.size
+        self.F_rows = out
+
+    def offsets(self, u: np.ndarray, u_dot: np.ndarray) -> np.ndarray:
+        """``[D_u u; D_u u']`` at each sample of the inputs ``u, u_dot (n_u, T)``: (T, 2R,
+        1, 1), contiguous per sample."""
+        off = np.concatenate([self.input_map @ u, self.input_map @ u_dot])
+        return np.ascontiguousarray(off.T)[:, :, None, None]
+
+    def evaluator(self, width: int | None = None
+                  ) -> Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                 np.ndarray], None]:
+        """A function ``(y2, offset, coef, inverse_mass, acc2, acc) -> None`` that writes
+        ``q''`` of ``width`` design columns (default P) into ``acc``.
+
+        ``y2 = [q; v]`` (2n, width); ``offset`` (2R, 1|width, 1), or None where the inputs
+        are zero; ``coef`` (2R, width, 1);
+        ``inverse_mass`` (n, width, 1), scaled when the caller wants a multiple of q'';
+        ``acc2``/``acc`` the (n, width) and (n, width, 1) views of the output. Its buffers for
+        the deformations and forces are allocated once, with the non-linear parts' views into
+        them, so that the integrator's stages allocate nothing.
+        """
+        R, width = self.R, width or self.P
+        e, F = np.empty((2 * R, width, 1)), np.empty((self.F_rows, width, 1))
+        e2, F2, linear = e.reshape(2 * R, -1), F.reshape(self.F_rows, -1), F[:2 * R]
+        extras = [(F[rows], F[rates], e[rows], e[rates], F[out], make(width), uses)
+                  for rows, rates, out, make, uses in self.extras]
+        product = np.dot if self.D2.ndim == 2 else _product
+        D2, G2, multiply, add = self.D2, self.G2, np.multiply, np.add
+
+        def evaluate(y2, offset, coef, inverse_mass, acc2, acc) -> None:
+            product(D2, y2, out=e2)
+            if offset is not None:
+                e.__iadd__(offset)
+            multiply(coef, e, out=linear)
+            for elastic, viscous, disp, rate, out, fn, uses_force in extras:
+                fn(disp, rate, add(elastic, viscous) if uses_force else None, out)
+            product(G2, F2, out=acc2)
+            acc.__imul__(inverse_mass)
+        return evaluate

@@ -382,13 +382,12 @@ class SeatModel:
         own, floor = self.network.generalised_forces(q, v, base[None], base_vel[None])
         return own, floor[0]
 
-    def signal_names(self) -> list[str]:
-        return list(self._signals)
-
-    def signal(self, name: str, q: np.ndarray, v: np.ndarray, acc: np.ndarray,
-               base: np.ndarray, base_vel: np.ndarray, base_acc: np.ndarray) -> np.ndarray:
-        """Signal ``name`` (P, T) from the seat's states (m, P, T) and the floor's (P, T)."""
-        return self._signals[name](q, v, acc, base, base_vel, base_acc)
+    def signals(self) -> dict[str, tuple[str, Callable[..., np.ndarray]]]:
+        """The seat's and the passenger's entries of the signal table
+        (:class:`suspopt.result.Attachment`): name -> (SI unit, ``compute(q, v, acc, base,
+        base_vel, base_acc)``), a signal (P, T) from the seat's states (m, P, T) and the
+        floor's (P, T)."""
+        return {name: (signal_units(name), compute) for name, compute in self._signals.items()}
 
     def _signal_table(self) -> dict[str, Callable[..., np.ndarray]]:
         table: dict[str, Callable[..., np.ndarray]] = {

@@ -31,7 +31,7 @@ from ..config.optimise import DesignVariable, Objective
 from ..control.controller import build_controller
 from ..params import ParamView, numeric_paths, one_per_run
 from ..seat import CONSTRAINT_UNITS, build_attachments, seat_constraints, seat_static_deflection
-from ..simulate import signal_names, signal_units, simulate
+from ..simulate import signal_table, simulate
 from ..specs import evaluate_spec, metric_unit, spec_signals
 from ..vehicle import build_vehicle
 
@@ -271,12 +271,12 @@ def _signals_at_bounds(cfg: Config):
         attachments = build_attachments(cfg, pv)
     except ConfigError as exc:
         raise _at_variable(cfg, str(exc)) from None
-    units = dict(getattr(controller, "units", {}))
+    table = signal_table(model, dict(getattr(controller, "units", {})), attachments)
 
     def unit_of(name: str) -> str:
-        return units.get(name.split(".")[0]) or signal_units(name)
+        return table[name].unit
 
-    return signal_names(model, units, attachments), unit_of, model.corners
+    return list(table), unit_of, model.corners
 
 
 def _at_variable(cfg: Config, message: str) -> ConfigError:
