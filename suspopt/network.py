@@ -35,7 +35,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 __all__ = ["Elements", "Network", "LinearModel", "Assembled", "apply", "parameter_rows",
-           "widen"]
+           "shared_rows", "widen"]
 
 
 def apply(matrix: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -50,6 +50,11 @@ def parameter_rows(values: np.ndarray) -> np.ndarray:
     """Per-design values ``(P, rows)`` (element parameters, DOF masses) in the network layout
     ``(rows, P, 1)``, contiguous."""
     return np.ascontiguousarray(values.T)[:, :, None]
+
+
+def shared_rows(a: np.ndarray) -> np.ndarray:
+    """Collapse a (P, ...) array to (1, ...) when every design has the same values."""
+    return a[:1] if a.shape[0] > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape)) else a
 
 
 def widen(a: np.ndarray, width: int) -> np.ndarray:

@@ -48,9 +48,8 @@ from typing import Any
 import numpy as np
 
 from .config import Config, ConfigError
-from .network import Elements, Network, parameter_rows, widen
+from .network import Elements, Network, parameter_rows, shared_rows, widen
 from .params import ParamView
-from .vehicle import _shared
 
 __all__ = [
     "PASSENGER_PARTS", "SIGNAL_HEADS", "SeatModel", "Mechanism", "LinearSeat",
@@ -527,7 +526,7 @@ def build_seat(cfg: Config, pv: ParamView | None = None) -> SeatModel:
                                                                form)
         mass = np.stack(masses, axis=1)[:, None, :]
         network = seat_network(names, mass[:, 0, :], iso_links + links, mechanism)
-    return SeatModel(kind=seat.kind, dof_names=names, mass=_shared(mass),
+    return SeatModel(kind=seat.kind, dof_names=names, mass=shared_rows(mass),
                      point=(seat.position.x, seat.position.y),
                      coupled=seat.coupling == "two_way", network=network,
                      mechanism=mechanism, isolator={**isolator, "load_mass": load})

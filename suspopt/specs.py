@@ -16,8 +16,11 @@ from __future__ import annotations
 import difflib
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+
+from .metrics import energy, iso2631, springs, stats, transient
 
 
 __all__ = ["METRICS", "MetricDef", "evaluate_spec", "spec_signals", "metric_unit"]
@@ -25,11 +28,17 @@ __all__ = ["METRICS", "MetricDef", "evaluate_spec", "spec_signals", "metric_unit
 
 @dataclass(frozen=True)
 class MetricDef:
-    """A metric: ``kind`` says what it is computed from; ``unit`` maps the signal's unit."""
+    """A metric: ``kind`` says what it is computed from (statistic | iso2631 | transient |
+    switches | derived), ``unit`` maps the signal's unit to the metric's, ``compute(spec,
+    result, signal)`` gives its (P,) values from one signal of a Result, and a ``derived``
+    metric reads the per-corner signals of ``family`` (it takes no ``signal``). Adding a
+    metric is adding one entry to :data:`METRICS`."""
 
-    kind: str                    # statistic | iso2631 | transient | switches | derived
+    kind: str
     unit: Callable[[str], str]
     description: str
+    compute: Callable[[Any, Any, str], np.ndarray]
+    family: str | None = None
 
 
 def _same(u: str) -> str:
@@ -44,36 +53,88 @@ def _fixed(unit: str) -> Callable[[str], str]:
     return lambda _u: unit
 
 
-METRICS: dict[str, MetricDef] = {
-    "var": MetricDef("statistic", _square, "variance (Eq 2.87, 2.89, 2.91, 5.4)"),
-    "std": MetricDef("statistic", _same, "standard deviation"),
-    "rms": MetricDef("statistic", _same, "root mean square"),
-    "max": MetricDef("statistic", _same, "maximum (Eq 2.88, 2.90)"),
-    "min": MetricDef("statistic", _same, "minimum"),
-    "max_abs": MetricDef("statistic", _same, "maximum absolute value"),
-    "mean": MetricDef("statistic", _same, "mean"),
-    "peak_to_peak": MetricDef("statistic", _same, "maximum minus minimum"),
-    "rms_weighted": MetricDef("iso2631", _same, "ISO 2631-1 weighted r.m.s., RC (Eq 2.78)"),
-    "vdv": MetricDef("iso2631", lambda u: f"{u} s^0.25" if u != "m/s^2" else "m/s^1.75",
-                     "vibration dose value (Eq 2.82)"),
-    "mtvv": MetricDef("iso2631", _same, "maximum transient vibration value (Eq 2.81)"),
-    "crest_factor": MetricDef("iso2631", _fixed("1"), "crest factor (Eq 2.83)"),
-    "peak": MetricDef("transient", _same, "transient peak M_p (Sec 2.4.1)"),
-    "peak_time": MetricDef("transient", _fixed("s"), "time of the peak t_p (Sec 2.4.1)"),
-    "rise_time": MetricDef("transient", _fixed("s"), "10-90 % rise time t_r (Sec 2.4.1)"),
-    "settling_time": MetricDef("transient", _fixed("s"), "settling time t_s (Sec 2.4.1)"),
-    "overshoot": MetricDef("transient", _fixed("%"), "overshoot M_ov (Sec 2.4.1)"),
-    "steady_state": MetricDef("transient", _same, "steady state SST (Sec 2.4.1)"),
-    "switches": MetricDef("switches", _fixed("1"), "number of state changes SW (Sec 2.4.6)"),
-    "dissipated_power": MetricDef("derived", _fixed("W"), "mean damper power DE (Eq 2.92)"),
-    "spring_usage": MetricDef("derived", _fixed("1"), "non-linear spring usage (Eq 5.3)"),
-    "dynamic_tyre_load": MetricDef("derived", _fixed("1"),
-                                   "std of dynamic tyre load over static load"),
-}
+def _rate(result) -> float:
+    """The output sample rate of a Result [Hz]."""
+    return 1.0 / (result.time[1] - result.time[0])
 
-#: The statistics by metric name: functions of :mod:`suspopt.metrics.stats`.
-_STAT = {"var": "var", "std": "std", "rms": "rms", "max": "maximum", "min": "minimum",
-         "max_abs": "max_abs", "mean": "mean", "peak_to_peak": "peak_to_peak"}
+
+def _statistic(name: str) -> MetricDef:
+    description = {"var": "variance (Eq 2.87, 2.89, 2.91, 5.4)", "std": "standard deviation",
+                   "rms": "root mean square", "max": "maximum (Eq 2.88, 2.90)",
+                   "min": "minimum", "max_abs": "maximum absolute value", "mean": "mean",
+                   "peak_to_peak": "maximum minus minimum"}[name]
+    function = stats.STATISTICS[name]
+    return MetricDef("statistic", _square if name == "var" else _same, description,
+                     lambda spec, r, signal: function(r.signals[signal]))
+
+
+def _weighted(function) -> Callable[[Any, Any, str], np.ndarray]:
+    return lambda spec, r, signal: function(r.signals[signal], _rate(r), spec.weighting)
+
+
+def _transient(key: str) -> Callable[[Any, Any, str], np.ndarray]:
+    def compute(spec, r, signal):
+        start = getattr(r.config.road, "start", None)
+        return transient.transient_metrics(r.time, r.signals[signal], band=spec.band,
+                                           start=start)[key]
+    return compute
+
+
+def _corner(r, signal: str) -> tuple[str, int]:
+    corner = signal.rsplit(".", 1)[1]
+    return corner, r.model.corners.index(corner)
+
+
+def _dissipated_power(spec, r, signal):
+    corner, _ = _corner(r, signal)
+    return energy.mean_dissipated_power(r.signals[f"damper_force.{corner}"], r.signals[signal],
+                                        r.time)
+
+
+def _spring_usage(spec, r, signal):
+    _, c = _corner(r, signal)
+    return springs.nonlinear_spring_usage(r.signals[signal], r.model.spring_linear[:, 0, c],
+                                          r.model.spring_cubic[:, 0, c])
+
+
+def _dynamic_tyre_load(spec, r, signal):
+    _, c = _corner(r, signal)
+    return stats.dynamic_tyre_load_ratio(r.signals[signal],
+                                         r.model.static_tyre_load[:, 0, c])
+
+
+METRICS: dict[str, MetricDef] = {
+    **{name: _statistic(name) for name in stats.STATISTICS},
+    "rms_weighted": MetricDef("iso2631", _same, "ISO 2631-1 weighted r.m.s., RC (Eq 2.78)",
+                              _weighted(iso2631.weighted_rms)),
+    "vdv": MetricDef("iso2631", lambda u: f"{u} s^0.25" if u != "m/s^2" else "m/s^1.75",
+                     "vibration dose value (Eq 2.82)", _weighted(iso2631.vdv)),
+    "mtvv": MetricDef("iso2631", _same, "maximum transient vibration value (Eq 2.81)",
+                      lambda spec, r, signal: iso2631.mtvv(r.signals[signal], _rate(r),
+                                                           spec.weighting, tau=spec.tau)),
+    "crest_factor": MetricDef("iso2631", _fixed("1"), "crest factor (Eq 2.83)",
+                              _weighted(iso2631.crest_factor)),
+    "peak": MetricDef("transient", _same, "transient peak M_p (Sec 2.4.1)", _transient("peak")),
+    "peak_time": MetricDef("transient", _fixed("s"), "time of the peak t_p (Sec 2.4.1)",
+                           _transient("peak_time")),
+    "rise_time": MetricDef("transient", _fixed("s"), "10-90 % rise time t_r (Sec 2.4.1)",
+                           _transient("rise_time")),
+    "settling_time": MetricDef("transient", _fixed("s"), "settling time t_s (Sec 2.4.1)",
+                               _transient("settling_time")),
+    "overshoot": MetricDef("transient", _fixed("%"), "overshoot M_ov (Sec 2.4.1)",
+                           _transient("overshoot")),
+    "steady_state": MetricDef("transient", _same, "steady state SST (Sec 2.4.1)",
+                              _transient("steady_state")),
+    "switches": MetricDef("switches", _fixed("1"), "number of state changes SW (Sec 2.4.6)",
+                          lambda spec, r, signal: energy.damper_switches(r.signals[signal])),
+    "dissipated_power": MetricDef("derived", _fixed("W"), "mean damper power DE (Eq 2.92)",
+                                  _dissipated_power, family="travel_vel"),
+    "spring_usage": MetricDef("derived", _fixed("1"), "non-linear spring usage (Eq 5.3)",
+                              _spring_usage, family="travel"),
+    "dynamic_tyre_load": MetricDef("derived", _fixed("1"),
+                                   "std of dynamic tyre load over static load",
+                                   _dynamic_tyre_load, family="tyre_force"),
+}
 _REDUCE = {"mean": np.mean, "max": np.max, "min": np.min, "sum": np.sum}
 
 
@@ -83,8 +144,7 @@ def spec_signals(spec, available: list[str], corners: tuple[str, ...]) -> list[s
     if kind == "derived":
         if spec.signal is not None:
             raise ValueError(f"metric {spec.metric!r} takes no signal (it uses each corner's own)")
-        family = {"dissipated_power": "travel_vel", "spring_usage": "travel",
-                  "dynamic_tyre_load": "tyre_force"}[spec.metric]
+        family = METRICS[spec.metric].family
     elif spec.signal is None:
         raise ValueError(f"metric {spec.metric!r} needs a signal")
     else:
@@ -109,40 +169,6 @@ def metric_unit(spec, signal_unit: str) -> str:
     return METRICS[spec.metric].unit(signal_unit)
 
 
-def _one(spec, result, name: str) -> np.ndarray:
-    """The metric of one signal, (P,)."""
-    # the metrics (scipy) load when a metric is first computed, not when a config is read
-    from .metrics import energy, iso2631, springs, stats, transient
-
-    kind = METRICS[spec.metric].kind
-    if kind == "derived":
-        corner = name.rsplit(".", 1)[1]
-        c = result.model.corners.index(corner)
-        if spec.metric == "dissipated_power":
-            return energy.mean_dissipated_power(result.signals[f"damper_force.{corner}"],
-                                                result.signals[name], result.time)
-        if spec.metric == "spring_usage":
-            return springs.nonlinear_spring_usage(result.signals[name],
-                                                  result.model.spring_linear[:, 0, c],
-                                                  result.model.spring_cubic[:, 0, c])
-        return stats.dynamic_tyre_load_ratio(result.signals[name],
-                                             result.model.static_tyre_load[:, 0, c])
-    x = result.signals[name]
-    if kind == "statistic":
-        return getattr(stats, _STAT[spec.metric])(x)
-    fs = 1.0 / (result.time[1] - result.time[0])
-    if kind == "iso2631":
-        if spec.metric == "mtvv":
-            return iso2631.mtvv(x, fs, spec.weighting, tau=spec.tau)
-        return {"rms_weighted": iso2631.weighted_rms, "vdv": iso2631.vdv,
-                "crest_factor": iso2631.crest_factor}[spec.metric](x, fs, spec.weighting)
-    if kind == "transient":
-        start = getattr(result.config.road, "start", None)
-        values = transient.transient_metrics(result.time, x, band=spec.band, start=start)
-        return values[spec.metric]
-    return energy.damper_switches(x)
-
-
 def evaluate_spec(spec, result, signal_units: Callable[[str], str]
                   ) -> list[tuple[str, np.ndarray, str]]:
     """``[(name, values (P,), unit), ...]`` of one spec on a Result."""
@@ -150,7 +176,8 @@ def evaluate_spec(spec, result, signal_units: Callable[[str], str]
     base = spec.name or ".".join(filter(None, [spec.metric, spec.signal or None,
                                                spec.weighting]))
     unit = metric_unit(spec, signal_units(names[0]))
-    values = [np.asarray(_one(spec, result, n), dtype=float) for n in names]
+    compute = METRICS[spec.metric].compute
+    values = [np.asarray(compute(spec, result, n), dtype=float) for n in names]
     if len(names) == 1 and spec.signal in result.signals:
         return [(base, values[0], unit)]
     if spec.reduce != "none":

@@ -34,19 +34,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .config import Config, ConfigError
-from .config.vehicle import PRESET_BODY_DOFS, PRESET_CORNERS
-from .network import Elements, Network, parameter_rows, widen
+from .config.vehicle import DOF_FIELDS, PRESET_BODY_DOFS, PRESET_CORNERS
+from .network import Elements, Network, parameter_rows, shared_rows, widen
 from .params import ParamView
 
 __all__ = ["VehicleModel", "build_vehicle", "vehicle_network", "modal_analysis", "ModalResult",
            "frequency_response"]
 
-_INERTIA_FIELD = {"heave": "mass", "roll": "roll_inertia", "pitch": "pitch_inertia"}
-
-
-def _shared(a: np.ndarray) -> np.ndarray:
-    """Collapse a (P, ...) array to (1, ...) when every design has the same values."""
-    return a[:1] if a.shape[0] > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape)) else a
 
 
 @dataclass
@@ -98,16 +92,18 @@ class VehicleModel:
         return row
 
 
-def _corner_geometry(pv: ParamView, preset: str, corners: tuple[str, ...]):
+def _corner_geometry(pv: ParamView, body_dofs: tuple[str, ...], corners: tuple[str, ...]):
+    """Each corner's position (x, y) (P, N) [m]: its lever arms where the body pitches
+    (``x``) and rolls (``y``), 0 elsewhere (:class:`~suspopt.config.vehicle.Preset`)."""
     P = pv.P
     x = np.zeros((P, len(corners)))
     y = np.zeros((P, len(corners)))
     body = "vehicle.body."
     for i, name in enumerate(corners):
-        if preset in ("half_pitch", "full"):
+        if "pitch" in body_dofs:
             x[:, i] = pv.require_positive(body + "a_front") if name[0] == "F" \
                 else -pv.require_positive(body + "a_rear")
-        if preset in ("half_roll", "full"):
+        if "roll" in body_dofs:
             y[:, i] = pv.require_positive(body + "b_right") if name[1] == "1" \
                 else -pv.require_positive(body + "b_left")
     return x, y
@@ -122,7 +118,7 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     body_dofs = PRESET_BODY_DOFS[veh.preset]
     nb, N = len(body_dofs), len(corners)
     n = nb + N
-    x, y = _corner_geometry(pv, veh.preset, corners)
+    x, y = _corner_geometry(pv, body_dofs, corners)
 
     def corner_param(key: str, positive: bool = False) -> np.ndarray:
         get = pv.require_positive if positive else pv.get
@@ -141,7 +137,7 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
 
     mass = np.empty((P, n))
     for j, dof in enumerate(body_dofs):
-        mass[:, j] = pv.require_positive("vehicle.body." + _INERTIA_FIELD[dof])
+        mass[:, j] = pv.require_positive("vehicle.body." + DOF_FIELDS[dof][0])
     mass[:, nb:] = mu
 
     # travel map J: ST_i = z_s + y_i φ - x_i θ - z_ui
@@ -152,9 +148,9 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
 
     bar_map, bar_k = _anti_roll_bars(pv, corners, body_dofs)
     dof_names = tuple(f"body.{d}" for d in body_dofs) + tuple(f"wheel.{cn}" for cn in corners)
-    shared_J = _shared(J)
+    shared_J = shared_rows(J)
     network = vehicle_network(dof_names, mass, shared_J, kl, knl, c, kt, ct,
-                              None if bar_map is None else _shared(bar_map), bar_k)
+                              None if bar_map is None else shared_rows(bar_map), bar_k)
     linear = network.linear_model()
     K, C = linear.stiffness, linear.damping
     static = _static_tyre_load(mass, K, nb, N, kt, body_dofs, veh.gravity)
@@ -173,9 +169,9 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     e = (slice(None), None, slice(None))
     return VehicleModel(
         preset=veh.preset, body_dofs=body_dofs, corners=corners, P=P,
-        mass=_shared(mass[:, None, :]), stiffness=_shared(K), damping=_shared(C),
-        travel_map=shared_J, input_stiffness=_shared(linear.input_stiffness),
-        input_damping=_shared(linear.input_damping), unsprung_mass=mu[e], tyre_stiffness=kt[e], tyre_damping=ct[e], spring_linear=kl[e],
+        mass=shared_rows(mass[:, None, :]), stiffness=shared_rows(K), damping=shared_rows(C),
+        travel_map=shared_J, input_stiffness=shared_rows(linear.input_stiffness),
+        input_damping=shared_rows(linear.input_damping), unsprung_mass=mu[e], tyre_stiffness=kt[e], tyre_damping=ct[e], spring_linear=kl[e],
         spring_cubic=knl[e], damper=c[e], static_tyre_load=static[e],
         gravity=veh.gravity, offsets=offsets, sides=sides, dof_names=dof_names,
         network=network)

@@ -139,14 +139,14 @@ def test_balanced_weights_are_inverse_medians():
 
 
 def test_pymoo_algorithms_by_name_with_checked_options():
-    gde3 = pymoo_algorithm(ALGORITHMS["gde3"], {"CR": 0.5}, 20, 2)     # a DE variant option
+    gde3 = pymoo_algorithm(ALGORITHMS["gde3"].target, {"CR": 0.5}, 20, 2)     # a DE variant option
     front = minimize(TwoObjectives(), PymooOptimiser(gde3, termination(2, 10, None, 1e-9, 50)),
                      seed=1)
     assert front.feasible.all()
     with pytest.raises(ValueError, match="did you mean eliminate_duplicates"):
-        pymoo_algorithm(ALGORITHMS["ga"], {"eliminate_duplicate": True}, 10, 1)
+        pymoo_algorithm(ALGORITHMS["ga"].target, {"eliminate_duplicate": True}, 10, 1)
     with pytest.raises(ValueError, match="set by suspopt"):
-        pymoo_algorithm(ALGORITHMS["nsga2"], {"seed": 3}, 10, 2)
+        pymoo_algorithm(ALGORITHMS["nsga2"].target, {"seed": 3}, 10, 2)
 
 
 class Mixed(PymooProblem):
@@ -167,11 +167,11 @@ def test_every_registered_pymoo_algorithm_is_seeded_and_resumes_by_replay(name, 
     (the data-only checkpoint) rebuilds it exactly: no design is evaluated again."""
     from suspopt.optimise.run import _Recorder
 
-    n_obj = 3 if ".moo." in ALGORITHMS[name] else 1
+    n_obj = 1 if ALGORITHMS[name].single_objective else 3
     problem = Mixed(n_obj)
 
     def optimiser():
-        return PymooOptimiser(pymoo_algorithm(ALGORITHMS[name], {}, 12, n_obj),
+        return PymooOptimiser(pymoo_algorithm(ALGORITHMS[name].target, {}, 12, n_obj),
                               termination(n_obj, 8, None, 1e-12, 30))
     default_rng = np.random.default_rng
 

@@ -19,6 +19,7 @@ Design variables are numeric config fields by dotted path; derived quantities (a
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
 from pydantic import Field, field_validator, model_validator
@@ -26,7 +27,7 @@ from pydantic import Field, field_validator, model_validator
 from .base import Section, Seed, check_known, quantity
 from .metrics import MetricSpec
 
-__all__ = ["QUANTITIES", "ALGORITHMS", "DesignVariable", "Objective", "Constraint",
+__all__ = ["QUANTITIES", "Algorithm", "ALGORITHMS", "DesignVariable", "Objective", "Constraint",
            "Objectives", "WeightedSum", "Balance", "Hybrid", "Gradient", "Optimiser"]
 
 #: a bound or limit in a field's or a metric's SI unit
@@ -44,20 +45,29 @@ QUANTITIES: dict[str, str] = {
                      "8.7, 8.9, 8.11), one value each; constraints only",
 }
 
-#: Algorithms by name: the four of Ch. 5-7 and the pymoo algorithms ("module:Class") that are
-#: reproducible and can be checkpointed in pymoo 0.6.2. Left out: DE, PSO, ES, SRES, ISRES,
-#: NSGA-III and U-NSGA-III (some of their comparisons and survivals draw from an unseeded
-#: Generator, e.g. to break ties between designs of equal violation), SPEA2 (runs with one
-#: seed differ), Nelder-Mead, pattern search and G3PCX (their state holds Python generators,
-#: which do not pickle), MOEA/D, C-TAEA and RVEA (they need settings suspopt does not pass)
-#: and AGE-MOEA (needs numba). tests/test_optimise.py checks every entry.
-ALGORITHMS: dict[str, str] = {
-    "ga": "pymoo.algorithms.soo.nonconvex.ga:GA",
-    "nsga2": "pymoo.algorithms.moo.nsga2:NSGA2",
-    "gradient": "scipy.optimize:minimize",
-    "hybrid": "pymoo.algorithms.soo.nonconvex.ga:GA",
-    "smsemoa": "pymoo.algorithms.moo.sms:SMSEMOA",
-    "gde3": "pymoo.algorithms.moo.gde3:GDE3",
+@dataclass(frozen=True)
+class Algorithm:
+    """An optimiser by name: ``target`` the "module:Class" (or function) that implements it
+    and whether it minimises one objective (a weighted sum turns several into one)."""
+
+    target: str
+    single_objective: bool
+
+
+#: Algorithms by name: the four of Ch. 5-7 and the pymoo algorithms that are reproducible
+#: from one seeded Generator in pymoo 0.6.2. Left out: DE, PSO, ES, SRES, ISRES, NSGA-III and
+#: U-NSGA-III (some of their comparisons and survivals draw from an unseeded Generator, e.g.
+#: to break ties between designs of equal violation), SPEA2 (runs with one seed differ),
+#: Nelder-Mead, pattern search and G3PCX (not yet checked against the replayed checkpoints),
+#: MOEA/D, C-TAEA and RVEA (they need settings suspopt does not pass) and AGE-MOEA (needs
+#: numba). tests/test_optimise.py checks every entry.
+ALGORITHMS: dict[str, Algorithm] = {
+    "ga": Algorithm("pymoo.algorithms.soo.nonconvex.ga:GA", True),
+    "nsga2": Algorithm("pymoo.algorithms.moo.nsga2:NSGA2", False),
+    "gradient": Algorithm("scipy.optimize:minimize", True),
+    "hybrid": Algorithm("pymoo.algorithms.soo.nonconvex.ga:GA", True),
+    "smsemoa": Algorithm("pymoo.algorithms.moo.sms:SMSEMOA", False),
+    "gde3": Algorithm("pymoo.algorithms.moo.gde3:GDE3", False),
 }
 
 

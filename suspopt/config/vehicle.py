@@ -12,6 +12,7 @@ the ``control:`` section (:mod:`suspopt.config.control`).
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 from typing import Annotated, Any, ClassVar, Literal, Union
 
 from pydantic import Discriminator, Field, Tag, create_model, model_validator
@@ -22,33 +23,47 @@ from .base import (CubicStiffness, Damping, Inertia, Mass, Section, Stiffness,
                    TorsionalStiffness, VehicleLength, quantity)
 
 __all__ = [
-    "PRESET_CORNERS", "PRESET_BODY_DOFS", "DAMPER_LAWS", "LAW_PARAMETERS", "Spring", "Tyre",
+    "Preset", "PRESETS", "DOF_FIELDS", "CORNER_NAMES", "PRESET_CORNERS", "PRESET_BODY_DOFS", "DAMPER_LAWS", "LAW_PARAMETERS", "Spring", "Tyre",
     "PassiveDamper", "SemiActiveDamper", "Damper", "Corner", "Body",
     "AntiRollBars", "Vehicle", "corner_defaults_schema",
 ]
 
-#: Corners of each preset (thesis names: F1 front right, F2 front left, R1 rear right,
-#: R2 rear left).
-PRESET_CORNERS: dict[str, tuple[str, ...]] = {
-    "quarter": ("F1",),
-    "half_roll": ("F1", "F2"),
-    "half_pitch": ("F1", "R1"),
-    "full": ("F1", "F2", "R1", "R2"),
-}
-#: Body degrees of freedom of each preset (Eq 2.1, 2.5-2.6, 2.13-2.14, 2.19-2.21).
-PRESET_BODY_DOFS: dict[str, tuple[str, ...]] = {
-    "quarter": ("heave",),
-    "half_roll": ("heave", "roll"),
-    "half_pitch": ("heave", "pitch"),
-    "full": ("heave", "roll", "pitch"),
-}
-#: Body fields each preset needs.
-_REQUIRED_BODY = {
-    "quarter": (),
-    "half_roll": ("roll_inertia", "b_right", "b_left"),
-    "half_pitch": ("pitch_inertia", "a_front", "a_rear"),
-    "full": ("roll_inertia", "pitch_inertia", "a_front", "a_rear", "b_right", "b_left"),
-}
+@dataclass(frozen=True)
+class Preset:
+    """A vehicle model: the rigid body's degrees of freedom (a subset of heave, roll and
+    pitch) and its corners (thesis names: F1 front right, F2 front left, R1 rear right, R2
+    rear left). What the body needs follows from its DOFs (:data:`DOF_FIELDS`), and where a
+    corner sits from its name and the DOFs (a front corner ``a_front`` ahead of the centre of
+    gravity when the body pitches, a right one ``b_right`` to the right when it rolls)."""
+
+    name: str
+    label: str
+    body_dofs: tuple[str, ...]
+    corners: tuple[str, ...]
+
+    @property
+    def required_body(self) -> tuple[str, ...]:
+        """The body fields this preset needs besides the mass."""
+        return tuple(f for dof in self.body_dofs for f in DOF_FIELDS[dof][1:])
+
+
+#: What each body DOF needs of the body: its inertia (or the mass) and the corners' lever arms.
+DOF_FIELDS = {"heave": ("mass",), "roll": ("roll_inertia", "b_right", "b_left"),
+              "pitch": ("pitch_inertia", "a_front", "a_rear")}
+#: The vehicle models, all presets of one corner-based model (Eq 2.1, 2.5-2.6, 2.13-2.14,
+#: 2.19-2.21). Adding a preset is adding one entry here.
+PRESETS: dict[str, Preset] = {p.name: p for p in (
+    Preset("quarter", "QC", ("heave",), ("F1",)),
+    Preset("half_roll", "HC1", ("heave", "roll"), ("F1", "F2")),
+    Preset("half_pitch", "HC2", ("heave", "pitch"), ("F1", "R1")),
+    Preset("full", "FC", ("heave", "roll", "pitch"), ("F1", "F2", "R1", "R2")),
+)}
+#: Corners of each preset.
+PRESET_CORNERS: dict[str, tuple[str, ...]] = {k: p.corners for k, p in PRESETS.items()}
+#: Body degrees of freedom of each preset.
+PRESET_BODY_DOFS: dict[str, tuple[str, ...]] = {k: p.body_dofs for k, p in PRESETS.items()}
+#: Every corner name of the presets, in order.
+CORNER_NAMES = tuple(dict.fromkeys(c for p in PRESETS.values() for c in p.corners))
 
 
 class Spring(Section):
@@ -206,8 +221,8 @@ class Vehicle(Section):
     """A rigid body on corners; the four thesis models are presets
     (docs/architecture.md#conventions)."""
 
-    preset: Literal["quarter", "half_roll", "half_pitch", "full"] = Field(
-        description="quarter (QC) | half_roll (HC1) | half_pitch (HC2) | full (FC)")
+    preset: Literal[tuple(PRESETS)] = Field(
+        description=" | ".join(f"{p.name} ({p.label})" for p in PRESETS.values()))
     body: Body
     corner_defaults: dict[str, Any] | None = Field(
         None, description="values shared by every corner; a corner's own keys override them")
@@ -245,12 +260,13 @@ class Vehicle(Section):
         if missing:
             raise ValueError(f"preset {self.preset!r} needs corners {list(wanted)}; "
                              f"missing {missing} (give them or corner_defaults)")
-        need = [f for f in _REQUIRED_BODY[self.preset] if getattr(self.body, f) is None]
+        need = [f for f in PRESETS[self.preset].required_body if getattr(self.body, f) is None]
         if need:
             raise ValueError(f"preset {self.preset!r} needs body.{', body.'.join(need)}")
         if (self.anti_roll_bars.front or self.anti_roll_bars.rear) and \
-                self.preset not in ("half_roll", "full"):
-            raise ValueError("anti_roll_bars need a model with roll (half_roll or full)")
+                "roll" not in PRESETS[self.preset].body_dofs:
+            rolling = " or ".join(k for k, p in PRESETS.items() if "roll" in p.body_dofs)
+            raise ValueError(f"anti_roll_bars need a model with roll ({rolling})")
         return self
 
 
@@ -301,7 +317,7 @@ def corner_defaults_schema(defs: dict) -> None:
     vehicle = defs["Vehicle"]
     props = vehicle["properties"]
     part = {"$ref": "#/$defs/" + _partial(defs, "Corner")}
-    names = PRESET_CORNERS["full"]
+    names = CORNER_NAMES
     props["corner_defaults"]["anyOf"] = [part, {"type": "null"}]
     props["corners"].pop("additionalProperties")
     props["corners"]["properties"] = {name: {"anyOf": [part, {"type": "null"}]}

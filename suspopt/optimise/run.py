@@ -211,7 +211,7 @@ def build_optimiser(cfg: Config, problem: Problem) -> Optimiser:
         return _gradient(cfg, problem, opt.generations, opt.max_evaluations)
     n_obj = 1 if opt.weighted_sum else problem.n_obj
     try:
-        algorithm = pymoo_algorithm(ALGORITHMS[opt.algorithm], opt.options, opt.population,
+        algorithm = pymoo_algorithm(ALGORITHMS[opt.algorithm].target, opt.options, opt.population,
                                     n_obj)
     except ValueError as exc:
         raise cfg.error(("optimiser", "options"), str(exc)) from None
@@ -236,7 +236,7 @@ def _gradient(cfg: Config, problem: Problem, iterations, evaluations) -> Gradien
 def _check_objectives(cfg: Config, problem: Problem) -> None:
     """The algorithm suits the number of objectives; weights match the objectives."""
     opt = cfg.optimiser
-    single = opt.algorithm in ("gradient", "hybrid") or ".soo." in ALGORITHMS[opt.algorithm]
+    single = ALGORITHMS[opt.algorithm].single_objective
     if opt.weighted_sum is None:
         if single and problem.n_obj > 1:
             raise cfg.error(("optimiser", "algorithm"), f"{opt.algorithm} minimises one "
