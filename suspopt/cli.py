@@ -70,27 +70,36 @@ class _FoldingTable(Table):
     """A table whose cells fold onto further lines when the terminal is narrow (a CI log's
     80 columns) instead of being cut to "…"."""
 
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.cells: list[tuple[str, ...]] = []      # the rows as given, for _show
+
     def add_column(self, *args, **kwargs) -> None:
         kwargs.setdefault("overflow", "fold")
         super().add_column(*args, **kwargs)
+
+    def add_row(self, *cells, **kwargs) -> None:
+        self.cells.append(tuple(str(c) for c in cells))
+        super().add_row(*cells, **kwargs)
 
 
 def _table(title: str | None = None) -> Table:
     return _FoldingTable(title=title)
 
 
-def _show(table: Table, keys: int = 1) -> None:
+def _show(table: _FoldingTable, keys: int = 1) -> None:
     """Print ``table``; when it is wider than the terminal (a CI log's 80 columns), as several
     tables of the columns that fit, each with the first ``keys`` columns again, so that no
     number is cut or broken across lines."""
-    def needs(column) -> int:             # its widest cell and the border and padding
-        return max(len(str(c)) for c in [column.header, *column._cells]) + 3
+    def needs(j: int) -> int:             # column j's widest cell and the border and padding
+        return max(len(str(c)) for c in [table.columns[j].header,
+                                          *(row[j] for row in table.cells)]) + 3
 
-    width = out.width
-    if 1 + sum(needs(c) for c in table.columns) <= width or len(table.columns) <= keys + 1:
+    width, count = out.width, len(table.columns)
+    if 1 + sum(needs(j) for j in range(count)) <= width or count <= keys + 1:
         out.print(table)
         return
-    key, rest = table.columns[:keys], table.columns[keys:]
+    key, rest = list(range(keys)), list(range(keys, count))
     base = 1 + sum(needs(c) for c in key)
     groups, current, used = [], [], base
     for column in rest:
@@ -103,10 +112,10 @@ def _show(table: Table, keys: int = 1) -> None:
     title = str(table.title or "")
     for i, group in enumerate(groups, start=1):
         part = _table(f"{title} ({i} of {len(groups)})" if title else None)
-        for column in key + group:
-            part.add_column(column.header, justify=column.justify)
-        for row in range(table.row_count):
-            part.add_row(*(column._cells[row] for column in key + group))
+        for j in key + group:
+            part.add_column(table.columns[j].header, justify=table.columns[j].justify)
+        for row in table.cells:
+            part.add_row(*(row[j] for j in key + group))
         out.print(part)
 
 

@@ -17,7 +17,8 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 
-__all__ = ["reuse_memory", "parse_size", "set_limit", "available", "limit", "describe", "check"]
+__all__ = ["reuse_memory", "parse_size", "set_limit", "explicit_limit", "available", "limit",
+           "describe", "check"]
 
 #: mallopt parameters of glibc's malloc.h.
 _M_TRIM_THRESHOLD, _M_MMAP_MAX = -1, -4
@@ -68,6 +69,11 @@ def set_limit(size: int | None) -> None:
     """Cap what a run may allocate (``--max-memory``); None: the machine's free memory."""
     global _limit
     _limit = size
+
+
+def explicit_limit() -> int | None:
+    """The ``--max-memory`` limit [bytes], or None when none was set."""
+    return _limit
 
 
 def available() -> int:

@@ -167,8 +167,8 @@ class Problem(_PymooProblem):
             signals = len({n for t in self._all_terms() if t.spec.metric
                            for n in t.signals})
             _, per_design = run_memory(self._sim_cfg, model, attachments, 1, signals)
-            budget = BATCH_BYTES if memory._limit is None else min(BATCH_BYTES,
-                                                                   memory._limit // 2)
+            cap = memory.explicit_limit()
+            budget = BATCH_BYTES if cap is None else min(BATCH_BYTES, cap // 2)
             self._width = max(1, int(budget // per_design))
         return self._width
 
