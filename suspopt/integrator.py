@@ -451,6 +451,20 @@ class _Splitter:
                 self.impulse(found[j])
 
 
+def _controller_hold(controller: Controller, rk4: "_RK4", asm: Assembled, n_vehicle: int,
+                     n_out: int, dt: float) -> "_ControllerHold":
+    """The controller's hold over the stepper ``rk4``: it reads the vehicle's states and, when
+    a law needs them, the accelerations at its sample (the first stage of that step)."""
+    n, P = asm.n, asm.P
+
+    def vehicle_acceleration() -> np.ndarray:
+        rk4.first(hold.sample_index)
+        return rk4.acc[:n_vehicle, :P, 0].copy()
+    vehicle = _VehicleState(rk4.y[n:n + n_vehicle, :P, 0], vehicle_acceleration)
+    hold = _ControllerHold(controller, rk4.coef, asm.damper_rows, P, n_out, dt, vehicle)
+    return hold
+
+
 def integrate(asm: Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, n_steps: int,
               every: int, controller: Controller | None = None,
               edges: Edges | None = None) -> Trajectory:
@@ -498,11 +512,7 @@ def integrate(asm: Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, n_
     buffers = [(rk4.y, states), (rk4.acc, accelerations)]
     hold = None
     if controller is not None:
-        def vehicle_acceleration() -> np.ndarray:
-            rk4.first(hold.sample_index)
-            return rk4.acc[:n_vehicle, :P, 0].copy()
-        vehicle = _VehicleState(rk4.y[n:n + n_vehicle, :P, 0], vehicle_acceleration)
-        hold = _ControllerHold(controller, rk4.coef, asm.damper_rows, P, n_out, dt, vehicle)
+        hold = _controller_hold(controller, rk4, asm, n_vehicle, n_out, dt)
         if hold.lagged is not None:
             buffers.append((hold.damping, hold.lagged))
     recorder, divergence = _Recorder(buffers, P, n_out), _Divergence(rk4.y2, P, dt)

@@ -141,6 +141,43 @@ class LinearModel:
     input_stiffness: np.ndarray
     input_damping: np.ndarray
 
+    @property
+    def P(self) -> int:
+        return self.mass.shape[0]
+
+    def part(self, dofs: slice) -> "LinearModel":
+        """The DOFs ``dofs`` alone, the others held still (their coupling terms dropped)."""
+        return LinearModel(self.dof_names[dofs], self.input_names, self.mass[:, dofs],
+                           self.stiffness[:, dofs, dofs], self.damping[:, dofs, dofs],
+                           self.input_stiffness[:, dofs], self.input_damping[:, dofs])
+
+    def frequency_response(self, f: np.ndarray, inputs: np.ndarray | None = None) -> np.ndarray:
+        """Complex DOF amplitudes ``Q (P, F, n)`` under harmonic inputs ``u = R exp(jωt)``:
+        ``(K - ω² M + jω C) Q = (B_k + jω B_c) R``.
+
+        ``f (F,)`` [Hz]; ``inputs (F, n_u)`` the complex input amplitudes ``R`` per frequency
+        [m] (default: a unit amplitude on every input). Accelerations are ``-ω² Q``; for a
+        unit input displacement, ``Q`` is also the acceleration ratio to the input's.
+        """
+        f = np.atleast_1d(np.asarray(f, dtype=float))
+        omega = 2.0 * np.pi * f
+        n, nu = len(self.dof_names), self.input_stiffness.shape[-1]
+        R = np.ones((f.size, nu)) if inputs is None else np.asarray(inputs)
+        w = omega[None, :, None, None]
+        dyn = self.stiffness[:, None] - w ** 2 * (self.mass[:, None, :, None] * np.eye(n)) \
+            + 1j * w * self.damping[:, None]
+        B = self.input_stiffness[:, None] + 1j * w * self.input_damping[:, None]  # (P, F, n, nu)
+        rhs = np.broadcast_to(B @ R[None, :, :, None], (self.P, f.size, n, 1))
+        return np.linalg.solve(dyn, rhs)[..., 0]
+
+    def modes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Undamped natural frequencies ``(P, n)`` [Hz], ascending, and mode shapes
+        ``(P, n, n)`` (columns, in the DOFs' own units) of ``K φ = ω² M φ``, inputs held still;
+        solved as the symmetric ``M^-1/2 K M^-1/2`` (M diagonal), batched over designs."""
+        s = 1.0 / np.sqrt(self.mass)
+        lam, vec = np.linalg.eigh(s[:, :, None] * self.stiffness * s[:, None, :])
+        return np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi), s[:, :, None] * vec
+
 
 @dataclass
 class Network:

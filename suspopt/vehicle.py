@@ -35,7 +35,7 @@ import numpy as np
 
 from .config import Config, ConfigError
 from .config.vehicle import DOF_FIELDS, PRESET_BODY_DOFS, PRESET_CORNERS
-from .network import Elements, Network, parameter_rows, shared_rows, widen
+from .network import Elements, LinearModel, Network, parameter_rows, shared_rows, widen
 from .params import ParamView
 
 __all__ = ["VehicleModel", "build_vehicle", "vehicle_network", "modal_analysis", "ModalResult",
@@ -82,6 +82,18 @@ class VehicleModel:
     def wheels(self) -> slice:
         """Slice of the wheel heaves in ``q``."""
         return slice(self.n_body, self.n_body + len(self.corners))
+
+    @property
+    def linear(self) -> LinearModel:
+        """The linear(ised) equations of motion, (P, ...) rows; the road under each wheel the
+        inputs. Duffing and lift-off are not in it."""
+        P, n, N = self.P, self.n_dof, len(self.corners)
+        return LinearModel(self.dof_names, tuple(f"road.{cn}" for cn in self.corners),
+                           np.broadcast_to(self.mass[:, 0, :], (P, n)),
+                           np.broadcast_to(self.stiffness, (P, n, n)),
+                           np.broadcast_to(self.damping, (P, n, n)),
+                           np.broadcast_to(self.input_stiffness, (P, n, N)),
+                           np.broadcast_to(self.input_damping, (P, n, N)))
 
     def point_map(self, x: float, y: float) -> np.ndarray:
         """Row (n,) giving the body's vertical displacement at the body point (x, y) [m]
@@ -323,16 +335,13 @@ def modal_analysis(model: VehicleModel) -> ModalResult:
     hop modes are collective (a pair of wheels in or against phase), so no single wheel names
     them.
     """
-    m = np.broadcast_to(model.mass[:, 0, :], (model.P, model.n_dof))
-    K = np.broadcast_to(model.stiffness, (model.P, model.n_dof, model.n_dof))
-    s = 1.0 / np.sqrt(m)
-    lam, vec = np.linalg.eigh(s[:, :, None] * K * s[:, None, :])
-    shape = s[:, :, None] * vec
+    frequency, shape = model.linear.modes()
+    m = model.linear.mass
     shape = shape / np.max(np.abs(shape), axis=1, keepdims=True)
     energy = m[:, :, None] * shape ** 2
     energy = energy / energy.sum(axis=1, keepdims=True)
     names = np.array(model.dof_names)
-    return ModalResult(frequency=np.sqrt(np.clip(lam, 0, None)) / (2 * np.pi), shape=shape,
+    return ModalResult(frequency=frequency, shape=shape,
                        energy=energy, dominant=names[np.argmax(energy, axis=1)],
                        label=_mode_labels(shape, energy, names), dof_names=model.dof_names)
 
@@ -353,13 +362,4 @@ def frequency_response(model: VehicleModel, f: np.ndarray, speed: float | None =
     use = np.array([c in (corners or model.corners) for c in model.corners], dtype=float)
     delay = model.offsets / speed if speed else np.zeros(len(model.corners))
     road = use[None, :] * np.exp(-1j * omega[:, None] * delay[None, :])  # (F, N)
-    n = model.n_dof
-    m = np.broadcast_to(model.mass[:, 0, :], (model.P, n))
-    K = np.broadcast_to(model.stiffness, (model.P, n, n))
-    C = np.broadcast_to(model.damping, (model.P, n, n))
-    dyn = K[:, None] - omega[None, :, None, None] ** 2 * (m[:, None, :, None] * np.eye(n)) \
-        + 1j * omega[None, :, None, None] * C[:, None]
-    B = model.input_stiffness[:, None] + 1j * omega[None, :, None, None] \
-        * model.input_damping[:, None]                                 # (P|1, F, n, N)
-    rhs = np.broadcast_to(B @ road[None, :, :, None], (model.P, f.size, n, 1))
-    return np.linalg.solve(dyn, rhs)[..., 0]
+    return model.linear.frequency_response(f, road)

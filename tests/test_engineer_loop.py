@@ -164,11 +164,14 @@ def test_the_command_follows_the_conventions(capsys):
 
 
 def test_tables_fit_80_columns_without_cutting_a_cell(kesort_file, monkeypatch, capsys):
-    from suspopt import cli as cli_module
+    import sys
+
     from rich.console import Console
 
-    monkeypatch.setattr(cli_module, "out", Console(width=80, markup=False, emoji=False,
-                                                   highlight=False))
+    narrow = Console(width=80, markup=False, emoji=False, highlight=False)
+    for name, module in list(sys.modules.items()):      # every command module prints to it
+        if name.startswith("suspopt.cli") and hasattr(module, "out"):
+            monkeypatch.setattr(module, "out", narrow)
     front, ke = kesort_file
     for args in (("simulate", CONFIGS / "ch3/part1a_fc_bump.yaml"), ("kesort", front),
                  ("simulate", ke, "--pick", "knee,best_f1,best_f2,best_f3"),

@@ -508,13 +508,13 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
 
 
 def test_numpy_warnings_are_one_line_each():
-    code = ("import numpy as np, suspopt.cli as cli\n"
+    code = ("import numpy as np, suspopt.cli.configs as cli\n"
             "from suspopt._entry import main\n"
             "def noisy(path):\n"
             "    for _ in range(3):\n"
             "        np.log(np.zeros(2))\n"
             "    raise SystemExit(0)\n"
-            "cli._load = noisy\n"
+            "cli.read_config = noisy\n"
             "raise SystemExit(main(['validate', 'x.yaml']))\n")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           cwd=ROOT, timeout=120)

@@ -97,7 +97,7 @@ def test_the_simulation_figure_has_time_psd_and_comfort_panels_for_every_design(
     signals = plots.default_signals(sweep)
     assert signals == ["body.heave_acc", "travel.F1", "travel.R1", "tyre_deflection.F1",
                        "tyre_deflection.R1"]
-    labels = plots._design_labels(sweep.designs, [0, 1, 2], 3, sweep.diverged_at)
+    labels = plots.design_labels(sweep.designs, [0, 1, 2], 3, sweep.diverged_at)
     assert labels[1] == "#1 F1.damper.c=3000, R1.damper.c=3500"
     fig = plots.simulation_figure(sweep.time, {n: sweep.signals[n] for n in signals},
                                   {n: sweep.signal_unit(n) for n in signals}, labels)
@@ -156,9 +156,9 @@ def test_more_designs_than_fit_are_thinned_evenly_and_the_title_says_so(tmp_path
     cfg = suspopt.load_config(CONFIGS / "quickstart.yaml")
     res = suspopt.simulate(cfg, params={"vehicle.corners.F1.damper.c":
                                         np.linspace(1000.0, 8000.0, 20)})
-    chosen, note = plots._chosen_designs(20, None)
+    chosen, note = plots.chosen_designs(20, None)
     assert chosen == [0, 3, 5, 8, 11, 14, 16, 19] and note.startswith("8 of 20 designs drawn")
-    assert plots._chosen_designs(5, None) == ([0, 1, 2, 3, 4], "")
+    assert plots.chosen_designs(5, None) == ([0, 1, 2, 3, 4], "")
     path = plots.plot_simulation(res, tmp_path / "many.svg", signals=["body.heave_acc"])
     text = path.read_text()
     assert "8 of 20 designs drawn" in text and "#19 damper.c=8000" in text
@@ -192,10 +192,10 @@ def test_design_labels_show_what_varies_and_where_a_design_diverged():
     designs = {"vehicle.corners.F1.spring.linear": np.array([1e4, 2e4]),
                "vehicle.corners.R1.spring.linear": np.array([1e4, 3e4]),
                "vehicle.body.mass": np.array([300.0, 300.0])}
-    assert plots._design_labels(designs, [0, 1], 2, np.array([np.nan, 1.25])) == [
+    assert plots.design_labels(designs, [0, 1], 2, np.array([np.nan, 1.25])) == [
         "#0 F1.spring.linear=1e+04, R1.spring.linear=1e+04",
         "#1 F1.spring.linear=2e+04, R1.spring.linear=3e+04 (diverged at 1.25 s)"]
-    assert plots._design_labels({}, [0], 1, np.array([np.nan])) == ["design"]
+    assert plots.design_labels({}, [0], 1, np.array([np.nan])) == ["design"]
 
 
 # --- optimise ------------------------------------------------------------------------------

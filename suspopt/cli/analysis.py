@@ -1,0 +1,96 @@
+"""``analyse``: the analyses of Ch. 3, 7 and 8 (see :mod:`suspopt.cli`)."""
+
+from __future__ import annotations
+
+from contextlib import ExitStack
+from pathlib import Path
+from typing import Optional
+import typer
+from ..errors import ConfigError
+from .base import (app, out, FORCE_HELP, MEMORY_HELP, new_table, show_table, fail, set_memory_limit, claim_output)
+
+
+_ANALYSE_OPTIONS = {"reference": "--reference", "road": "--road", "with_": "--with",
+                    "mass_change": "--mass-change"}
+
+
+def _analysis_help() -> str:
+    from ..analyse import SUMMARIES
+
+    return "analysis kind: " + "; ".join(f"{k}: {v}" for k, v in SUMMARIES.items())
+
+
+def _analysis_kinds(incomplete: str) -> list[str]:
+    from ..analyse import SUMMARIES
+
+    return [k for k in SUMMARIES if k.startswith(incomplete)]
+
+
+@app.command()
+def analyse(kind: str = typer.Argument(..., help=_analysis_help(),
+                                       autocompletion=_analysis_kinds),
+            sources: list[Path] = typer.Argument(
+                ..., help="YAML config, or Pareto HDF5 file; models takes several configs"),
+            output: Optional[Path] = typer.Option(None, "-o", "--output",
+                                                  help="HDF5 file for the numbers"),
+            plot: Optional[Path] = typer.Option(None, "--plot",
+                                                help="figure file (.png or .svg)"),
+            reference: Optional[Path] = typer.Option(
+                None, "--reference", help="models: the config the others are compared with "
+                "(default the first)"),
+            road: Optional[list[str]] = typer.Option(
+                None, "--road", help="roads: an ISO 8608 class (A-E), or a config whose road "
+                "and simulation sections replace the stored ones; repeatable"),
+            with_: Optional[list[Path]] = typer.Option(
+                None, "--with", help="controllers: YAML whose control: section and dampers "
+                "replace the stored ones; repeatable"),
+            mass_change: Optional[list[float]] = typer.Option(
+                None, "--mass-change", help="masses: change of the load on the seat, in kg; "
+                "repeatable (default -20 and +20)"),
+            force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+            max_memory: Optional[str] = typer.Option(None, "--max-memory",
+                                                     help=MEMORY_HELP)) -> None:
+    """Run an analysis of configs or of a Pareto file and print its table: models, roads,
+    masses, controllers, transmissibility or cdf-sensitivity (see KIND below)."""
+    from ..analyse import analysis_kinds
+    from ..plots import check_path
+
+    kinds = analysis_kinds()
+    if kind not in kinds:
+        fail(f"analyse: unknown kind {kind!r}; available: {', '.join(sorted(kinds))}")
+    spec = kinds[kind]
+    if len(sources) > 1 and not spec.many:
+        fail(f"analyse {kind} takes one SOURCE, got {len(sources)}")
+    for source in sources:
+        if not source.exists():
+            fail(f"{source}: no such file")
+    given = {"reference": reference, "road": road or None, "with_": with_ or None,
+             "mass_change": mass_change or None}
+    options = {key: value for key, value in given.items() if value is not None}
+    wrong = [_ANALYSE_OPTIONS[key] for key in options if key not in spec.options]
+    if wrong:
+        fail(f"analyse {kind} does not take {', '.join(wrong)}")
+    set_memory_limit(max_memory)
+    with ExitStack() as stack:
+        try:
+            if plot is not None:
+                check_path(plot)
+        except ValueError as exc:
+            fail(str(exc))
+        claim_output(stack, output, force)
+        claim_output(stack, plot, force, "--plot")
+        try:
+            report = spec.run(sources if spec.many else sources[0], output, plot, **options)
+        except (ConfigError, FileNotFoundError, ValueError) as exc:
+            fail(str(exc))
+    table = new_table(report.title)
+    for col in report.columns:
+        table.add_column(col)
+    for row in report.rows:
+        table.add_row(*row)
+    show_table(table, keys=2 if report.columns[:2] == ["metric", "unit"] else 1)
+    for note in report.notes:
+        out.print(note)
+    for path in (output, plot):
+        if path is not None:
+            out.print(f"wrote {path}")

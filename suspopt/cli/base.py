@@ -1,0 +1,153 @@
+"""The command's shared parts: the typer app and its global options, the consoles, the tables that fold to the terminal, output claiming and config loading (see :mod:`suspopt.cli`)."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+from contextlib import ExitStack
+from pathlib import Path
+import typer
+from rich.console import Console
+from rich.table import Table
+from ..errors import ConfigError
+
+
+app = typer.Typer(add_completion=True, no_args_is_help=True, pretty_exceptions_enable=False,
+                  help="Simulate, optimise and select vehicle and seat suspensions from YAML.")
+# text from files and arguments is printed as it is: no rich markup, no emoji codes
+# (":x:" in a file name), no highlighting
+out = Console(markup=False, emoji=False, highlight=False, soft_wrap=True)
+err = Console(stderr=True, markup=False, emoji=False, highlight=False, soft_wrap=True)
+
+#: Exit code of a run that finished but whose every design failed to simulate.
+EXIT_ALL_FAILED = 3
+
+FORCE_HELP = "replace an existing output that suspopt did not write"
+MEMORY_HELP = ("most memory a run may take, e.g. 4G (default: what the machine has free); "
+                "evaluations of many designs run in batches of at most half of it")
+
+
+#: ``-v``: what each step did and how long it took, on stderr.
+VERBOSE = [False]
+
+
+def verbose_info(message: str) -> None:
+    if VERBOSE[0]:
+        err.print(f"info: {message}", soft_wrap=True)
+
+
+def _show_version(value: bool) -> None:
+    if value:
+        from .. import __version__
+        out.print(f"suspopt {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(version: bool = typer.Option(False, "--version", callback=_show_version,
+                                       is_eager=True, help="print the version and exit"),
+          quiet: bool = typer.Option(False, "-q", "--quiet", help="print nothing but warnings "
+                                     "and errors (no tables, no progress)"),
+          verbose: bool = typer.Option(False, "-v", "--verbose", help="also print, on stderr, "
+                                       "what each step did and how long it took")) -> None:
+    """Simulate, optimise and select vehicle and seat suspensions from YAML."""
+    from ..memory import reuse_memory
+
+    out.quiet = quiet
+    VERBOSE[0] = verbose and not quiet
+    reuse_memory()          # a command's repeated batches reuse their memory (suspopt.memory)
+
+
+class FoldingTable(Table):
+    """A table whose cells fold onto further lines when the terminal is narrow (a CI log's
+    80 columns) instead of being cut to "…"."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.cells: list[tuple[str, ...]] = []      # the rows as given, for show_table
+
+    def add_column(self, *args, **kwargs) -> None:
+        kwargs.setdefault("overflow", "fold")
+        super().add_column(*args, **kwargs)
+
+    def add_row(self, *cells, **kwargs) -> None:
+        self.cells.append(tuple(str(c) for c in cells))
+        super().add_row(*cells, **kwargs)
+
+
+def new_table(title: str | None = None) -> Table:
+    return FoldingTable(title=title)
+
+
+def show_table(table: FoldingTable, keys: int = 1) -> None:
+    """Print ``table``; when it is wider than the terminal (a CI log's 80 columns), as several
+    tables of the columns that fit, each with the first ``keys`` columns again, so that no
+    number is cut or broken across lines."""
+    def needs(j: int) -> int:             # column j's widest cell and the border and padding
+        return max(len(str(c)) for c in [table.columns[j].header,
+                                          *(row[j] for row in table.cells)]) + 3
+
+    width, count = out.width, len(table.columns)
+    if 1 + sum(needs(j) for j in range(count)) <= width or count <= keys + 1:
+        out.print(table)
+        return
+    key, rest = list(range(keys)), list(range(keys, count))
+    base = 1 + sum(needs(c) for c in key)
+    groups, current, used = [], [], base
+    for column in rest:
+        if current and used + needs(column) > width:
+            groups.append(current)
+            current, used = [], base
+        current.append(column)
+        used += needs(column)
+    groups.append(current)
+    title = str(table.title or "")
+    for i, group in enumerate(groups, start=1):
+        part = new_table(f"{title} ({i} of {len(groups)})" if title else None)
+        for j in key + group:
+            part.add_column(table.columns[j].header, justify=table.columns[j].justify)
+        for row in table.cells:
+            part.add_row(*(row[j] for j in key + group))
+        out.print(part)
+
+
+def fail(message: str) -> None:
+    """Report bad input in one line and exit with code 2."""
+    err.print("error: " + " ".join(str(message).split()), soft_wrap=True)
+    raise typer.Exit(code=2)
+
+
+def set_memory_limit(max_memory: str | None) -> None:
+    """Apply ``--max-memory``."""
+    from ..memory import parse_size, set_limit
+
+    try:
+        set_limit(None if max_memory is None else parse_size(max_memory))
+    except ValueError as exc:
+        fail(f"--max-memory: {exc}")
+
+
+def claim_output(stack: ExitStack, path: Path | None, force: bool, option: str = "-o") -> None:
+    """Check an output and hold its writer's lock for the rest of the command
+    (:func:`suspopt.io.claim`)."""
+    from ..io import claim
+
+    if path is None:
+        return
+    try:
+        stack.enter_context(claim(path, force, option))
+    except ConfigError as exc:
+        fail(str(exc))
+
+
+def read_config(path: Path):
+    from ..config import load_config
+
+    try:
+        return load_config(path)
+    except ConfigError as exc:
+        fail(str(exc))
+
+
+def command_line() -> str:
+    return "suspopt " + " ".join(shlex.quote(a) for a in sys.argv[1:])

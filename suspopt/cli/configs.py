@@ -1,0 +1,118 @@
+"""``validate``, ``schema``, ``init`` and ``export``: configs in and out (see :mod:`suspopt.cli`)."""
+
+from __future__ import annotations
+
+import sys
+import time
+from contextlib import ExitStack
+from pathlib import Path
+from typing import Optional
+import typer
+from ..errors import ConfigError
+from .base import (app, out, FORCE_HELP, MEMORY_HELP, verbose_info, fail, set_memory_limit, claim_output, read_config)
+
+
+@app.command()
+def validate(config: Path = typer.Argument(..., help="YAML config file"),
+             max_memory: Optional[str] = typer.Option(None, "--max-memory",
+                                                      help=MEMORY_HELP)) -> None:
+    """Check a config and report its first problem with its line (what any command would
+    reject about it)."""
+    from ..checks import check_config
+
+    set_memory_limit(max_memory)
+    started = time.perf_counter()
+    cfg = read_config(config)
+    verbose_info(f"{config}: read and typed in {time.perf_counter() - started:.3g} s")
+    try:
+        check_config(cfg)
+    except ConfigError as exc:
+        fail(str(exc))
+    verbose_info(f"checked the run (steps, road, RK4 stability, memory"
+          f"{', the optimisation' if cfg.design_variables else ''}) in "
+          f"{time.perf_counter() - started:.3g} s")
+    out.print(f"{config}: valid ({cfg.vehicle.preset}, road {cfg.road.kind})")
+
+
+@app.command()
+def schema() -> None:
+    """Print the JSON Schema of the config (for editor completion)."""
+    from importlib import resources
+
+    # the schema as suspopt.config.config_schema() makes it, stored with the package so that
+    # printing it needs no model (tests/test_schema.py checks the two are the same)
+    sys.stdout.write(resources.files("suspopt").joinpath("schema.json").read_text())
+
+
+def _template_help() -> str:
+    from ..templates import TEMPLATES
+
+    return "the kind of study: " + "; ".join(f"{k}: {v}" for k, v in TEMPLATES.items())
+
+
+def _template_kinds(incomplete: str) -> list[str]:
+    from ..templates import template_names
+
+    return [k for k in template_names() if k.startswith(incomplete)]
+
+
+@app.command()
+def init(kind: str = typer.Argument(..., help=_template_help(),
+                                    autocompletion=_template_kinds),
+         output: Path = typer.Option(..., "-o", "--output", help="the new config (YAML)"),
+         force: bool = typer.Option(False, "--force", help=FORCE_HELP)) -> None:
+    """Write a commented starter config of one kind of study, ready to validate and run."""
+    from ..io import atomic_file
+    from ..templates import template_text
+
+    with ExitStack() as stack:
+        try:
+            text = template_text(kind)
+        except ValueError as exc:
+            fail(f"init: {exc}")
+        claim_output(stack, output, force)
+        with atomic_file(output) as stream:
+            stream.write(text.encode())
+    command = "optimise" if kind in ("optimise", "kesort") else "simulate"
+    out.print(f"wrote {output}; next: suspopt validate {output}, then suspopt {command} "
+              f"{output} -o {Path(output).with_suffix('.h5')}")
+
+
+@app.command()
+def export(source: Path = typer.Argument(..., help="result file of optimise, kesort or "
+                                         "analyse"),
+           pick: list[str] = typer.Option([], "--pick", help="the design to write as a config: "
+                                          "knee, best_<objective>, chosen or a row number"),
+           output: Optional[Path] = typer.Option(None, "-o", "--output",
+                                                 help="YAML file for the picked design"),
+           csv: Optional[Path] = typer.Option(None, "--csv", help="folder for the file's "
+                                              "tables as CSV, units in the headers"),
+           force: bool = typer.Option(False, "--force", help=FORCE_HELP)) -> None:
+    """Write a picked design as a standalone config (-o design.yaml), or a result file's
+    tables as CSV (--csv DIR)."""
+    if (output is None) == (csv is None):
+        fail("export: give -o FILE.yaml (with --pick) or --csv DIR")
+    with ExitStack() as stack:
+        try:
+            if csv is not None:
+                from ..export import write_csv
+                if pick:
+                    fail("--csv writes every table of the file; --pick is for -o")
+                for path in write_csv(source, csv, force=force):
+                    out.print(f"wrote {path}")
+                return
+            from ..io import atomic_file
+            from ..picks import design_config, read_picks, split_picks
+
+            claim_output(stack, output, force)
+            names = split_picks(pick)
+            if len(names) != 1:
+                fail(f"--pick: -o writes one design; got {len(names)} ({', '.join(names)})")
+            picked = read_picks(source, names)
+            _, text = design_config(picked)
+            with atomic_file(output) as stream:
+                stream.write(text.encode())
+        except ConfigError as exc:
+            fail(str(exc))
+    out.print(f"wrote {output} (design {names[0]!r}, row {int(picked.rows[0])} of "
+              f"{source})")

@@ -1,0 +1,139 @@
+"""``optimise``: the run, its progress line and its optimum table (see :mod:`suspopt.cli`)."""
+
+from __future__ import annotations
+
+from contextlib import ExitStack
+from pathlib import Path
+from typing import Optional
+import typer
+from rich.table import Table
+from ..errors import ConfigError
+from .base import (app, out, err, EXIT_ALL_FAILED, FORCE_HELP, MEMORY_HELP, new_table, show_table, fail, set_memory_limit, claim_output, read_config, command_line)
+
+
+def _progress_line(p) -> str:
+    """One generation's report: budget, evaluations, best or hypervolume, feasible share."""
+    import numpy as np
+
+    gen = f"gen {p.generation}" + (f"/{p.max_generations}" if p.max_generations else "")
+    if not np.isfinite(p.best).any():
+        score = "none feasible yet"
+    else:
+        score = f"HV {p.hypervolume:.4g}" if p.best.size > 1 else f"best {p.best[0]:.4g}"
+    left = f", {p.time_left:.0f} s left" if p.time_left is not None else ""
+    return (f"{p.phase} {gen}, {p.evaluations} evaluations, {score}, "
+            f"{100 * p.feasible:.0f} % feasible{left}")
+
+
+def _optimum_table(result, rows: int = 12) -> Table:
+    """The best design (one column), or up to ``rows`` designs spread along the Pareto front
+    (one row each)."""
+    import numpy as np
+
+    N = len(result.X)
+    names = result.obj_names + result.var_names
+    units = result.obj_units + result.var_units
+    values = np.hstack([result.F, result.X])
+    feasible = ["yes" if ok else "no" for ok in (result.G <= 0).all(axis=1)]
+    suffix = "" if result.status == "finished" else " (interrupted)"
+    if N == 1:
+        table = new_table("best design" + suffix)
+        for col in ("quantity", "unit", "value"):
+            table.add_column(col, justify="right" if col == "value" else "left")
+        for name, unit, value in zip(names, units, values[0]):
+            table.add_row(name, unit, f"{value:.5g}")
+        table.add_row("feasible", "", feasible[0])
+        return table
+    pick = np.unique(np.linspace(0, N - 1, min(rows, N)).round().astype(int))
+    table = new_table(f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
+    table.add_column("#", justify="right")
+    for name, unit in zip(names, units):
+        table.add_column(f"{name} [{unit}]", justify="right")
+    table.add_column("feasible")
+    for i in pick:
+        table.add_row(str(i), *(f"{v:.4g}" for v in values[i]), feasible[i])
+    return table
+
+
+@app.command()
+def optimise(config: Path = typer.Argument(..., help="YAML config file"),
+             output: Optional[Path] = typer.Option(
+                 None, "-o", "--output", help="HDF5 file (default CONFIG's name with .h5 in "
+                 "the current folder), rewritten every generation"),
+             resume: bool = typer.Option(False, "--resume",
+                                         help="continue from the checkpoint in OUT.h5"),
+             plot: Optional[Path] = typer.Option(None, "--plot", help="figure of the front "
+                                                 "(or the best value) and the history per "
+                                                 "generation (.png or .svg)"),
+             force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+             max_memory: Optional[str] = typer.Option(None, "--max-memory",
+                                                      help=MEMORY_HELP)) -> None:
+    """Optimise the config's design variables; write the optimum or Pareto set to HDF5.
+
+    The progress line's HV is the hypervolume of every feasible non-dominated design found so
+    far, objectives scaled by the first feasible generation's range (reference point 1.1):
+    it never falls."""
+    with ExitStack() as stack:
+        output = output if output is not None else Path(config.stem + ".h5")
+        set_memory_limit(max_memory)
+        if plot is not None:
+            from ..plots import check_path
+            try:
+                check_path(plot)
+            except ValueError as exc:
+                fail(str(exc))
+        claim_output(stack, output, force)
+        claim_output(stack, plot, force, "--plot")
+        _optimise(config, output, resume, plot)
+
+
+def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> None:
+    from rich.progress import BarColumn, Progress, TextColumn
+
+    from ..checks import check_config
+    from ..optimise import optimise as run
+
+    cfg = read_config(config)
+    try:
+        check_config(cfg)
+    except ConfigError as exc:
+        fail(str(exc))
+    total = cfg.optimiser.generations if cfg.optimiser is not None else None
+    bar = Progress(TextColumn("{task.description}"), BarColumn(), console=err,
+                   disable=not err.is_terminal or out.quiet)
+    task = bar.add_task("starting", total=total)
+
+    def report(p) -> None:
+        bar.update(task, completed=p.generation, description=_progress_line(p))
+        if not err.is_terminal and not out.quiet:
+            err.print(_progress_line(p))
+
+    try:
+        with bar:
+            result = run(cfg, output, resume=resume, callback=report, command=command_line())
+    except ConfigError as exc:
+        fail(str(exc))
+    except KeyboardInterrupt:
+        err.print("the first generation had not completed: nothing written")
+        raise typer.Exit(code=130)
+    show_table(_optimum_table(result))
+    if result.weights is not None:
+        out.print("weighted sum (Eq 5.7): " + " + ".join(
+            f"{w:.4g} {name}" for w, name in zip(result.weights, result.obj_names)))
+    if result.status == "interrupted":
+        err.print(f"wrote the designs found so far to {output}; continue with "
+                  f"suspopt optimise {config} -o {output} --resume", soft_wrap=True)
+        raise typer.Exit(code=130)
+    out.print(f"wrote {output}")
+    if plot is not None:
+        from ..plots import plot_optimisation
+        try:
+            plot_optimisation(result, plot)
+        except ValueError as exc:
+            fail(str(exc))
+        out.print(f"wrote {plot}")
+    if result.status == "failed":
+        err.print(f"error: every design of the optimum failed to simulate (diverged or gave "
+                  f"NaN); {output} holds them with the penalty values and status 'failed'",
+                  soft_wrap=True)
+        raise typer.Exit(code=EXIT_ALL_FAILED)
