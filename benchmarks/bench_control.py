@@ -38,8 +38,10 @@ from suspopt.config.control import Control, Threshold
 from suspopt.config.vehicle import PassiveDamper, SemiActiveDamper
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
-PROBLEMS = {"QC Table 4.1, class C, 5 s": (CONFIGS / "ch4" / "sh_2_class_c.yaml", 5.0),
-            "FC Table 3.1, class B, 2 s": (CONFIGS / "ch3" / "part1b_fc_class_b.yaml", 2.0)}
+PROBLEMS = {
+    "QC Table 4.1, class C, 5 s": (CONFIGS / "ch4" / "sh_2_class_c.yaml", 5.0),
+    "FC Table 3.1, class B, 2 s": (CONFIGS / "ch3" / "part1b_fc_class_b.yaml", 2.0),
+}
 #: (designs, rounds, output_dt [s]; None keeps every step as the configs do)
 SIZES = ((1, 15, None), (100, 10, None), (1000, 6, None), (1000, 6, 0.004))
 _simulate_module = importlib.import_module("suspopt.simulate")
@@ -50,22 +52,41 @@ def variants(cfg) -> dict:
     """The passive model and the controlled ones, as configs."""
     out = {}
     for name, law, control in (
-            ("passive", None, None),
-            ("SH-2", "sh_2", Control()),
-            ("SH-ADD-2", "sh_add_2", Control()),
-            ("SH-2 lag", "sh_2", Control(actuator_lag=0.01)),
-            ("SH-2 CDF empir.", "sh_2", Control(threshold=Threshold(
-                mode="adaptive", c_max_share=0.27, learn_time=1.0, distribution="empirical"))),
-            ("SH-2 CDF t", "sh_2", Control(threshold=Threshold(
-                mode="adaptive", c_max_share=0.27, learn_time=1.0)))):
+        ("passive", None, None),
+        ("SH-2", "sh_2", Control()),
+        ("SH-ADD-2", "sh_add_2", Control()),
+        ("SH-2 lag", "sh_2", Control(actuator_lag=0.01)),
+        (
+            "SH-2 CDF empir.",
+            "sh_2",
+            Control(
+                threshold=Threshold(
+                    mode="adaptive", c_max_share=0.27, learn_time=1.0, distribution="empirical"
+                )
+            ),
+        ),
+        (
+            "SH-2 CDF t",
+            "sh_2",
+            Control(threshold=Threshold(mode="adaptive", c_max_share=0.27, learn_time=1.0)),
+        ),
+    ):
         v = cfg.model_copy(deep=True)
         v.metrics = []
         v.control = control
         for corner in v.vehicle.corners.values():
             d = corner.damper
-            corner.damper = PassiveDamper(c=d.c_min) if law is None else SemiActiveDamper(
-                kind="semi_active", c_min=d.c_min, c_max=d.c_max, law=law,
-                crossover_frequency=39.0 if law == "sh_add_2" else None)
+            corner.damper = (
+                PassiveDamper(c=d.c_min)
+                if law is None
+                else SemiActiveDamper(
+                    kind="semi_active",
+                    c_min=d.c_min,
+                    c_max=d.c_max,
+                    law=law,
+                    crossover_frequency=39.0 if law == "sh_add_2" else None,
+                )
+            )
         out[name] = v
     return out
 
@@ -88,6 +109,7 @@ class _Timed:
             out = method(*args)
             self.spent += time.perf_counter() - start
             return out
+
         return call
 
 
@@ -106,7 +128,7 @@ def run(cfg, params) -> tuple[float, float, float]:
     try:
         cpu, wall = time.process_time(), time.perf_counter()
         result = suspopt.simulate(cfg, params=params)
-        for name in result.controller_records:      # published when first read: counted
+        for name in result.controller_records:  # published when first read: counted
             result.controller_records[name]
         cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
     finally:
@@ -115,12 +137,19 @@ def run(cfg, params) -> tuple[float, float, float]:
 
 
 def main() -> None:
-    memory = "reused" if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory() \
+    memory = (
+        "reused"
+        if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory()
         else "default"
-    print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
-          f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}")
-    print("cells: CPU time over the passive run's (total) / time inside the controller over "
-          "the passive run's (own)")
+    )
+    print(
+        f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
+        f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}"
+    )
+    print(
+        "cells: CPU time over the passive run's (total) / time inside the controller over "
+        "the passive run's (own)"
+    )
     rng = np.random.default_rng(2026)
     for title, (path, duration) in PROBLEMS.items():
         cfg = suspopt.load_config(path)
@@ -128,23 +157,30 @@ def main() -> None:
         configs = variants(cfg)
         k = cfg.vehicle.corners["F1"].spring.linear
         print(f"\n{title}: {cfg.simulation.n_steps} RK4 steps")
-        print(f"{'P':>5} {'passive CPU':>12} " + " ".join(f"{n:>16}" for n in configs
-                                                          if n != "passive"))
+        print(
+            f"{'P':>5} {'passive CPU':>12} "
+            + " ".join(f"{n:>16}" for n in configs if n != "passive")
+        )
         for P, rounds, output_dt in SIZES:
             params = {"vehicle.corners.F1.spring.linear": rng.uniform(0.8 * k, 1.2 * k, P)}
             best = {name: (np.inf, np.inf) for name in configs}
-            for _ in range(rounds):                 # interleaved, best of the rounds
+            for _ in range(rounds):  # interleaved, best of the rounds
                 for name, c in configs.items():
                     c.simulation.output_dt = output_dt
                     cpu, _wall, own = run(c, params)
                     best[name] = (min(best[name][0], cpu), min(best[name][1], own))
             base = best["passive"][0]
-            cells = [f"{100 * (cpu / base - 1):+4.0f} % / {100 * own / base:3.0f} %".rjust(16)
-                     for name, (cpu, own) in best.items() if name != "passive"]
+            cells = [
+                f"{100 * (cpu / base - 1):+4.0f} % / {100 * own / base:3.0f} %".rjust(16)
+                for name, (cpu, own) in best.items()
+                if name != "passive"
+            ]
             label = f"{P}" if output_dt is None else f"{P}*"
             print(f"{label:>5} {base:>10.2f} s " + " ".join(cells))
-    print("\n* output every 4 ms (= ΔT) instead of every step: the simulator stores a quarter of "
-          "the samples and records")
+    print(
+        "\n* output every 4 ms (= ΔT) instead of every step: the simulator stores a quarter of "
+        "the samples and records"
+    )
 
 
 if __name__ == "__main__":

@@ -25,20 +25,22 @@ def measure(call):
     wall = time.perf_counter() - start
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
-    return wall, peak / 2 ** 20
+    return wall, peak / 2**20
 
 
 def main() -> None:
     rng = np.random.default_rng(2026)
     m = 10
-    print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
-          f"numpy {np.__version__} | {platform.machine()}")
+    print(
+        f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
+        f"numpy {np.__version__} | {platform.machine()}"
+    )
     print("| N × m | kesort(F, P=0.1) [s] | peak [MB] | k_eps_levels alone [s] |")
     print("|---|---|---|---|")
     for N in (1_000, 3_000, 10_000):
         F = rng.random((N, m))
-        wall, peak = measure(lambda: suspopt.kesort(F, P=0.1))
-        levels, _ = measure(lambda: k_eps_levels(F, 0.1))
+        wall, peak = measure(lambda F=F: suspopt.kesort(F, P=0.1))
+        levels, _ = measure(lambda F=F: k_eps_levels(F, 0.1))
         print(f"| {N:,} × {m} | {wall:.2f} | {peak:.0f} | {levels:.2f} |")
 
 

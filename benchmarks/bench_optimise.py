@@ -51,8 +51,10 @@ def bump(road, offsets: np.ndarray, t) -> tuple[np.ndarray, np.ndarray]:
     duration = road.length / road.speed
     phase = np.pi * (t - t0) / duration
     on = (t >= t0) & (t < t0 + duration)
-    return (np.where(on, road.height * np.sin(phase), 0.0),
-            np.where(on, road.height * np.pi / duration * np.cos(phase), 0.0))
+    return (
+        np.where(on, road.height * np.sin(phase), 0.0),
+        np.where(on, road.height * np.pi / duration * np.cos(phase), 0.0),
+    )
 
 
 def per_design(cfg, values: dict[str, float], time_grid: np.ndarray) -> np.ndarray:
@@ -67,7 +69,7 @@ def per_design(cfg, values: dict[str, float], time_grid: np.ndarray) -> np.ndarr
     def acceleration(t, q, v):
         """q'' at times t (...,) from q, v (..., n)."""
         travel, rate = q @ J.T, v @ J.T
-        force = -(k_l * travel + k_nl * travel ** 3 + c * rate) @ J
+        force = -(k_l * travel + k_nl * travel**3 + c * rate) @ J
         z, zdot = bump(cfg.road, offsets, t)
         force[..., wheels] += k_t * (z - q[..., wheels]) + c_t * (zdot - v[..., wheels])
         return force / mass
@@ -76,56 +78,88 @@ def per_design(cfg, values: dict[str, float], time_grid: np.ndarray) -> np.ndarr
         return np.concatenate([y[n:], acceleration(t, y[:n], y[n:])])
 
     duration = cfg.road.length / cfg.road.speed
-    sol = solve_ivp(rhs, (0.0, time_grid[-1]), np.zeros(2 * n), method="RK45",
-                    t_eval=time_grid, rtol=RTOL, atol=ATOL, max_step=duration / 4)
+    sol = solve_ivp(
+        rhs,
+        (0.0, time_grid[-1]),
+        np.zeros(2 * n),
+        method="RK45",
+        t_eval=time_grid,
+        rtol=RTOL,
+        atol=ATOL,
+        max_step=duration / 4,
+    )
     q, v = sol.y[:n].T, sol.y[n:].T
     heave_acc = acceleration(time_grid, q, v)[:, 0]
     travel = q @ J.T
     tyre = q[:, wheels] - bump(cfg.road, offsets, time_grid)[0]
     fs = 1.0 / (time_grid[1] - time_grid[0])
     usage = nonlinear_spring_usage(travel.T, k_l, k_nl)
-    return np.concatenate([[np.var(heave_acc), np.var(travel, axis=0).mean(),
-                            np.var(tyre, axis=0).mean(),
-                            iso2631.weighted_rms(heave_acc, fs, "Wk")], usage])
+    return np.concatenate(
+        [
+            [
+                np.var(heave_acc),
+                np.var(travel, axis=0).mean(),
+                np.var(tyre, axis=0).mean(),
+                iso2631.weighted_rms(heave_acc, fs, "Wk"),
+            ],
+            usage,
+        ]
+    )
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--default-allocator", action="store_true",
-                        help="leave glibc's allocator as it is (the command line makes it "
-                        "reuse freed memory, suspopt.reuse_memory)")
-    parser.add_argument("--per-design", type=int, default=40,
-                        help="designs evaluated one by one with solve_ivp")
+    parser.add_argument(
+        "--default-allocator",
+        action="store_true",
+        help="leave glibc's allocator as it is (the command line makes it "
+        "reuse freed memory, suspopt.reuse_memory)",
+    )
+    parser.add_argument(
+        "--per-design", type=int, default=40, help="designs evaluated one by one with solve_ivp"
+    )
     args = parser.parse_args()
     memory = "reused" if not args.default_allocator and suspopt.reuse_memory() else "default"
     cfg = suspopt.load_config(CONFIG)
     problem = suspopt.Problem.from_config(cfg)
     rng = np.random.default_rng(2026)
-    problem.evaluate(problem.xl[None] + 0.5 * (problem.xu - problem.xl)[None])   # warm-up
-    print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
-          f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}")
-    print(f"Ch. 5 HC2 problem ({CONFIG.name}): {problem.n_var} variables, {problem.n_obj} "
-          f"objectives, {problem.n_ieq_constr} constraints, {cfg.simulation.duration} s at "
-          f"dt = {cfg.simulation.dt} s")
+    problem.evaluate(problem.xl[None] + 0.5 * (problem.xu - problem.xl)[None])  # warm-up
+    print(
+        f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
+        f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}"
+    )
+    print(
+        f"Ch. 5 HC2 problem ({CONFIG.name}): {problem.n_var} variables, {problem.n_obj} "
+        f"objectives, {problem.n_ieq_constr} constraints, {cfg.simulation.duration} s at "
+        f"dt = {cfg.simulation.dt} s"
+    )
     time_grid = np.arange(cfg.simulation.n_steps + 1) * cfg.simulation.dt
-    print(f"{'P':>6} {'batched [s]':>12} {'batched /s':>11} {'solve_ivp /s':>13} "
-          f"{'speed-up':>9} {'max rel. diff f1-f3':>20}")
+    print(
+        f"{'P':>6} {'batched [s]':>12} {'batched /s':>11} {'solve_ivp /s':>13} "
+        f"{'speed-up':>9} {'max rel. diff f1-f3':>20}"
+    )
     for P in (200, 1000):
         X = problem.xl + rng.random((P, problem.n_var)) * (problem.xu - problem.xl)
         batched = np.inf
-        for _ in range(REPEATS):             # the optimiser's steady state, one generation
+        for _ in range(REPEATS):  # the optimiser's steady state, one generation
             start = time.perf_counter()
             F, G = problem.evaluate(X, return_values_of=["F", "G"])
             batched = min(batched, time.perf_counter() - start)
-        designs = problem.to_physical(X[:args.per_design])
+        designs = problem.to_physical(X[: args.per_design])
         start = time.perf_counter()
-        reference = np.array([per_design(cfg, dict(zip((v.path for v in problem.variables),
-                                                        row)), time_grid) for row in designs])
+        reference = np.array(
+            [
+                per_design(cfg, dict(zip((v.path for v in problem.variables), row)), time_grid)
+                for row in designs
+            ]
+        )
         single = (time.perf_counter() - start) / len(designs)
-        diff = np.max(np.abs(F[:len(designs)] - reference[:, :3]) / np.abs(reference[:, :3]))
-        rc = np.max(np.abs(G[:len(designs), 0] + 0.8 - reference[:, 3]) / reference[:, 3])
-        print(f"{P:>6} {batched:>12.2f} {P / batched:>11.1f} {1 / single:>13.2f} "
-              f"{single * P / batched:>8.1f}x {diff:>20.2e}   (RC: {rc:.1e})")
+        diff = np.max(np.abs(F[: len(designs)] - reference[:, :3]) / np.abs(reference[:, :3]))
+        rc = np.max(np.abs(G[: len(designs), 0] + 0.8 - reference[:, 3]) / reference[:, 3])
+        print(
+            f"{P:>6} {batched:>12.2f} {P / batched:>11.1f} {1 / single:>13.2f} "
+            f"{single * P / batched:>8.1f}x {diff:>20.2e}   (RC: {rc:.1e})"
+        )
 
 
 if __name__ == "__main__":

@@ -21,8 +21,7 @@ import numpy as np
 
 import suspopt
 
-CONFIG = Path(__file__).resolve().parents[1] / "configs" / "ch8" / \
-    "nss4_class_a_passenger.yaml"
+CONFIG = Path(__file__).resolve().parents[1] / "configs" / "ch8" / "nss4_class_a_passenger.yaml"
 
 
 def timed(cfg, params=None) -> tuple[float, float]:
@@ -33,18 +32,23 @@ def timed(cfg, params=None) -> tuple[float, float]:
         res = suspopt.simulate(cfg, params)
         acc = res.signals["seat.acc"] if cfg.seat is not None else res.signals["body.heave_acc"]
         best = min(best, time.perf_counter() - start)
-        rms = float(np.mean(np.sqrt(np.mean(acc ** 2, axis=-1))))
+        rms = float(np.mean(np.sqrt(np.mean(acc**2, axis=-1))))
     return best, rms
 
 
 def main() -> None:
-    memory = "reused" if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory() \
+    memory = (
+        "reused"
+        if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory()
         else "default"
-    print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
-          f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}")
+    )
+    print(
+        f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
+        f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}"
+    )
     cases = []
     cfg = suspopt.load_config(CONFIG)
-    cfg.metrics = []                          # time the simulation and one signal only
+    cfg.metrics = []  # time the simulation and one signal only
     cases.append(("QC + NSS4 + passenger, dt 1 ms (config)", cfg, None))
     fast = cfg.model_copy(deep=True)
     fast.simulation = fast.simulation.model_copy(update={"dt": 1.5e-3, "output_dt": 3.0e-3})
@@ -54,15 +58,20 @@ def main() -> None:
     cases.append(("QC alone, dt 1 ms", bare, None))
     batch = {"seat.damping": np.linspace(200.0, 2000.0, 100)}
     cases.append(("100 designs in one batch, dt 1 ms", cfg, batch))
-    print(f"{cfg.road.speed * cfg.simulation.duration:.0f} m of class {cfg.road.road_class} "
-          f"at {3.6 * cfg.road.speed:.0f} km/h ({cfg.simulation.duration} s)")
-    print(f"{'case':<42} {'steps':>6} {'wall [s]':>9} {'us/step':>8} {'s/design':>9} "
-          f"{'rms acc':>8}")
+    print(
+        f"{cfg.road.speed * cfg.simulation.duration:.0f} m of class {cfg.road.road_class} "
+        f"at {3.6 * cfg.road.speed:.0f} km/h ({cfg.simulation.duration} s)"
+    )
+    print(
+        f"{'case':<42} {'steps':>6} {'wall [s]':>9} {'us/step':>8} {'s/design':>9} {'rms acc':>8}"
+    )
     for label, c, params in cases:
         wall, rms = timed(c, params)
         steps, P = c.simulation.n_steps, 1 if params is None else len(params["seat.damping"])
-        print(f"{label:<42} {steps:>6} {wall:>9.2f} {1e6 * wall / steps:>8.0f} "
-              f"{wall / P:>9.3f} {rms:>8.4f}")
+        print(
+            f"{label:<42} {steps:>6} {wall:>9.2f} {1e6 * wall / steps:>8.0f} "
+            f"{wall / P:>9.3f} {rms:>8.4f}"
+        )
 
 
 if __name__ == "__main__":

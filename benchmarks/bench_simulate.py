@@ -37,15 +37,22 @@ def designs(P: int, rng: np.random.Generator) -> dict[str, np.ndarray]:
 
 
 def main() -> None:
-    memory = "reused" if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory() \
+    memory = (
+        "reused"
+        if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory()
         else "default"
+    )
     cfg = suspopt.load_config(CONFIG)
     rng = np.random.default_rng(2026)
-    suspopt.simulate(cfg, params=designs(2, rng))          # warm-up (imports, caches)
-    print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
-          f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}")
-    print(f"HC2 Ch. 5 problem: {cfg.simulation.duration} s at dt = {cfg.simulation.dt} s "
-          f"({cfg.simulation.n_steps} RK4 steps)")
+    suspopt.simulate(cfg, params=designs(2, rng))  # warm-up (imports, caches)
+    print(
+        f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
+        f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}"
+    )
+    print(
+        f"HC2 Ch. 5 problem: {cfg.simulation.duration} s at dt = {cfg.simulation.dt} s "
+        f"({cfg.simulation.n_steps} RK4 steps)"
+    )
     print(f"{'P':>6} {'wall [s]':>10} {'designs/s':>12} {'body acc metric (mean RMS)':>28}")
     for P in (1, 100, 1000):
         params = designs(P, rng)

@@ -24,8 +24,13 @@ QUICKSTART = ROOT / "configs" / "quickstart.yaml"
 def cpu_seconds(args: list[str]) -> float:
     """CPU time [s] of one ``python -m suspopt ARGS`` run (its process alone)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run([sys.executable, "-m", "suspopt", *args], check=True, cwd=ROOT,
-                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    subprocess.run(
+        [sys.executable, "-m", "suspopt", *args],
+        check=True,
+        cwd=ROOT,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
@@ -40,8 +45,12 @@ def main() -> None:
             "suspopt --help": ["--help"],
             "suspopt validate configs/quickstart.yaml": ["validate", str(QUICKSTART)],
             "suspopt schema": ["schema"],
-            "suspopt simulate configs/quickstart.yaml -o OUT.h5":
-                ["simulate", str(QUICKSTART), "-o", out],
+            "suspopt simulate configs/quickstart.yaml -o OUT.h5": [
+                "simulate",
+                str(QUICKSTART),
+                "-o",
+                out,
+            ],
             "python -c pass (the interpreter alone)": None,
         }
         rows = []
@@ -52,8 +61,9 @@ def main() -> None:
                     before = resource.getrusage(resource.RUSAGE_CHILDREN)
                     subprocess.run([sys.executable, "-c", "pass"], check=True)
                     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-                    times.append(after.ru_utime - before.ru_utime + after.ru_stime
-                                 - before.ru_stime)
+                    times.append(
+                        after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+                    )
             else:
                 times = [cpu_seconds(args) for _ in range(runs)]
             rows.append((label, min(times), sorted(times)[len(times) // 2]))

@@ -39,12 +39,15 @@ def objectives(cfg, X: np.ndarray, dt: float, output_dt: float) -> np.ndarray:
 def main() -> None:
     cfg = suspopt.load_config(CONFIG)
     problem = suspopt.Problem.from_config(cfg)
-    X = problem.xl + np.random.default_rng(3).random((40, problem.n_var)) \
-        * (problem.xu - problem.xl)
+    X = problem.xl + np.random.default_rng(3).random((40, problem.n_var)) * (
+        problem.xu - problem.xl
+    )
     reference = objectives(cfg, X, FINE, FINE)
     print(f"Ch. 5 HC2 ({CONFIG.name}), 40 designs; max relative difference over the designs")
-    print(f"{'dt [ms]':>8}  {'vs 0.25 ms: f1':>14} {'f2':>9} {'f3':>9} {'RC':>9}   "
-          f"{'RK4 only: f1':>12} {'f2':>9} {'f3':>9} {'RC':>9}")
+    print(
+        f"{'dt [ms]':>8}  {'vs 0.25 ms: f1':>14} {'f2':>9} {'f3':>9} {'RC':>9}   "
+        f"{'RK4 only: f1':>12} {'f2':>9} {'f3':>9} {'RC':>9}"
+    )
     for dt in STEPS:
         coarse = objectives(cfg, X, dt, dt)
         whole = np.max(np.abs(coarse / reference - 1.0), axis=0)
@@ -55,8 +58,11 @@ def main() -> None:
             tail = " ".join(f"{v:>9.1e}" for v in own)
         else:
             tail = "(not a multiple of 0.25 ms)"
-        print(f"{1e3 * dt:>8.2f}  {whole[0]:>14.1e} " + " ".join(f"{v:>9.1e}" for v in whole[1:])
-              + f"   {tail}")
+        print(
+            f"{1e3 * dt:>8.2f}  {whole[0]:>14.1e} "
+            + " ".join(f"{v:>9.1e}" for v in whole[1:])
+            + f"   {tail}"
+        )
 
 
 if __name__ == "__main__":

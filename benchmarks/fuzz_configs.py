@@ -73,12 +73,23 @@ def tally(cases, results) -> dict:
     return c
 
 
-ORDER = ["cases", "cases failing", "command runs", "exit 0", "exit 2", "other exits",
-         "tracebacks", "'Traceback' printed", "multi-line (or empty) messages",
-         "messages not naming the file / dataset", "time-outs",
-         "validate accepts, simulate rejects", "simulate exit 0, no file",
-         "commands skipped after a time-out",
-         "worker crashes / kills / harness errors"]
+ORDER = [
+    "cases",
+    "cases failing",
+    "command runs",
+    "exit 0",
+    "exit 2",
+    "other exits",
+    "tracebacks",
+    "'Traceback' printed",
+    "multi-line (or empty) messages",
+    "messages not naming the file / dataset",
+    "time-outs",
+    "validate accepts, simulate rejects",
+    "simulate exit 0, no file",
+    "commands skipped after a time-out",
+    "worker crashes / kills / harness errors",
+]
 
 
 def report(title: str, cases, results, slowest: int, causes: int) -> None:
@@ -86,8 +97,15 @@ def report(title: str, cases, results, slowest: int, causes: int) -> None:
     print(f"\n## {title}\n")
     print("| count | value |\n|---|---|")
     for key in ORDER:
-        if key in c or key in ("cases", "exit 0", "exit 2", "other exits", "tracebacks",
-                               "multi-line (or empty) messages", "time-outs"):
+        if key in c or key in (
+            "cases",
+            "exit 0",
+            "exit 2",
+            "other exits",
+            "tracebacks",
+            "multi-line (or empty) messages",
+            "time-outs",
+        ):
             print(f"| {key} | {c.get(key, 0)} |")
     groups: dict[tuple, list] = collections.defaultdict(list)
     for case in cases:
@@ -95,16 +113,20 @@ def report(title: str, cases, results, slowest: int, causes: int) -> None:
             key = (p["command"],) + fh.signature(p)
             groups[key].append((case, p))
     if groups:
-        print(f"\n### causes ({len(groups)}; command, category, exception, where) - "
-              f"{'all' if causes <= 0 else f'top {causes}'}\n")
+        print(
+            f"\n### causes ({len(groups)}; command, category, exception, where) - "
+            f"{'all' if causes <= 0 else f'top {causes}'}\n"
+        )
         print("| n | command | category | exception | where | example case | message |")
         print("|---|---|---|---|---|---|---|")
         ranked = sorted(groups.items(), key=lambda kv: -len(kv[1]))
-        for key, items in ranked[:causes if causes > 0 else None]:
+        for key, items in ranked[: causes if causes > 0 else None]:
             case, p = items[0]
             msg = (p.get("message") or p.get("stderr") or "")[:90].replace("|", "/")
-            print(f"| {len(items)} | {key[0]} | {key[1]} | {key[2]} | {key[3]} | "
-                  f"`{case.id[:60]}` | {msg} |")
+            print(
+                f"| {len(items)} | {key[0]} | {key[1]} | {key[2]} | {key[3]} | "
+                f"`{case.id[:60]}` | {msg} |"
+            )
     timed = []
     for case in cases:
         result = results[case.id]
@@ -124,6 +146,7 @@ def report(title: str, cases, results, slowest: int, causes: int) -> None:
 def keep(cases, results, folder: Path) -> None:
     """Copy the inputs of the failing Pareto cases (regular files only) to ``folder``."""
     import shutil
+
     folder.mkdir(parents=True, exist_ok=True)
     for case in cases:
         src = Path(case.setup["path"])
@@ -136,27 +159,39 @@ def main() -> None:
     ap.add_argument("--cases", type=int, default=1000, help="random config mutations")
     ap.add_argument("--seed", type=int, default=fh.SEED)
     ap.add_argument("--h5-cases", type=int, default=64, help="random byte flips of the front")
-    ap.add_argument("--no-fixed", action="store_true",
-                    help="leave out the seeds, the special inputs and the fixed Pareto files")
+    ap.add_argument(
+        "--no-fixed",
+        action="store_true",
+        help="leave out the seeds, the special inputs and the fixed Pareto files",
+    )
     ap.add_argument("--configs-only", action="store_true")
     ap.add_argument("--h5-only", action="store_true")
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--limit", type=float, default=fh.LIMIT, help="seconds per command")
-    ap.add_argument("--memory", type=float, default=fh.MEMORY / 2 ** 30,
-                    help="address-space cap of a worker [GB]")
+    ap.add_argument(
+        "--memory", type=float, default=fh.MEMORY / 2**30, help="address-space cap of a worker [GB]"
+    )
     ap.add_argument("--slowest", type=int, default=10)
     ap.add_argument("--causes", type=int, default=0, help="rows of the causes table (0: all)")
     ap.add_argument("--json", type=Path, help="write every case and result here")
-    ap.add_argument("--keep", type=Path, help="copy the Pareto file of every failing case "
-                    "into this folder (config cases are in --json)")
+    ap.add_argument(
+        "--keep",
+        type=Path,
+        help="copy the Pareto file of every failing case "
+        "into this folder (config cases are in --json)",
+    )
     opts = ap.parse_args()
 
     import numpy
+
     import suspopt
-    print(f"suspopt {suspopt.__version__} | Python {platform.python_version()} | numpy "
-          f"{numpy.__version__} | seed {opts.seed} | limit {opts.limit:g} s per command | "
-          f"memory cap {opts.memory:g} GB per worker")
-    run = dict(workers=opts.workers, memory=int(opts.memory * 2 ** 30), limit=opts.limit)
+
+    print(
+        f"suspopt {suspopt.__version__} | Python {platform.python_version()} | numpy "
+        f"{numpy.__version__} | seed {opts.seed} | limit {opts.limit:g} s per command | "
+        f"memory cap {opts.memory:g} GB per worker"
+    )
+    run = dict(workers=opts.workers, memory=int(opts.memory * 2**30), limit=opts.limit)
     dumped = {}
     if not opts.h5_only:
         start = time.perf_counter()
@@ -166,21 +201,33 @@ def main() -> None:
         made = time.perf_counter() - start
         results = fh.run_cases(cases, **run)
         wall = time.perf_counter() - start
-        report(f"configs: {len(cases)} cases ({opts.cases} random; made in {made:.1f} s, "
-               f"wall {wall:.1f} s)", cases, results, opts.slowest, opts.causes)
+        report(
+            f"configs: {len(cases)} cases ({opts.cases} random; made in {made:.1f} s, "
+            f"wall {wall:.1f} s)",
+            cases,
+            results,
+            opts.slowest,
+            opts.causes,
+        )
         dumped["configs"] = [{"case": fh.asdict(c), "result": results[c.id]} for c in cases]
     if not opts.configs_only:
         start = time.perf_counter()
-        variants = ([] if opts.no_fixed else fh.h5_variants()) + \
-            fh.h5_random_variants(opts.h5_cases, opts.seed)
+        variants = ([] if opts.no_fixed else fh.h5_variants()) + fh.h5_random_variants(
+            opts.h5_cases, opts.seed
+        )
         with tempfile.TemporaryDirectory(prefix="suspopt-fuzz-h5-") as folder:
             cases = fh.build_h5_cases(fh.h5_cases(variants), variants, Path(folder))
             results = fh.run_cases(cases, **run)
             if opts.keep:
                 keep(cases, results, opts.keep)
         wall = time.perf_counter() - start
-        report(f"Pareto files: {len(cases)} cases ({opts.h5_cases} random; wall {wall:.1f} s)",
-               cases, results, opts.slowest, opts.causes)
+        report(
+            f"Pareto files: {len(cases)} cases ({opts.h5_cases} random; wall {wall:.1f} s)",
+            cases,
+            results,
+            opts.slowest,
+            opts.causes,
+        )
         dumped["h5"] = [{"case": fh.asdict(c), "result": results[c.id]} for c in cases]
     if opts.json:
         opts.json.write_text(json.dumps(dumped))

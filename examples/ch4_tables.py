@@ -37,22 +37,32 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import mdtables as md                                           # noqa: E402
+import mdtables as md  # noqa: E402
 
-from suspopt.analyse.cdf import semi_active_metrics             # noqa: E402
-from suspopt.config.loader import load_config_text              # noqa: E402
-from suspopt.control import threshold_for_share                 # noqa: E402
-from suspopt.io import read_simulation_signals                  # noqa: E402
+from suspopt.analyse.cdf import semi_active_metrics  # noqa: E402
+from suspopt.config.loader import load_config_text  # noqa: E402
+from suspopt.control import threshold_for_share  # noqa: E402
+from suspopt.io import read_simulation_signals  # noqa: E402
 
-ROADS = {"bump": "Road bump", "class_a": "Road class A", "class_b": "Road class B",
-         "class_c": "Road class C"}
-LAWS = {"sh_2": ("SH-2", "SH-2-CDF", "4.2", "T_A"),
-        "sh_add_2": ("SH-ADD-2", "SH-ADD-2-CDF", "4.3", "T_B")}
+ROADS = {
+    "bump": "Road bump",
+    "class_a": "Road class A",
+    "class_b": "Road class B",
+    "class_c": "Road class C",
+}
+LAWS = {
+    "sh_2": ("SH-2", "SH-2-CDF", "4.2", "T_A"),
+    "sh_add_2": ("SH-ADD-2", "SH-ADD-2-CDF", "4.3", "T_B"),
+}
 FITS = ("student_t", "normal", "empirical")
 #: Display: label, our unit, the printed unit's factor from SI, significant digits.
-INDEX = {"SW": ("Switches", "#", 1.0, 4), "RC": ("RC", "m/s²", 1.0, 3),
-         "ST": ("ST (r.m.s.)", "mm", 1e3, 3), "TD": ("TD (r.m.s.)", "mm", 1e3, 3),
-         "DE": ("DE", "W", 1.0, 3)}
+INDEX = {
+    "SW": ("Switches", "#", 1.0, 4),
+    "RC": ("RC", "m/s²", 1.0, 3),
+    "ST": ("ST (r.m.s.)", "mm", 1e3, 3),
+    "TD": ("TD (r.m.s.)", "mm", 1e3, 3),
+    "DE": ("DE", "W", 1.0, 3),
+}
 
 
 def change(base: float, cdf: float) -> float:
@@ -71,8 +81,12 @@ def stored_metrics(path: Path, share_after: float = 0.0) -> dict[str, float]:
     """semi_active_metrics of one stored run (design 0), from its file."""
     cfg, _ = stored_config(path)
     time, signals = read_simulation_signals(path)
-    run = SimpleNamespace(config=cfg, time=time, signals=signals,
-                          model=SimpleNamespace(corners=tuple(cfg.vehicle.corners)))
+    run = SimpleNamespace(
+        config=cfg,
+        time=time,
+        signals=signals,
+        model=SimpleNamespace(corners=tuple(cfg.vehicle.corners)),
+    )
     return {k: float(v[0]) for k, v in semi_active_metrics(run, share_after).items()}
 
 
@@ -105,11 +119,15 @@ def write_fit_configs(out: Path) -> list[Path]:
             offline = None
             if spec.mode == "fixed":
                 offline = offline_thresholds(out / f"{law}_{road}.h5", law, share)
-                if (not np.isclose(offline["empirical"], spec.value, rtol=1e-3, atol=0.0)
-                        and os.environ.get("SUSPOPT_QUICK") != "1"):
-                    sys.exit(f"{law}_cdf_{road}: the config's threshold {spec.value} is not the "
-                             f"offline empirical design {offline['empirical']:.6g}; update the "
-                             f"config")
+                if (
+                    not np.isclose(offline["empirical"], spec.value, rtol=1e-3, atol=0.0)
+                    and os.environ.get("SUSPOPT_QUICK") != "1"
+                ):
+                    sys.exit(
+                        f"{law}_cdf_{road}: the config's threshold {spec.value} is not the "
+                        f"offline empirical design {offline['empirical']:.6g}; update the "
+                        f"config"
+                    )
             fit_used = "empirical" if offline else spec.distribution
             for fit in FITS:
                 if fit == fit_used:
@@ -139,10 +157,15 @@ def collect(out: Path) -> dict:
                 if fixed:
                     threshold = cfg.control.threshold.value
                 else:
-                    threshold = float(read_simulation_signals(path)[1]["control_threshold.F1"][0, -1])
+                    threshold = float(
+                        read_simulation_signals(path)[1]["control_threshold.F1"][0, -1]
+                    )
                 fits[fit] = (stored_metrics(path, share_after), threshold)
-            results[law, road] = {"base": stored_metrics(out / f"{law}_{road}.h5"),
-                                  "fits": fits, "config_fit": fit_used}
+            results[law, road] = {
+                "base": stored_metrics(out / f"{law}_{road}.h5"),
+                "fits": fits,
+                "config_fit": fit_used,
+            }
     return results
 
 
@@ -156,22 +179,68 @@ def table_markdown(results: dict, law: str) -> str:
         r = results[law, road]
         cdf, threshold = r["fits"][r["config_fit"]]
         t = printed[road]
-        rows.append([f"*{road_name}*", f"*{symbol}*", f"*{md.num(threshold)}*",
-                     f"*{md.printed(t['threshold'])}*", "", "", "", "", "", ""])
+        rows.append(
+            [
+                f"*{road_name}*",
+                f"*{symbol}*",
+                f"*{md.num(threshold)}*",
+                f"*{md.printed(t['threshold'])}*",
+                "",
+                "",
+                "",
+                "",
+                "",
+                "",
+            ]
+        )
         for key, (label, unit, factor, digits) in INDEX.items():
             b, c = factor * r["base"][key], factor * cdf[key]
             tb, tc, tp = t[key]
-            unit_cell = unit if thesis["units"][key] == unit.replace("²", "^2") else \
-                f"{unit} (thesis: {thesis['units'][key]})"
-            rows.append(["", f"{label} [{unit_cell}]", md.num(b, digits), md.printed(tb),
-                         md.pct(md.difference(b, tb)), md.num(c, digits), md.printed(tc),
-                         md.pct(md.difference(c, tc)), md.pct(change(b, c), False),
-                         md.pct(tp, False)])
-        rows.append(["", "C_max share [%]", md.num(100 * r["base"]["share"]), "-", "",
-                     md.num(100 * cdf["share"]), md.num(100 * thesis["c_max_share"]), "", "",
-                     ""])
-    header = ["road", "index", base_name, "thesis", "diff.", cdf_name, "thesis", "diff.",
-              "change", "thesis change"]
+            unit_cell = (
+                unit
+                if thesis["units"][key] == unit.replace("²", "^2")
+                else f"{unit} (thesis: {thesis['units'][key]})"
+            )
+            rows.append(
+                [
+                    "",
+                    f"{label} [{unit_cell}]",
+                    md.num(b, digits),
+                    md.printed(tb),
+                    md.pct(md.difference(b, tb)),
+                    md.num(c, digits),
+                    md.printed(tc),
+                    md.pct(md.difference(c, tc)),
+                    md.pct(change(b, c), False),
+                    md.pct(tp, False),
+                ]
+            )
+        rows.append(
+            [
+                "",
+                "C_max share [%]",
+                md.num(100 * r["base"]["share"]),
+                "-",
+                "",
+                md.num(100 * cdf["share"]),
+                md.num(100 * thesis["c_max_share"]),
+                "",
+                "",
+                "",
+            ]
+        )
+    header = [
+        "road",
+        "index",
+        base_name,
+        "thesis",
+        "diff.",
+        cdf_name,
+        "thesis",
+        "diff.",
+        "change",
+        "thesis change",
+    ]
     return md.table(header, rows)
 
 
@@ -184,19 +253,41 @@ def fits_markdown(results: dict) -> str:
         for fit in FITS:
             cdf, threshold = r["fits"][fit]
             mark = " (configs)" if fit == r["config_fit"] else ""
-            rows.append([LAWS[law][0], road, fit + mark, md.num(threshold), md.printed(printed),
-                         md.pct(100 * cdf["share"], False)]
-                        + [md.pct(change(r["base"][k], cdf[k]), False) for k in INDEX])
-    header = ["law", "road", "fit", "T", "T thesis", "C_max share", "SW change", "RC change",
-              "ST change", "TD change", "DE change"]
+            rows.append(
+                [
+                    LAWS[law][0],
+                    road,
+                    fit + mark,
+                    md.num(threshold),
+                    md.printed(printed),
+                    md.pct(100 * cdf["share"], False),
+                ]
+                + [md.pct(change(r["base"][k], cdf[k]), False) for k in INDEX]
+            )
+    header = [
+        "law",
+        "road",
+        "fit",
+        "T",
+        "T thesis",
+        "C_max share",
+        "SW change",
+        "RC change",
+        "ST change",
+        "TD change",
+        "DE change",
+    ]
     return md.table(header, rows)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", type=Path, help="folder of examples/ch4_runs.sh")
-    parser.add_argument("--fits", action="store_true",
-                        help="write the configs of the other fits to OUT/fits and list them")
+    parser.add_argument(
+        "--fits",
+        action="store_true",
+        help="write the configs of the other fits to OUT/fits and list them",
+    )
     args = parser.parse_args()
     if args.fits:
         for path in write_fit_configs(args.out):
@@ -204,11 +295,15 @@ def main() -> None:
         return
     results = collect(args.out)
     for law, (base_name, cdf_name, table, _) in LAWS.items():
-        print(f"\n**Table {table} form: {base_name} against {cdf_name}** (diff. = (ours - "
-              "thesis)/thesis; change = (X - X_CDF)/X)\n")
+        print(
+            f"\n**Table {table} form: {base_name} against {cdf_name}** (diff. = (ours - "
+            "thesis)/thesis; change = (X - X_CDF)/X)\n"
+        )
         print(table_markdown(results, law))
-    print(f"\n**Threshold fits at a requested "
-          f"{100 * md.thesis_values()['ch4']['c_max_share']:.0f} % C_max share**\n")
+    print(
+        f"\n**Threshold fits at a requested "
+        f"{100 * md.thesis_values()['ch4']['c_max_share']:.0f} % C_max share**\n"
+    )
     print(fits_markdown(results))
 
 

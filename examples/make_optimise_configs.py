@@ -50,7 +50,7 @@ design_variables:        # Eq 5.1, bounds of Table 5.2
   - {name: K_nlR1, path: vehicle.corners.R1.spring.cubic, lower: 5.0e5, upper: 3.0e7}
 """
 
-F = {   # Eq 5.4-5.6 (= Eq 6.13-6.15), SI: (m/s^2)^2 and m^2
+F = {  # Eq 5.4-5.6 (= Eq 6.13-6.15), SI: (m/s^2)^2 and m^2
     "f1": "{name: f1, metric: var, signal: body.heave_acc}                   # Eq 5.4",
     "f2": "{name: f2, metric: var, signal: travel, reduce: mean}             # Eq 5.5",
     "f3": "{name: f3, metric: var, signal: tyre_deflection, reduce: mean}    # Eq 5.6",
@@ -69,13 +69,20 @@ CASES = {
     1: ("f1, the body acceleration variance (Eq 5.4)", ["f1"], ["f2", "f3"], None),
     2: ("f2, the mean suspension travel variance (Eq 5.5)", ["f2"], ["f1", "f3"], None),
     3: ("f3, the mean tyre deflection variance (Eq 5.6)", ["f3"], ["f1", "f2"], None),
-    4: ("f4 = w1 f1 + w2 f2 + w3 f3 with balanced weights (Eq 5.7)", ["f1", "f2", "f3"], [],
+    4: (
+        "f4 = w1 f1 + w2 f2 + w3 f3 with balanced weights (Eq 5.7)",
+        ["f1", "f2", "f3"],
+        [],
         "  weighted_sum:             # Eq 5.7, Case 4: w_i = 1/median f_i of 200 random designs\n"
-        "    balance: {samples: 200}\n"),
-    5: ("f5 = w1 f1 + w2 f2 + w3 f3 with f1 one order above f2, f3 (Eq 5.7)",
-        ["f1", "f2", "f3"], [],
+        "    balance: {samples: 200}\n",
+    ),
+    5: (
+        "f5 = w1 f1 + w2 f2 + w3 f3 with f1 one order above f2, f3 (Eq 5.7)",
+        ["f1", "f2", "f3"],
+        [],
         "  weighted_sum:             # Eq 5.7, Case 5: f1's term ten times the others'\n"
-        "    balance: {samples: 200, dominant: f1, factor: 10}\n"),
+        "    balance: {samples: 200, dominant: f1, factor: 10}\n",
+    ),
 }
 
 # MATLAB R2016a ga defaults (the thesis's tool, Sec 5.2.2): 100 generations per variable,
@@ -96,8 +103,9 @@ def objectives_block(main: list[str], supplementary: list[str]) -> str:
     return text
 
 
-def optimiser_block(algorithm: str, population: int | None, generations: int,
-                    extra: str = "", seed: int = 1) -> str:
+def optimiser_block(
+    algorithm: str, population: int | None, generations: int, extra: str = "", seed: int = 1
+) -> str:
     text = f"optimiser:\n  algorithm: {algorithm}\n  seed: {seed}\n"
     if population is not None:
         text += f"  population: {population}\n"
@@ -105,12 +113,14 @@ def optimiser_block(algorithm: str, population: int | None, generations: int,
     if algorithm != "gradient":
         text += "  stall_generations: 50\n"
     if algorithm == "hybrid":
-        text += "  hybrid: {ga_generations: 10, shrink: 0.2}   # Sec 5.1.1: GA active 10 generations\n"
+        text += (
+            "  hybrid: {ga_generations: 10, shrink: 0.2}   # Sec 5.1.1: GA active 10 generations\n"
+        )
     return text + extra
 
 
 def write(path: Path, text: str) -> None:
-    yaml.safe_load(text)            # every file must parse
+    yaml.safe_load(text)  # every file must parse
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(text)
 
@@ -118,14 +128,21 @@ def write(path: Path, text: str) -> None:
 def chapter5() -> None:
     for case, (what, main, supplementary, weights) in CASES.items():
         for s, (how, algorithm, population, generations) in SCENARIOS.items():
-            header = (f"# Ch. 5, Case {case}: {what};\n# scenario S{s} of Table 5.3: {how}.\n"
-                      f"# HC2 of Table 5.1 over the Sec 5.1.3 bump (as configs/quickstart.yaml);\n"
-                      f"# constraints Eq 5.2-5.3; budget: MATLAB ga defaults (600 generations,\n"
-                      f"# 50 stall generations, tolerance 1e-6), SLSQP at most 100 iterations.\n")
-            write(CONFIGS / "ch5" / f"case{case}_s{s}.yaml",
-                  header + HC2_CH5 + DESIGN_VARIABLES_CH5 + objectives_block(main, supplementary)
-                  + CONSTRAINTS_CH5 + optimiser_block(algorithm, population, generations,
-                                                      weights or ""))
+            header = (
+                f"# Ch. 5, Case {case}: {what};\n# scenario S{s} of Table 5.3: {how}.\n"
+                f"# HC2 of Table 5.1 over the Sec 5.1.3 bump (as configs/quickstart.yaml);\n"
+                f"# constraints Eq 5.2-5.3; budget: MATLAB ga defaults (600 generations,\n"
+                f"# 50 stall generations, tolerance 1e-6), SLSQP at most 100 iterations.\n"
+            )
+            write(
+                CONFIGS / "ch5" / f"case{case}_s{s}.yaml",
+                header
+                + HC2_CH5
+                + DESIGN_VARIABLES_CH5
+                + objectives_block(main, supplementary)
+                + CONSTRAINTS_CH5
+                + optimiser_block(algorithm, population, generations, weights or ""),
+            )
 
 
 # --- Chapter 6: HC2 of Chapter 5 with a PS seat and the Table 2.3 passenger ------------------
@@ -145,27 +162,49 @@ PARTS_CH6 = {
     "part_a_c1": ("Part A, case C1: f1 alone", "ga", ["f1"], ["f2", "f3", "f4", "f5", "f6"], ""),
     "part_a_c2": ("Part A, case C2: f2 alone", "ga", ["f2"], ["f1", "f3", "f4", "f5", "f6"], ""),
     "part_a_c3": ("Part A, case C3: f3 alone", "ga", ["f3"], ["f1", "f2", "f4", "f5", "f6"], ""),
-    "part_a_c4": ("Part A, case C4: w1 f1 + w2 f2 + w3 f3 (Eq 5.7, Case 4 weights)", "ga",
-                  ["f1", "f2", "f3"], ["f4", "f5", "f6"],
-                  "  weighted_sum: {balance: {samples: 200}}   # Case 4 of Ch. 5\n"),
-    "part_b": ("Part B: NSGA-II on the main f1-f3; f4-f6 supplementary (Fig. 6.5)", "nsga2",
-               ["f1", "f2", "f3"], ["f4", "f5", "f6"], ""),
-    "part_c": ("Part C: NSGA-II on all six objectives f1-f6 (Fig. 6.6)", "nsga2",
-               ["f1", "f2", "f3", "f4", "f5", "f6"], [], ""),
+    "part_a_c4": (
+        "Part A, case C4: w1 f1 + w2 f2 + w3 f3 (Eq 5.7, Case 4 weights)",
+        "ga",
+        ["f1", "f2", "f3"],
+        ["f4", "f5", "f6"],
+        "  weighted_sum: {balance: {samples: 200}}   # Case 4 of Ch. 5\n",
+    ),
+    "part_b": (
+        "Part B: NSGA-II on the main f1-f3; f4-f6 supplementary (Fig. 6.5)",
+        "nsga2",
+        ["f1", "f2", "f3"],
+        ["f4", "f5", "f6"],
+        "",
+    ),
+    "part_c": (
+        "Part C: NSGA-II on all six objectives f1-f6 (Fig. 6.6)",
+        "nsga2",
+        ["f1", "f2", "f3", "f4", "f5", "f6"],
+        [],
+        "",
+    ),
 }
 
 
 def chapter6() -> None:
     for name, (what, algorithm, main, supplementary, extra) in PARTS_CH6.items():
-        header = (f"# Ch. 6, {what} (Table 6.1).\n"
-                  f"# HC2 and bump of Ch. 5 with the PS seat and the seated passenger (Sec 6.1.2,\n"
-                  f"# Fig. 6.3); design variables, bounds and constraints of Ch. 5 (Sec 6.2.1);\n"
-                  f"# objectives Eq 6.13-6.18 (f4 VDV and f5 crest factor of the head, unweighted\n"
-                  f"# as printed). Ch. 6 states no budget: population 100, 100 generations.\n")
-        write(CONFIGS / "ch6" / f"{name}.yaml",
-              header + HC2_CH5 + SEAT_CH6 + DESIGN_VARIABLES_CH5
-              + objectives_block(main, supplementary) + CONSTRAINTS_CH5
-              + optimiser_block(algorithm, 100, 100, extra))
+        header = (
+            f"# Ch. 6, {what} (Table 6.1).\n"
+            f"# HC2 and bump of Ch. 5 with the PS seat and the seated passenger (Sec 6.1.2,\n"
+            f"# Fig. 6.3); design variables, bounds and constraints of Ch. 5 (Sec 6.2.1);\n"
+            f"# objectives Eq 6.13-6.18 (f4 VDV and f5 crest factor of the head, unweighted\n"
+            f"# as printed). Ch. 6 states no budget: population 100, 100 generations.\n"
+        )
+        write(
+            CONFIGS / "ch6" / f"{name}.yaml",
+            header
+            + HC2_CH5
+            + SEAT_CH6
+            + DESIGN_VARIABLES_CH5
+            + objectives_block(main, supplementary)
+            + CONSTRAINTS_CH5
+            + optimiser_block(algorithm, 100, 100, extra),
+        )
 
 
 # --- Chapter 7: HC2 of Table 7.1 with semi-active dampers and a PS seat ------------------------
@@ -187,10 +226,12 @@ control:                 # Delta T = 4 ms (Sec 4.2); CDF strategy of Ch. 4 (Fig.
 
 
 def vehicle_ch7(law: str, control: str = CONTROL_CH7) -> str:
-    alpha = "\n      crossover_frequency: 39    # alpha [rad/s] (Sec 4.2.2)" \
-        if law == "sh_add_2" else ""
-    damper = (f"kind: semi_active\n      c_min: 1500\n      c_max: 3500\n"
-              f"      law: {law}{alpha}")
+    alpha = (
+        "\n      crossover_frequency: 39    # alpha [rad/s] (Sec 4.2.2)"
+        if law == "sh_add_2"
+        else ""
+    )
+    damper = f"kind: semi_active\n      c_min: 1500\n      c_max: 3500\n      law: {law}{alpha}"
     return f"""\
 vehicle:                 # HC2 of Table 7.1
   preset: half_pitch
@@ -222,13 +263,17 @@ road:                    # Sec 7.1.3: ISO 8608 class C, 50 km/h over 100 m
 def design_variables_ch7(law: str) -> str:
     text = "design_variables:        # Table 7.2, bounds of Table 7.3\n"
     for c in ("F1", "R1"):
-        text += (f"  - {{name: K_{c}, path: vehicle.corners.{c}.spring.linear, lower: 15000, upper: 70000}}\n"
-                 f"  - {{name: Cmax_{c}, path: vehicle.corners.{c}.damper.c_max, lower: 2500, upper: 5000}}\n"
-                 f"  - {{name: Cmin_{c}, path: vehicle.corners.{c}.damper.c_min, lower: 500, upper: 2500}}\n")
+        text += (
+            f"  - {{name: K_{c}, path: vehicle.corners.{c}.spring.linear, lower: 15000, upper: 70000}}\n"
+            f"  - {{name: Cmax_{c}, path: vehicle.corners.{c}.damper.c_max, lower: 2500, upper: 5000}}\n"
+            f"  - {{name: Cmin_{c}, path: vehicle.corners.{c}.damper.c_min, lower: 500, upper: 2500}}\n"
+        )
     if law == "sh_add_2":
         for c in ("F1", "R1"):
-            text += (f"  - {{name: a_{c}, path: vehicle.corners.{c}.damper.crossover_frequency, "
-                     f"lower: 10, upper: 60}}\n")
+            text += (
+                f"  - {{name: a_{c}, path: vehicle.corners.{c}.damper.crossover_frequency, "
+                f"lower: 10, upper: 60}}\n"
+            )
     return text
 
 
@@ -250,61 +295,98 @@ constraints:
   - {name: max_z_R1, metric: max_abs, signal: wheel.R1.heave, max: 0.07}
 """
 
-CASES_CH7 = {"sh_2": "Case 1, SH-2 (Eq 2.34)", "add": "Case 2, ADD (Eq 2.36)",
-             "sh_add_2": "Case 3, SH-ADD-2 (Eq 2.39)"}
+CASES_CH7 = {
+    "sh_2": "Case 1, SH-2 (Eq 2.34)",
+    "add": "Case 2, ADD (Eq 2.36)",
+    "sh_add_2": "Case 3, SH-ADD-2 (Eq 2.39)",
+}
 
 
 def chapter7() -> None:
     for law, what in CASES_CH7.items():
-        header = (f"# Ch. 7, {what}: NSGA-II on RC_se and the tyre deflection (Tables 7.2-7.3).\n"
-                  f"# Ch. 7 states no budget: population 100, 100 generations. Eq 7.3 and 7.6 bound\n"
-                  f"# maxima: taken as maxima of magnitudes (max_abs). The dampers' starting\n"
-                  f"# values are mid-range; the optimiser sets them.\n")
-        write(CONFIGS / "ch7" / f"{law}.yaml",
-              header + vehicle_ch7(law) + design_variables_ch7(law) + OBJECTIVES_CH7
-              + optimiser_block("nsga2", 100, 100))
+        header = (
+            f"# Ch. 7, {what}: NSGA-II on RC_se and the tyre deflection (Tables 7.2-7.3).\n"
+            f"# Ch. 7 states no budget: population 100, 100 generations. Eq 7.3 and 7.6 bound\n"
+            f"# maxima: taken as maxima of magnitudes (max_abs). The dampers' starting\n"
+            f"# values are mid-range; the optimiser sets them.\n"
+        )
+        write(
+            CONFIGS / "ch7" / f"{law}.yaml",
+            header
+            + vehicle_ch7(law)
+            + design_variables_ch7(law)
+            + OBJECTIVES_CH7
+            + optimiser_block("nsga2", 100, 100),
+        )
     for case, law in ((4, "sh_2"), (5, "sh_add_2")):
         name = law.upper().replace("_", "-")
-        header = (f"# Ch. 7, {name}-CDF (Table 7.4, case {case}): the \"pseudo Pareto front\" of\n"
-                  f"# Fig. 7.4b: the designs of ch7/{law}.yaml's front simulated again with the CDF\n"
-                  f"# strategy (Eq 4.3-4.4), not optimised (no optimiser: run\n"
-                  f"#   suspopt kesort {law}.h5 --config configs/ch7/{law}_cdf.yaml).\n"
-                  f"# Same car, road, design variables, objectives and constraints as {law}.yaml.\n")
-        write(CONFIGS / "ch7" / f"{law}_cdf.yaml",
-              header + vehicle_ch7(law, CONTROL_CH7_CDF) + design_variables_ch7(law)
-              + OBJECTIVES_CH7)
+        header = (
+            f'# Ch. 7, {name}-CDF (Table 7.4, case {case}): the "pseudo Pareto front" of\n'
+            f"# Fig. 7.4b: the designs of ch7/{law}.yaml's front simulated again with the CDF\n"
+            f"# strategy (Eq 4.3-4.4), not optimised (no optimiser: run\n"
+            f"#   suspopt kesort {law}.h5 --config configs/ch7/{law}_cdf.yaml).\n"
+            f"# Same car, road, design variables, objectives and constraints as {law}.yaml.\n"
+        )
+        write(
+            CONFIGS / "ch7" / f"{law}_cdf.yaml",
+            header + vehicle_ch7(law, CONTROL_CH7_CDF) + design_variables_ch7(law) + OBJECTIVES_CH7,
+        )
 
 
 # --- Chapter 8: seat isolators, RC_se against X_ST (Pareto fronts, Sec 8.2) --------------------
 
-BOUNDS_CH8 = {   # Tables 8.2, 8.4, 8.6, 8.8, 8.10: (config field, label, lower, upper)
+BOUNDS_CH8 = {  # Tables 8.2, 8.4, 8.6, 8.8, 8.10: (config field, label, lower, upper)
     "ps": ("Tables 8.2-8.3", [("stiffness", "K_v", 1.0e4, 1.5e5)]),
-    "nss1": ("Tables 8.4-8.5", [("gamma", "gamma", 0.01, 0.99),
-                                ("stiffness_ratio", "alpha", 0.0, 5.0),
-                                ("wall_distance", "a_o", 0.10, 0.30)]),
-    "nss2": ("Tables 8.6-8.7", [("stiffness_ratio", "alpha", 0.0, 1.0),
-                                ("spring_free_length", "L_o", 0.10, 0.30),
-                                ("wall_distance", "a_o", 0.10, 0.30),
-                                ("bar_length", "b", 0.05, 0.30)]),
-    "nss3": ("Tables 8.8-8.9", [("stiffness_ratio", "alpha", 0.0, 5.0),
-                                ("cam_radius", "R", 0.01, 0.25),
-                                ("cam_offset", "d", 0.0, 0.25),
-                                ("roller_radius", "r", 0.01, 0.25)]),
-    "nss4": ("Tables 8.10-8.11", [("wall_distance", "a_o", 0.10, 0.30),
-                                  ("spring_free_length", "L_o", 0.10, 0.30),
-                                  ("bar_length", "b", 0.10, 0.30),
-                                  ("support_stiffness", "K_S", 1.0e4, 1.5e5),
-                                  ("inner_stiffness", "K_v", 2.0e3, 7.0e4),
-                                  ("horizontal_stiffness", "K_h", 2.0e3, 7.0e4)]),
+    "nss1": (
+        "Tables 8.4-8.5",
+        [
+            ("gamma", "gamma", 0.01, 0.99),
+            ("stiffness_ratio", "alpha", 0.0, 5.0),
+            ("wall_distance", "a_o", 0.10, 0.30),
+        ],
+    ),
+    "nss2": (
+        "Tables 8.6-8.7",
+        [
+            ("stiffness_ratio", "alpha", 0.0, 1.0),
+            ("spring_free_length", "L_o", 0.10, 0.30),
+            ("wall_distance", "a_o", 0.10, 0.30),
+            ("bar_length", "b", 0.05, 0.30),
+        ],
+    ),
+    "nss3": (
+        "Tables 8.8-8.9",
+        [
+            ("stiffness_ratio", "alpha", 0.0, 5.0),
+            ("cam_radius", "R", 0.01, 0.25),
+            ("cam_offset", "d", 0.0, 0.25),
+            ("roller_radius", "r", 0.01, 0.25),
+        ],
+    ),
+    "nss4": (
+        "Tables 8.10-8.11",
+        [
+            ("wall_distance", "a_o", 0.10, 0.30),
+            ("spring_free_length", "L_o", 0.10, 0.30),
+            ("bar_length", "b", 0.10, 0.30),
+            ("support_stiffness", "K_S", 1.0e4, 1.5e5),
+            ("inner_stiffness", "K_v", 2.0e3, 7.0e4),
+            ("horizontal_stiffness", "K_h", 2.0e3, 7.0e4),
+        ],
+    ),
 }
 
-GEOMETRY_CH8 = {   # the seat's own conditions of each table, plus static stability
+GEOMETRY_CH8 = {  # the seat's own conditions of each table, plus static stability
     "ps": ["stability"],
     "nss1": ["stability"],
-    "nss2": ["stability", "stiffness_ratio_limit", "static_deflection_exists",
-             "gamma2_above_one"],                          # Table 8.7 #3-5
-    "nss3": ["stability", "roller_within_cam", "cam_offset_ratio"],   # Table 8.9 #3-4
-    "nss4": ["stability", "c_I_upper", "c_I_lower"],       # Table 8.11 #3
+    "nss2": [
+        "stability",
+        "stiffness_ratio_limit",
+        "static_deflection_exists",
+        "gamma2_above_one",
+    ],  # Table 8.7 #3-5
+    "nss3": ["stability", "roller_within_cam", "cam_offset_ratio"],  # Table 8.9 #3-4
+    "nss4": ["stability", "c_I_upper", "c_I_lower"],  # Table 8.11 #3
 }
 
 
@@ -312,28 +394,39 @@ def chapter8() -> None:
     for kind, (tables, bounds) in BOUNDS_CH8.items():
         for road in ("a", "b"):
             base = (CONFIGS / "ch8" / f"{kind}_class_{road}.yaml").read_text()
-            body = base[base.index("vehicle:"):]
+            body = base[base.index("vehicle:") :]
             dv = "design_variables:\n" + "".join(
                 f"  - {{name: {label}, path: seat.{field}, lower: {lo:g}, upper: {hi:g}}}\n"
-                for field, label, lo, hi in bounds)
+                for field, label, lo, hi in bounds
+            )
             dv += "  - {name: C_v, path: seat.damping, lower: 200, upper: 2500}\n"
-            margin = "" if kind in ("ps", "nss1") else (
-                "  - {name: travel_margin, metric: min, signal: seat.travel_margin, min: 0}"
-                "   # the mechanism's reach\n")
+            margin = (
+                ""
+                if kind in ("ps", "nss1")
+                else (
+                    "  - {name: travel_margin, metric: min, signal: seat.travel_margin, min: 0}"
+                    "   # the mechanism's reach\n"
+                )
+            )
             conditions = ", ".join(GEOMETRY_CH8[kind])
-            text = (f"# Ch. 8 Pareto front of the {kind.upper()} seat, {tables}: RC_se against X_ST\n"
-                    f"# (Eq 8.1-8.2) on an ISO 8608 class {road.upper()} road; vehicle, road and seat as\n"
-                    f"# configs/ch8/{kind}_class_{road}.yaml. Ch. 8 states no budget: population 100,\n"
-                    f"# 100 generations. Constraint 'stability' (a statically stable isolator) is ours.\n"
-                    + body.rstrip("\n") + "\n" + dv
-                    + "objectives:\n  main:\n"
-                    "    - {name: RC_se, metric: rms_weighted, signal: seat.acc, weighting: Wk}   # Eq 8.1 [m/s^2]\n"
-                    "    - {name: X_ST, quantity: seat.static_deflection}                        # Eq 8.2 [m]\n"
-                    "constraints:\n"
-                    "  - {name: RC_se, metric: rms_weighted, signal: seat.acc, weighting: Wk, max: 1.0}   # constraint 1\n"
-                    "  - {name: X_ST, quantity: seat.static_deflection, max: 0.1}                       # constraint 2\n"
-                    f"  - {{name: seat, quantity: seat.geometry, max: 0, conditions: [{conditions}]}}\n"
-                    + margin + optimiser_block("nsga2", 100, 100))
+            text = (
+                f"# Ch. 8 Pareto front of the {kind.upper()} seat, {tables}: RC_se against X_ST\n"
+                f"# (Eq 8.1-8.2) on an ISO 8608 class {road.upper()} road; vehicle, road and seat as\n"
+                f"# configs/ch8/{kind}_class_{road}.yaml. Ch. 8 states no budget: population 100,\n"
+                f"# 100 generations. Constraint 'stability' (a statically stable isolator) is ours.\n"
+                + body.rstrip("\n")
+                + "\n"
+                + dv
+                + "objectives:\n  main:\n"
+                "    - {name: RC_se, metric: rms_weighted, signal: seat.acc, weighting: Wk}   # Eq 8.1 [m/s^2]\n"
+                "    - {name: X_ST, quantity: seat.static_deflection}                        # Eq 8.2 [m]\n"
+                "constraints:\n"
+                "  - {name: RC_se, metric: rms_weighted, signal: seat.acc, weighting: Wk, max: 1.0}   # constraint 1\n"
+                "  - {name: X_ST, quantity: seat.static_deflection, max: 0.1}                       # constraint 2\n"
+                f"  - {{name: seat, quantity: seat.geometry, max: 0, conditions: [{conditions}]}}\n"
+                + margin
+                + optimiser_block("nsga2", 100, 100)
+            )
             write(CONFIGS / "ch8" / f"pareto_{kind}_class_{road}.yaml", text)
 
 

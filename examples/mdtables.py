@@ -17,10 +17,31 @@ from suspopt.analyse import relative_change
 THESIS_VALUES = Path(__file__).resolve().with_name("thesis_values.yaml")
 
 #: Factor from the SI value to the printed unit (the thesis's units and ours).
-UNITS = {"m": 1.0, "mm": 1e3, "m^2": 1.0, "mm^2": 1e6, "m/s^2": 1.0, "(m/s^2)^2": 1.0,
-         "s": 1.0, "Hz": 1.0, "rad": 1.0, "rad^2": 1.0, "10^-6 rad^2": 1e6, "N": 1.0,
-         "N/m": 1.0, "N s/m": 1.0, "10^6 N/m^3": 1e-6, "N/m^3": 1.0, "%": 100.0, "#": 1.0,
-         "1": 1.0, "W": 1.0, "rad/s": 1.0, "m/s^1.75": 1.0, "kg": 1.0}
+UNITS = {
+    "m": 1.0,
+    "mm": 1e3,
+    "m^2": 1.0,
+    "mm^2": 1e6,
+    "m/s^2": 1.0,
+    "(m/s^2)^2": 1.0,
+    "s": 1.0,
+    "Hz": 1.0,
+    "rad": 1.0,
+    "rad^2": 1.0,
+    "10^-6 rad^2": 1e6,
+    "N": 1.0,
+    "N/m": 1.0,
+    "N s/m": 1.0,
+    "10^6 N/m^3": 1e-6,
+    "N/m^3": 1.0,
+    "%": 100.0,
+    "#": 1.0,
+    "1": 1.0,
+    "W": 1.0,
+    "rad/s": 1.0,
+    "m/s^1.75": 1.0,
+    "kg": 1.0,
+}
 
 
 def thesis_values() -> dict:
@@ -71,6 +92,8 @@ def pct(value, signed: bool = True) -> str:
 
 def table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     """A markdown table (cells already formatted); '|' inside cells is escaped."""
+
     def line(cells):
         return "| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |"
+
     return "\n".join([line(header), "|" + "---|" * len(header)] + [line(r) for r in rows])

@@ -18,11 +18,20 @@ __version__ = "0.1.0"
 
 #: Public name -> the module that defines it.
 _EXPORTS = {
-    "Config": "config", "ConfigError": "config", "config_schema": "config",
-    "load_config": "config", "Result": "simulate", "simulate": "simulate",
-    "build_vehicle": "vehicle", "modal_analysis": "vehicle", "frequency_response": "vehicle",
-    "Problem": "optimise", "kesort": "kesort", "KEpsilonSort": "kesort",
-    "pareto_picks": "kesort", "reuse_memory": "memory",
+    "Config": "config",
+    "ConfigError": "config",
+    "config_schema": "config",
+    "load_config": "config",
+    "Result": "simulate",
+    "simulate": "simulate",
+    "build_vehicle": "vehicle",
+    "modal_analysis": "vehicle",
+    "frequency_response": "vehicle",
+    "Problem": "optimise",
+    "kesort": "kesort",
+    "KEpsilonSort": "kesort",
+    "pareto_picks": "kesort",
+    "reuse_memory": "memory",
 }
 
 __all__ = ["__version__", *_EXPORTS]
@@ -37,8 +46,9 @@ class _Package(types.ModuleType):
         def get(self):
             return getattr(importlib.import_module(f"suspopt.{name}"), name)
 
-        def keep(self, module):          # the import system's setattr: the function stays
+        def keep(self, module):  # the import system's setattr: the function stays
             pass
+
         return property(get, keep)
 
     simulate = _function("simulate")

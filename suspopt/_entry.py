@@ -30,7 +30,7 @@ def _one_line_warning(message, category, filename, lineno, file=None, line=None)
 
 def _interrupted() -> int:
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, signal.SIG_IGN)   # a second Ctrl-C while leaving
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C while leaving
     sys.stderr.write("interrupted\n")
     return EXIT_INTERRUPTED
 
@@ -55,20 +55,21 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGINT, _Interrupts.handler)
     try:
         warnings.showwarning = _one_line_warning
-        warnings.simplefilter("default")           # each place once
+        warnings.simplefilter("default")  # each place once
         import typer
 
         from .cli import app
+
         try:
             code = app(args=argv, prog_name="suspopt", standalone_mode=False)
-        except typer.Abort:                          # click's form of a KeyboardInterrupt
+        except typer.Abort:  # click's form of a KeyboardInterrupt
             return _interrupted()
         except Exception as exc:
             if not (hasattr(exc, "format_message") and hasattr(exc, "exit_code")):
-                raise                                # a bug: its traceback
+                raise  # a bug: its traceback
             # a usage error (click's, vendored by newer typer)
             message = " ".join(exc.format_message().split())
-            if message:                              # (no message: the help was shown)
+            if message:  # (no message: the help was shown)
                 ctx = getattr(exc, "ctx", None)
                 hint = f" (see {ctx.command_path} --help)" if ctx is not None else ""
                 sys.stderr.write(f"error: {message}{hint}\n")
@@ -80,7 +81,8 @@ def main(argv: list[str] | None = None) -> int:
         return _interrupted()
     finally:
         from .memory import set_limit
-        set_limit(None)                  # --max-memory holds for one command
+
+        set_limit(None)  # --max-memory holds for one command
 
 
 def run() -> None:

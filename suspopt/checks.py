@@ -23,8 +23,14 @@ from .config import Config
 from .config.road import BumpHalfSine, BumpStep, Iso8608Road
 from .network import Network
 
-__all__ = ["MIN_STEPS_PER_BUMP", "MIN_STEPS_PER_WAVE", "check_steps", "stability_limit",
-           "check_stability", "full_network"]
+__all__ = [
+    "MIN_STEPS_PER_BUMP",
+    "MIN_STEPS_PER_WAVE",
+    "check_steps",
+    "stability_limit",
+    "check_stability",
+    "full_network",
+]
 
 #: A bump (the time a wheel takes to cross it) must span this many integration steps: RK4
 #: samples the road at half steps, and a half-sine crossed in 10 steps moves the peak body
@@ -50,39 +56,59 @@ def check_steps(cfg: Config) -> None:
 
     sim, road = cfg.simulation, cfg.road
     if not _whole(sim.duration / sim.dt):
-        raise cfg.error(("simulation", "duration"), f"{sim.duration:g} s is not a whole number "
-                        f"of steps dt = {sim.dt:g} s ({sim.duration / sim.dt:.6g} steps); "
-                        f"give a multiple of dt")
+        raise cfg.error(
+            ("simulation", "duration"),
+            f"{sim.duration:g} s is not a whole number "
+            f"of steps dt = {sim.dt:g} s ({sim.duration / sim.dt:.6g} steps); "
+            f"give a multiple of dt",
+        )
     if isinstance(road, (BumpStep, BumpHalfSine)):
         if road.start >= sim.duration:
-            raise cfg.error(("road", "start"), f"the bump starts at {road.start:g} s, after "
-                            f"the run ends (simulation.duration = {sim.duration:g} s)")
+            raise cfg.error(
+                ("road", "start"),
+                f"the bump starts at {road.start:g} s, after "
+                f"the run ends (simulation.duration = {sim.duration:g} s)",
+            )
         crossing = road.length / road.speed
         if crossing < MIN_STEPS_PER_BUMP * sim.dt * (1 - _WHOLE):
-            raise cfg.error(("simulation", "dt"), f"{sim.dt:g} s steps over the bump: a wheel "
-                            f"crosses it in {crossing:.4g} s (road.length/road.speed), which "
-                            f"must span at least {MIN_STEPS_PER_BUMP} steps; use dt <= "
-                            f"{crossing / MIN_STEPS_PER_BUMP:.3g} s")
+            raise cfg.error(
+                ("simulation", "dt"),
+                f"{sim.dt:g} s steps over the bump: a wheel "
+                f"crosses it in {crossing:.4g} s (road.length/road.speed), which "
+                f"must span at least {MIN_STEPS_PER_BUMP} steps; use dt <= "
+                f"{crossing / MIN_STEPS_PER_BUMP:.3g} s",
+            )
     if isinstance(road, Iso8608Road):
         period = 1.0 / (road.n_max * road.speed)
         if period < MIN_STEPS_PER_WAVE * sim.dt * (1 - _WHOLE):
-            raise cfg.error(("simulation", "dt"), f"{sim.dt:g} s steps over the road's "
-                            f"shortest wave: 1/(n_max V) = {period:.4g} s must span at least "
-                            f"{MIN_STEPS_PER_WAVE} steps; use dt <= "
-                            f"{period / MIN_STEPS_PER_WAVE:.3g} s or a lower road.n_max")
+            raise cfg.error(
+                ("simulation", "dt"),
+                f"{sim.dt:g} s steps over the road's "
+                f"shortest wave: 1/(n_max V) = {period:.4g} s must span at least "
+                f"{MIN_STEPS_PER_WAVE} steps; use dt <= "
+                f"{period / MIN_STEPS_PER_WAVE:.3g} s or a lower road.n_max",
+            )
     rate = sim.output_rate
     specs = [(("metrics", i), spec) for i, spec in enumerate(cfg.metrics)]
     if cfg.objectives is not None:
         specs += [(("objectives", "main", i), s) for i, s in enumerate(cfg.objectives.main)]
-        specs += [(("objectives", "supplementary", i), s)
-                  for i, s in enumerate(cfg.objectives.supplementary)]
+        specs += [
+            (("objectives", "supplementary", i), s)
+            for i, s in enumerate(cfg.objectives.supplementary)
+        ]
     specs += [(("constraints", i), spec) for i, spec in enumerate(cfg.constraints)]
     for loc, spec in specs:
-        if spec.metric is not None and METRICS[spec.metric].kind == "iso2631" \
-                and rate < MIN_SAMPLE_RATE:
-            raise cfg.error(loc + ("metric",), f"{spec.metric} needs signals sampled at "
-                            f"{MIN_SAMPLE_RATE:g} Hz or more; simulation.output_dt gives "
-                            f"{rate:.4g} Hz")
+        if (
+            spec.metric is not None
+            and METRICS[spec.metric].kind == "iso2631"
+            and rate < MIN_SAMPLE_RATE
+        ):
+            raise cfg.error(
+                loc + ("metric",),
+                f"{spec.metric} needs signals sampled at "
+                f"{MIN_SAMPLE_RATE:g} Hz or more; simulation.output_dt gives "
+                f"{rate:.4g} Hz",
+            )
 
 
 def full_network(model, attachments) -> Network:
@@ -98,12 +124,13 @@ def _rk4_radius(direction: np.ndarray) -> np.ndarray:
     ``r`` with ``|R(r d)| <= 1`` on the whole segment from 0, ``R(z) = 1 + z + z^2/2 + z^3/6
     + z^4/24`` RK4's amplification factor (2.785 on the negative real axis, 2 sqrt 2 on the
     imaginary one)."""
+
     def grows(r):
         z = r * direction
         return np.abs(1 + z * (1 + z * (1 / 2 + z * (1 / 6 + z / 24)))) > 1 + 1e-12
 
     grid = np.linspace(0.0, 3.0, 301)[1:, None]
-    first = np.argmax(grows(grid), axis=0)                 # the first radius that grows
+    first = np.argmax(grows(grid), axis=0)  # the first radius that grows
     low, high = np.where(first > 0, grid[first - 1, 0], 0.0), grid[first, 0]
     for _ in range(40):
         mid = 0.5 * (low + high)
@@ -112,8 +139,9 @@ def _rk4_radius(direction: np.ndarray) -> np.ndarray:
     return low
 
 
-def stability_limit(network: Network, damping_rows: dict[str, np.ndarray] | None = None
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def stability_limit(
+    network: Network, damping_rows: dict[str, np.ndarray] | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The largest RK4 step [s] of each design of ``network`` linearised about rest, with the
     frequency [Hz] and the index of the mode that sets it: ``(dt_max (P,), f (P,), dof (P,))``
     (``dof`` the DOF with most of that mode's kinetic energy).
@@ -126,9 +154,13 @@ def stability_limit(network: Network, damping_rows: dict[str, np.ndarray] | None
     spring at large travel, or a tyre in the air, moves the limit.
     """
     if damping_rows:
-        network = replace(network, groups=tuple(
-            replace(g, damping=damping_rows[g.name]) if g.name in damping_rows else g
-            for g in network.groups))
+        network = replace(
+            network,
+            groups=tuple(
+                replace(g, damping=damping_rows[g.name]) if g.name in damping_rows else g
+                for g in network.groups
+            ),
+        )
     lin = network.linear_model()
     P, n = lin.mass.shape
     inverse = 1.0 / lin.mass
@@ -147,17 +179,24 @@ def stability_limit(network: Network, damping_rows: dict[str, np.ndarray] | None
         decaying = (lam.real <= 1e-9 * size) & (size > 0)
         direction = np.where(decaying, lam / np.where(size > 0, size, 1.0), -1.0)
         direction = np.where(direction.real > 0, 1j * np.sign(direction.imag), direction)
-        limit = np.where(decaying, _rk4_radius(direction.reshape(-1)).reshape(lam.shape)
-                         / np.where(size > 0, size, 1.0), np.inf)
+        limit = np.where(
+            decaying,
+            _rk4_radius(direction.reshape(-1)).reshape(lam.shape) / np.where(size > 0, size, 1.0),
+            np.inf,
+        )
     worst = np.argmin(limit, axis=1)
     rows = np.arange(P)
     energy = lin.mass * np.abs(vectors[rows, :n, worst]) ** 2
-    return (limit[rows, worst], np.abs(lam[rows, worst].imag) / (2 * math.pi),
-            np.argmax(energy, axis=1))
+    return (
+        limit[rows, worst],
+        np.abs(lam[rows, worst].imag) / (2 * math.pi),
+        np.argmax(energy, axis=1),
+    )
 
 
-def check_stability(cfg: Config, pv, model, attachments, loc: tuple = ("simulation", "dt"),
-                    what: str = "") -> None:
+def check_stability(
+    cfg: Config, pv, model, attachments, loc: tuple = ("simulation", "dt"), what: str = ""
+) -> None:
     """ConfigError when ``simulation.dt`` exceeds RK4's stability limit for some design of the
     assembled model (:func:`stability_limit`; semi-active dampers at ``c_min`` and at
     ``c_max``). ``pv`` holds the designs; ``what`` says which designs they are."""
@@ -167,9 +206,16 @@ def check_stability(cfg: Config, pv, model, attachments, loc: tuple = ("simulati
     cases = [None]
     corners = cfg.vehicle.corners
     if any(corners[c].damper.kind == "semi_active" for c in model.corners):
-        stiff = np.stack([pv.get(f"vehicle.corners.{c}.damper."
-                                 f"{'c_max' if corners[c].damper.kind == 'semi_active' else 'c'}")
-                          for c in model.corners], axis=1)
+        stiff = np.stack(
+            [
+                pv.get(
+                    f"vehicle.corners.{c}.damper."
+                    f"{'c_max' if corners[c].damper.kind == 'semi_active' else 'c'}"
+                )
+                for c in model.corners
+            ],
+            axis=1,
+        )
         cases.append({"suspension": parameter_rows(stiff)})
     dt = cfg.simulation.dt
     for case in cases:
@@ -178,10 +224,13 @@ def check_stability(cfg: Config, pv, model, attachments, loc: tuple = ("simulati
         if bad.size:
             p = bad[np.argmin(limit[bad])]
             state = " with the dampers at c_max" if case else ""
-            raise cfg.error(loc, f"{dt:g} s exceeds classical RK4's stability limit "
-                            f"{limit[p]:.3g} s for the fastest mode of the linearised model"
-                            f"{state} ({network.dof_names[dof[p]]}, {frequency[p]:.4g} Hz"
-                            f"{what}); use dt <= {0.9 * limit[p]:.2g} s")
+            raise cfg.error(
+                loc,
+                f"{dt:g} s exceeds classical RK4's stability limit "
+                f"{limit[p]:.3g} s for the fastest mode of the linearised model"
+                f"{state} ({network.dof_names[dof[p]]}, {frequency[p]:.4g} Hz"
+                f"{what}); use dt <= {0.9 * limit[p]:.2g} s",
+            )
 
 
 #: Most corners of the design variables' box whose stability is checked: all of them up to
@@ -195,7 +244,7 @@ def bound_corners(cfg: Config) -> dict[str, np.ndarray]:
 
     variables = cfg.design_variables
     n = len(variables)
-    if 2 ** n <= _CORNERS:
+    if 2**n <= _CORNERS:
         upper = np.array(list(itertools.product((False, True), repeat=n)), dtype=bool)
     else:
         upper = np.random.default_rng(0).integers(0, 2, (_CORNERS, n)).astype(bool)
@@ -211,15 +260,16 @@ def check_config(cfg: Config, optimisation: bool = True) -> None:
     it; the commands that simulate run what they use."""
     from .params import ParamView
     from .seat import build_attachments
-    from .simulate import prepare
+    from .simulate import check_memory, prepare, signal_names
     from .vehicle import build_vehicle
-
-    from .simulate import check_memory, signal_names
 
     pv, model, controller, attachments = prepare(cfg)
     check_stability(cfg, pv, model, attachments)
-    written = cfg.output.signals if cfg.output.signals != "all" else signal_names(
-        model, getattr(controller, "units", {}), attachments)
+    written = (
+        cfg.output.signals
+        if cfg.output.signals != "all"
+        else signal_names(model, getattr(controller, "units", {}), attachments)
+    )
     check_memory(cfg, model, attachments, 1, signals=len(written) + len(cfg.metrics))
     if not optimisation or not (cfg.design_variables or cfg.objectives or cfg.optimiser):
         return
@@ -227,7 +277,12 @@ def check_config(cfg: Config, optimisation: bool = True) -> None:
 
     problem = Problem.from_config(cfg)
     pv = ParamView(cfg, bound_corners(cfg))
-    check_stability(cfg, pv, build_vehicle(cfg, pv), build_attachments(cfg, pv),
-                    what=" at a corner of the design variables' bounds")
+    check_stability(
+        cfg,
+        pv,
+        build_vehicle(cfg, pv),
+        build_attachments(cfg, pv),
+        what=" at a corner of the design variables' bounds",
+    )
     if cfg.optimiser is not None:
         build_optimiser(cfg, problem)

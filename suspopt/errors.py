@@ -17,6 +17,8 @@ def check_known(what: str, name: str, known: Iterable[str]) -> str:
     known = list(known)
     if name not in known:
         close = difflib.get_close_matches(name, known, n=3)
-        raise ValueError(f"unknown {what} {name!r}" + (
-            f"; did you mean {', '.join(close)}?" if close else f"; known: {', '.join(known)}"))
+        raise ValueError(
+            f"unknown {what} {name!r}"
+            + (f"; did you mean {', '.join(close)}?" if close else f"; known: {', '.join(known)}")
+        )
     return name

@@ -49,16 +49,18 @@ from .config import ConfigError
 __all__ = ["write_csv"]
 
 _SKIP = ("checkpoint",)
-_ROWS = 20000                       # rows per block written
+_ROWS = 20000  # rows per block written
 
 
 def _text(values) -> list:
-    return [v.decode("utf-8", "replace") if isinstance(v, bytes) else v
-            for v in np.asarray(values).ravel().tolist()]
+    return [
+        v.decode("utf-8", "replace") if isinstance(v, bytes) else v
+        for v in np.asarray(values).ravel().tolist()
+    ]
 
 
 def _is_text(ds) -> bool:
-    return ds.dtype.kind in "SO"        # fixed-length bytes, variable-length strings
+    return ds.dtype.kind in "SO"  # fixed-length bytes, variable-length strings
 
 
 def _values(ds) -> np.ndarray:
@@ -84,8 +86,9 @@ def _dims(ds) -> list[tuple[str, object]]:
     out = []
     for axis in range(ds.ndim):
         scales = ds.dims[axis]
-        out.append((scales[0].name.rsplit("/", 1)[-1], scales[0]) if len(scales)
-                   else (f"dim{axis}", None))
+        out.append(
+            (scales[0].name.rsplit("/", 1)[-1], scales[0]) if len(scales) else (f"dim{axis}", None)
+        )
     return out
 
 
@@ -132,27 +135,34 @@ def _plan(h5) -> list[tuple[str, str, list, list]]:
     from .h5read import MAX_DATASET_BYTES
 
     groups = [h5]
-    h5.visititems(lambda name, obj: groups.append(obj) if isinstance(obj, h5py.Group)
-                  and name.split("/")[0] not in _SKIP else None)
+    h5.visititems(
+        lambda name, obj: (
+            groups.append(obj)
+            if isinstance(obj, h5py.Group) and name.split("/")[0] not in _SKIP
+            else None
+        )
+    )
     tables = []
     for group in groups:
         parts = [_safe(p) for p in group.name.split("/") if p]
         wide, long = [], {}
         for name, ds in group.items():
-            if not isinstance(ds, h5py.Dataset) or ds.is_scale or \
-                    ds.dtype.kind not in "biufSO":
+            if not isinstance(ds, h5py.Dataset) or ds.is_scale or ds.dtype.kind not in "biufSO":
                 continue
             if ds.size * max(ds.dtype.itemsize, 8) > MAX_DATASET_BYTES:
-                raise ConfigError(f"{h5.filename}: {ds.name}: shape {ds.shape} is larger than "
-                                  f"{MAX_DATASET_BYTES >> 20} MB: not a file of suspopt's")
+                raise ConfigError(
+                    f"{h5.filename}: {ds.name}: shape {ds.shape} is larger than "
+                    f"{MAX_DATASET_BYTES >> 20} MB: not a file of suspopt's"
+                )
             dims = _dims(ds)
             if _names(ds, dims) is not None:
                 wide.append((".".join(parts + [_safe(name)]), group.name, [ds], dims))
             else:
-                key = tuple((d, s.name if s is not None else None, n)
-                            for (d, s), n in zip(dims, ds.shape))
+                key = tuple(
+                    (d, s.name if s is not None else None, n) for (d, s), n in zip(dims, ds.shape)
+                )
                 long.setdefault(key, (dims, []))[1].append(ds)
-        for key, (dims, members) in long.items():
+        for dims, members in long.values():
             label = [] if len(long) == 1 else ["-".join(_safe(d) for d, _ in dims) or "scalars"]
             tables.append((".".join(parts + label), group.name, members, dims))
         tables.extend(wide)
@@ -163,15 +173,19 @@ def _columns(members, dims) -> tuple[list[str], list[np.ndarray]]:
     """Header and columns of a table (module docstring)."""
     first = members[0]
     names = _names(first, dims)
-    if names is not None:                      # wide: one dataset, a column per name
+    if names is not None:  # wide: one dataset, a column per name
         header, index = _index(dims[:-1], first.shape[:-1])
         data = _values(first).reshape(-1, len(names))
         units = _units(first, len(names))
-        return (header + [f"{n} [{u}]" for n, u in zip(names, units)],
-                index + [data[:, j] for j in range(len(names))])
+        return (
+            header + [f"{n} [{u}]" for n, u in zip(names, units)],
+            index + [data[:, j] for j in range(len(names))],
+        )
     header, index = _index(dims, first.shape)
-    return (header + [f"{ds.name.rsplit('/', 1)[-1]} [{_units(ds, 1)[0]}]" for ds in members],
-            index + [_values(ds) for ds in members])
+    return (
+        header + [f"{ds.name.rsplit('/', 1)[-1]} [{_units(ds, 1)[0]}]" for ds in members],
+        index + [_values(ds) for ds in members],
+    )
 
 
 def _write_table(stream, comment: str, header: list[str], columns: list[np.ndarray]) -> None:
@@ -181,7 +195,7 @@ def _write_table(stream, comment: str, header: list[str], columns: list[np.ndarr
         writer = csv.writer(text, lineterminator="\n")
         writer.writerow(header)
         for start in range(0, len(columns[0]) if columns else 0, _ROWS):
-            writer.writerows(zip(*(c[start:start + _ROWS].tolist() for c in columns)))
+            writer.writerows(zip(*(c[start : start + _ROWS].tolist() for c in columns)))
         text.flush()
     finally:
         text.detach()
@@ -202,15 +216,15 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
     h5_path, folder = Path(h5_path), Path(folder)
     with H5Reader(h5_path) as reader:
         if not reader.has_attr("suspopt_version"):
-            raise ConfigError(f"{h5_path}: not a file suspopt wrote (no root attribute "
-                              f"'suspopt_version')")
+            raise ConfigError(
+                f"{h5_path}: not a file suspopt wrote (no root attribute 'suspopt_version')"
+            )
         with _reading(h5_path):
             tables = _plan(reader.file)
         try:
             folder.mkdir(exist_ok=True)
         except OSError as exc:
-            raise ConfigError(f"--csv {folder}: cannot make the folder "
-                              f"({exc.strerror})") from None
+            raise ConfigError(f"--csv {folder}: cannot make the folder ({exc.strerror})") from None
         if not folder.is_dir():
             raise ConfigError(f"--csv {folder}: is not a folder")
         stem, names, targets = _safe(h5_path.stem), set(), []
@@ -223,8 +237,10 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
         for target, (_, group, members, dims) in zip(targets, tables):
             with _reading(h5_path):
                 header, columns = _columns(members, dims)
-            comment = (f"# written by suspopt {__version__} from "
-                       f"{' '.join(str(h5_path).splitlines())} ({group})\n")
+            comment = (
+                f"# written by suspopt {__version__} from "
+                f"{' '.join(str(h5_path).splitlines())} ({group})\n"
+            )
             with atomic_file(target, force) as stream:
                 _write_table(stream, comment, header, columns)
     return targets
@@ -238,5 +254,6 @@ def _reading(h5_path: Path):
     except ConfigError:
         raise
     except (OSError, RuntimeError, KeyError, ValueError, TypeError) as exc:
-        raise ConfigError(f"{h5_path}: damaged, cannot be read "
-                          f"({' '.join(str(exc).split())[:120]})") from None
+        raise ConfigError(
+            f"{h5_path}: damaged, cannot be read ({' '.join(str(exc).split())[:120]})"
+        ) from None

@@ -49,7 +49,7 @@ class H5Reader:
         except (OSError, ValueError):
             raise ConfigError(f"{self.where}: not an HDF5 file (or a damaged one)") from None
 
-    def __enter__(self) -> "H5Reader":
+    def __enter__(self) -> H5Reader:
         return self
 
     def __exit__(self, *exc) -> None:
@@ -67,8 +67,9 @@ class H5Reader:
 
         node = self._node(name)
         if not isinstance(node, h5py.Group):
-            raise ConfigError(f"{self.where}: /{name}: missing (is this a suspopt file of the "
-                              f"right kind?)")
+            raise ConfigError(
+                f"{self.where}: /{name}: missing (is this a suspopt file of the right kind?)"
+            )
         return node
 
     def dataset(self, name: str):
@@ -77,12 +78,14 @@ class H5Reader:
 
         node = self._node(name)
         if not isinstance(node, h5py.Dataset):
-            raise ConfigError(f"{self.where}: /{name}: missing (is this a suspopt file of the "
-                              f"right kind?)")
+            raise ConfigError(
+                f"{self.where}: /{name}: missing (is this a suspopt file of the right kind?)"
+            )
         return node
 
-    def array(self, name: str, ndim: int, columns: int | None = None,
-              integer: bool = False) -> np.ndarray:
+    def array(
+        self, name: str, ndim: int, columns: int | None = None, integer: bool = False
+    ) -> np.ndarray:
         """The numeric dataset ``/name`` as float64 (int64 with ``integer``), checked to have
         ``ndim`` dimensions and ``columns`` columns."""
         ds = self.dataset(name)
@@ -91,14 +94,19 @@ class H5Reader:
             want = "whole numbers" if integer else "numbers"
             raise ConfigError(f"{self.where}: /{name}: holds {ds.dtype} values, not {want}")
         if ds.ndim != ndim:
-            raise ConfigError(f"{self.where}: /{name}: expected {ndim} dimension"
-                              f"{'s' if ndim > 1 else ''}, got shape {ds.shape}")
+            raise ConfigError(
+                f"{self.where}: /{name}: expected {ndim} dimension"
+                f"{'s' if ndim > 1 else ''}, got shape {ds.shape}"
+            )
         if columns is not None and ds.shape[-1] != columns:
-            raise ConfigError(f"{self.where}: /{name}: expected {columns} columns, got "
-                              f"{ds.shape[-1]}")
+            raise ConfigError(
+                f"{self.where}: /{name}: expected {columns} columns, got {ds.shape[-1]}"
+            )
         if ds.size * 8 > MAX_DATASET_BYTES:
-            raise ConfigError(f"{self.where}: /{name}: shape {ds.shape} is larger than "
-                              f"{MAX_DATASET_BYTES >> 20} MB: not a file of suspopt's")
+            raise ConfigError(
+                f"{self.where}: /{name}: shape {ds.shape} is larger than "
+                f"{MAX_DATASET_BYTES >> 20} MB: not a file of suspopt's"
+            )
         try:
             values = ds[()]
         except (OSError, ValueError, RuntimeError):
@@ -111,8 +119,7 @@ class H5Reader:
             value = value[()]
         if isinstance(value, (bytes, np.bytes_)):
             if len(value) > MAX_CONFIG_BYTES:
-                raise ConfigError(f"{self.where}: {name}: longer than "
-                                  f"{MAX_CONFIG_BYTES >> 10} kB")
+                raise ConfigError(f"{self.where}: {name}: longer than {MAX_CONFIG_BYTES >> 10} kB")
             try:
                 return bytes(value).decode("utf-8")
             except UnicodeDecodeError:
@@ -129,8 +136,9 @@ class H5Reader:
         try:
             return obj is not None and key in obj.attrs
         except (OSError, ValueError, TypeError, RuntimeError, KeyError):
-            raise ConfigError(f"{self.where}: attributes of /{node}: damaged, cannot be "
-                              f"read") from None
+            raise ConfigError(
+                f"{self.where}: attributes of /{node}: damaged, cannot be read"
+            ) from None
 
     def text_attr(self, key: str, node: str = "") -> str:
         """The text attribute ``key`` of ``/node`` (the root by default)."""
@@ -154,10 +162,14 @@ class H5Reader:
             value = None
         if isinstance(value, np.ndarray) and value.ndim == 0:
             value = value[()]
-        if not isinstance(value, (int, np.integer)) or isinstance(value, bool) \
-                or not low <= value <= high:
-            raise ConfigError(f"{self.where}: {label}: missing or not a whole number in "
-                              f"[{low}, {high}]")
+        if (
+            not isinstance(value, (int, np.integer))
+            or isinstance(value, bool)
+            or not low <= value <= high
+        ):
+            raise ConfigError(
+                f"{self.where}: {label}: missing or not a whole number in [{low}, {high}]"
+            )
         return int(value)
 
     def labels(self, name: str, key: str, columns: int) -> list[str]:
@@ -173,6 +185,7 @@ class H5Reader:
             raise ConfigError(f"{self.where}: {label}: missing")
         entries = [self.text(v, label) for v in np.atleast_1d(raw)]
         if len(entries) != columns:
-            raise ConfigError(f"{self.where}: {label}: {len(entries)} entries for {columns} "
-                              f"columns")
+            raise ConfigError(
+                f"{self.where}: {label}: {len(entries)} entries for {columns} columns"
+            )
         return entries

@@ -27,7 +27,15 @@ import numpy as np
 
 from .network import Assembled, widen
 
-__all__ = ["Controller", "Held", "HeldRecords", "Trajectory", "Edges", "integrate", "DIVERGENCE_LIMIT"]
+__all__ = [
+    "Controller",
+    "Held",
+    "HeldRecords",
+    "Trajectory",
+    "Edges",
+    "integrate",
+    "DIVERGENCE_LIMIT",
+]
 
 #: |state| above this (m, rad, m/s, rad/s) counts as divergence.
 DIVERGENCE_LIMIT = 1.0e6
@@ -136,8 +144,9 @@ class HeldRecords(Mapping):
     """The controller's records by name, each a :class:`Held` of one index: published (see
     the ``Controller`` protocol) from the values kept at each sample when one is first read."""
 
-    def __init__(self, names: Sequence[str], publish: Callable[[], dict[str, np.ndarray]],
-                 index: np.ndarray):
+    def __init__(
+        self, names: Sequence[str], publish: Callable[[], dict[str, np.ndarray]], index: np.ndarray
+    ):
         self._names, self._publish, self._index = tuple(names), publish, index
         self._held: dict[str, Held] | None = None
 
@@ -202,8 +211,8 @@ def _stacked(arrays: list[np.ndarray]) -> np.ndarray:
 class _Edges(NamedTuple):
     """The road's edges (:func:`suspopt.road.road_edges`) as :func:`integrate` takes them."""
 
-    times: np.ndarray      #: (E,) ascending [s]
-    jumps: np.ndarray      #: (E, n_u) the step in the inputs u at each edge [m]
+    times: np.ndarray  #: (E,) ascending [s]
+    jumps: np.ndarray  #: (E, n_u) the step in the inputs u at each edge [m]
     #: ``inputs(t, left)``: the inputs' part of the deformations (T, 2R, 1, 1) at times ``t``
     #: (T,), their left limits if ``left``, else the right ones
     inputs: Callable[[np.ndarray, bool], np.ndarray]
@@ -225,8 +234,9 @@ class _Recorder:
         self.blocks = []
         for buffer, record in buffers:
             block = np.empty((_BLOCK,) + record.shape[:2])
-            self.blocks.append((buffer, block, block.reshape(_BLOCK, -1),
-                                record.reshape(-1, n_out)))
+            self.blocks.append(
+                (buffer, block, block.reshape(_BLOCK, -1), record.reshape(-1, n_out))
+            )
 
     def keep(self, j: int) -> None:
         """Sample ``j`` of every buffer."""
@@ -235,7 +245,7 @@ class _Recorder:
             block[row] = buffer[:, :P, 0]
         if row == _BLOCK - 1 or j == self.n_out - 1:
             for _, _, by_sample, by_time in self.blocks:
-                by_time[:, j - row:j + 1] = by_sample[:row + 1].T
+                by_time[:, j - row : j + 1] = by_sample[: row + 1].T
 
 
 class _ControllerHold:
@@ -244,23 +254,32 @@ class _ControllerHold:
     per step, and the values to publish, stored when they change (at the controller's
     samples; a lagged coefficient changes every step and is recorded like a state)."""
 
-    def __init__(self, controller: Controller, coef: np.ndarray, rows: slice, P: int,
-                 n_out: int, dt: float, vehicle: _VehicleState):
+    def __init__(
+        self,
+        controller: Controller,
+        coef: np.ndarray,
+        rows: slice,
+        P: int,
+        n_out: int,
+        dt: float,
+        vehicle: _VehicleState,
+    ):
         self.controller, self.dt, self.vehicle = controller, dt, vehicle
-        self.damping = coef[rows]                          # (N, width, 1), a view
-        self.command = controller.start(P)                 # the latest command (P, 1, N)
+        self.damping = coef[rows]  # (N, width, 1), a view
+        self.command = controller.start(P)  # the latest command (P, 1, N)
         self.damping[...] = self.command.transpose(2, 0, 1)
         self.every, decay = controller.sample_every, controller.lag_decay
-        self.sample_index = 0                              # the half step of the latest sample
-        self.decay = None if decay is None else widen(decay.transpose(2, 0, 1),
-                                                      self.damping.shape[1])
+        self.sample_index = 0  # the half step of the latest sample
+        self.decay = (
+            None if decay is None else widen(decay.transpose(2, 0, 1), self.damping.shape[1])
+        )
         self.lagged = None
         if self.decay is not None:
             self.rise, self.pulled = 1.0 - self.decay, np.empty_like(self.damping)
             self.lagged = np.empty((self.damping.shape[0], P, n_out))
-        self.held_damping: list[np.ndarray] = []     # (P, N) views of the commands
+        self.held_damping: list[np.ndarray] = []  # (P, N) views of the commands
         self.held_records: list[dict[str, np.ndarray]] = []
-        self.changes: list[int] = []                 # the output samples where they changed
+        self.changes: list[int] = []  # the output samples where they changed
         self.last_samples = -1
 
     def due(self, k: int) -> bool:
@@ -277,7 +296,7 @@ class _ControllerHold:
                 self.damping[...] = new
             else:
                 np.multiply(new, self.rise, out=self.pulled)
-        if self.decay is not None:   # c <- c_cmd - (c_cmd - c) exp(-dt/τ) = c e + c_cmd (1 - e)
+        if self.decay is not None:  # c <- c_cmd - (c_cmd - c) exp(-dt/τ) = c e + c_cmd (1 - e)
             np.multiply(self.damping, self.decay, out=self.damping)
             np.add(self.damping, self.pulled, out=self.damping)
 
@@ -287,7 +306,7 @@ class _ControllerHold:
         if controller.samples != self.last_samples:
             self.held_records.append(controller.record())  # they change with samples only
             if self.decay is None:
-                self.held_damping.append(self.command[:, 0])   # the damping is the command
+                self.held_damping.append(self.command[:, 0])  # the damping is the command
             self.changes.append(j)
             self.last_samples = controller.samples
 
@@ -295,12 +314,15 @@ class _ControllerHold:
         """The damping (held, or the lagged record) and the records of the whole run."""
         held_at = np.searchsorted(self.changes, np.arange(n_out), side="right") - 1
         held_damping, held_records = self.held_damping, self.held_records
-        damping = self.lagged if self.decay is not None \
-            else Held(lambda: _stacked(held_damping), held_at)
+        damping = (
+            self.lagged if self.decay is not None else Held(lambda: _stacked(held_damping), held_at)
+        )
 
         def publish() -> dict[str, np.ndarray]:
-            return self.controller.published({name: _stacked([h[name] for h in held_records])
-                                              for name in held_records[0]})
+            return self.controller.published(
+                {name: _stacked([h[name] for h in held_records]) for name in held_records[0]}
+            )
+
         return damping, HeldRecords(self.controller.units, publish, held_at)
 
 
@@ -316,11 +338,11 @@ class _Divergence:
     def check(self, k: int, y: np.ndarray, n_steps: int) -> None:
         """After step ``k``."""
         if (k + 1) % _CHECK_EVERY == 0 or k + 1 == n_steps:
-            bad = ~(np.abs(self.y2[:, :self.P]) < DIVERGENCE_LIMIT).all(axis=0)
+            bad = ~(np.abs(self.y2[:, : self.P]) < DIVERGENCE_LIMIT).all(axis=0)
             new_bad = bad & np.isnan(self.at)
             if new_bad.any():
                 self.at[new_bad] = (k + 1) * self.dt
-                y[:, :self.P][:, bad] = np.nan
+                y[:, : self.P][:, bad] = np.nan
 
 
 class _RK4:
@@ -350,17 +372,35 @@ class _RK4:
 
         def stage(state2, state, shift, slope, h, target):
             # (state, half-steps after t_k, M^-1 scaled, slope and its views, scale, target)
-            return (state2, shift, widen(asm.inverse_mass * h, width),
-                    slope[n:].reshape(n, width), slope[n:], slope[:n], state[n:], h, slope,
-                    target)
-        self.rest = self._make_rest(s1, s2, s3, s4, ys, (
-            stage(ys2, ys, 1, s2, half, ys), stage(ys2, ys, 1, s3, dt, ys),
-            stage(ys2, ys, 2, s4, dt / 6.0, None)))
+            return (
+                state2,
+                shift,
+                widen(asm.inverse_mass * h, width),
+                slope[n:].reshape(n, width),
+                slope[n:],
+                slope[:n],
+                state[n:],
+                h,
+                slope,
+                target,
+            )
+
+        self.rest = self._make_rest(
+            s1,
+            s2,
+            s3,
+            s4,
+            ys,
+            (
+                stage(ys2, ys, 1, s2, half, ys),
+                stage(ys2, ys, 1, s3, dt, ys),
+                stage(ys2, ys, 2, s4, dt / 6.0, None),
+            ),
+        )
 
     def first(self, i: int) -> None:
         """The accelerations at the state, with the inputs of half step ``i``, into ``acc``."""
-        self.evaluate(self.y2, self.offsets[i], self.coef, self.unscaled_mass, self.acc2,
-                      self.acc)
+        self.evaluate(self.y2, self.offsets[i], self.coef, self.unscaled_mass, self.acc2, self.acc)
 
     def _make_rest(self, s1, s2, s3, s4, ys, stages):
         """The rest of a step after :meth:`first` (a closure: its names are local, the
@@ -385,6 +425,7 @@ class _RK4:
             s1.__imul__(third)
             s1.__iadd__(s4)
             y.__iadd__(s1)
+
         return rest
 
     def derivative(self, state: np.ndarray, offset: np.ndarray | None) -> np.ndarray:
@@ -392,8 +433,14 @@ class _RK4:
         n = self.n
         out = np.empty_like(state)
         out[:n] = state[n:]
-        self.evaluate(state.reshape(self.n2, self.width), offset, self.coef,
-                      self.unscaled_mass, out[n:].reshape(n, self.width), out[n:])
+        self.evaluate(
+            state.reshape(self.n2, self.width),
+            offset,
+            self.coef,
+            self.unscaled_mass,
+            out[n:].reshape(n, self.width),
+            out[n:],
+        )
         return out
 
 
@@ -411,7 +458,7 @@ class _Splitter:
             if edges.times[e] >= 0.0 and k < n_steps:
                 self.steps.setdefault(int(k), []).append(e)
         R = asm.R
-        self.rate_forces = asm.G2[..., R:2 * R]      # q'' per unit viscous force, times M
+        self.rate_forces = asm.G2[..., R : 2 * R]  # q'' per unit viscous force, times M
 
     def at_start(self) -> None:
         """The impulses of edges at t = 0, before the first sample."""
@@ -422,13 +469,16 @@ class _Splitter:
     def impulse(self, e: int) -> None:
         """The velocity jump M^-1 G (c D_u Δu) of the inputs' jump Δu at edge ``e``."""
         rk4, R, edges = self.rk4, self.asm.R, self.edges
-        force = rk4.coef[R:2 * R] * (self.asm.input_map @ edges.jumps[e])[:, None, None]  # [N s]
-        if edges.no_pull is not None:   # a tyre that cannot pull takes no pulling impulse
+        force = rk4.coef[R : 2 * R] * (self.asm.input_map @ edges.jumps[e])[:, None, None]  # [N s]
+        if edges.no_pull is not None:  # a tyre that cannot pull takes no pulling impulse
             force[edges.no_pull] = np.minimum(force[edges.no_pull], 0.0)
         force2 = force.reshape(R, rk4.width)
-        jump = self.rate_forces @ force2 if self.rate_forces.ndim == 2 \
+        jump = (
+            self.rate_forces @ force2
+            if self.rate_forces.ndim == 2
             else np.einsum("prc,cp->rp", self.rate_forces, force2)
-        rk4.y[rk4.n:] += jump[:, :, None] * rk4.unscaled_mass
+        )
+        rk4.y[rk4.n :] += jump[:, :, None] * rk4.unscaled_mass
 
     def step(self, k: int) -> None:
         """Step ``k`` in RK4 sub-steps between its edges, each edge's impulse applied at its
@@ -451,8 +501,9 @@ class _Splitter:
                 self.impulse(found[j])
 
 
-def _controller_hold(controller: Controller, rk4: "_RK4", asm: Assembled, n_vehicle: int,
-                     n_out: int, dt: float) -> "_ControllerHold":
+def _controller_hold(
+    controller: Controller, rk4: _RK4, asm: Assembled, n_vehicle: int, n_out: int, dt: float
+) -> _ControllerHold:
     """The controller's hold over the stepper ``rk4``: it reads the vehicle's states and, when
     a law needs them, the accelerations at its sample (the first stage of that step)."""
     n, P = asm.n, asm.P
@@ -460,14 +511,22 @@ def _controller_hold(controller: Controller, rk4: "_RK4", asm: Assembled, n_vehi
     def vehicle_acceleration() -> np.ndarray:
         rk4.first(hold.sample_index)
         return rk4.acc[:n_vehicle, :P, 0].copy()
-    vehicle = _VehicleState(rk4.y[n:n + n_vehicle, :P, 0], vehicle_acceleration)
+
+    vehicle = _VehicleState(rk4.y[n : n + n_vehicle, :P, 0], vehicle_acceleration)
     hold = _ControllerHold(controller, rk4.coef, asm.damper_rows, P, n_out, dt, vehicle)
     return hold
 
 
-def integrate(asm: Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, n_steps: int,
-              every: int, controller: Controller | None = None,
-              edges: Edges | None = None) -> Trajectory:
+def integrate(
+    asm: Assembled,
+    n_vehicle: int,
+    offsets: np.ndarray,
+    dt: float,
+    n_steps: int,
+    every: int,
+    controller: Controller | None = None,
+    edges: Edges | None = None,
+) -> Trajectory:
     """Classical RK4 over ``n_steps``; ``offsets`` (2 n_steps + 1, 2R, 1, 1) are the inputs'
     part of the deformations on the half-step grid ``t = j dt/2`` (their right limits at a
     road edge). Samples are kept every ``every``-th step.
@@ -503,7 +562,7 @@ def integrate(asm: Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, n_
     n, P = asm.n, asm.P
     width = max(P, 2)
     active = offsets.any(axis=(1, 2, 3))
-    if offsets.size * width <= _WIDE_OFFSETS:          # small batches: no broadcasting
+    if offsets.size * width <= _WIDE_OFFSETS:  # small batches: no broadcasting
         offsets = widen(offsets, width)
     # the inputs' part of each half-step, None where it is zero (a bump's road before and after)
     rk4 = _RK4(asm, width, dt, [o if a else None for o, a in zip(offsets, active)])
@@ -534,7 +593,7 @@ def integrate(asm: Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, n_
             else:
                 rk4.rest(2 * k)
             divergence.check(k, rk4.y, n_steps)
-        if n_steps % every == 0:                         # the final instant is a sample
+        if n_steps % every == 0:  # the final instant is a sample
             if hold is not None:
                 hold.control(n_steps)
             rk4.first(2 * n_steps)
@@ -542,5 +601,10 @@ def integrate(asm: Assembled, n_vehicle: int, offsets: np.ndarray, dt: float, n_
             if hold is not None:
                 hold.kept(n_out - 1)
     damping, records = hold.held(n_out) if hold is not None else (None, {})
-    return Trajectory(states=states, accelerations=accelerations, damping=damping,
-                      records=records, diverged_at=divergence.at)
+    return Trajectory(
+        states=states,
+        accelerations=accelerations,
+        damping=damping,
+        records=records,
+        diverged_at=divergence.at,
+    )

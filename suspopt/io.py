@@ -43,7 +43,7 @@ import sys
 import tempfile
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -51,9 +51,20 @@ import numpy as np
 from . import __version__
 from .config import Config, ConfigError
 
-__all__ = ["OUTPUT_MARKER", "check_target", "claim", "atomic_file", "atomic_h5",
-           "write_dataset", "write_attrs", "text_array", "write_simulation",
-           "read_simulation_signals", "open_dataset", "is_suspopt_output"]
+__all__ = [
+    "OUTPUT_MARKER",
+    "check_target",
+    "claim",
+    "atomic_file",
+    "atomic_h5",
+    "write_dataset",
+    "write_attrs",
+    "text_array",
+    "write_simulation",
+    "read_simulation_signals",
+    "open_dataset",
+    "is_suspopt_output",
+]
 
 #: Written into every non-HDF5 file suspopt makes (figure metadata, a comment), so that it
 #: can tell its own outputs from other files.
@@ -75,6 +86,7 @@ def is_suspopt_output(path: Path) -> bool:
         head = stream.read(_HEAD)
     if head.startswith(b"\x89HDF\r\n\x1a\n"):
         import h5py
+
         try:
             with h5py.File(path, "r") as h5:
                 return "suspopt_version" in h5.attrs
@@ -101,20 +113,33 @@ def check_target(path: str | Path, force: bool = False, option: str = "-o") -> P
         return path
     except OSError as exc:
         raise ConfigError(f"{option} {path}: cannot inspect it ({exc.strerror})") from None
-    kind = ("a directory" if stat.S_ISDIR(mode) else "a symbolic link" if stat.S_ISLNK(mode)
-            else "a FIFO" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode)
-            else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else None)
+    kind = (
+        "a directory"
+        if stat.S_ISDIR(mode)
+        else "a symbolic link"
+        if stat.S_ISLNK(mode)
+        else "a FIFO"
+        if stat.S_ISFIFO(mode)
+        else "a socket"
+        if stat.S_ISSOCK(mode)
+        else "a device"
+        if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+        else None
+    )
     if kind is not None:
-        raise ConfigError(f"{option} {path}: is {kind}; an output must be a regular file or "
-                          f"a new name")
+        raise ConfigError(
+            f"{option} {path}: is {kind}; an output must be a regular file or a new name"
+        )
     if not force:
         try:
             ours = is_suspopt_output(path)
         except OSError as exc:
             raise ConfigError(f"{option} {path}: cannot read it ({exc.strerror})") from None
         if not ours:
-            raise ConfigError(f"{option} {path}: exists and was not written by suspopt; "
-                              f"give --force to replace it")
+            raise ConfigError(
+                f"{option} {path}: exists and was not written by suspopt; "
+                f"give --force to replace it"
+            )
     return path
 
 
@@ -146,18 +171,19 @@ def claim(path: str | Path, force: bool = False, option: str = "-o") -> Iterator
         try:
             fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
         except OSError as exc:
-            raise ConfigError(f"{path}: cannot write in {path.parent} "
-                              f"({exc.strerror})") from None
+            raise ConfigError(f"{path}: cannot write in {path.parent} ({exc.strerror})") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
             owner = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
             os.close(fd)
             if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                raise ConfigError(f"{path}: another suspopt run (process {owner}) is writing "
-                                  f"it; wait for it to finish or choose another output") from None
+                raise ConfigError(
+                    f"{path}: another suspopt run (process {owner}) is writing "
+                    f"it; wait for it to finish or choose another output"
+                ) from None
             raise
-        try:                       # the lock file may have been removed and made anew
+        try:  # the lock file may have been removed and made anew
             same = os.stat(lock, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
         except FileNotFoundError:
             same = False
@@ -200,12 +226,12 @@ def atomic_file(path: str | Path, force: bool = False) -> Iterator:
     with claim(path, force):
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=_TMP, dir=path.parent)
         try:
-            os.fchmod(fd, 0o666 & ~_umask())         # mkstemp's 0600 is for the temp name only
+            os.fchmod(fd, 0o666 & ~_umask())  # mkstemp's 0600 is for the temp name only
             with os.fdopen(fd, "w+b") as stream:
                 yield stream
                 stream.flush()
                 os.fsync(stream.fileno())
-            check_target(path, force=True)        # nothing took its place meanwhile
+            check_target(path, force=True)  # nothing took its place meanwhile
             os.replace(tmp, path)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
@@ -231,7 +257,7 @@ def atomic_h5(path: str | Path, cfg: Config, command: str | None = None, force: 
     with atomic_file(path, force) as stream:
         with h5py.File(stream, "w") as h5:
             h5.attrs["suspopt_version"] = __version__
-            h5.attrs["created"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+            h5.attrs["created"] = datetime.now(UTC).isoformat(timespec="seconds")
             h5.attrs["command"] = command if command is not None else " ".join(sys.argv)
             h5.attrs["config"] = cfg.text
             h5.attrs["seed"] = _seed_of(cfg)
@@ -243,8 +269,9 @@ def text_array(values) -> np.ndarray:
     import h5py
 
     items = np.asarray(values, dtype=object)
-    flat = [v.decode("utf-8") if isinstance(v, (bytes, np.bytes_)) else str(v)
-            for v in items.ravel()]
+    flat = [
+        v.decode("utf-8") if isinstance(v, (bytes, np.bytes_)) else str(v) for v in items.ravel()
+    ]
     return np.array(flat, dtype=h5py.string_dtype()).reshape(items.shape)
 
 
@@ -289,20 +316,31 @@ def _scale(group, dim: str, size: int, values=None):
     numbers 0 ... size-1)."""
     found = _find_scale(group, dim)
     if found is None:
-        return write_dataset(group, dim, np.arange(size) if values is None else values, "1",
-                             dims=(dim,))
+        return write_dataset(
+            group, dim, np.arange(size) if values is None else values, "1", dims=(dim,)
+        )
     if found.shape != (size,):
-        raise ValueError(f"{group.name}: dimension {dim!r} of length {size}, but {found.name} "
-                         f"has {found.shape[0]}")
+        raise ValueError(
+            f"{group.name}: dimension {dim!r} of length {size}, but {found.name} "
+            f"has {found.shape[0]}"
+        )
     if values is not None and _text_values(found) != list(values):
-        raise ValueError(f"{group.name}: dimension {dim!r}: {list(values)} are not the "
-                         f"values of {found.name}")
+        raise ValueError(
+            f"{group.name}: dimension {dim!r}: {list(values)} are not the values of {found.name}"
+        )
     return found
 
 
-def write_dataset(group, name: str, data, units: str | Sequence[str],
-                  dims: Sequence[str] = (), coords: dict | None = None,
-                  names: Sequence[str] | None = None, **attrs):
+def write_dataset(
+    group,
+    name: str,
+    data,
+    units: str | Sequence[str],
+    dims: Sequence[str] = (),
+    coords: dict | None = None,
+    names: Sequence[str] | None = None,
+    **attrs,
+):
     """Create ``group[name]`` holding ``data``, with its ``units`` attribute (one string, or
     one per column) and its dimensions (module docstring); return the dataset.
 
@@ -323,9 +361,11 @@ def write_dataset(group, name: str, data, units: str | Sequence[str],
         attrs["names"] = text_array(list(names))
         coords.setdefault(dims[-1], list(names))
     above = _find_scale(group.parent, name) if dims == (name,) and group.name != "/" else None
-    if above is not None and above.shape != data.shape:     # one length along every path
-        raise ValueError(f"{group.name}/{name}: dimension {name!r} of length "
-                         f"{data.shape[0]}, but {above.name} has {above.shape[0]}")
+    if above is not None and above.shape != data.shape:  # one length along every path
+        raise ValueError(
+            f"{group.name}/{name}: dimension {name!r} of length "
+            f"{data.shape[0]}, but {above.name} has {above.shape[0]}"
+        )
     ds = group.create_dataset(name, data=data)
     ds.attrs["units"] = text_array(list(units)) if isinstance(units, (list, tuple)) else units
     write_attrs(ds, **attrs)
@@ -337,9 +377,14 @@ def write_dataset(group, name: str, data, units: str | Sequence[str],
     return ds
 
 
-def write_simulation(path: str | Path, result, signals: Iterable[str] | None = None,
-                     float32: bool = False, command: str | None = None,
-                     extra=None) -> Path:
+def write_simulation(
+    path: str | Path,
+    result,
+    signals: Iterable[str] | None = None,
+    float32: bool = False,
+    command: str | None = None,
+    extra=None,
+) -> Path:
     """Write a simulation ``Result`` (README, "Signals and HDF5 layout").
 
     ``/time (T,)`` [s] and ``/design (P,)`` (row numbers) are the dimension scales ``time``
@@ -361,26 +406,49 @@ def write_simulation(path: str | Path, result, signals: Iterable[str] | None = N
         write_dataset(h5, "design", np.arange(len(result.diverged_at)), "1", dims=("design",))
         grp = h5.create_group("signals")
         for name in names:
-            write_dataset(grp, name, np.asarray(result.signals[name], dtype=dtype),
-                          result.signal_unit(name), dims=("design", "time"))
+            write_dataset(
+                grp,
+                name,
+                np.asarray(result.signals[name], dtype=dtype),
+                result.signal_unit(name),
+                dims=("design", "time"),
+            )
         met = h5.create_group("metrics")
         for name, value in result.metrics.items():
-            write_dataset(met, name, np.asarray(value), result.metric_units[name],
-                          dims=("design",))
+            write_dataset(met, name, np.asarray(value), result.metric_units[name], dims=("design",))
         write_dataset(h5, "diverged_at", result.diverged_at, "s", dims=("design",))
         if result.designs:
             X = np.column_stack([result.designs[k] for k in result.designs])
-            write_dataset(h5.create_group("designs"), "X", X, "SI", dims=("design", "variable"),
-                          names=list(result.designs))
-        if extra is not None:                    # what the caller adds (e.g. the picks)
+            write_dataset(
+                h5.create_group("designs"),
+                "X",
+                X,
+                "SI",
+                dims=("design", "variable"),
+                names=list(result.designs),
+            )
+        if extra is not None:  # what the caller adds (e.g. the picks)
             extra(h5)
         modes = modal_analysis(result.model)
         modal = h5.create_group("modal")
-        write_dataset(modal, "frequency", modes.frequency, "Hz", dims=("design", "mode"),
-                      dominant=list(modes.dominant[0]))
+        write_dataset(
+            modal,
+            "frequency",
+            modes.frequency,
+            "Hz",
+            dims=("design", "mode"),
+            dominant=list(modes.dominant[0]),
+        )
         write_dataset(modal, "label", modes.label, "1", dims=("design", "mode"))
-        write_dataset(modal, "energy_share", modes.energy, "1", dims=("design", "mode", "dof"),
-                      coords={"dof": list(modes.dof_names)}, dofs=list(modes.dof_names))
+        write_dataset(
+            modal,
+            "energy_share",
+            modes.energy,
+            "1",
+            dims=("design", "mode", "dof"),
+            coords={"dof": list(modes.dof_names)},
+            dofs=list(modes.dof_names),
+        )
     return Path(path)
 
 
@@ -404,21 +472,31 @@ def open_dataset(path: str | Path, group: str | None = None):
         import h5netcdf  # noqa: F401
         import xarray
     except ImportError:
-        raise ModuleNotFoundError("suspopt.io.open_dataset needs xarray and h5netcdf: "
-                                  "pip install 'suspopt[xarray]'") from None
+        raise ModuleNotFoundError(
+            "suspopt.io.open_dataset needs xarray and h5netcdf: pip install 'suspopt[xarray]'"
+        ) from None
 
     def load(name: str | None):
-        return xarray.open_dataset(path, engine="h5netcdf", group=name, phony_dims="sort",
-                                   decode_times=False, decode_timedelta=False)
+        return xarray.open_dataset(
+            path,
+            engine="h5netcdf",
+            group=name,
+            phony_dims="sort",
+            decode_times=False,
+            decode_timedelta=False,
+        )
 
     ds = load(group)
     parts = [p for p in (group or "").split("/") if p]
-    for depth in range(len(parts) - 1, -1, -1):         # the nearest group above first
+    for depth in range(len(parts) - 1, -1, -1):  # the nearest group above first
         missing = [d for d in ds.sizes if d not in ds.coords]
         if not missing:
             break
         with load("/".join(parts[:depth]) or None) as above:
-            found = {d: above[d].load() for d in missing
-                     if d in above.coords and above.sizes[d] == ds.sizes[d]}
+            found = {
+                d: above[d].load()
+                for d in missing
+                if d in above.coords and above.sizes[d] == ds.sizes[d]
+            }
         ds = ds.assign_coords(found)
     return ds

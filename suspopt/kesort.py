@@ -51,13 +51,20 @@ from functools import cached_property
 
 import numpy as np
 
-__all__ = ["kesort", "KEpsilonSort", "k_eps_levels", "normalise_objectives", "pareto_picks",
-           "check_options", "NORMALISATIONS"]
+__all__ = [
+    "kesort",
+    "KEpsilonSort",
+    "k_eps_levels",
+    "normalise_objectives",
+    "pareto_picks",
+    "check_options",
+    "NORMALISATIONS",
+]
 
 #: Normalisations of the objectives before ε = P · max NF (Eq 7.12 and min-max).
 NORMALISATIONS = ("max", "minmax")
 
-_CHUNK_BYTES = 64 * 2 ** 20
+_CHUNK_BYTES = 64 * 2**20
 
 
 @dataclass(frozen=True)
@@ -96,13 +103,15 @@ class KEpsilonSort:
 def _objectives(F) -> np.ndarray:
     F = np.array(F, dtype=float)
     if F.ndim != 2 or F.shape[0] == 0 or F.shape[1] == 0:
-        raise ValueError(f"F must be (N solutions, m objectives) with N, m >= 1; got shape "
-                         f"{F.shape}")
+        raise ValueError(
+            f"F must be (N solutions, m objectives) with N, m >= 1; got shape {F.shape}"
+        )
     bad = np.argwhere(~np.isfinite(F))
     if len(bad):
         i, j = bad[0]
-        raise ValueError(f"F[{i}, {j}] is {F[i, j]}: objectives must be finite (drop failed "
-                         f"designs first)")
+        raise ValueError(
+            f"F[{i}, {j}] is {F[i, j]}: objectives must be finite (drop failed designs first)"
+        )
     return F
 
 
@@ -114,8 +123,9 @@ def _names(names: Sequence[str] | None, m: int) -> tuple[str, ...]:
     return tuple(names)
 
 
-def normalise_objectives(F, how: str = "max", names: Sequence[str] | None = None
-                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def normalise_objectives(
+    F, how: str = "max", names: Sequence[str] | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(NF, offset, scale)`` with ``NF = (F - offset) / scale`` column by column.
 
     ``max``: offset 0, scale ``max F`` (Eq 7.12); a column whose maximum is not positive is an
@@ -127,9 +137,11 @@ def normalise_objectives(F, how: str = "max", names: Sequence[str] | None = None
     if how == "max":
         scale = F.max(axis=0)
         for j in np.flatnonzero(scale <= 0):
-            raise ValueError(f"objective {names[j]} has maximum {scale[j]:g} <= 0 over the "
-                             f"set: normalising by the maximum (Eq 7.12) needs a positive "
-                             f"one; use min-max normalisation")
+            raise ValueError(
+                f"objective {names[j]} has maximum {scale[j]:g} <= 0 over the "
+                f"set: normalising by the maximum (Eq 7.12) needs a positive "
+                f"one; use min-max normalisation"
+            )
         offset = np.zeros_like(scale)
     elif how == "minmax":
         offset = F.min(axis=0)
@@ -166,7 +178,7 @@ def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
     levels = np.empty(N)
     for start in range(0, N, rows):
         stop = min(start + rows, N)
-        S, T = total[:stop - start], merit[:stop - start]
+        S, T = total[: stop - start], merit[: stop - start]
         S.fill(0.0)
         for j in range(m):
             if soft[j]:
@@ -175,7 +187,7 @@ def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
             else:
                 np.less_equal(F[start:stop, j, None], F[None, :, j], out=T)
             S += T
-        S[np.arange(stop - start), np.arange(start, stop)] = np.inf    # not against itself
+        S[np.arange(stop - start), np.arange(start, stop)] = np.inf  # not against itself
         levels[start:stop] = S.min(axis=1) - 1.0
     return levels
 
@@ -184,33 +196,51 @@ def _ties(levels: np.ndarray, tie_tol: float) -> np.ndarray:
     return np.flatnonzero(levels >= levels.max() - tie_tol)
 
 
-def check_options(eps=None, P: float | str | None = None, normalise: str = "max",
-                  P_range: tuple[float, float] = (0.01, 1.0), P_step: float = 0.01) -> None:
+def check_options(
+    eps=None,
+    P: float | str | None = None,
+    normalise: str = "max",
+    P_range: tuple[float, float] = (0.01, 1.0),
+    P_step: float = 0.01,
+) -> None:
     """Raise ValueError for options :func:`kesort` cannot use (before any work is done)."""
     if eps is not None and P is not None:
         raise ValueError("give either eps (absolute thresholds) or P (eps = P max NF), not both")
     if eps is not None:
         values = np.asarray(eps, dtype=float)
         if values.ndim > 1 or (values < 0).any() or not np.isfinite(values).all():
-            raise ValueError(f"eps must be one value or one per objective, finite and >= 0; "
-                             f"got {values.tolist()}")
+            raise ValueError(
+                f"eps must be one value or one per objective, finite and >= 0; "
+                f"got {values.tolist()}"
+            )
     elif P is not None and P != "auto":
         if not float(P) > 0:
             raise ValueError(f"P must be > 0 or 'auto'; got {P}")
     else:
         lo, hi = (float(p) for p in P_range)
         if not 0 < lo <= hi or not P_step > 0:
-            raise ValueError(f"P_range must satisfy 0 < low <= high and P_step > 0; got "
-                             f"{tuple(P_range)}, {P_step}")
+            raise ValueError(
+                f"P_range must satisfy 0 < low <= high and P_step > 0; got "
+                f"{tuple(P_range)}, {P_step}"
+            )
     if normalise not in NORMALISATIONS:
-        raise ValueError(f"unknown normalisation {normalise!r}; use one of "
-                         f"{', '.join(NORMALISATIONS)}")
+        raise ValueError(
+            f"unknown normalisation {normalise!r}; use one of {', '.join(NORMALISATIONS)}"
+        )
 
 
-def kesort(F, eps=None, *, P: float | str | None = None, normalise: str = "max",
-           names: Sequence[str] | None = None, P_range: tuple[float, float] = (0.01, 1.0),
-           P_step: float = 0.01, tie_tol: float = 1e-9,
-           chunk_bytes: int = _CHUNK_BYTES) -> KEpsilonSort:
+def kesort(
+    F,
+    eps=None,
+    *,
+    P: float | str | None = None,
+    normalise: str = "max",
+    names: Sequence[str] | None = None,
+    P_range: tuple[float, float] = (0.01, 1.0),
+    P_step: float = 0.01,
+    tie_tol: float = 1e-9,
+    chunk_bytes: int = _CHUNK_BYTES,
+) -> KEpsilonSort:
     """Sort the solutions ``F (N, m)`` (minimised) by k-ε optimality and choose one.
 
     Give either ``eps`` (absolute thresholds in the units of ``F``: one value or ``(m,)``) or
@@ -235,15 +265,24 @@ def kesort(F, eps=None, *, P: float | str | None = None, normalise: str = "max",
         eps_nf = P_value * NF.max(axis=0)
         levels, auto = k_eps_levels(NF, eps_nf, chunk_bytes), False
     ties = _ties(levels, tie_tol)
-    return KEpsilonSort(k_eps=levels, chosen=int(ties[0]), ties=ties, epsilon=eps_nf * scale,
-                        P=P_value, P_auto=auto, normalisation=normalise, NF=NF, names=names)
+    return KEpsilonSort(
+        k_eps=levels,
+        chosen=int(ties[0]),
+        ties=ties,
+        epsilon=eps_nf * scale,
+        P=P_value,
+        P_auto=auto,
+        normalisation=normalise,
+        NF=NF,
+        names=names,
+    )
 
 
 def _auto_P(NF: np.ndarray, P_range, P_step: float, tie_tol: float, chunk_bytes: int):
     """The smallest P of the grid with a single best solution: (P, ε in NF units, levels)."""
     lo, hi = (float(p) for p in P_range)
     steps = np.arange(int(np.floor((hi - lo) / P_step + 1e-9)) + 1)
-    grid = np.round(lo + P_step * steps, 12)        # 0.15, not 0.15000000000000002
+    grid = np.round(lo + P_step * steps, 12)  # 0.15, not 0.15000000000000002
     peak = NF.max(axis=0)
     for P_value in grid:
         levels = k_eps_levels(NF, P_value * peak, chunk_bytes)
@@ -277,8 +316,10 @@ def pareto_picks(F, names: Sequence[str] | None = None) -> dict[str, int]:
     names = _names(names, F.shape[1])
     NF, _, _ = normalise_objectives(F, "minmax", names)
     total = NF.sum(axis=1)
-    picks = {f"best_{name}": int(np.lexsort((total - NF[:, j], F[:, j]))[0])
-             for j, name in enumerate(names)}
+    picks = {
+        f"best_{name}": int(np.lexsort((total - NF[:, j], F[:, j]))[0])
+        for j, name in enumerate(names)
+    }
     ideal = F.min(axis=0)
     span = F[list(picks.values())].max(axis=0) - ideal
     scaled = (F - ideal) / np.where(span > 0, span, 1.0)

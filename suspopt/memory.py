@@ -17,14 +17,22 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 
-__all__ = ["reuse_memory", "parse_size", "set_limit", "explicit_limit", "available", "limit",
-           "describe", "check"]
+__all__ = [
+    "reuse_memory",
+    "parse_size",
+    "set_limit",
+    "explicit_limit",
+    "available",
+    "limit",
+    "describe",
+    "check",
+]
 
 #: mallopt parameters of glibc's malloc.h.
 _M_TRIM_THRESHOLD, _M_MMAP_MAX = -1, -4
 #: Free memory at the top of the heap kept rather than returned to the kernel [bytes]: the
 #: largest value mallopt takes (an int).
-_KEEP = 2 ** 31 - 1
+_KEEP = 2**31 - 1
 
 
 def reuse_memory() -> bool:
@@ -36,7 +44,7 @@ def reuse_memory() -> bool:
         return False
     try:
         libc = ctypes.CDLL(name)
-        libc.gnu_get_libc_version          # glibc only
+        _ = libc.gnu_get_libc_version  # glibc only
         mallopt = libc.mallopt
     except (OSError, AttributeError):
         return False
@@ -122,5 +130,6 @@ def check(need: float, what: str, advice: str) -> None:
 
     cap, source = limit()
     if need > cap:
-        raise ConfigError(f"{what} needs about {describe(need)}, more than {source} "
-                          f"({describe(cap)}); {advice}")
+        raise ConfigError(
+            f"{what} needs about {describe(need)}, more than {source} ({describe(cap)}); {advice}"
+        )

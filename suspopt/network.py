@@ -34,8 +34,16 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-__all__ = ["Elements", "Network", "LinearModel", "Assembled", "apply", "parameter_rows",
-           "shared_rows", "widen"]
+__all__ = [
+    "Elements",
+    "Network",
+    "LinearModel",
+    "Assembled",
+    "apply",
+    "parameter_rows",
+    "shared_rows",
+    "widen",
+]
 
 
 def apply(matrix: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -145,11 +153,17 @@ class LinearModel:
     def P(self) -> int:
         return self.mass.shape[0]
 
-    def part(self, dofs: slice) -> "LinearModel":
+    def part(self, dofs: slice) -> LinearModel:
         """The DOFs ``dofs`` alone, the others held still (their coupling terms dropped)."""
-        return LinearModel(self.dof_names[dofs], self.input_names, self.mass[:, dofs],
-                           self.stiffness[:, dofs, dofs], self.damping[:, dofs, dofs],
-                           self.input_stiffness[:, dofs], self.input_damping[:, dofs])
+        return LinearModel(
+            self.dof_names[dofs],
+            self.input_names,
+            self.mass[:, dofs],
+            self.stiffness[:, dofs, dofs],
+            self.damping[:, dofs, dofs],
+            self.input_stiffness[:, dofs],
+            self.input_damping[:, dofs],
+        )
 
     def frequency_response(self, f: np.ndarray, inputs: np.ndarray | None = None) -> np.ndarray:
         """Complex DOF amplitudes ``Q (P, F, n)`` under harmonic inputs ``u = R exp(jωt)``:
@@ -164,8 +178,11 @@ class LinearModel:
         n, nu = len(self.dof_names), self.input_stiffness.shape[-1]
         R = np.ones((f.size, nu)) if inputs is None else np.asarray(inputs)
         w = omega[None, :, None, None]
-        dyn = self.stiffness[:, None] - w ** 2 * (self.mass[:, None, :, None] * np.eye(n)) \
+        dyn = (
+            self.stiffness[:, None]
+            - w**2 * (self.mass[:, None, :, None] * np.eye(n))
             + 1j * w * self.damping[:, None]
+        )
         B = self.input_stiffness[:, None] + 1j * w * self.input_damping[:, None]  # (P, F, n, nu)
         rhs = np.broadcast_to(B @ R[None, :, :, None], (self.P, f.size, n, 1))
         return np.linalg.solve(dyn, rhs)[..., 0]
@@ -203,26 +220,32 @@ class Network:
                 return g
         raise KeyError(name)
 
-    def forces(self, q: np.ndarray, v: np.ndarray, u: np.ndarray | None = None,
-               u_dot: np.ndarray | None = None,
-               damping: Mapping[str, np.ndarray] | None = None
-               ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    def forces(
+        self,
+        q: np.ndarray,
+        v: np.ndarray,
+        u: np.ndarray | None = None,
+        u_dot: np.ndarray | None = None,
+        damping: Mapping[str, np.ndarray] | None = None,
+    ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Every group's ``(elastic, viscous)`` force parts (m, P, S) [N] for the states
         ``q, v (n, P, S)`` and inputs ``u, u_dot (n_u, 1|P, S)``; ``damping`` maps group
         names to coefficients that replace theirs."""
         damping = damping or {}
         return {g.name: g.parts(q, v, u, u_dot, damping.get(g.name)) for g in self.groups}
 
-    def generalised_forces(self, q, v, u=None, u_dot=None, damping=None
-                           ) -> tuple[np.ndarray, np.ndarray]:
+    def generalised_forces(
+        self, q, v, u=None, u_dot=None, damping=None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """``-Σ D_qᵀ F`` on the DOFs (n, P, S) [N, N m] and ``-Σ D_uᵀ F`` on the inputs
         (n_u, P, S) [N] (the reaction on the road or the floor), from one evaluation of the
         element forces."""
         shape = np.broadcast_shapes(q.shape[1:], v.shape[1:])
         dofs = np.zeros((self.n,) + shape)
         inputs = np.zeros((len(self.input_names),) + shape)
-        for g, (elastic, viscous) in zip(self.groups,
-                                          self.forces(q, v, u, u_dot, damping).values()):
+        for g, (elastic, viscous) in zip(
+            self.groups, self.forces(q, v, u, u_dot, damping).values()
+        ):
             force = elastic + viscous
             dofs += apply(g.force_map, force)
             inputs -= apply(g.input_map.T, force)
@@ -247,10 +270,17 @@ class Network:
             if nu:
                 Bk += np.einsum("pim,pm,mj->pij", G, g.stiffness[:, :, 0].T, g.input_map)
                 Bc += np.einsum("pim,pm,mj->pij", G, c, g.input_map)
-        return LinearModel(self.dof_names, self.input_names,
-                           np.broadcast_to(self.mass[:, :, 0].T, (P, n)).copy(), K, C, Bk, Bc)
+        return LinearModel(
+            self.dof_names,
+            self.input_names,
+            np.broadcast_to(self.mass[:, :, 0].T, (P, n)).copy(),
+            K,
+            C,
+            Bk,
+            Bc,
+        )
 
-    def attach(self, other: "Network", point: np.ndarray, coupled: bool) -> "Network":
+    def attach(self, other: Network, point: np.ndarray, coupled: bool) -> Network:
         """This network with ``other`` mounted on it: ``other``'s single input (its floor)
         follows ``point @ q`` (``point (n,)``: the body's vertical displacement at the mount
         per DOF of this network); ``coupled`` puts the floor's reaction on this network's DOFs,
@@ -258,25 +288,38 @@ class Network:
         if len(other.input_names) != 1:
             raise ValueError("an attached network needs exactly one input (its floor)")
         n, m = self.n, other.n
-        own = tuple(replace(g, dof_map=_pad(g.dof_map, 0, m),
-                            reacts=None if g.reacts is None else np.r_[g.reacts, np.ones(m, bool)])
-                    for g in self.groups)
+        own = tuple(
+            replace(
+                g,
+                dof_map=_pad(g.dof_map, 0, m),
+                reacts=None if g.reacts is None else np.r_[g.reacts, np.ones(m, bool)],
+            )
+            for g in self.groups
+        )
         mounted = []
         for g in other.groups:
             floor = g.input_map[:, 0]
             onto_body = floor[:, None] * point[None, :]
-            dof_map = np.concatenate([np.broadcast_to(onto_body, g.dof_map.shape[:-2]
-                                                      + onto_body.shape), g.dof_map], axis=-1)
-            reacts = np.r_[np.full(n, coupled), np.ones(m, bool) if g.reacts is None
-                           else g.reacts]
-            mounted.append(replace(g, dof_map=dof_map,
-                                   input_map=np.zeros((g.size, len(self.input_names))),
-                                   reacts=None if reacts.all() else reacts))
+            dof_map = np.concatenate(
+                [np.broadcast_to(onto_body, g.dof_map.shape[:-2] + onto_body.shape), g.dof_map],
+                axis=-1,
+            )
+            reacts = np.r_[np.full(n, coupled), np.ones(m, bool) if g.reacts is None else g.reacts]
+            mounted.append(
+                replace(
+                    g,
+                    dof_map=dof_map,
+                    input_map=np.zeros((g.size, len(self.input_names))),
+                    reacts=None if reacts.all() else reacts,
+                )
+            )
         P = max(self.mass.shape[1], other.mass.shape[1])
-        mass = np.concatenate([np.broadcast_to(self.mass, (n, P, 1)),
-                               np.broadcast_to(other.mass, (m, P, 1))])
-        return Network(self.dof_names + other.dof_names, self.input_names, mass,
-                       own + tuple(mounted))
+        mass = np.concatenate(
+            [np.broadcast_to(self.mass, (n, P, 1)), np.broadcast_to(other.mass, (m, P, 1))]
+        )
+        return Network(
+            self.dof_names + other.dof_names, self.input_names, mass, own + tuple(mounted)
+        )
 
 
 def _pad(matrix: np.ndarray, before: int, after: int) -> np.ndarray:
@@ -309,36 +352,50 @@ class Assembled:
         R = sum(g.size for g in groups)
         self.n, self.R, self.P = n, R, P
         per_design = any(g.dof_map.ndim == 3 for g in groups)
-        dq = [np.broadcast_to(g.dof_map, (P, g.size, n)) if per_design else g.dof_map
-              for g in groups]
+        dq = [
+            np.broadcast_to(g.dof_map, (P, g.size, n)) if per_design else g.dof_map for g in groups
+        ]
         Dq = np.concatenate(dq, axis=-2)
         D2 = np.zeros(Dq.shape[:-2] + (2 * R, 2 * n))
         D2[..., :R, :n] = Dq
         D2[..., R:, n:] = Dq
-        self.input_map = np.concatenate([g.input_map for g in groups])       # (R, n_u)
-        G = np.concatenate([np.broadcast_to(g.force_map, (P, n, g.size)) if per_design
-                            else g.force_map for g in groups], axis=-1)
+        self.input_map = np.concatenate([g.input_map for g in groups])  # (R, n_u)
+        G = np.concatenate(
+            [
+                np.broadcast_to(g.force_map, (P, n, g.size)) if per_design else g.force_map
+                for g in groups
+            ],
+            axis=-1,
+        )
         # the non-linear parts are forces of their own rows of F, acting like their elements
-        extra_rows = np.concatenate([np.arange(start, start + g.size) for start, g
-                                     in zip(np.cumsum([0] + [g.size for g in groups]), groups)
-                                     if g.extra is not None] or [np.arange(0)])
+        extra_rows = np.concatenate(
+            [
+                np.arange(start, start + g.size)
+                for start, g in zip(np.cumsum([0] + [g.size for g in groups]), groups)
+                if g.extra is not None
+            ]
+            or [np.arange(0)]
+        )
         G2 = np.concatenate([G, G, G[..., extra_rows]], axis=-1)
         # M^-1 multiplies the accelerations even where it could be folded into G2: folding
         # rounds differently, and a design must give the same bits whatever else varies in
         # its batch
-        self.inverse_mass = np.ascontiguousarray(1.0 / np.broadcast_to(network.mass,
-                                                                       (n, P, 1)))
+        self.inverse_mass = np.ascontiguousarray(1.0 / np.broadcast_to(network.mass, (n, P, 1)))
         self.D2, self.G2 = np.ascontiguousarray(D2), np.ascontiguousarray(G2)
-        self.coef = np.ascontiguousarray(np.concatenate(
-            [np.broadcast_to(g.stiffness, (g.size, P, 1)) for g in groups]
-            + [np.broadcast_to(g.damping, (g.size, P, 1)) for g in groups]))
+        self.coef = np.ascontiguousarray(
+            np.concatenate(
+                [np.broadcast_to(g.stiffness, (g.size, P, 1)) for g in groups]
+                + [np.broadcast_to(g.damping, (g.size, P, 1)) for g in groups]
+            )
+        )
         self.extras, self.damper_rows, start, out = [], None, 0, 2 * R
         for g in groups:
             rows = slice(start, start + g.size)
             rates = slice(R + start, R + start + g.size)
             if g.extra is not None:
-                self.extras.append((rows, rates, slice(out, out + g.size), g.extra,
-                                    g.extra_uses_force))
+                self.extras.append(
+                    (rows, rates, slice(out, out + g.size), g.extra, g.extra_uses_force)
+                )
                 out += g.size
             if g.name == controlled:
                 self.damper_rows = rates
@@ -351,9 +408,9 @@ class Assembled:
         off = np.concatenate([self.input_map @ u, self.input_map @ u_dot])
         return np.ascontiguousarray(off.T)[:, :, None, None]
 
-    def evaluator(self, width: int | None = None
-                  ) -> Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                                 np.ndarray], None]:
+    def evaluator(
+        self, width: int | None = None
+    ) -> Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray], None]:
         """A function ``(y2, offset, coef, inverse_mass, acc2, acc) -> None`` that writes
         ``q''`` of ``width`` design columns (default P) into ``acc``.
 
@@ -366,9 +423,11 @@ class Assembled:
         """
         R, width = self.R, width or self.P
         e, F = np.empty((2 * R, width, 1)), np.empty((self.F_rows, width, 1))
-        e2, F2, linear = e.reshape(2 * R, -1), F.reshape(self.F_rows, -1), F[:2 * R]
-        extras = [(F[rows], F[rates], e[rows], e[rates], F[out], make(width), uses)
-                  for rows, rates, out, make, uses in self.extras]
+        e2, F2, linear = e.reshape(2 * R, -1), F.reshape(self.F_rows, -1), F[: 2 * R]
+        extras = [
+            (F[rows], F[rates], e[rows], e[rates], F[out], make(width), uses)
+            for rows, rates, out, make, uses in self.extras
+        ]
         product = np.dot if self.D2.ndim == 2 else _product
         D2, G2, multiply, add = self.D2, self.G2, np.multiply, np.add
 
@@ -381,4 +440,5 @@ class Assembled:
                 fn(disp, rate, add(elastic, viscous) if uses_force else None, out)
             product(G2, F2, out=acc2)
             acc.__imul__(inverse_mass)
+
         return evaluate

@@ -26,7 +26,7 @@ ONE_PER_RUN = {
     "optimiser": "the optimiser settings are one per run",
     "vehicle.gravity": "gravity is one per run",
     "vehicle.corner_defaults": "corner_defaults are merged into the corners when the config "
-                               "loads; vary vehicle.corners.<corner>... instead",
+    "loads; vary vehicle.corners.<corner>... instead",
 }
 
 
@@ -60,7 +60,7 @@ def _limits(model: type, name: str) -> tuple[float, bool, float, bool]:
     low, low_closed, high, high_closed = -np.inf, True, np.inf, True
     info = model.model_fields[name]
     metadata = list(info.metadata)
-    for arg in get_args(info.annotation):           # Annotated[...] | None
+    for arg in get_args(info.annotation):  # Annotated[...] | None
         for inner in getattr(arg, "__metadata__", ()):
             metadata += getattr(inner, "metadata", [])
     for item in metadata:
@@ -88,13 +88,19 @@ def field_range(cfg: Config, path: str) -> tuple[float, bool, float, bool]:
 def _check_range(cfg: Config, path: str, values: np.ndarray) -> None:
     """ConfigError unless every design's value lies in the field's range."""
     low, low_closed, high, high_closed = field_range(cfg, path)
-    bad = (values < low) | (values > high) | (~low_closed & (values == low)) \
+    bad = (
+        (values < low)
+        | (values > high)
+        | (~low_closed & (values == low))
         | (~high_closed & (values == high))
+    )
     if bad.any():
         where = np.flatnonzero(bad)
         span = f"{'[' if low_closed else '('}{low:g}, {high:g}{']' if high_closed else ')'}"
-        raise ConfigError(f"params: {path}: must be in {span}, got {values[where[0]]:g} "
-                          f"(designs {where[:5].tolist()})")
+        raise ConfigError(
+            f"params: {path}: must be in {span}, got {values[where[0]]:g} "
+            f"(designs {where[:5].tolist()})"
+        )
 
 
 class ParamView:
@@ -122,8 +128,9 @@ class ParamView:
             sizes.add(arr.size)
             self.params[path] = arr
         if len(sizes) > 1:
-            raise ConfigError(f"params: all design arrays must have the same length, got "
-                              f"{sorted(sizes)}")
+            raise ConfigError(
+                f"params: all design arrays must have the same length, got {sorted(sizes)}"
+            )
         self.P = sizes.pop() if sizes else 1
 
     def get(self, path: str) -> np.ndarray:
@@ -162,8 +169,10 @@ def _numeric_path(cfg: Config, path: str, option: str) -> None:
     paths = numeric_paths(cfg)
     if path not in paths:
         close = difflib.get_close_matches(path, list(paths), n=3)
-        raise ConfigError(f"{option} {path}: not a numeric field of this config" + (
-            f"; did you mean {', '.join(close)}?" if close else ""))
+        raise ConfigError(
+            f"{option} {path}: not a numeric field of this config"
+            + (f"; did you mean {', '.join(close)}?" if close else "")
+        )
 
 
 def apply_sets(cfg: Config, items: list[str]) -> Config:
@@ -189,6 +198,7 @@ def apply_sets(cfg: Config, items: list[str]) -> Config:
     def put(data: dict) -> None:
         for path, value in values.items():
             set_path(data, path, value)
+
     described = ", ".join(f"{p} = {v!r}" for p, v in values.items())
     return edit_config(cfg.text, put, cfg.source, f"--set {described}")
 
@@ -203,8 +213,9 @@ def sweep(cfg: Config, items: list[str], zipped: bool = False) -> dict[str, np.n
         _numeric_path(cfg, path, "--sweep")
         why = one_per_run(path)
         if why is not None:
-            raise ConfigError(f"--sweep {path}: cannot vary between the designs of one run: "
-                              f"{why}; use --set")
+            raise ConfigError(
+                f"--sweep {path}: cannot vary between the designs of one run: {why}; use --set"
+            )
         parts = text.split(":")
         try:
             start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
@@ -212,10 +223,10 @@ def sweep(cfg: Config, items: list[str], zipped: bool = False) -> dict[str, np.n
                 raise ValueError
         except (ValueError, IndexError):
             raise ConfigError(f"--sweep {item}: expected PATH=START:STOP:N") from None
-        if not (np.isfinite(start) and np.isfinite(stop)) or not 1 <= count <= \
-                MAX_SWEEP_DESIGNS:
-            raise ConfigError(f"--sweep {item}: START and STOP must be finite and N from 1 "
-                              f"to {MAX_SWEEP_DESIGNS}")
+        if not (np.isfinite(start) and np.isfinite(stop)) or not 1 <= count <= MAX_SWEEP_DESIGNS:
+            raise ConfigError(
+                f"--sweep {item}: START and STOP must be finite and N from 1 to {MAX_SWEEP_DESIGNS}"
+            )
         if path in ranges:
             raise ConfigError(f"--sweep {path}: given twice")
         ranges[path] = np.linspace(start, stop, count)
@@ -224,12 +235,15 @@ def sweep(cfg: Config, items: list[str], zipped: bool = False) -> dict[str, np.n
     if zipped:
         sizes = {len(v) for v in ranges.values()}
         if len(sizes) > 1:
-            raise ConfigError(f"--zip: the sweeps have {sorted(sizes)} values; zipped sweeps "
-                              f"need the same N")
+            raise ConfigError(
+                f"--zip: the sweeps have {sorted(sizes)} values; zipped sweeps need the same N"
+            )
         return ranges
     total = int(np.prod([len(v) for v in ranges.values()], dtype=float))
     if total > MAX_SWEEP_DESIGNS:
-        raise ConfigError(f"--sweep: the grid has {total} designs, more than "
-                          f"{MAX_SWEEP_DESIGNS}; use fewer values or --zip")
+        raise ConfigError(
+            f"--sweep: the grid has {total} designs, more than "
+            f"{MAX_SWEEP_DESIGNS}; use fewer values or --zip"
+        )
     grid = np.meshgrid(*ranges.values(), indexing="ij")
     return {path: g.reshape(-1) for path, g in zip(ranges, grid)}

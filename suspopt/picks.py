@@ -28,8 +28,7 @@ from .config.loader import edit_config, load_config_text, set_path
 from .config.road import FileRoad, resolve_road_file
 from .params import ParamView
 
-__all__ = ["Picked", "DesignTable", "read_table", "read_picks", "design_config",
-           "split_picks"]
+__all__ = ["Picked", "DesignTable", "read_table", "read_picks", "design_config", "split_picks"]
 
 
 @dataclass
@@ -59,11 +58,13 @@ class DesignTable:
             row = int(pick)
         except ValueError:
             known = ", ".join(list(self.picks) + ["a row number"])
-            raise ConfigError(f"--pick {pick}: {self.path} has no such pick; it has "
-                              f"{known}") from None
+            raise ConfigError(
+                f"--pick {pick}: {self.path} has no such pick; it has {known}"
+            ) from None
         if not 0 <= row < len(self.X):
-            raise ConfigError(f"--pick {pick}: {self.path}: /{self.table} has rows 0 to "
-                              f"{len(self.X) - 1}")
+            raise ConfigError(
+                f"--pick {pick}: {self.path}: /{self.table} has rows 0 to {len(self.X) - 1}"
+            )
         return row
 
 
@@ -96,8 +97,7 @@ def split_picks(given: list[str]) -> list[str]:
     """``--pick`` values as given (repeatable, each may list several separated by commas)."""
     picks = [p.strip() for item in given for p in item.split(",") if p.strip()]
     if not picks:
-        raise ConfigError("--pick: name a design: knee, best_<objective>, chosen or a row "
-                          "number")
+        raise ConfigError("--pick: name a design: knee, best_<objective>, chosen or a row number")
     return picks
 
 
@@ -117,8 +117,10 @@ def read_table(path: str | Path) -> DesignTable:
         elif "designs" in groups and "F" in h5.file["designs"]:
             table = "designs"
         else:
-            raise ConfigError(f"{path}: holds no designs to pick (/pareto, /kesort or "
-                              f"/designs): give a file of suspopt optimise, kesort or analyse")
+            raise ConfigError(
+                f"{path}: holds no designs to pick (/pareto, /kesort or "
+                f"/designs): give a file of suspopt optimise, kesort or analyse"
+            )
         X = h5.array(f"{table}/X", ndim=2)
         F = h5.array(f"{table}/F", ndim=2)
         if len(X) != len(F) or len(X) == 0:
@@ -130,8 +132,10 @@ def read_table(path: str | Path) -> DesignTable:
         picks: dict[str, int] = {}
         if table == "kesort":
             sets = h5.group("kesort/sets")
-            configs = [h5.text(v, "/kesort/sets/config")
-                       for v in np.atleast_1d(h5.dataset("kesort/sets/config")[()])]
+            configs = [
+                h5.text(v, "/kesort/sets/config")
+                for v in np.atleast_1d(h5.dataset("kesort/sets/config")[()])
+            ]
             config_of = h5.array("kesort/source", ndim=1, integer=True)
             del sets
             picks["chosen"] = _index(h5, "kesort/chosen", len(X))
@@ -140,8 +144,11 @@ def read_table(path: str | Path) -> DesignTable:
             configs = [h5.text_attr("config")]
             config_of = np.zeros(len(X), dtype=np.int64)
             if table == "designs":
-                entries = h5.labels("designs/F", "picks", len(X)) if "picks" in \
-                    h5.dataset("designs/F").attrs else []
+                entries = (
+                    h5.labels("designs/F", "picks", len(X))
+                    if "picks" in h5.dataset("designs/F").attrs
+                    else []
+                )
                 if not entries and "picks" in h5.dataset("designs/X").attrs:
                     entries = h5.labels("designs/X", "picks", len(X))
                 for row, entry in enumerate(entries):
@@ -153,8 +160,9 @@ def read_table(path: str | Path) -> DesignTable:
             raise ConfigError(f"{path}: /kesort/source: indices beyond /kesort/sets")
     if not picks and np.isfinite(F).all():
         picks = pareto_picks(F, obj_names)
-    return DesignTable(path, table, X, var_names, var_units, F, obj_names, obj_units, picks,
-                       configs, config_of)
+    return DesignTable(
+        path, table, X, var_names, var_units, F, obj_names, obj_units, picks, configs, config_of
+    )
 
 
 def _index(h5, name: str, rows: int) -> int:
@@ -174,31 +182,49 @@ def read_picks(path: str | Path, picks: list[str]) -> Picked:
     rows = np.array([table.resolve(p) for p in picks])
     which = sorted({int(table.config_of[r]) for r in rows})
     if len(which) > 1:
-        raise ConfigError(f"--pick: {', '.join(picks)} come from sets of {table.path} with "
-                          f"different configs; pick designs of one set at a time")
-    cfg = load_config_text(table.configs[which[0]],
-                           table.path.with_name(table.path.name + ":config"))
+        raise ConfigError(
+            f"--pick: {', '.join(picks)} come from sets of {table.path} with "
+            f"different configs; pick designs of one set at a time"
+        )
+    cfg = load_config_text(
+        table.configs[which[0]], table.path.with_name(table.path.name + ":config")
+    )
     path_of = {v.label: v.path for v in cfg.design_variables}
     missing = [n for n in table.var_names if n not in path_of]
     X = table.X[rows]
     keep = [j for j, n in enumerate(table.var_names) if n in path_of]
-    if missing and not np.isnan(X[:, [j for j, n in enumerate(table.var_names)
-                                       if n in missing]]).all():
-        raise ConfigError(f"{table.path}: /{table.table}/X holds {', '.join(missing)}, which "
-                          f"the stored config's design_variables do not have")
+    if (
+        missing
+        and not np.isnan(X[:, [j for j, n in enumerate(table.var_names) if n in missing]]).all()
+    ):
+        raise ConfigError(
+            f"{table.path}: /{table.table}/X holds {', '.join(missing)}, which "
+            f"the stored config's design_variables do not have"
+        )
     X = X[:, keep]
     if not np.isfinite(X).all():
-        raise ConfigError(f"{table.path}: /{table.table}/X: the picked designs have no value "
-                          f"for some variable")
+        raise ConfigError(
+            f"{table.path}: /{table.table}/X: the picked designs have no value for some variable"
+        )
     names = [table.var_names[j] for j in keep]
-    try:                                     # a stored value its field cannot take
+    try:  # a stored value its field cannot take
         ParamView(cfg, {path_of[n]: X[:, j] for j, n in enumerate(names)})
     except ConfigError as exc:
         raise ConfigError(f"{table.path}: /{table.table}/X: {exc}") from None
-    return Picked(source=table.path, table=table.table, names=list(picks), rows=rows, X=X,
-                  var_names=names, var_units=[table.var_units[j] for j in keep],
-                  paths=[path_of[n] for n in names], F=table.F[rows],
-                  obj_names=table.obj_names, obj_units=table.obj_units, config=cfg)
+    return Picked(
+        source=table.path,
+        table=table.table,
+        names=list(picks),
+        rows=rows,
+        X=X,
+        var_names=names,
+        var_units=[table.var_units[j] for j in keep],
+        paths=[path_of[n] for n in names],
+        F=table.F[rows],
+        obj_names=table.obj_names,
+        obj_units=table.obj_units,
+        config=cfg,
+    )
 
 
 def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
@@ -217,17 +243,23 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
             data["road"]["path"] = str(resolve_road_file(cfg.road, cfg.base_dir).resolve())
 
     edited = edit_config(cfg.text, put, cfg.source, "the picked design's values")
-    objectives = ", ".join(f"{n} = {v:.6g} {u}".rstrip()
-                           for n, v, u in zip(picked.obj_names, picked.F[i], picked.obj_units))
-    variables = ", ".join(f"{n} = {v:.6g} {u}".rstrip()
-                          for n, v, u in zip(picked.var_names, picked.X[i], picked.var_units))
-    header = "\n".join([
-        f"# Design {picked.names[i]!r} (row {int(picked.rows[i])} of /{picked.table}) of "
-        f"{picked.source}",
-        f"# written by suspopt {__version__}: the stored config with the design's values in "
-        f"place.",
-        f"# stored objectives: {objectives}",
-        f"# design variables: {variables}",
-    ])
+    objectives = ", ".join(
+        f"{n} = {v:.6g} {u}".rstrip()
+        for n, v, u in zip(picked.obj_names, picked.F[i], picked.obj_units)
+    )
+    variables = ", ".join(
+        f"{n} = {v:.6g} {u}".rstrip()
+        for n, v, u in zip(picked.var_names, picked.X[i], picked.var_units)
+    )
+    header = "\n".join(
+        [
+            f"# Design {picked.names[i]!r} (row {int(picked.rows[i])} of /{picked.table}) of "
+            f"{picked.source}",
+            f"# written by suspopt {__version__}: the stored config with the design's values in "
+            f"place.",
+            f"# stored objectives: {objectives}",
+            f"# design variables: {variables}",
+        ]
+    )
     text = header + "\n" + edited.text
     return load_config_text(text, cfg.source), text

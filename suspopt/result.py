@@ -50,14 +50,14 @@ class Signal:
     """An entry of the signal table: its SI ``unit`` and ``compute(result) -> (P, T)``."""
 
     unit: str
-    compute: Callable[["Result"], np.ndarray]
+    compute: Callable[[Result], np.ndarray]
 
 
 _DOF_UNITS = {"heave": "m", "roll": "rad", "pitch": "rad"}
 _DERIVATIVES = (("", ""), ("_vel", "/s"), ("_acc", "/s^2"))
 
 
-def _tyre_force(r: "Result", c: int) -> np.ndarray:
+def _tyre_force(r: Result, c: int) -> np.ndarray:
     """The normal load, compression +: static load less the tyre element's force."""
     elastic, viscous = r.element_forces("tyre")
     static = r.model.static_tyre_load[:, 0, c, None]
@@ -69,14 +69,14 @@ def _tyre_force(r: "Result", c: int) -> np.ndarray:
     return static - force
 
 
-def _per_sample(values: Callable[["Result"], np.ndarray]) -> Callable[["Result"], np.ndarray]:
+def _per_sample(values: Callable[[Result], np.ndarray]) -> Callable[[Result], np.ndarray]:
     """A signal held at one value per design over the run, or shared by the designs, as
     (P, T)."""
     return lambda r: np.broadcast_to(values(r), (r.P, r.time.size)).copy()
 
 
 #: The vehicle's per-corner signals: head -> (unit, compute(result, corner index)).
-_CORNER_SIGNALS: dict[str, tuple[str, Callable[["Result", int], np.ndarray]]] = {
+_CORNER_SIGNALS: dict[str, tuple[str, Callable[[Result, int], np.ndarray]]] = {
     "travel": ("m", lambda r, c: r.deformation("suspension")[c]),
     "travel_vel": ("m/s", lambda r, c: r.deformation("suspension", rate=True)[c]),
     "tyre_deflection": ("m", lambda r, c: r.deformation("tyre")[c]),
@@ -89,34 +89,43 @@ _CORNER_SIGNALS: dict[str, tuple[str, Callable[["Result", int], np.ndarray]]] = 
 }
 
 
-def signal_table(model: VehicleModel, controller_units: Mapping[str, str] = {},
-                 attachments: Sequence[Attachment] = ()) -> dict[str, Signal]:
+def signal_table(
+    model: VehicleModel,
+    controller_units: Mapping[str, str] = {},
+    attachments: Sequence[Attachment] = (),
+) -> dict[str, Signal]:
     """Every signal a simulation of this model (its controller's records, with their units,
     and its attachments) provides (module docstring)."""
     table: dict[str, Signal] = {}
     for j, dof in enumerate(model.body_dofs):
         for (suffix, per), deriv in zip(_DERIVATIVES, ("", "vel", "acc")):
             table[f"body.{dof}{suffix}"] = Signal(
-                _DOF_UNITS[dof] + per, lambda r, j=j, d=deriv: r.channel(d, j))
+                _DOF_UNITS[dof] + per, lambda r, j=j, d=deriv: r.channel(d, j)
+            )
     for c, corner in enumerate(model.corners):
         for (suffix, per), deriv in zip(_DERIVATIVES, ("", "vel", "acc")):
             table[f"wheel.{corner}.heave{suffix}"] = Signal(
-                "m" + per, lambda r, j=model.n_body + c, d=deriv: r.channel(d, j))
+                "m" + per, lambda r, j=model.n_body + c, d=deriv: r.channel(d, j)
+            )
     for head, (unit, compute) in _CORNER_SIGNALS.items():
         for c, corner in enumerate(model.corners):
             table[f"{head}.{corner}"] = Signal(unit, lambda r, c=c, f=compute: f(r, c))
     for head, unit in controller_units.items():
         for c, corner in enumerate(model.corners):
             table[f"{head}.{corner}"] = Signal(
-                unit, lambda r, c=c, h=head: r.controller_records[h].corner(c))
+                unit, lambda r, c=c, h=head: r.controller_records[h].corner(c)
+            )
     for j, att in enumerate(attachments):
         for name, (unit, compute) in att.signals().items():
             table[name] = Signal(unit, lambda r, j=j, f=compute: r.attachment_signal(j, f))
     return table
 
 
-def signal_names(model: VehicleModel, controller_units: Mapping[str, str] = {},
-                 attachments: Sequence[Attachment] = ()) -> list[str]:
+def signal_names(
+    model: VehicleModel,
+    controller_units: Mapping[str, str] = {},
+    attachments: Sequence[Attachment] = (),
+) -> list[str]:
     """Every signal a simulation of this model (controller, attachments) provides."""
     return list(signal_table(model, controller_units, attachments))
 
@@ -124,7 +133,7 @@ def signal_names(model: VehicleModel, controller_units: Mapping[str, str] = {},
 class SignalMap(Mapping):
     """Lazy, cached mapping of signal name -> (P, T) array, computed from the states."""
 
-    def __init__(self, result: "Result"):
+    def __init__(self, result: Result):
         # the result keeps the cache, not this map: a cycle result <-> map would keep the
         # (large) arrays alive until the cyclic garbage collector happens to run
         self._result = result
@@ -144,8 +153,10 @@ class SignalMap(Mapping):
         if name not in self._cache:
             if name not in self._table:
                 close = difflib.get_close_matches(name, list(self._table), n=3)
-                raise KeyError(f"unknown signal {name!r}" +
-                               (f"; did you mean {', '.join(close)}?" if close else ""))
+                raise KeyError(
+                    f"unknown signal {name!r}"
+                    + (f"; did you mean {', '.join(close)}?" if close else "")
+                )
             self._cache[name] = self._table[name].compute(self._result)
         return self._cache[name]
 
@@ -168,8 +179,8 @@ class Result:
     time: np.ndarray
     states: np.ndarray
     accelerations: np.ndarray
-    road: np.ndarray            # (N, 1, T) road height under each wheel [m]
-    road_vel: np.ndarray        # (N, 1, T) [m/s]
+    road: np.ndarray  # (N, 1, T) road height under each wheel [m]
+    road_vel: np.ndarray  # (N, 1, T) [m/s]
     diverged_at: np.ndarray
     designs: dict[str, np.ndarray]
     _assembled: Assembled
@@ -213,12 +224,12 @@ class Result:
     @property
     def q(self) -> np.ndarray:
         """Displacements of every DOF (vehicle, then attachments), (P, T, n) (a view)."""
-        return np.moveaxis(self.states[:self.n], 0, -1)
+        return np.moveaxis(self.states[: self.n], 0, -1)
 
     @property
     def v(self) -> np.ndarray:
         """Velocities of every DOF, (P, T, n) (a view)."""
-        return np.moveaxis(self.states[self.n:], 0, -1)
+        return np.moveaxis(self.states[self.n :], 0, -1)
 
     def damping_coefficient(self) -> np.ndarray:
         """Damper coefficient of every corner, (N, P, T) or (N, P, 1) when passive [N s/m]."""
@@ -242,7 +253,7 @@ class Result:
         if key not in self._deformation:
             g = self.model.network.group(group)
             nv = self.model.n_dof
-            x = self.states[self.n:self.n + nv] if rate else self.states[:nv]
+            x = self.states[self.n : self.n + nv] if rate else self.states[:nv]
             self._deformation[key] = g.deformation(x, self.road_vel if rate else self.road)
         return self._deformation[key]
 
@@ -253,7 +264,8 @@ class Result:
         if group not in self._forces:
             damping = self.damping_history if group == "suspension" else None
             self._forces[group] = self.model.network.group(group).parts_at(
-                self.deformation(group), self.deformation(group, rate=True), damping)
+                self.deformation(group), self.deformation(group, rate=True), damping
+            )
         return self._forces[group]
 
     def acceleration(self) -> np.ndarray:
@@ -265,7 +277,7 @@ class Result:
         """Body displacement (velocity, acceleration) at attachment ``j``'s point, (P, T),
         from the vehicle rows of ``x (n_vehicle, P, T)``."""
         row = self.model.point_map(*self.attachments[j].point)
-        return np.tensordot(row, x[:self.model.n_dof], axes=1)
+        return np.tensordot(row, x[: self.model.n_dof], axes=1)
 
     def attachment_signal(self, j: int, compute: Callable[..., np.ndarray]) -> np.ndarray:
         """A signal of attachment ``j`` (P, T) from its states and the floor's
@@ -275,8 +287,7 @@ class Result:
         sl = slice(start, start + len(self.attachments[j].dof_names))
         n = self.n
         q, v, acc = self.states[:n], self.states[n:], self.acceleration()
-        return compute(q[sl], v[sl], acc[sl], self.base(j, q), self.base(j, v),
-                       self.base(j, acc))
+        return compute(q[sl], v[sl], acc[sl], self.base(j, q), self.base(j, v), self.base(j, acc))
 
     def channel(self, deriv: str, j: int) -> np.ndarray:
         """DOF ``j`` displacement (''), velocity ('vel') or acceleration ('acc'), (P, T)."""

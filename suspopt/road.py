@@ -14,25 +14,42 @@ The ``tracks`` setting of the road decides what each side sees (see
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import NamedTuple, Sequence
+from typing import NamedTuple
 
 import numpy as np
 
 from .config.road import (
-    BumpHalfSine, BumpStep, FileRoad, Iso8608Road, RoadConfig, read_profile, resolve_road_file,
+    BumpHalfSine,
+    BumpStep,
+    FileRoad,
+    Iso8608Road,
+    RoadConfig,
+    read_profile,
+    resolve_road_file,
 )
 
 __all__ = [
-    "ISO8608_CLASS_LEVELS", "Harmonics", "road_inputs", "road_memory", "road_edges", "profile",
-    "iso8608_harmonics", "iso8608_level",
+    "ISO8608_CLASS_LEVELS",
+    "Harmonics",
+    "road_inputs",
+    "road_memory",
+    "road_edges",
+    "profile",
+    "iso8608_harmonics",
+    "iso8608_level",
 ]
 
 #: Geometric-mean displacement PSD level G_d(n0) of each ISO 8608 class [m^3], n0 = 0.1 cycles/m
 #: (ISO 8608:1995, docs/iso-facts.md#classes-a-e). Thesis Table 2.4 lists the same roads as
 #: Phi(Omega0) = G_d(n0) (2 pi n0)^2 / (2 pi), about G_d(n0)/16, for w = 2.
 ISO8608_CLASS_LEVELS: dict[str, float] = {
-    "A": 16e-6, "B": 64e-6, "C": 256e-6, "D": 1024e-6, "E": 4096e-6,
+    "A": 16e-6,
+    "B": 64e-6,
+    "C": 256e-6,
+    "D": 1024e-6,
+    "E": 4096e-6,
 }
 #: Reference spatial frequency n0 of ISO 8608 [cycles/m].
 _N0 = 0.1
@@ -44,13 +61,19 @@ _SIDES = ("right", "left")
 class Harmonics(NamedTuple):
     """Harmonics of ``z(s) = sum_i amplitude_i sin(omega_i s - phase_i)`` (Eq 2.97)."""
 
-    omega: np.ndarray      #: angular spatial frequencies Omega_i [rad/m], uniformly spaced
+    omega: np.ndarray  #: angular spatial frequencies Omega_i [rad/m], uniformly spaced
     amplitude: np.ndarray  #: amplitudes A_i [m]
-    phase: np.ndarray      #: phases phi_i [rad], uniform in [0, 2 pi)
+    phase: np.ndarray  #: phases phi_i [rad], uniform in [0, 2 pi)
 
 
-def road_inputs(road: RoadConfig, offsets: np.ndarray, sides: Sequence[str], t: np.ndarray,
-                base_dir: Path | None = None, left: bool = False) -> tuple[np.ndarray, np.ndarray]:
+def road_inputs(
+    road: RoadConfig,
+    offsets: np.ndarray,
+    sides: Sequence[str],
+    t: np.ndarray,
+    base_dir: Path | None = None,
+    left: bool = False,
+) -> tuple[np.ndarray, np.ndarray]:
     """Vertical road height and its time derivative under each wheel.
 
     offsets (N,) [m]: distance of each wheel behind the front axle (0 for front wheels,
@@ -84,8 +107,9 @@ def road_inputs(road: RoadConfig, offsets: np.ndarray, sides: Sequence[str], t: 
     return np.where(on_road, z, 0.0), np.where(on_road, zdot, 0.0)
 
 
-def road_edges(road: RoadConfig, offsets: np.ndarray,
-               sides: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+def road_edges(
+    road: RoadConfig, offsets: np.ndarray, sides: Sequence[str]
+) -> tuple[np.ndarray, np.ndarray]:
     """The instants where a bump's ``z`` or ``zdot`` is discontinuous, and the steps in ``z``.
 
     A wheel ``d`` behind the front axle meets the bump at ``t_0 + d/V`` and leaves it
@@ -120,12 +144,13 @@ def road_memory(road: RoadConfig, wheels: int, times: int, span: float) -> float
     if isinstance(road, Iso8608Road):
         count = _n_waves(road, span)
         grid = max(4096, 1 << math.ceil(math.log2(_OVERSAMPLING * count)))
-        size += 2 * 3 * 16 * grid + 4 * 8 * count          # coefficients, transforms, cells
+        size += 2 * 3 * 16 * grid + 4 * 8 * count  # coefficients, transforms, cells
     return size
 
 
-def profile(road: Iso8608Road | FileRoad, s: np.ndarray, side: str = "right",
-            base_dir: Path | None = None) -> np.ndarray:
+def profile(
+    road: Iso8608Road | FileRoad, s: np.ndarray, side: str = "right", base_dir: Path | None = None
+) -> np.ndarray:
     """Road height z(s) [m] at road positions ``s`` [m] under the ``side`` wheels.
 
     For ``iso8608`` roads without ``n_waves`` the harmonics follow from the span of ``s`` (as
@@ -133,8 +158,10 @@ def profile(road: Iso8608Road | FileRoad, s: np.ndarray, side: str = "right",
     same road. Bumps are defined in time (Eq 2.101-2.104): use :func:`road_inputs`.
     """
     if not isinstance(road, (Iso8608Road, FileRoad)):
-        raise TypeError(f"profile() takes iso8608 or file roads, not {road.kind!r}; bumps are "
-                        "defined in time, use road_inputs()")
+        raise TypeError(
+            f"profile() takes iso8608 or file roads, not {road.kind!r}; bumps are "
+            "defined in time, use road_inputs()"
+        )
     s = np.asarray(s, dtype=float)
     if _is_flat(road, side):
         return np.zeros_like(s)
@@ -220,8 +247,9 @@ def iso8608_harmonics(road: Iso8608Road, length_m: float, side: str = "right") -
     return Harmonics(2.0 * math.pi * n, np.sqrt(2.0 * variance), phase)
 
 
-def _psd_integral(level: float, waviness: float, lower: np.ndarray,
-                  upper: np.ndarray) -> np.ndarray:
+def _psd_integral(
+    level: float, waviness: float, lower: np.ndarray, upper: np.ndarray
+) -> np.ndarray:
     """``int_lower^upper level (n / n0)^-w dn`` [m^2] in closed form, any ``w`` > 0.
 
     ``level n0 (a/n0)^(1-w) r E((1 - w) r)`` with ``r = ln(b/a)`` and ``E(x) = (e^x - 1)/x``
@@ -271,8 +299,9 @@ def _is_flat(road: RoadConfig, side: str) -> bool:
     return (road.tracks, side) in {("right_only", "left"), ("left_only", "right")}
 
 
-def _bump_window(road: BumpStep | BumpHalfSine,
-                 offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _bump_window(
+    road: BumpStep | BumpHalfSine, offsets: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """When each wheel meets and leaves the bump (N,) [s]: ``t_0 + d/V`` and ``L/V`` later
     (Eq 2.102/2.104 with ``t_distance = d/V``; the rear duration as mended, slip:
     docs/thesis-slips.md#eq-2104)."""
@@ -280,8 +309,9 @@ def _bump_window(road: BumpStep | BumpHalfSine,
     return up, up + road.length / road.speed
 
 
-def _bump_inputs(road: BumpStep | BumpHalfSine, offsets: np.ndarray, t: np.ndarray,
-                 left: bool = False) -> tuple[np.ndarray, np.ndarray]:
+def _bump_inputs(
+    road: BumpStep | BumpHalfSine, offsets: np.ndarray, t: np.ndarray, left: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """Bump under each wheel, Eq 2.101-2.104: the front wheels' input delayed by d/V.
 
     On the bump is ``up <= t < down`` (the right limits at the edges), or with ``left``
@@ -301,8 +331,9 @@ def _bump_inputs(road: BumpStep | BumpHalfSine, offsets: np.ndarray, t: np.ndarr
     return z, zdot
 
 
-def _spatial_profile(road: Iso8608Road | FileRoad, positions: np.ndarray, sides: Sequence[str],
-                     base_dir: Path | None) -> tuple[np.ndarray, np.ndarray]:
+def _spatial_profile(
+    road: Iso8608Road | FileRoad, positions: np.ndarray, sides: Sequence[str], base_dir: Path | None
+) -> tuple[np.ndarray, np.ndarray]:
     """Height [m] and slope dz/ds [-] at ``positions`` (N, T) [m], row i under ``sides[i]``.
 
     Flat sides are not zeroed here (the callers do).
@@ -350,23 +381,31 @@ def _harmonic_sum(harmonics: Harmonics, s: np.ndarray) -> tuple[np.ndarray, np.n
     baseband = _hermite(g, dg * spacing, index, fraction)
     baseband_slope = _hermite(dg, d2g * spacing, index, fraction)
     carrier = np.exp(1j * harmonics.omega[0] * s)
-    return ((carrier * baseband).imag,
-            (carrier * (1j * harmonics.omega[0] * baseband + baseband_slope)).imag)
+    return (
+        (carrier * baseband).imag,
+        (carrier * (1j * harmonics.omega[0] * baseband + baseband_slope)).imag,
+    )
 
 
-def _hermite(values: np.ndarray, steps: np.ndarray, index: np.ndarray,
-             fraction: np.ndarray) -> np.ndarray:
+def _hermite(
+    values: np.ndarray, steps: np.ndarray, index: np.ndarray, fraction: np.ndarray
+) -> np.ndarray:
     """Cubic Hermite interpolation of a periodic grid function between ``index`` and the next
     point at ``fraction`` in [0, 1); ``steps`` are the derivatives times the grid spacing."""
     following = (index + 1) % values.size
     u2 = fraction * fraction
     u3 = u2 * fraction
-    return ((2 * u3 - 3 * u2 + 1) * values[index] + (u3 - 2 * u2 + fraction) * steps[index]
-            + (3 * u2 - 2 * u3) * values[following] + (u3 - u2) * steps[following])
+    return (
+        (2 * u3 - 3 * u2 + 1) * values[index]
+        + (u3 - 2 * u2 + fraction) * steps[index]
+        + (3 * u2 - 2 * u3) * values[following]
+        + (u3 - u2) * steps[following]
+    )
 
 
-def _interpolate(distance: np.ndarray, height: np.ndarray,
-                 positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _interpolate(
+    distance: np.ndarray, height: np.ndarray, positions: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Linear interpolation of the profile and its slope; flat (0) outside the distance range.
 
     At a knot the slope is that of the segment that starts there.

@@ -54,11 +54,20 @@ from .io import atomic_h5, write_attrs, write_dataset
 from .kesort import KEpsilonSort, kesort, pareto_picks
 from .optimise.problem import PENALTY, Problem
 
-__all__ = ["ParetoSet", "DesignSet", "CaseSort", "Selection", "read_pareto", "evaluate_pareto",
-           "load_design_sets", "select", "write_selection"]
+__all__ = [
+    "ParetoSet",
+    "DesignSet",
+    "CaseSort",
+    "Selection",
+    "read_pareto",
+    "evaluate_pareto",
+    "load_design_sets",
+    "select",
+    "write_selection",
+]
 
 _FAILED = "simulation_failed"
-_AGREE = 1e-6            # relative: re-simulated main objectives against the file's
+_AGREE = 1e-6  # relative: re-simulated main objectives against the file's
 
 
 @dataclass(frozen=True)
@@ -79,8 +88,7 @@ class ParetoSet:
     def config(self) -> Config:
         """The config the set was optimised with; errors point into the file
         (``PARETO.h5:config:LINE``), and relative paths resolve from the file's folder."""
-        return load_config_text(self.config_text, self.path.with_name(self.path.name
-                                                                      + ":config"))
+        return load_config_text(self.config_text, self.path.with_name(self.path.name + ":config"))
 
 
 @dataclass(frozen=True)
@@ -171,29 +179,40 @@ def read_pareto(path: str | Path) -> ParetoSet:
         for key in ("X", "F", "G"):
             name = f"pareto/{key}"
             values = h5.array(name, ndim=2)
-            data[key] = (values, h5.labels(name, "names", values.shape[1]),
-                         h5.labels(name, "units", values.shape[1]))
+            data[key] = (
+                values,
+                h5.labels(name, "names", values.shape[1]),
+                h5.labels(name, "units", values.shape[1]),
+            )
         rows = {key: value[0].shape[0] for key, value in data.items()}
         if len(set(rows.values())) != 1:
-            raise ConfigError(f"{path}: /pareto: X, F and G have {rows['X']}, {rows['F']} and "
-                              f"{rows['G']} rows")
+            raise ConfigError(
+                f"{path}: /pareto: X, F and G have {rows['X']}, {rows['F']} and {rows['G']} rows"
+            )
         if rows["X"] == 0:
             raise ConfigError(f"{path}: /pareto/X: the set is empty")
         for key in ("X", "F", "G"):
             if not np.isfinite(data[key][0]).all():
-                raise ConfigError(f"{path}: /pareto/{key}: values must be finite (a failed "
-                                  f"design has the penalty values, never NaN)")
+                raise ConfigError(
+                    f"{path}: /pareto/{key}: values must be finite (a failed "
+                    f"design has the penalty values, never NaN)"
+                )
         if not h5.has_attr("config"):
-            raise ConfigError(f"{path}: attribute 'config' (the YAML text) is missing; give "
-                              f"--config")
+            raise ConfigError(
+                f"{path}: attribute 'config' (the YAML text) is missing; give --config"
+            )
         text = h5.text_attr("config")
-    (X, var_names, var_units), (F, obj_names, _), (G, constraint_names, _) = \
-        data["X"], data["F"], data["G"]
+    (X, var_names, var_units), (F, obj_names, _), (G, constraint_names, _) = (
+        data["X"],
+        data["F"],
+        data["G"],
+    )
     return ParetoSet(path, X, var_names, var_units, F, obj_names, G, constraint_names, text)
 
 
-def evaluate_pareto(pareto: ParetoSet, cfg: Config | None = None,
-                    label: str | None = None) -> DesignSet:
+def evaluate_pareto(
+    pareto: ParetoSet, cfg: Config | None = None, label: str | None = None
+) -> DesignSet:
     """The designs of ``pareto`` with their main and supplementary objectives under ``cfg``
     (default: the file's own config), in one batch; see the module docstring."""
     own = cfg is None
@@ -201,28 +220,34 @@ def evaluate_pareto(pareto: ParetoSet, cfg: Config | None = None,
     problem = Problem.from_config(cfg)
     where = cfg.source if cfg.source is not None else "the config"
     if sorted(pareto.var_names) != sorted(problem.var_names):
-        raise ConfigError(f"{pareto.path}: /pareto/X holds {', '.join(pareto.var_names)}; "
-                          f"{where} varies {', '.join(problem.var_names)}: the designs do not "
-                          f"fit its design_variables")
+        raise ConfigError(
+            f"{pareto.path}: /pareto/X holds {', '.join(pareto.var_names)}; "
+            f"{where} varies {', '.join(problem.var_names)}: the designs do not "
+            f"fit its design_variables"
+        )
     X = pareto.X[:, [pareto.var_names.index(n) for n in problem.var_names]]
     names = problem.obj_names + problem.supplementary_names
     units = problem.obj_units + problem.supplementary_units
     notes = []
     if own and pareto.obj_names != problem.obj_names:
-        raise ConfigError(f"{pareto.path}: /pareto/F holds {', '.join(pareto.obj_names)} but "
-                          f"its config's main objectives are {', '.join(problem.obj_names)}")
+        raise ConfigError(
+            f"{pareto.path}: /pareto/F holds {', '.join(pareto.obj_names)} but "
+            f"its config's main objectives are {', '.join(problem.obj_names)}"
+        )
     resimulate = not own or bool(problem.supplementary_names)
     if resimulate:
         try:
             F, G, S = problem.evaluate(problem.to_search(X), return_values_of=["F", "G", "S"])
-        except ConfigError as exc:           # a stored value the config's field cannot take
+        except ConfigError as exc:  # a stored value the config's field cannot take
             raise ConfigError(f"{pareto.path}: /pareto/X: {exc}") from None
         if own:
             gap = _relative_gap(F, pareto.F)
             if gap > _AGREE:
-                notes.append(f"{pareto.path}: the re-simulated main objectives differ from the "
-                             f"file's by up to {gap:.2g} (relative): the file was written by "
-                             f"another version of the model")
+                notes.append(
+                    f"{pareto.path}: the re-simulated main objectives differ from the "
+                    f"file's by up to {gap:.2g} (relative): the file was written by "
+                    f"another version of the model"
+                )
         F = np.hstack([F, S])
         constraint_names = problem.constraint_names
     else:
@@ -232,10 +257,22 @@ def evaluate_pareto(pareto: ParetoSet, cfg: Config | None = None,
         failed |= G[:, -1] > 0
         G = G[:, :-1]
     feasible = (G <= 0).all(axis=1) & ~failed
-    default = (cfg.source.stem if not own and cfg.source is not None else pareto.path.stem)
-    return DesignSet(label or default, pareto.path, cfg, X, problem.var_names,
-                     problem.var_units, F, names, units, feasible, failed, resimulate,
-                     tuple(notes))
+    default = cfg.source.stem if not own and cfg.source is not None else pareto.path.stem
+    return DesignSet(
+        label or default,
+        pareto.path,
+        cfg,
+        X,
+        problem.var_names,
+        problem.var_units,
+        F,
+        names,
+        units,
+        feasible,
+        failed,
+        resimulate,
+        tuple(notes),
+    )
 
 
 def _relative_gap(a: np.ndarray, b: np.ndarray) -> float:
@@ -246,8 +283,9 @@ def _relative_gap(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.max(np.abs(a - b) / np.maximum(np.abs(b), np.finfo(float).tiny)))
 
 
-def load_design_sets(files: Sequence[str | Path], configs: Sequence[str | Path] = (),
-                     labels: Sequence[str] = ()) -> list[DesignSet]:
+def load_design_sets(
+    files: Sequence[str | Path], configs: Sequence[str | Path] = (), labels: Sequence[str] = ()
+) -> list[DesignSet]:
     """Read and evaluate Pareto files for :func:`select`, as ``suspopt kesort`` takes them.
 
     ``configs``: none (each file's own), one (for every file) or one per file. ``labels``: none
@@ -259,11 +297,12 @@ def load_design_sets(files: Sequence[str | Path], configs: Sequence[str | Path] 
     if not files:
         raise ConfigError("give at least one Pareto file")
     if len(configs) not in (0, 1, len(files)):
-        raise ConfigError(f"--config: give one config for every file, or one per file "
-                          f"({len(files)}); got {len(configs)}")
+        raise ConfigError(
+            f"--config: give one config for every file, or one per file "
+            f"({len(files)}); got {len(configs)}"
+        )
     if len(labels) not in (0, len(files)):
-        raise ConfigError(f"--label: give one label per file ({len(files)}); got "
-                          f"{len(labels)}")
+        raise ConfigError(f"--label: give one label per file ({len(files)}); got {len(labels)}")
     for lab in labels:
         if not lab or "/" in lab:
             raise ConfigError(f"--label {lab!r}: a label must be non-empty and have no '/'")
@@ -287,9 +326,16 @@ def load_design_sets(files: Sequence[str | Path], configs: Sequence[str | Path] 
     return sets
 
 
-def select(sets: Sequence[DesignSet], eps=None, *, P=None, normalise: str = "max",
-           feasible_only: bool = True, P_range=(0.01, 1.0), P_step: float = 0.01
-           ) -> Selection:
+def select(
+    sets: Sequence[DesignSet],
+    eps=None,
+    *,
+    P=None,
+    normalise: str = "max",
+    feasible_only: bool = True,
+    P_range=(0.01, 1.0),
+    P_step: float = 0.01,
+) -> Selection:
     """Pool ``sets`` and sort them by k-ε optimality (see the module docstring); ``eps``,
     ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`suspopt.kesort.kesort`.
     ConfigError when the sets have different objectives or no design is left to sort."""
@@ -297,13 +343,17 @@ def select(sets: Sequence[DesignSet], eps=None, *, P=None, normalise: str = "max
     names, units = sets[0].names, sets[0].units
     for s in sets[1:]:
         if sorted(s.names) != sorted(names):
-            raise ConfigError(f"{s.source} ({s.label}): objectives {', '.join(s.names)} differ "
-                              f"from {sets[0].source} ({sets[0].label}): "
-                              f"{', '.join(names)}; pooled sets need the same ones")
+            raise ConfigError(
+                f"{s.source} ({s.label}): objectives {', '.join(s.names)} differ "
+                f"from {sets[0].source} ({sets[0].label}): "
+                f"{', '.join(names)}; pooled sets need the same ones"
+            )
         for name, unit in zip(s.names, s.units):
             if unit != units[names.index(name)]:
-                raise ConfigError(f"{s.source} ({s.label}): objective {name} is in {unit}, in "
-                                  f"{units[names.index(name)]} for {sets[0].source}")
+                raise ConfigError(
+                    f"{s.source} ({s.label}): objective {name} is in {unit}, in "
+                    f"{units[names.index(name)]} for {sets[0].source}"
+                )
     var_names, var_units = [], []
     for s in sets:
         for n, u in zip(s.var_names, s.var_units):
@@ -318,23 +368,23 @@ def select(sets: Sequence[DesignSet], eps=None, *, P=None, normalise: str = "max
             why = f"{dropped_failed} failed simulation" if dropped_failed else ""
             if dropped > dropped_failed:
                 why += (", " if why else "") + f"{dropped - dropped_failed} infeasible"
-            notes.append(f"{s.source} ({s.label}): left out {dropped} of {len(k)} designs "
-                         f"({why})")
+            notes.append(f"{s.source} ({s.label}): left out {dropped} of {len(k)} designs ({why})")
     cases = list(dict.fromkeys(s.label for s in sets))
     for label in cases:
         if not any(k.any() for s, k in zip(sets, keep) if s.label == label):
             files = ", ".join(str(s.source) for s in sets if s.label == label)
             hint = "" if not feasible_only else "; --keep-infeasible sorts infeasible ones too"
-            raise ConfigError(f"{files}: no design of case {label} to sort (every one failed "
-                              f"or is infeasible){hint}")
+            raise ConfigError(
+                f"{files}: no design of case {label} to sort (every one failed "
+                f"or is infeasible){hint}"
+            )
     F = np.vstack([s.F[k][:, [s.names.index(n) for n in names]] for s, k in zip(sets, keep)])
     X = np.vstack([_columns(s.X[k], s.var_names, var_names) for s, k in zip(sets, keep)])
     case = np.concatenate([np.full(k.sum(), s.label, dtype=object) for s, k in zip(sets, keep)])
     source = np.concatenate([np.full(k.sum(), i) for i, k in enumerate(keep)])
     row = np.concatenate([np.flatnonzero(k) for k in keep])
     feasible = np.concatenate([s.feasible[k] for s, k in zip(sets, keep)])
-    options = dict(eps=eps, P=P, normalise=normalise, names=names, P_range=P_range,
-                   P_step=P_step)
+    options = dict(eps=eps, P=P, normalise=normalise, names=names, P_range=P_range, P_step=P_step)
     try:
         pool = kesort(F, **options)
         case_sorts = {}
@@ -345,10 +395,24 @@ def select(sets: Sequence[DesignSet], eps=None, *, P=None, normalise: str = "max
                 case_sorts[label] = CaseSort(label, rows, kesort(F[rows], **options), picks)
     except ValueError as exc:
         raise ConfigError(f"{', '.join(str(s.source) for s in sets)}: {exc}") from None
-    return Selection(F=F, names=names, units=units, X=X, var_names=var_names,
-                     var_units=var_units, case=case, cases=cases, source=source, row=row,
-                     feasible=feasible, sets=sets, sort=pool, picks=pareto_picks(F, names),
-                     case_sorts=case_sorts, notes=notes)
+    return Selection(
+        F=F,
+        names=names,
+        units=units,
+        X=X,
+        var_names=var_names,
+        var_units=var_units,
+        case=case,
+        cases=cases,
+        source=source,
+        row=row,
+        feasible=feasible,
+        sets=sets,
+        sort=pool,
+        picks=pareto_picks(F, names),
+        case_sorts=case_sorts,
+        notes=notes,
+    )
 
 
 def _columns(X: np.ndarray, have: list[str], want: list[str]) -> np.ndarray:
@@ -360,8 +424,7 @@ def _columns(X: np.ndarray, have: list[str], want: list[str]) -> np.ndarray:
     return out
 
 
-def _write_sort(group, sort: KEpsilonSort, rows: np.ndarray | None,
-                picks: dict[str, int]) -> None:
+def _write_sort(group, sort: KEpsilonSort, rows: np.ndarray | None, picks: dict[str, int]) -> None:
     """k_eps, k, chosen, ties and picks of one sort; indices in the pool (``rows`` maps a
     case's own indices to the pool's and is the dimension of its k_eps and k)."""
     index = (lambda i: i) if rows is None else (lambda i: rows[i])
@@ -375,19 +438,23 @@ def _write_sort(group, sort: KEpsilonSort, rows: np.ndarray | None,
     grp = group.create_group("picks")
     for key, value in picks.items():
         write_dataset(grp, key, int(value), "1")
-    write_attrs(group, epsilon=sort.epsilon, P=np.nan if sort.P is None else sort.P,
-                P_auto=sort.P_auto, normalisation=sort.normalisation, unique=sort.unique)
+    write_attrs(
+        group,
+        epsilon=sort.epsilon,
+        P=np.nan if sort.P is None else sort.P,
+        P_auto=sort.P_auto,
+        normalisation=sort.normalisation,
+        unique=sort.unique,
+    )
 
 
-def write_selection(path: str | Path, selection: Selection, command: str | None = None
-                    ) -> Path:
+def write_selection(path: str | Path, selection: Selection, command: str | None = None) -> Path:
     """Write ``/kesort`` (module docstring) to a new HDF5 file, atomically."""
     s = selection
     with atomic_h5(path, s.sets[0].config, command) as h5:
         grp = h5.create_group("kesort")
         write_dataset(grp, "F", s.F, s.units, dims=("design", "objective"), names=s.names)
-        write_dataset(grp, "X", s.X, s.var_units, dims=("design", "variable"),
-                      names=s.var_names)
+        write_dataset(grp, "X", s.X, s.var_units, dims=("design", "variable"), names=s.var_names)
         write_dataset(grp, "case", list(s.case), "1", dims=("design",))
         write_dataset(grp, "source", s.source, "1", dims=("design",))
         write_dataset(grp, "row", s.row, "1", dims=("design",))
@@ -395,9 +462,11 @@ def write_selection(path: str | Path, selection: Selection, command: str | None 
         _write_sort(grp, s.sort, None, s.picks)
         write_attrs(grp, cases=list(s.cases))
         sets = grp.create_group("sets")
-        for key, values in (("file", [str(d.source) for d in s.sets]),
-                            ("label", [d.label for d in s.sets]),
-                            ("config", [d.config.text for d in s.sets])):
+        for key, values in (
+            ("file", [str(d.source) for d in s.sets]),
+            ("label", [d.label for d in s.sets]),
+            ("config", [d.config.text for d in s.sets]),
+        ):
             write_dataset(sets, key, values, "1", dims=("set",))
         if s.case_sorts:
             cases = grp.create_group("cases")

@@ -29,9 +29,19 @@ from .seat import build_attachments
 from .specs import evaluate_spec, spec_signals
 from .vehicle import VehicleModel, build_vehicle
 
-__all__ = ["simulate", "prepare", "run_memory", "check_memory", "signal_names",
-           "signal_table", "Result", "SignalMap", "Controller", "Attachment",
-           "DIVERGENCE_LIMIT"]
+__all__ = [
+    "simulate",
+    "prepare",
+    "run_memory",
+    "check_memory",
+    "signal_names",
+    "signal_table",
+    "Result",
+    "SignalMap",
+    "Controller",
+    "Attachment",
+    "DIVERGENCE_LIMIT",
+]
 
 
 def prepare(cfg: Config, params: Mapping[str, Any] | None = None):
@@ -54,12 +64,15 @@ def prepare(cfg: Config, params: Mapping[str, Any] | None = None):
         for i, name in enumerate(cfg.output.signals):
             if name not in available:
                 close = difflib.get_close_matches(name, available, n=3)
-                raise cfg.error(("output", "signals", i), f"unknown signal {name!r}" + (
-                    f"; did you mean {', '.join(close)}?" if close else ""))
+                raise cfg.error(
+                    ("output", "signals", i),
+                    f"unknown signal {name!r}"
+                    + (f"; did you mean {', '.join(close)}?" if close else ""),
+                )
     return pv, model, controller, attachments
 
 
-def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> "Result":
+def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:
     """Simulate ``cfg`` for one design, or for P designs given as dotted-path arrays.
 
     ``params`` maps dotted config paths (e.g. ``"vehicle.corners.F1.damper.c"``) to arrays of
@@ -76,8 +89,9 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> "Result":
     return result
 
 
-def run_memory(cfg: Config, model: VehicleModel, attachments: Sequence[Attachment], P: int,
-               signals: int = 0) -> tuple[float, float]:
+def run_memory(
+    cfg: Config, model: VehicleModel, attachments: Sequence[Attachment], P: int, signals: int = 0
+) -> tuple[float, float]:
     """Peak bytes of a run of P designs, ``(shared, per_design)``: what does not grow with P
     (the road's inputs on the half-step grid, their part of the element deformations) and
     what each design adds (its states and accelerations at every output sample, the
@@ -87,7 +101,8 @@ def run_memory(cfg: Config, model: VehicleModel, attachments: Sequence[Attachmen
     sim, road = cfg.simulation, cfg.road
     n = model.n_dof + sum(len(att.dof_names) for att in attachments)
     rows = sum(g.size for g in model.network.groups) + sum(
-        g.size for att in attachments for g in att.network.groups)
+        g.size for att in attachments for g in att.network.groups
+    )
     corners = len(model.corners)
     half_steps = 2 * sim.n_steps + 1
     samples = sim.n_steps // sim.output_every + 1
@@ -98,21 +113,30 @@ def run_memory(cfg: Config, model: VehicleModel, attachments: Sequence[Attachmen
     return shared, per_design
 
 
-def check_memory(cfg: Config, model: VehicleModel, attachments: Sequence[Attachment], P: int,
-                 signals: int = 0) -> None:
+def check_memory(
+    cfg: Config, model: VehicleModel, attachments: Sequence[Attachment], P: int, signals: int = 0
+) -> None:
     """ConfigError when a run of P designs (:func:`run_memory`) needs more memory than the
     limit (:func:`suspopt.memory.check`)."""
     shared, per_design = run_memory(cfg, model, attachments, P, signals)
-    memory.check(shared + P * per_design, f"simulating {P} design{'s' if P > 1 else ''} for "
-                 f"{cfg.simulation.duration:g} s at dt = {cfg.simulation.dt:g} s",
-                 ("simulate fewer designs at once, " if P > 1 else "")
-                 + "shorten simulation.duration, raise simulation.dt or output_dt, store fewer "
-                 "output.signals" + (", lower road.n_max or set road.n_waves"
-                                     if cfg.road.kind == "iso8608" else ""))
+    memory.check(
+        shared + P * per_design,
+        f"simulating {P} design{'s' if P > 1 else ''} for "
+        f"{cfg.simulation.duration:g} s at dt = {cfg.simulation.dt:g} s",
+        ("simulate fewer designs at once, " if P > 1 else "")
+        + "shorten simulation.duration, raise simulation.dt or output_dt, store fewer "
+        "output.signals"
+        + (", lower road.n_max or set road.n_waves" if cfg.road.kind == "iso8608" else ""),
+    )
 
 
-def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller | None,
-         attachments: Sequence[Attachment]) -> "Result":
+def _run(
+    cfg: Config,
+    pv: ParamView,
+    model: VehicleModel,
+    controller: Controller | None,
+    attachments: Sequence[Attachment],
+) -> Result:
     sim = cfg.simulation
     n_steps, every = sim.n_steps, sim.output_every
     t_grid = np.arange(2 * n_steps + 1) * (0.5 * sim.dt)
@@ -122,19 +146,37 @@ def _run(cfg: Config, pv: ParamView, model: VehicleModel, controller: Controller
     times, jumps = road_edges(cfg.road, model.offsets, model.sides)
     edges = None
     if times.size:
+
         def inputs(t: np.ndarray, left: bool) -> np.ndarray:
-            return asm.offsets(*road_inputs(cfg.road, model.offsets, model.sides, t,
-                                            base_dir=cfg.base_dir, left=left))
-        no_pull = np.concatenate([np.full(g.size, g.name == "tyre") for g in network.groups]) \
-            if cfg.vehicle.tyre_lift_off else None
+            return asm.offsets(
+                *road_inputs(
+                    cfg.road, model.offsets, model.sides, t, base_dir=cfg.base_dir, left=left
+                )
+            )
+
+        no_pull = (
+            np.concatenate([np.full(g.size, g.name == "tyre") for g in network.groups])
+            if cfg.vehicle.tyre_lift_off
+            else None
+        )
         edges = Edges(times, jumps.T, inputs, no_pull)
-    traj = integrate(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller,
-                      edges)
+    traj = integrate(
+        asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller, edges
+    )
     out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
-    return Result(config=cfg, model=model, time=t_grid[out_idx], states=traj.states,
-                  accelerations=traj.accelerations, road=z[:, None, out_idx],
-                  road_vel=zd[:, None, out_idx],
-                  diverged_at=traj.diverged_at, designs=dict(pv.params), _assembled=asm,
-                  attachments=tuple(attachments), held_damping=traj.damping,
-                  controller_records=traj.records,
-                  controller_units=dict(getattr(controller, "units", {})))
+    return Result(
+        config=cfg,
+        model=model,
+        time=t_grid[out_idx],
+        states=traj.states,
+        accelerations=traj.accelerations,
+        road=z[:, None, out_idx],
+        road_vel=zd[:, None, out_idx],
+        diverged_at=traj.diverged_at,
+        designs=dict(pv.params),
+        _assembled=asm,
+        attachments=tuple(attachments),
+        held_damping=traj.damping,
+        controller_records=traj.records,
+        controller_units=dict(getattr(controller, "units", {})),
+    )

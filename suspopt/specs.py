@@ -22,7 +22,6 @@ import numpy as np
 
 from .metrics import energy, iso2631, springs, stats, transient
 
-
 __all__ = ["METRICS", "MetricDef", "evaluate_spec", "spec_signals", "metric_unit"]
 
 
@@ -59,13 +58,23 @@ def _rate(result) -> float:
 
 
 def _statistic(name: str) -> MetricDef:
-    description = {"var": "variance (Eq 2.87, 2.89, 2.91, 5.4)", "std": "standard deviation",
-                   "rms": "root mean square", "max": "maximum (Eq 2.88, 2.90)",
-                   "min": "minimum", "max_abs": "maximum absolute value", "mean": "mean",
-                   "peak_to_peak": "maximum minus minimum"}[name]
+    description = {
+        "var": "variance (Eq 2.87, 2.89, 2.91, 5.4)",
+        "std": "standard deviation",
+        "rms": "root mean square",
+        "max": "maximum (Eq 2.88, 2.90)",
+        "min": "minimum",
+        "max_abs": "maximum absolute value",
+        "mean": "mean",
+        "peak_to_peak": "maximum minus minimum",
+    }[name]
     function = stats.STATISTICS[name]
-    return MetricDef("statistic", _square if name == "var" else _same, description,
-                     lambda spec, r, signal: function(r.signals[signal]))
+    return MetricDef(
+        "statistic",
+        _square if name == "var" else _same,
+        description,
+        lambda spec, r, signal: function(r.signals[signal]),
+    )
 
 
 def _weighted(function) -> Callable[[Any, Any, str], np.ndarray]:
@@ -75,8 +84,10 @@ def _weighted(function) -> Callable[[Any, Any, str], np.ndarray]:
 def _transient(key: str) -> Callable[[Any, Any, str], np.ndarray]:
     def compute(spec, r, signal):
         start = getattr(r.config.road, "start", None)
-        return transient.transient_metrics(r.time, r.signals[signal], band=spec.band,
-                                           start=start)[key]
+        return transient.transient_metrics(r.time, r.signals[signal], band=spec.band, start=start)[
+            key
+        ]
+
     return compute
 
 
@@ -87,53 +98,87 @@ def _corner(r, signal: str) -> tuple[str, int]:
 
 def _dissipated_power(spec, r, signal):
     corner, _ = _corner(r, signal)
-    return energy.mean_dissipated_power(r.signals[f"damper_force.{corner}"], r.signals[signal],
-                                        r.time)
+    return energy.mean_dissipated_power(
+        r.signals[f"damper_force.{corner}"], r.signals[signal], r.time
+    )
 
 
 def _spring_usage(spec, r, signal):
     _, c = _corner(r, signal)
-    return springs.nonlinear_spring_usage(r.signals[signal], r.model.spring_linear[:, 0, c],
-                                          r.model.spring_cubic[:, 0, c])
+    return springs.nonlinear_spring_usage(
+        r.signals[signal], r.model.spring_linear[:, 0, c], r.model.spring_cubic[:, 0, c]
+    )
 
 
 def _dynamic_tyre_load(spec, r, signal):
     _, c = _corner(r, signal)
-    return stats.dynamic_tyre_load_ratio(r.signals[signal],
-                                         r.model.static_tyre_load[:, 0, c])
+    return stats.dynamic_tyre_load_ratio(r.signals[signal], r.model.static_tyre_load[:, 0, c])
 
 
 METRICS: dict[str, MetricDef] = {
     **{name: _statistic(name) for name in stats.STATISTICS},
-    "rms_weighted": MetricDef("iso2631", _same, "ISO 2631-1 weighted r.m.s., RC (Eq 2.78)",
-                              _weighted(iso2631.weighted_rms)),
-    "vdv": MetricDef("iso2631", lambda u: f"{u} s^0.25" if u != "m/s^2" else "m/s^1.75",
-                     "vibration dose value (Eq 2.82)", _weighted(iso2631.vdv)),
-    "mtvv": MetricDef("iso2631", _same, "maximum transient vibration value (Eq 2.81)",
-                      lambda spec, r, signal: iso2631.mtvv(r.signals[signal], _rate(r),
-                                                           spec.weighting, tau=spec.tau)),
-    "crest_factor": MetricDef("iso2631", _fixed("1"), "crest factor (Eq 2.83)",
-                              _weighted(iso2631.crest_factor)),
+    "rms_weighted": MetricDef(
+        "iso2631",
+        _same,
+        "ISO 2631-1 weighted r.m.s., RC (Eq 2.78)",
+        _weighted(iso2631.weighted_rms),
+    ),
+    "vdv": MetricDef(
+        "iso2631",
+        lambda u: f"{u} s^0.25" if u != "m/s^2" else "m/s^1.75",
+        "vibration dose value (Eq 2.82)",
+        _weighted(iso2631.vdv),
+    ),
+    "mtvv": MetricDef(
+        "iso2631",
+        _same,
+        "maximum transient vibration value (Eq 2.81)",
+        lambda spec, r, signal: iso2631.mtvv(
+            r.signals[signal], _rate(r), spec.weighting, tau=spec.tau
+        ),
+    ),
+    "crest_factor": MetricDef(
+        "iso2631", _fixed("1"), "crest factor (Eq 2.83)", _weighted(iso2631.crest_factor)
+    ),
     "peak": MetricDef("transient", _same, "transient peak M_p (Sec 2.4.1)", _transient("peak")),
-    "peak_time": MetricDef("transient", _fixed("s"), "time of the peak t_p (Sec 2.4.1)",
-                           _transient("peak_time")),
-    "rise_time": MetricDef("transient", _fixed("s"), "10-90 % rise time t_r (Sec 2.4.1)",
-                           _transient("rise_time")),
-    "settling_time": MetricDef("transient", _fixed("s"), "settling time t_s (Sec 2.4.1)",
-                               _transient("settling_time")),
-    "overshoot": MetricDef("transient", _fixed("%"), "overshoot M_ov (Sec 2.4.1)",
-                           _transient("overshoot")),
-    "steady_state": MetricDef("transient", _same, "steady state SST (Sec 2.4.1)",
-                              _transient("steady_state")),
-    "switches": MetricDef("switches", _fixed("1"), "number of state changes SW (Sec 2.4.6)",
-                          lambda spec, r, signal: energy.damper_switches(r.signals[signal])),
-    "dissipated_power": MetricDef("derived", _fixed("W"), "mean damper power DE (Eq 2.92)",
-                                  _dissipated_power, family="travel_vel"),
-    "spring_usage": MetricDef("derived", _fixed("1"), "non-linear spring usage (Eq 5.3)",
-                              _spring_usage, family="travel"),
-    "dynamic_tyre_load": MetricDef("derived", _fixed("1"),
-                                   "std of dynamic tyre load over static load",
-                                   _dynamic_tyre_load, family="tyre_force"),
+    "peak_time": MetricDef(
+        "transient", _fixed("s"), "time of the peak t_p (Sec 2.4.1)", _transient("peak_time")
+    ),
+    "rise_time": MetricDef(
+        "transient", _fixed("s"), "10-90 % rise time t_r (Sec 2.4.1)", _transient("rise_time")
+    ),
+    "settling_time": MetricDef(
+        "transient", _fixed("s"), "settling time t_s (Sec 2.4.1)", _transient("settling_time")
+    ),
+    "overshoot": MetricDef(
+        "transient", _fixed("%"), "overshoot M_ov (Sec 2.4.1)", _transient("overshoot")
+    ),
+    "steady_state": MetricDef(
+        "transient", _same, "steady state SST (Sec 2.4.1)", _transient("steady_state")
+    ),
+    "switches": MetricDef(
+        "switches",
+        _fixed("1"),
+        "number of state changes SW (Sec 2.4.6)",
+        lambda spec, r, signal: energy.damper_switches(r.signals[signal]),
+    ),
+    "dissipated_power": MetricDef(
+        "derived",
+        _fixed("W"),
+        "mean damper power DE (Eq 2.92)",
+        _dissipated_power,
+        family="travel_vel",
+    ),
+    "spring_usage": MetricDef(
+        "derived", _fixed("1"), "non-linear spring usage (Eq 5.3)", _spring_usage, family="travel"
+    ),
+    "dynamic_tyre_load": MetricDef(
+        "derived",
+        _fixed("1"),
+        "std of dynamic tyre load over static load",
+        _dynamic_tyre_load,
+        family="tyre_force",
+    ),
 }
 _REDUCE = {"mean": np.mean, "max": np.max, "min": np.min, "sum": np.sum}
 
@@ -160,8 +205,9 @@ def spec_signals(spec, available: list[str], corners: tuple[str, ...]) -> list[s
         bad = missing[0] if missing else family
         families = sorted({n.rsplit(".", 1)[0] for n in available} | set(available))
         close = difflib.get_close_matches(bad, families + available, n=3)
-        raise ValueError(f"unknown signal {bad!r}" +
-                         (f"; did you mean {', '.join(close)}?" if close else ""))
+        raise ValueError(
+            f"unknown signal {bad!r}" + (f"; did you mean {', '.join(close)}?" if close else "")
+        )
     return names
 
 
@@ -169,12 +215,12 @@ def metric_unit(spec, signal_unit: str) -> str:
     return METRICS[spec.metric].unit(signal_unit)
 
 
-def evaluate_spec(spec, result, signal_units: Callable[[str], str]
-                  ) -> list[tuple[str, np.ndarray, str]]:
+def evaluate_spec(
+    spec, result, signal_units: Callable[[str], str]
+) -> list[tuple[str, np.ndarray, str]]:
     """``[(name, values (P,), unit), ...]`` of one spec on a Result."""
     names = spec_signals(spec, list(result.signals), result.model.corners)
-    base = spec.name or ".".join(filter(None, [spec.metric, spec.signal or None,
-                                               spec.weighting]))
+    base = spec.name or ".".join(filter(None, [spec.metric, spec.signal or None, spec.weighting]))
     unit = metric_unit(spec, signal_units(names[0]))
     compute = METRICS[spec.metric].compute
     values = [np.asarray(compute(spec, result, n), dtype=float) for n in names]

@@ -38,9 +38,14 @@ from .config.vehicle import DOF_FIELDS, PRESET_BODY_DOFS, PRESET_CORNERS
 from .network import Elements, LinearModel, Network, parameter_rows, shared_rows, widen
 from .params import ParamView
 
-__all__ = ["VehicleModel", "build_vehicle", "vehicle_network", "modal_analysis", "ModalResult",
-           "frequency_response"]
-
+__all__ = [
+    "VehicleModel",
+    "build_vehicle",
+    "vehicle_network",
+    "modal_analysis",
+    "ModalResult",
+    "frequency_response",
+]
 
 
 @dataclass
@@ -51,24 +56,24 @@ class VehicleModel:
     body_dofs: tuple[str, ...]
     corners: tuple[str, ...]
     P: int
-    mass: np.ndarray            # (1|P, 1, n) diagonal of M [kg, kg m^2]
-    stiffness: np.ndarray       # (1|P, n, n) K [N/m, N m/rad]
-    damping: np.ndarray         # (1|P, n, n) C [N s/m]
-    travel_map: np.ndarray      # (1|P, N, n) J: ST = J q
+    mass: np.ndarray  # (1|P, 1, n) diagonal of M [kg, kg m^2]
+    stiffness: np.ndarray  # (1|P, n, n) K [N/m, N m/rad]
+    damping: np.ndarray  # (1|P, n, n) C [N s/m]
+    travel_map: np.ndarray  # (1|P, N, n) J: ST = J q
     input_stiffness: np.ndarray  # (1|P, n, N) B_k: the road's force per m under each wheel
-    input_damping: np.ndarray   # (1|P, n, N) B_c: per m/s [N s/m]
-    unsprung_mass: np.ndarray   # (P, 1, N) [kg]
+    input_damping: np.ndarray  # (1|P, n, N) B_c: per m/s [N s/m]
+    unsprung_mass: np.ndarray  # (P, 1, N) [kg]
     tyre_stiffness: np.ndarray  # (P, 1, N) [N/m]
-    tyre_damping: np.ndarray    # (P, 1, N) [N s/m]
-    spring_linear: np.ndarray   # (P, 1, N) [N/m]
-    spring_cubic: np.ndarray    # (P, 1, N) [N/m^3]
-    damper: np.ndarray          # (P, 1, N) passive coefficient, C_min if semi-active [N s/m]
+    tyre_damping: np.ndarray  # (P, 1, N) [N s/m]
+    spring_linear: np.ndarray  # (P, 1, N) [N/m]
+    spring_cubic: np.ndarray  # (P, 1, N) [N/m^3]
+    damper: np.ndarray  # (P, 1, N) passive coefficient, C_min if semi-active [N s/m]
     static_tyre_load: np.ndarray  # (P, 1, N) tyre load at rest, compression positive [N]
     gravity: float
-    offsets: np.ndarray         # (N,) distance behind the front axle [m] (wheelbase delay)
-    sides: tuple[str, ...]      # 'right' | 'left' per corner
+    offsets: np.ndarray  # (N,) distance behind the front axle [m] (wheelbase delay)
+    sides: tuple[str, ...]  # 'right' | 'left' per corner
     dof_names: tuple[str, ...]
-    network: Network            # the equations of motion (module docstring)
+    network: Network  # the equations of motion (module docstring)
 
     @property
     def n_dof(self) -> int:
@@ -88,12 +93,15 @@ class VehicleModel:
         """The linear(ised) equations of motion, (P, ...) rows; the road under each wheel the
         inputs. Duffing and lift-off are not in it."""
         P, n, N = self.P, self.n_dof, len(self.corners)
-        return LinearModel(self.dof_names, tuple(f"road.{cn}" for cn in self.corners),
-                           np.broadcast_to(self.mass[:, 0, :], (P, n)),
-                           np.broadcast_to(self.stiffness, (P, n, n)),
-                           np.broadcast_to(self.damping, (P, n, n)),
-                           np.broadcast_to(self.input_stiffness, (P, n, N)),
-                           np.broadcast_to(self.input_damping, (P, n, N)))
+        return LinearModel(
+            self.dof_names,
+            tuple(f"road.{cn}" for cn in self.corners),
+            np.broadcast_to(self.mass[:, 0, :], (P, n)),
+            np.broadcast_to(self.stiffness, (P, n, n)),
+            np.broadcast_to(self.damping, (P, n, n)),
+            np.broadcast_to(self.input_stiffness, (P, n, N)),
+            np.broadcast_to(self.input_damping, (P, n, N)),
+        )
 
     def point_map(self, x: float, y: float) -> np.ndarray:
         """Row (n,) giving the body's vertical displacement at the body point (x, y) [m]
@@ -113,11 +121,17 @@ def _corner_geometry(pv: ParamView, body_dofs: tuple[str, ...], corners: tuple[s
     body = "vehicle.body."
     for i, name in enumerate(corners):
         if "pitch" in body_dofs:
-            x[:, i] = pv.require_positive(body + "a_front") if name[0] == "F" \
+            x[:, i] = (
+                pv.require_positive(body + "a_front")
+                if name[0] == "F"
                 else -pv.require_positive(body + "a_rear")
+            )
         if "roll" in body_dofs:
-            y[:, i] = pv.require_positive(body + "b_right") if name[1] == "1" \
+            y[:, i] = (
+                pv.require_positive(body + "b_right")
+                if name[1] == "1"
                 else -pv.require_positive(body + "b_left")
+            )
     return x, y
 
 
@@ -141,8 +155,13 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     kl, knl = corner_param("spring.linear", True), corner_param("spring.cubic")
     # a semi-active damper enters the linear model (modes, frequency response) at its soft
     # state C_min; the controller (suspopt.control) sets its coefficient while integrating
-    c = np.stack([pv.get(f"vehicle.corners.{cn}.damper.{veh.corners[cn].damper.soft_field}")
-                  for cn in corners], axis=1)
+    c = np.stack(
+        [
+            pv.get(f"vehicle.corners.{cn}.damper.{veh.corners[cn].damper.soft_field}")
+            for cn in corners
+        ],
+        axis=1,
+    )
     for name, arr in (("tyre.damping", ct), ("damper.c (c_min if semi-active)", c)):
         if np.any(arr < 0):
             raise ConfigError(f"params: vehicle.corners.*.{name}: must be >= 0")
@@ -161,8 +180,18 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     bar_map, bar_k = _anti_roll_bars(pv, corners, body_dofs)
     dof_names = tuple(f"body.{d}" for d in body_dofs) + tuple(f"wheel.{cn}" for cn in corners)
     shared_J = shared_rows(J)
-    network = vehicle_network(dof_names, mass, shared_J, kl, knl, c, kt, ct,
-                              None if bar_map is None else shared_rows(bar_map), bar_k)
+    network = vehicle_network(
+        dof_names,
+        mass,
+        shared_J,
+        kl,
+        knl,
+        c,
+        kt,
+        ct,
+        None if bar_map is None else shared_rows(bar_map),
+        bar_k,
+    )
     linear = network.linear_model()
     K, C = linear.stiffness, linear.damping
     static = _static_tyre_load(mass, K, nb, N, kt, body_dofs, veh.gravity)
@@ -174,27 +203,51 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     offsets = np.where(rear, wheelbase, 0.0) if cfg.road.wheelbase_delay else np.zeros(N)
     if pv.varies("vehicle.body.a_front") or pv.varies("vehicle.body.a_rear"):
         if any(cn[0] == "R" for cn in corners):
-            raise ConfigError("params: vehicle.body.a_front/a_rear cannot be design parameters "
-                              "of a model with a rear axle: the road's wheelbase delay is one "
-                              "per run")
+            raise ConfigError(
+                "params: vehicle.body.a_front/a_rear cannot be design parameters "
+                "of a model with a rear axle: the road's wheelbase delay is one "
+                "per run"
+            )
     sides = tuple("right" if cn[1] == "1" else "left" for cn in corners)
     e = (slice(None), None, slice(None))
     return VehicleModel(
-        preset=veh.preset, body_dofs=body_dofs, corners=corners, P=P,
-        mass=shared_rows(mass[:, None, :]), stiffness=shared_rows(K), damping=shared_rows(C),
-        travel_map=shared_J, input_stiffness=shared_rows(linear.input_stiffness),
-        input_damping=shared_rows(linear.input_damping), unsprung_mass=mu[e], tyre_stiffness=kt[e], tyre_damping=ct[e], spring_linear=kl[e],
-        spring_cubic=knl[e], damper=c[e], static_tyre_load=static[e],
-        gravity=veh.gravity, offsets=offsets, sides=sides, dof_names=dof_names,
-        network=network)
+        preset=veh.preset,
+        body_dofs=body_dofs,
+        corners=corners,
+        P=P,
+        mass=shared_rows(mass[:, None, :]),
+        stiffness=shared_rows(K),
+        damping=shared_rows(C),
+        travel_map=shared_J,
+        input_stiffness=shared_rows(linear.input_stiffness),
+        input_damping=shared_rows(linear.input_damping),
+        unsprung_mass=mu[e],
+        tyre_stiffness=kt[e],
+        tyre_damping=ct[e],
+        spring_linear=kl[e],
+        spring_cubic=knl[e],
+        damper=c[e],
+        static_tyre_load=static[e],
+        gravity=veh.gravity,
+        offsets=offsets,
+        sides=sides,
+        dof_names=dof_names,
+        network=network,
+    )
 
 
-
-
-def vehicle_network(dof_names: tuple[str, ...], mass: np.ndarray, travel_map: np.ndarray,
-                    spring_linear: np.ndarray, spring_cubic: np.ndarray, damper: np.ndarray,
-                    tyre_stiffness: np.ndarray, tyre_damping: np.ndarray,
-                    bar_map: np.ndarray | None, bar_stiffness: np.ndarray | None) -> Network:
+def vehicle_network(
+    dof_names: tuple[str, ...],
+    mass: np.ndarray,
+    travel_map: np.ndarray,
+    spring_linear: np.ndarray,
+    spring_cubic: np.ndarray,
+    damper: np.ndarray,
+    tyre_stiffness: np.ndarray,
+    tyre_damping: np.ndarray,
+    bar_map: np.ndarray | None,
+    bar_stiffness: np.ndarray | None,
+) -> Network:
     """The vehicle's :class:`~suspopt.network.Network` (module docstring).
 
     ``mass (P, n)``; ``travel_map`` J (1|P, N, n); per-corner ``(P, N)`` arrays: k_l [N/m],
@@ -210,21 +263,40 @@ def vehicle_network(dof_names: tuple[str, ...], mass: np.ndarray, travel_map: np
 
     def duffing(width: int):
         k_nl = widen(cubic, width)
-        return lambda disp, rate, force, out: np.multiply(k_nl, disp * disp * disp,
-                                                          out=out)     # k_nl ST^3 (Eq 2.31)
-    groups = [Elements("suspension", squeeze(travel_map), np.zeros((N, N)),
-                       parameter_rows(spring_linear), parameter_rows(damper),
-                       extra=duffing if np.any(spring_cubic) else None)]
+        return lambda disp, rate, force, out: np.multiply(
+            k_nl, disp * disp * disp, out=out
+        )  # k_nl ST^3 (Eq 2.31)
+
+    groups = [
+        Elements(
+            "suspension",
+            squeeze(travel_map),
+            np.zeros((N, N)),
+            parameter_rows(spring_linear),
+            parameter_rows(damper),
+            extra=duffing if np.any(spring_cubic) else None,
+        )
+    ]
     wheels = np.zeros((N, n))
     wheels[np.arange(N), nb + np.arange(N)] = 1.0
-    groups.append(Elements("tyre", wheels, -np.eye(N), parameter_rows(tyre_stiffness),
-                           parameter_rows(tyre_damping)))
+    groups.append(
+        Elements(
+            "tyre", wheels, -np.eye(N), parameter_rows(tyre_stiffness), parameter_rows(tyre_damping)
+        )
+    )
     if bar_map is not None:
-        groups.append(Elements("anti_roll_bar", squeeze(bar_map),
-                               np.zeros((bar_map.shape[1], N)), parameter_rows(bar_stiffness),
-                               np.zeros((bar_map.shape[1], P, 1))))
-    return Network(dof_names, tuple(f"road.{i}" for i in range(N)),
-                   parameter_rows(mass), tuple(groups))
+        groups.append(
+            Elements(
+                "anti_roll_bar",
+                squeeze(bar_map),
+                np.zeros((bar_map.shape[1], N)),
+                parameter_rows(bar_stiffness),
+                np.zeros((bar_map.shape[1], P, 1)),
+            )
+        )
+    return Network(
+        dof_names, tuple(f"road.{i}" for i in range(N)), parameter_rows(mass), tuple(groups)
+    )
 
 
 def tyre_lift_off(static_load: np.ndarray):
@@ -234,10 +306,13 @@ def tyre_lift_off(static_load: np.ndarray):
 
     def make(width: int):
         load = widen(rows, width)
+
         def lift_off(disp, rate, force, out):
             np.minimum(force, load, out=out)
             out -= force
+
         return lift_off
+
     return make
 
 
@@ -308,7 +383,7 @@ def _mode_labels(shape: np.ndarray, energy: np.ndarray, names: np.ndarray) -> np
     """:attr:`ModalResult.label` from the shapes and energy shares (P, n, n)."""
     P, n, _ = shape.shape
     labels = np.empty((P, n), dtype=object)
-    for p in range(P):                   # labels are text: a loop over designs and modes
+    for p in range(P):  # labels are text: a loop over designs and modes
         for k in range(n):
             share = energy[p, :, k]
             order = np.argsort(-share, kind="stable")
@@ -338,16 +413,25 @@ def modal_analysis(model: VehicleModel) -> ModalResult:
     frequency, shape = model.linear.modes()
     m = model.linear.mass
     shape = shape / np.max(np.abs(shape), axis=1, keepdims=True)
-    energy = m[:, :, None] * shape ** 2
+    energy = m[:, :, None] * shape**2
     energy = energy / energy.sum(axis=1, keepdims=True)
     names = np.array(model.dof_names)
-    return ModalResult(frequency=frequency, shape=shape,
-                       energy=energy, dominant=names[np.argmax(energy, axis=1)],
-                       label=_mode_labels(shape, energy, names), dof_names=model.dof_names)
+    return ModalResult(
+        frequency=frequency,
+        shape=shape,
+        energy=energy,
+        dominant=names[np.argmax(energy, axis=1)],
+        label=_mode_labels(shape, energy, names),
+        dof_names=model.dof_names,
+    )
 
 
-def frequency_response(model: VehicleModel, f: np.ndarray, speed: float | None = None,
-                       corners: tuple[str, ...] | None = None) -> np.ndarray:
+def frequency_response(
+    model: VehicleModel,
+    f: np.ndarray,
+    speed: float | None = None,
+    corners: tuple[str, ...] | None = None,
+) -> np.ndarray:
     """Analytic response of the linear(ised) model to a road input, (P, F, n) [m per m].
 
     The same unit-amplitude road height ``exp(jωt)`` enters under each wheel in ``corners``

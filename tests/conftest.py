@@ -22,8 +22,12 @@ def make_config(data: dict):
 
 
 def corner(m_u=40.0, k_t=1.5e5, c_t=0.0, k=1.0e4, k_nl=0.0, c=800.0) -> dict:
-    return {"unsprung_mass": m_u, "tyre": {"stiffness": k_t, "damping": c_t},
-            "spring": {"linear": k, "cubic": k_nl}, "damper": {"c": c}}
+    return {
+        "unsprung_mass": m_u,
+        "tyre": {"stiffness": k_t, "damping": c_t},
+        "spring": {"linear": k, "cubic": k_nl},
+        "damper": {"c": c},
+    }
 
 
 @pytest.fixture
@@ -36,8 +40,9 @@ def tiny(text: str, duration: float, population: int = 10, generations: int = 2)
     """A config's text with a tiny optimiser budget and a short run."""
     text = re.sub(r"(?m)^(  population:) \d+", rf"\1 {population}", text)
     text = re.sub(r"(?m)^(  generations:) \d+", rf"\1 {generations}", text)
-    return re.sub(r"(?m)^simulation: \{duration: [0-9.]+", f"simulation: {{duration: {duration}",
-                  text)
+    return re.sub(
+        r"(?m)^simulation: \{duration: [0-9.]+", f"simulation: {{duration: {duration}", text
+    )
 
 
 def optimised_front(folder: Path, name: str, duration: float, **budget) -> tuple[Path, Path]:

@@ -67,7 +67,7 @@ LIMIT = 3.0
 HARD_GRACE = 8.0
 #: Address-space cap of a worker [bytes] (``SUSPOPT_FUZZ_MEMORY_GB``, default 2); a worker with
 #: everything imported maps ~0.4 GB. A MemoryError under the cap is a failure (exit 1).
-MEMORY = int(float(os.environ.get("SUSPOPT_FUZZ_MEMORY_GB", "2")) * 2 ** 30)
+MEMORY = int(float(os.environ.get("SUSPOPT_FUZZ_MEMORY_GB", "2")) * 2**30)
 #: The base transformations of every seed: a short run and a tiny optimiser budget.
 DURATION = 0.3
 BUMP_START = 0.1
@@ -75,6 +75,7 @@ BUDGET = {"population": 8, "generations": 2, "max_evaluations": 16}
 
 
 # --- cases ---------------------------------------------------------------------------------
+
 
 @dataclass
 class Case:
@@ -89,12 +90,12 @@ class Case:
     """
 
     id: str
-    family: str                      # "config" or "h5"
+    family: str  # "config" or "h5"
     label: str
     setup: dict
     runs: list[list[str]]
-    source: str = ""                 # the bundled config (or front) it was made from
-    name: str = "config.yaml"        # file name of the input
+    source: str = ""  # the bundled config (or front) it was made from
+    name: str = "config.yaml"  # file name of the input
     dataset: str | None = None
 
     def to_json(self) -> str:
@@ -117,7 +118,7 @@ def seed_data(path: Path) -> dict:
     return copy.deepcopy(_seed_data(path))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _seed_data(path: Path) -> dict:
     """The bundled config with the base transformations: ``simulation.duration`` cut to
     :data:`DURATION` (a bump's ``start`` moved to :data:`BUMP_START` so the cut run still
@@ -147,16 +148,26 @@ def dump(data) -> str:
 
 def flow(value) -> str:
     """``value`` as one line of flow-style YAML."""
-    return yaml.safe_dump(value, default_flow_style=True, width=float("inf")).strip().removesuffix(
-        "\n...").strip()
+    return (
+        yaml.safe_dump(value, default_flow_style=True, width=float("inf"))
+        .strip()
+        .removesuffix("\n...")
+        .strip()
+    )
 
 
 # --- the tree of a config ------------------------------------------------------------------
 
+
 def walk(node, prefix=()):
     """Every (path, value) below ``node`` (not the root), depth first."""
-    items = (node.items() if isinstance(node, dict) else
-             enumerate(node) if isinstance(node, list) else ())
+    items = (
+        node.items()
+        if isinstance(node, dict)
+        else enumerate(node)
+        if isinstance(node, list)
+        else ()
+    )
     for key, value in items:
         path = prefix + (key,)
         yield path, value
@@ -178,8 +189,13 @@ def delete_at(data, path) -> None:
 
 
 def dotted(path) -> str:
-    return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p))
-                   for i, p in enumerate(path)) or "(root)"
+    return (
+        "".join(
+            f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p))
+            for i, p in enumerate(path)
+        )
+        or "(root)"
+    )
 
 
 def is_number(value) -> bool:
@@ -187,10 +203,15 @@ def is_number(value) -> bool:
 
 
 def short(value, n: int = 40) -> str:
-    text = value if isinstance(value, str) else flow(value) if not isinstance(
-        value, float) else repr(value)
+    text = (
+        value
+        if isinstance(value, str)
+        else flow(value)
+        if not isinstance(value, float)
+        else repr(value)
+    )
     text = text.replace("\n", "\\n")
-    return text if len(text) <= n else text[:n - 3] + "..."
+    return text if len(text) <= n else text[: n - 3] + "..."
 
 
 # --- mutation values -----------------------------------------------------------------------
@@ -198,40 +219,119 @@ def short(value, n: int = 40) -> str:
 #: Sizes are either cheap or absurd (>= 1e8 steps or waves, tens of GB): never a legal run
 #: that merely takes longer than LIMIT (a 1000 s run, dt = 1e-7, 10^6 waves), whose time-out
 #: would say nothing about robustness.
-EXTREMES = [math.inf, -math.inf, math.nan, 1e308, -1e308, 0, 0.0, -1, -1.0, 1e-300, -1e-300,
-            5e-324, 2 ** 70, -2 ** 70, 2 ** 63, 2 ** 64 + 1, 10 ** 9, 10 ** 12, 1e9, 1e12, 1e15,
-            1e-9]
+EXTREMES = [
+    math.inf,
+    -math.inf,
+    math.nan,
+    1e308,
+    -1e308,
+    0,
+    0.0,
+    -1,
+    -1.0,
+    1e-300,
+    -1e-300,
+    5e-324,
+    2**70,
+    -(2**70),
+    2**63,
+    2**64 + 1,
+    10**9,
+    10**12,
+    1e9,
+    1e12,
+    1e15,
+    1e-9,
+]
 #: numbers YAML reads as strings that pydantic may still turn into floats
-NUMBER_STRINGS = ["1e309", "-1e309", "1e400", "nan", "inf", "-inf", "Infinity", "1_0",
-                  "0x10", " 1", "2e0", "", "NaN"]
-WRONG_TYPES = ["abc", "", [1, 2], [], {"a": 1}, {}, True, False, None, "true", [[]],
-               {"kind": "x"}, "0.0.0", "\u00e9\u00e8\u2603", "x" * 10_000]
+NUMBER_STRINGS = [
+    "1e309",
+    "-1e309",
+    "1e400",
+    "nan",
+    "inf",
+    "-inf",
+    "Infinity",
+    "1_0",
+    "0x10",
+    " 1",
+    "2e0",
+    "",
+    "NaN",
+]
+WRONG_TYPES = [
+    "abc",
+    "",
+    [1, 2],
+    [],
+    {"a": 1},
+    {},
+    True,
+    False,
+    None,
+    "true",
+    [[]],
+    {"kind": "x"},
+    "0.0.0",
+    "\u00e9\u00e8\u2603",
+    "x" * 10_000,
+]
 #: sizes of a run: (path, values). Paths that a config lacks are added (unknown keys there).
 SIZES = {
-    ("simulation", "duration"): [math.inf, math.nan, 1e6, 1e7, 1e9, 1e12, 1e308, 2 ** 70,
-                                 1e-300, 5e-324, 0, -1, 1.0, 2.0, 1e-3],
-    ("simulation", "dt"): [1e-300, 5e-324, 1e-12, 1e-9, math.inf, math.nan, 0, -1e-3, 0.3,
-                           0.29, 0.1],
+    ("simulation", "duration"): [
+        math.inf,
+        math.nan,
+        1e6,
+        1e7,
+        1e9,
+        1e12,
+        1e308,
+        2**70,
+        1e-300,
+        5e-324,
+        0,
+        -1,
+        1.0,
+        2.0,
+        1e-3,
+    ],
+    ("simulation", "dt"): [
+        1e-300,
+        5e-324,
+        1e-12,
+        1e-9,
+        math.inf,
+        math.nan,
+        0,
+        -1e-3,
+        0.3,
+        0.29,
+        0.1,
+    ],
     ("simulation", "output_dt"): [1e-300, 1e308, math.inf, math.nan, 0, 0.3, 1e-3, 3e-3, 0.2],
-    ("road", "n_waves"): [10 ** 8, 10 ** 9, 10 ** 12, 2 ** 70, 1e9, 1e12, 0, -1, 1, 2, 3,
-                          math.inf, 2.5],
-    ("road", "n_max"): [1e8, 1e12, 1e308, math.inf, 2 ** 70, 1e-300, 0.0111],
+    ("road", "n_waves"): [10**8, 10**9, 10**12, 2**70, 1e9, 1e12, 0, -1, 1, 2, 3, math.inf, 2.5],
+    ("road", "n_max"): [1e8, 1e12, 1e308, math.inf, 2**70, 1e-300, 0.0111],
     ("road", "n_min"): [1e-300, 5e-324, 0, 2.8, 1e-12],
     ("road", "speed"): [1e-300, 1e308, math.inf, 1e9, 1e-9],
     ("road", "length"): [1e-300, 1e308, 1e12, 1e-12],
     ("road", "start"): [1e6, 1e308, 0.29, 0.3, 0.31, 10.0],
-    ("road", "seed"): [2 ** 70, 2 ** 64, 2 ** 63 - 1, -1, 1e12],
+    ("road", "seed"): [2**70, 2**64, 2**63 - 1, -1, 1e12],
     ("road", "waviness"): [1e308, 1e-300, 100, 1e3],
     ("road", "level"): [1e308, 1e-300, 1e6],
-    ("optimiser", "population"): [10 ** 6, 10 ** 9, 10 ** 12, 2 ** 70, 0, 1, 2, 1e6],
-    ("optimiser", "generations"): [10 ** 12, 2 ** 70, 0, 1e9],
-    ("optimiser", "max_evaluations"): [10 ** 12, 2 ** 70, 0, 1],
-    ("optimiser", "stall_generations"): [10 ** 12, 2 ** 70, 0],
-    ("optimiser", "seed"): [2 ** 70, -1, 2 ** 64, 1e12],
+    ("optimiser", "population"): [10**6, 10**9, 10**12, 2**70, 0, 1, 2, 1e6],
+    ("optimiser", "generations"): [10**12, 2**70, 0, 1e9],
+    ("optimiser", "max_evaluations"): [10**12, 2**70, 0, 1],
+    ("optimiser", "stall_generations"): [10**12, 2**70, 0],
+    ("optimiser", "seed"): [2**70, -1, 2**64, 1e12],
     ("optimiser", "tolerance"): [1e-300, 1e308, math.inf, math.nan],
-    ("optimiser", "options"): [{"n_offsprings": 10 ** 12}, {"pop_size": 10 ** 9},
-                               {"bogus": 1}, {"eliminate_duplicates": "x"}, {"sampling": 5},
-                               "abc"],
+    ("optimiser", "options"): [
+        {"n_offsprings": 10**12},
+        {"pop_size": 10**9},
+        {"bogus": 1},
+        {"eliminate_duplicates": "x"},
+        {"sampling": 5},
+        "abc",
+    ],
     ("control", "sample_time"): [1e-300, 1e-12, 1e308, math.inf],
     ("control", "lag"): [1e-300, 1e308, math.inf],
     ("seat", "mass"): [1e308, 1e-300, math.inf, 0, 1e12],
@@ -244,19 +344,22 @@ def typo(rng, text: str) -> str:
     if not text:
         return "x"
     i = int(rng.integers(len(text)))
-    ops = [lambda: text[:i] + text[i + 1:],                       # drop
-           lambda: text[:i] + text[i] * 2 + text[i + 1:],          # double
-           lambda: text[:i] + text[i + 1:i + 2] + text[i:i + 1] + text[i + 2:],   # swap
-           lambda: text.upper() if text.upper() != text else text.lower(),
-           lambda: text + " ",
-           lambda: text + "_",
-           lambda: text.replace("_", "-") if "_" in text else text + "s",
-           lambda: text[:i] + "\u0430" + text[i + 1:]]              # a Cyrillic 'а'
+    ops = [
+        lambda: text[:i] + text[i + 1 :],  # drop
+        lambda: text[:i] + text[i] * 2 + text[i + 1 :],  # double
+        lambda: text[:i] + text[i + 1 : i + 2] + text[i : i + 1] + text[i + 2 :],  # swap
+        lambda: text.upper() if text.upper() != text else text.lower(),
+        lambda: text + " ",
+        lambda: text + "_",
+        lambda: text.replace("_", "-") if "_" in text else text + "s",
+        lambda: text[:i] + "\u0430" + text[i + 1 :],
+    ]  # a Cyrillic 'а'
     out = ops[int(rng.integers(len(ops)))]()
     return out if out != text else text + "x"
 
 
 # --- YAML fragments ------------------------------------------------------------------------
+
 
 def alias_bomb(levels: int = 9, width: int = 9) -> tuple[str, str]:
     """(anchors, alias): top-level keys ``_a``-``_i`` of a 'billion laughs' and the alias of
@@ -280,8 +383,12 @@ def deep_nesting(depth: int, style: str = "[") -> str:
 
 def block_nesting(depth: int) -> str:
     """``depth`` levels of block mappings (about depth**2 bytes; keep depth ~1000)."""
-    return "\n" + "".join(" " * (2 * i + 2) + "a:\n" for i in range(depth)) + \
-        " " * (2 * depth + 2) + "1"
+    return (
+        "\n"
+        + "".join(" " * (2 * i + 2) + "a:\n" for i in range(depth))
+        + " " * (2 * depth + 2)
+        + "1"
+    )
 
 
 RAW = "__FUZZ_RAW_{}__"
@@ -299,6 +406,7 @@ def with_raw(data: dict, path, raw: str, header: str = "") -> str:
 
 
 # --- mutations -----------------------------------------------------------------------------
+
 
 def _leaves(data, want=None):
     out = []
@@ -344,8 +452,11 @@ def mutate_size(rng, data):
     keys = [k for k in SIZES if k[0] in data]
     key = _pick(rng, keys)
     value = copy.deepcopy(_pick(rng, SIZES[key]))
-    parent = get_at(data, key[:-1]) if all(
-        isinstance(get_at(data, key[:i]), dict) for i in range(1, len(key))) else None
+    parent = (
+        get_at(data, key[:-1])
+        if all(isinstance(get_at(data, key[:i]), dict) for i in range(1, len(key)))
+        else None
+    )
     if not isinstance(parent, dict):
         return mutate_number(rng, data)
     parent[key[-1]] = value
@@ -400,8 +511,9 @@ def mutate_section(rng, data):
 def mutate_combo(rng, data):
     labels = []
     for _ in range(int(rng.integers(2, 4))):
-        op = _pick(rng, [mutate_delete, mutate_type, mutate_number, mutate_size, mutate_enum,
-                         mutate_key])
+        op = _pick(
+            rng, [mutate_delete, mutate_type, mutate_number, mutate_size, mutate_enum, mutate_key]
+        )
         try:
             label, _ = op(rng, data)
         except (KeyError, IndexError, TypeError):
@@ -412,6 +524,7 @@ def mutate_combo(rng, data):
 
 # text-level mutations: return (label, text)
 
+
 def _any_path(rng, data):
     return _pick(rng, [p for p, _ in walk(data)])
 
@@ -419,8 +532,10 @@ def _any_path(rng, data):
 SYNTAX_BREAKS = [
     ("unclosed [", lambda line: line + " ["),
     ("unclosed {", lambda line: line + " {"),
-    ("unterminated quote", lambda line: line.replace(": ", ': "', 1) if ": " in line
-     else line + ' "'),
+    (
+        "unterminated quote",
+        lambda line: line.replace(": ", ': "', 1) if ": " in line else line + ' "',
+    ),
     ("tab indentation", lambda line: "\t" + line),
     ("one more space", lambda line: " " + line),
     ("one less space", lambda line: line[1:] if line.startswith(" ") else "  " + line),
@@ -437,8 +552,10 @@ SYNTAX_BREAKS = [
     ("bad !!float", lambda line: line.replace(": ", ": !!float ", 1)),
     ("bad !!binary", lambda line: line.replace(": ", ": !!binary ", 1)),
     ("bad !!timestamp", lambda line: line.replace(": ", ": !!timestamp ", 1)),
-    ("undefined alias", lambda line: line.split(":")[0] + ": *nowhere" if ":" in line
-     else "*nowhere"),
+    (
+        "undefined alias",
+        lambda line: line.split(":")[0] + ": *nowhere" if ":" in line else "*nowhere",
+    ),
     ("anchor only", lambda line: line + " &"),
     ("complex key", lambda line: "? [a, b]\n: 1\n" + line),
     ("control character", lambda line: line + " \x07"),
@@ -463,8 +580,9 @@ def mutate_alias(rng, data):
     if how == 0:
         levels = int(_pick(rng, [3, 5, 7, 8, 9]))
         header, alias = alias_bomb(levels)
-        return f"alias bomb ({levels} levels) at {dotted(path)}", with_raw(data, path, alias,
-                                                                           header)
+        return f"alias bomb ({levels} levels) at {dotted(path)}", with_raw(
+            data, path, alias, header
+        )
     if how == 1:
         return f"self-referencing list at {dotted(path)}", with_raw(data, path, "&r [*r]")
     if how == 2:
@@ -483,7 +601,8 @@ def mutate_alias(rng, data):
         target = _pick(rng, maps)
         header = f"_defaults: &d {flow(get_at(data, target))}\n"
         return f"merge key (with unknown _defaults) at {dotted(target)}", with_raw(
-            data, target, "{<<: *d}", header)
+            data, target, "{<<: *d}", header
+        )
     # a merge inside the document that keeps it valid: the first corner merged into the second
     corners = data.get("vehicle", {}).get("corners")
     if isinstance(corners, dict) and len(corners) >= 2:
@@ -492,8 +611,11 @@ def mutate_alias(rng, data):
         merged = copy.deepcopy(data)
         merged["vehicle"]["corners"][first] = RAW.format(1)
         merged["vehicle"]["corners"][second] = RAW.format(2)
-        text = dump(merged).replace(RAW.format(1), "&c0 " + flow(corners[first])).replace(
-            RAW.format(2), "{<<: *c0" + (", " + flow(rest)[1:-1] if rest else "") + "}")
+        text = (
+            dump(merged)
+            .replace(RAW.format(1), "&c0 " + flow(corners[first]))
+            .replace(RAW.format(2), "{<<: *c0" + (", " + flow(rest)[1:-1] if rest else "") + "}")
+        )
         return f"corner {second} merges corner {first}'s tyre", text
     return f"undefined alias at {dotted(path)}", with_raw(data, path, "*nowhere")
 
@@ -502,12 +624,15 @@ def mutate_nesting(rng, data):
     path = _any_path(rng, data)
     style = _pick(rng, ["[", "[unclosed", "{", "block"])
     depth = int(_pick(rng, [50, 500, 990, 1100, 5000, 20_000]))
-    if style == "block":                  # block maps need a top-level key's indentation
+    if style == "block":  # block maps need a top-level key's indentation
         depth, path = min(depth, 1100), path[:1]
-        return f"{depth} nested block maps at {dotted(path)}", with_raw(data, path,
-                                                                       block_nesting(depth))
-    return (f"{depth} nested {style} at {dotted(path)}",
-            with_raw(data, path, deep_nesting(depth, style)))
+        return f"{depth} nested block maps at {dotted(path)}", with_raw(
+            data, path, block_nesting(depth)
+        )
+    return (
+        f"{depth} nested {style} at {dotted(path)}",
+        with_raw(data, path, deep_nesting(depth, style)),
+    )
 
 
 def mutate_duplicate(rng, data):
@@ -523,7 +648,8 @@ def mutate_duplicate(rng, data):
     body = flow(value)[1:-1]
     raw = "{" + body + f", {flow(key)}: {flow(extreme)}" + "}"
     return f"duplicate key {dotted(target + (key,))} = {short(extreme)}", with_raw(
-        data, target, raw)
+        data, target, raw
+    )
 
 
 def mutate_bytes(rng, data):
@@ -549,11 +675,24 @@ def mutate_bytes(rng, data):
     return "random bytes after the text", text + rng.bytes(64)
 
 
-DATA_MUTATIONS = [(mutate_delete, 3), (mutate_type, 3), (mutate_number, 4), (mutate_size, 4),
-                  (mutate_enum, 2), (mutate_key, 2), (mutate_list, 1), (mutate_section, 1),
-                  (mutate_combo, 2)]
-TEXT_MUTATIONS = [(mutate_syntax, 2), (mutate_alias, 2), (mutate_nesting, 1),
-                  (mutate_duplicate, 1), (mutate_bytes, 1)]
+DATA_MUTATIONS = [
+    (mutate_delete, 3),
+    (mutate_type, 3),
+    (mutate_number, 4),
+    (mutate_size, 4),
+    (mutate_enum, 2),
+    (mutate_key, 2),
+    (mutate_list, 1),
+    (mutate_section, 1),
+    (mutate_combo, 2),
+]
+TEXT_MUTATIONS = [
+    (mutate_syntax, 2),
+    (mutate_alias, 2),
+    (mutate_nesting, 1),
+    (mutate_duplicate, 1),
+    (mutate_bytes, 1),
+]
 
 
 def _choose(rng, table):
@@ -581,14 +720,20 @@ def mutated_case(i: int, seed: int = SEED, configs: list[Path] | None = None) ->
     else:
         setup = {"kind": "text", "text": out}
     kind = op.__name__.removeprefix("mutate_")
-    return Case(id=_case_id(f"{i:04d}", source, f"{kind}:{label}"), family="config",
-                label=f"{kind}: {label}", setup=setup, runs=CONFIG_RUNS, source=source,
-                name=_file_name(source))
+    return Case(
+        id=_case_id(f"{i:04d}", source, f"{kind}:{label}"),
+        family="config",
+        label=f"{kind}: {label}",
+        setup=setup,
+        runs=CONFIG_RUNS,
+        source=source,
+        name=_file_name(source),
+    )
 
 
 def _case_id(*parts: str) -> str:
     text = "-".join(parts)
-    text = re.sub(r"[^A-Za-z0-9_.:+\[\]-]+", "_", text)      # what pytest -k can match
+    text = re.sub(r"[^A-Za-z0-9_.:+\[\]-]+", "_", text)  # what pytest -k can match
     return text[:110]
 
 
@@ -597,9 +742,17 @@ def seed_cases(configs: list[Path] | None = None) -> list[Case]:
     out = []
     for path in configs or bundled_configs():
         source = rel_name(path)
-        out.append(Case(id=_case_id("seed", source), family="config", label="seed",
-                        setup={"kind": "text", "text": dump(seed_data(path))}, runs=CONFIG_RUNS,
-                        source=source, name=_file_name(source)))
+        out.append(
+            Case(
+                id=_case_id("seed", source),
+                family="config",
+                label="seed",
+                setup={"kind": "text", "text": dump(seed_data(path))},
+                runs=CONFIG_RUNS,
+                source=source,
+                name=_file_name(source),
+            )
+        )
     return out
 
 
@@ -625,13 +778,21 @@ def special_cases() -> list[Case]:
 
     cases.append(("config is a directory", {"kind": "dir"}, "quickstart"))
     cases.append(("config is a FIFO (nobody writes)", {"kind": "fifo"}, "quickstart"))
-    cases.append(("config is a symlink to /dev/zero", {"kind": "symlink",
-                                                       "target": "/dev/zero"}, "quickstart"))
-    cases.append(("config is a symlink loop", {"kind": "symlink", "target": "self"},
-                  "quickstart"))
-    cases.append(("config is a dangling symlink", {"kind": "symlink",
-                                                   "target": "/nonexistent/x.yaml"},
-                  "quickstart"))
+    cases.append(
+        (
+            "config is a symlink to /dev/zero",
+            {"kind": "symlink", "target": "/dev/zero"},
+            "quickstart",
+        )
+    )
+    cases.append(("config is a symlink loop", {"kind": "symlink", "target": "self"}, "quickstart"))
+    cases.append(
+        (
+            "config is a dangling symlink",
+            {"kind": "symlink", "target": "/nonexistent/x.yaml"},
+            "quickstart",
+        )
+    )
     cases.append(("config does not exist", {"kind": "missing"}, "quickstart"))
     text("empty file", "")
     text("only a comment", "# nothing\n")
@@ -640,13 +801,17 @@ def special_cases() -> list[Case]:
     text("a number", "42\n")
     text("a string", "hello\n")
     header, alias = alias_bomb(9)
-    text("alias bomb, 9 levels, at vehicle.body.mass", with_raw(base, ("vehicle", "body", "mass"),
-                                                               alias, header))
+    text(
+        "alias bomb, 9 levels, at vehicle.body.mass",
+        with_raw(base, ("vehicle", "body", "mass"), alias, header),
+    )
     text("alias bomb, 9 levels, as metrics", header + good + f"metrics: {alias}\n")
     text("alias bomb, 9 levels, unused (unknown top-level keys)", header + good)
     text("self-referencing anchor: metrics: &m [*m]", good + "metrics: &m [*m]\n")
-    text("self-referencing anchor: vehicle.body: &b {mass: *b}",
-         with_raw(base, ("vehicle", "body"), "&b {mass: *b}"))
+    text(
+        "self-referencing anchor: vehicle.body: &b {mass: *b}",
+        with_raw(base, ("vehicle", "body"), "&b {mass: *b}"),
+    )
     text("merge key merging itself", with_raw(base, ("vehicle", "body"), "&b {<<: *b}"))
     text("merge key of a scalar", with_raw(base, ("vehicle", "body"), "{<<: 5, mass: 2210}"))
     corners = base["vehicle"]["corners"]
@@ -654,21 +819,36 @@ def special_cases() -> list[Case]:
     merged["vehicle"]["corners"]["F1"] = RAW.format(1)
     merged["vehicle"]["corners"]["R1"] = RAW.format(2)
     rear = {k: v for k, v in corners["R1"].items() if k != "tyre"}
-    text("merge key: R1 merges F1's tyre (valid)",
-         dump(merged).replace(RAW.format(1), "&f1 " + flow(corners["F1"])).replace(
-             RAW.format(2), "{<<: *f1, " + flow(rear)[1:]))
-    text("5000 [ at simulation.duration (closed)",
-         with_raw(base, ("simulation", "duration"), deep_nesting(5000)))
-    text("5000 [ at simulation.duration (unclosed)",
-         with_raw(base, ("simulation", "duration"), deep_nesting(5000, "[unclosed")))
+    text(
+        "merge key: R1 merges F1's tyre (valid)",
+        dump(merged)
+        .replace(RAW.format(1), "&f1 " + flow(corners["F1"]))
+        .replace(RAW.format(2), "{<<: *f1, " + flow(rear)[1:]),
+    )
+    text(
+        "5000 [ at simulation.duration (closed)",
+        with_raw(base, ("simulation", "duration"), deep_nesting(5000)),
+    )
+    text(
+        "5000 [ at simulation.duration (unclosed)",
+        with_raw(base, ("simulation", "duration"), deep_nesting(5000, "[unclosed")),
+    )
     text("5000 { at vehicle.body", with_raw(base, ("vehicle", "body"), deep_nesting(5000, "{")))
     text("1100 nested block maps at road", with_raw(base, ("road",), block_nesting(1100)))
-    text("duplicate top-level key simulation (second: duration .inf)",
-         good + "simulation: {duration: .inf, dt: 1.0e-3}\n")
-    text("duplicate key simulation.duration (.inf last)",
-         with_raw(base, ("simulation",), "{duration: 0.3, dt: 1.0e-3, duration: .inf}"))
-    text("duplicate key vehicle.body.mass (equal)", with_raw(
-        base, ("vehicle", "body"), "{" + flow(base["vehicle"]["body"])[1:-1] + ", mass: 2210}"))
+    text(
+        "duplicate top-level key simulation (second: duration .inf)",
+        good + "simulation: {duration: .inf, dt: 1.0e-3}\n",
+    )
+    text(
+        "duplicate key simulation.duration (.inf last)",
+        with_raw(base, ("simulation",), "{duration: 0.3, dt: 1.0e-3, duration: .inf}"),
+    )
+    text(
+        "duplicate key vehicle.body.mass (equal)",
+        with_raw(
+            base, ("vehicle", "body"), "{" + flow(base["vehicle"]["body"])[1:-1] + ", mass: 2210}"
+        ),
+    )
     lines = good.splitlines()
     text("unclosed bracket", sub(good, "body:", "body: ["))
     text("bad indentation", "\n".join(lines[:3] + [" " + lines[3]] + lines[4:]) + "\n")
@@ -681,42 +861,62 @@ def special_cases() -> list[Case]:
     raw("NUL bytes", good.encode().replace(b"\n", b"\n\x00", 3))
     text("enum typo road.kind", sub(good, "bump_half_sine", "bump_half_sin"))
     text("enum typo vehicle.preset", sub(good, "half_pitch", "Half_pitch"))
-    for key, values in (("duration", [".inf", ".nan", "1e308", "1.0e+12", "2e6",
-                                      str(2 ** 70)]),
-                        ("dt", ["1.0e-300", "5.0e-324"])):
+    for key, values in (
+        ("duration", [".inf", ".nan", "1e308", "1.0e+12", "2e6", str(2**70)]),
+        ("dt", ["1.0e-300", "5.0e-324"]),
+    ):
         for v in values:
-            text(f"simulation.{key} = {v}", sub(
-                good, f"  {key}: {base['simulation'][key]}\n", f"  {key}: {v}\n"))
+            text(
+                f"simulation.{key} = {v}",
+                sub(good, f"  {key}: {base['simulation'][key]}\n", f"  {key}: {v}\n"),
+            )
     seat_text = dump(seat)
-    for v in ["1000000000000", "1.0e+9", str(2 ** 70), "100000000"]:
-        text(f"road.n_waves = {v}", sub(seat_text, "  seed: 1\n", f"  seed: 1\n  n_waves: {v}\n"),
-             "ch8/ps_class_a")
+    for v in ["1000000000000", "1.0e+9", str(2**70), "100000000"]:
+        text(
+            f"road.n_waves = {v}",
+            sub(seat_text, "  seed: 1\n", f"  seed: 1\n  n_waves: {v}\n"),
+            "ch8/ps_class_a",
+        )
     for v in ["1.0e+12", ".inf"]:
-        text(f"road.n_max = {v}", sub(seat_text, "  seed: 1\n", f"  seed: 1\n  n_max: {v}\n"),
-             "ch8/ps_class_a")
+        text(
+            f"road.n_max = {v}",
+            sub(seat_text, "  seed: 1\n", f"  seed: 1\n  n_max: {v}\n"),
+            "ch8/ps_class_a",
+        )
     opt = seed_data(CONFIGS / "ch8" / "pareto_ps_class_a.yaml")
-    for v in [10 ** 12, 10 ** 9, 2 ** 70]:
+    for v in [10**12, 10**9, 2**70]:
         o = copy.deepcopy(opt)
         o["optimiser"]["population"] = v
         text(f"optimiser.population = {v}", dump(o), "ch8/pareto_ps_class_a")
-    for label, mass in (("vehicle.body.mass = .inf", math.inf), ("vehicle.body.mass = 1e308",
-                                                                  1e308)):
+    for label, mass in (
+        ("vehicle.body.mass = .inf", math.inf),
+        ("vehicle.body.mass = 1e308", 1e308),
+    ):
         b = copy.deepcopy(base)
         b["vehicle"]["body"]["mass"] = mass
         text(label, dump(b))
     out = []
     for n, (label, setup, source) in enumerate(cases):
-        out.append(Case(id=_case_id("special", f"{n:02d}", label), family="config",
-                        label=label, setup=setup, runs=CONFIG_RUNS, source=source,
-                        name=_file_name(source)))
+        out.append(
+            Case(
+                id=_case_id("special", f"{n:02d}", label),
+                family="config",
+                label=label,
+                setup=setup,
+                runs=CONFIG_RUNS,
+                source=source,
+                name=_file_name(source),
+            )
+        )
     return out
 
 
 def config_cases(n: int, seed: int = SEED) -> list[Case]:
     """CI's config cases: the seeds, the special inputs and ``n`` random mutations."""
     configs = bundled_configs()
-    return seed_cases(configs) + special_cases() + [mutated_case(i, seed, configs)
-                                                   for i in range(n)]
+    return (
+        seed_cases(configs) + special_cases() + [mutated_case(i, seed, configs) for i in range(n)]
+    )
 
 
 def case_count(default: int) -> int:
@@ -727,52 +927,62 @@ def case_count(default: int) -> int:
 
 # --- Pareto files ----------------------------------------------------------------------------
 
-H5_RUNS = [["kesort", "{path}", "-o", "{out}"],
-           ["analyse", "roads", "{path}", "--road", "B", "-o", "{out}"],
-           ["analyse", "masses", "{path}", "-o", "{out}"],
-           ["analyse", "transmissibility", "{path}", "-o", "{out}"],
-           ["simulate", "{path}", "--pick", "knee,0", "-o", "{out}"],
-           ["export", "{path}", "--pick", "knee", "-o", "{out}.yaml"],
-           ["export", "{path}", "--csv", "{out}.csv"]]
+H5_RUNS = [
+    ["kesort", "{path}", "-o", "{out}"],
+    ["analyse", "roads", "{path}", "--road", "B", "-o", "{out}"],
+    ["analyse", "masses", "{path}", "-o", "{out}"],
+    ["analyse", "transmissibility", "{path}", "-o", "{out}"],
+    ["simulate", "{path}", "--pick", "knee,0", "-o", "{out}"],
+    ["export", "{path}", "--pick", "knee", "-o", "{out}.yaml"],
+    ["export", "{path}", "--csv", "{out}.csv"],
+]
 #: the bundled config of the tiny front, and its run length [s]
 FRONT = "ch8/pareto_ps_class_a"
 FRONT_DURATION = 0.3
-HUGE_ROWS = 10 ** 12
+HUGE_ROWS = 10**12
 
 
 def make_front(folder: Path) -> tuple[Path, Path]:
     """A real tiny Pareto file (``tests/conftest.py: optimised_front``)."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from conftest import optimised_front
+
     return optimised_front(folder, FRONT, FRONT_DURATION)
 
 
 def _copy_edit(edit):
     """A variant that copies the good file and edits it with h5py (``edit(h5)``)."""
+
     def build(good: Path, dst: Path) -> None:
         import shutil
 
         import h5py
+
         shutil.copyfile(good, dst)
         with h5py.File(dst, "r+") as h5:
             edit(h5)
+
     return build
 
 
 def _bytes_of(transform):
     """A variant whose bytes are ``transform(bytes of the good file)``."""
+
     def build(good: Path, dst: Path) -> None:
         dst.write_bytes(transform(good.read_bytes()))
+
     return build
 
 
 def _replace(key: str, make):
     """``/pareto/<key>`` replaced by ``make(h5, old values, old attrs)``, which creates it."""
+
     def edit(h5):
         ds = h5[f"pareto/{key}"]
         values, attrs = ds[()], dict(ds.attrs)
         del h5[f"pareto/{key}"]
         make(h5, f"pareto/{key}", values, attrs)
+
     return _copy_edit(edit)
 
 
@@ -782,12 +992,18 @@ def _data(fn, keep_attrs: bool = True):
         if keep_attrs:
             for k, v in attrs.items():
                 ds.attrs[k] = v
+
     return make
 
 
 def _huge(h5, name, values, attrs):
-    ds = h5.create_dataset(name, shape=(HUGE_ROWS, values.shape[1]), dtype="f8",
-                           chunks=(1024, values.shape[1]), maxshape=(None, values.shape[1]))
+    ds = h5.create_dataset(
+        name,
+        shape=(HUGE_ROWS, values.shape[1]),
+        dtype="f8",
+        chunks=(1024, values.shape[1]),
+        maxshape=(None, values.shape[1]),
+    )
     for k, v in attrs.items():
         ds.attrs[k] = v
 
@@ -799,6 +1015,7 @@ def _attr(key: str, attr: str, value):
             del ds.attrs[attr]
         else:
             ds.attrs[attr] = value(ds) if callable(value) else value
+
     return _copy_edit(edit)
 
 
@@ -811,13 +1028,15 @@ def _root_config(value):
             del h5.attrs["config"]
         else:
             h5.attrs["config"] = value(h5.attrs["config"]) if callable(value) else value
+
     return _copy_edit(edit)
 
 
 def _names(ds, n_more=0):
     names = [n.encode() if isinstance(n, str) else bytes(n) for n in ds.attrs["names"]]
-    return np.array(names[:len(names) + n_more] if n_more < 0 else names + [b"extra"] * n_more,
-                    dtype="S")
+    return np.array(
+        names[: len(names) + n_more] if n_more < 0 else names + [b"extra"] * n_more, dtype="S"
+    )
 
 
 def _config_of(rel: str) -> str:
@@ -830,12 +1049,14 @@ def _edit_config(edit):
         data = yaml.safe_load(text)
         edit(data)
         return dump(data)
+
     return change
 
 
 def _set_config(path, value):
     def edit(data):
         set_at(data, path, value)
+
     return _edit_config(edit)
 
 
@@ -847,6 +1068,7 @@ def _special_file(kind: str):
             os.mkfifo(dst)
         elif kind == "zero":
             os.symlink("/dev/zero", dst)
+
     return build
 
 
@@ -857,33 +1079,55 @@ def h5_variants() -> list[tuple[str, object, str | None]]:
     out: list[tuple[str, object, str | None]] = [
         ("intact", _bytes_of(lambda b: b), None),
         ("empty_file", _bytes_of(lambda b: b""), None),
-        ("truncated_half", _bytes_of(lambda b: b[:len(b) // 2]), None),
+        ("truncated_half", _bytes_of(lambda b: b[: len(b) // 2]), None),
         ("truncated_2048_bytes", _bytes_of(lambda b: b[:2048]), None),
         ("truncated_last_byte", _bytes_of(lambda b: b[:-1]), None),
         ("random_4KB", _bytes_of(lambda b: np.random.default_rng([SEED, 2]).bytes(4096)), None),
-        ("hdf5_signature_then_random", _bytes_of(
-            lambda b: b[:8] + np.random.default_rng([SEED, 3]).bytes(len(b) - 8)), None),
+        (
+            "hdf5_signature_then_random",
+            _bytes_of(lambda b: b[:8] + np.random.default_rng([SEED, 3]).bytes(len(b) - 8)),
+            None,
+        ),
         ("text_file", _bytes_of(lambda b: b"vehicle: {}\n"), None),
         ("directory", _special_file("dir"), None),
         ("fifo", _special_file("fifo"), None),
         ("symlink_dev_zero", _special_file("zero"), None),
         ("no_pareto_group", _copy_edit(lambda h5: h5.__delitem__("pareto")), "/pareto"),
-        ("pareto_empty_group", _copy_edit(lambda h5: [h5["pareto"].__delitem__(k) for k in
-                                                      list(h5["pareto"])]), "/pareto"),
-        ("pareto_is_a_dataset", _copy_edit(lambda h5: (h5.__delitem__("pareto"),
-                                                       h5.create_dataset("pareto", data=1.0))),
-         "/pareto"),
+        (
+            "pareto_empty_group",
+            _copy_edit(lambda h5: [h5["pareto"].__delitem__(k) for k in list(h5["pareto"])]),
+            "/pareto",
+        ),
+        (
+            "pareto_is_a_dataset",
+            _copy_edit(
+                lambda h5: (h5.__delitem__("pareto"), h5.create_dataset("pareto", data=1.0))
+            ),
+            "/pareto",
+        ),
     ]
     for key in ("X", "F", "G"):
         ds = f"/pareto/{key}"
         out += [
             (f"{key}_deleted", _copy_edit(lambda h5, k=key: h5["pareto"].__delitem__(k)), ds),
             (f"{key}_text_scalar", _replace(key, _data(lambda v: "abc")), ds),
-            (f"{key}_text_array", _replace(key, _data(
-                lambda v: np.full(v.shape, b"abc", dtype="S3"))), ds),
-            (f"{key}_vlen_text", _replace(key, _data(
-                lambda v: np.array([["x"] * v.shape[1]] * v.shape[0], dtype=object)
-                .astype("O"))), ds),
+            (
+                f"{key}_text_array",
+                _replace(key, _data(lambda v: np.full(v.shape, b"abc", dtype="S3"))),
+                ds,
+            ),
+            (
+                f"{key}_vlen_text",
+                _replace(
+                    key,
+                    _data(
+                        lambda v: np.array([["x"] * v.shape[1]] * v.shape[0], dtype=object).astype(
+                            "O"
+                        )
+                    ),
+                ),
+                ds,
+            ),
             (f"{key}_1d", _replace(key, _data(lambda v: v[:, 0])), ds),
             (f"{key}_3d", _replace(key, _data(lambda v: v[:, :, None])), ds),
             (f"{key}_zero_rows", _replace(key, _data(lambda v: v[:0])), ds),
@@ -892,81 +1136,168 @@ def h5_variants() -> list[tuple[str, object, str | None]]:
             (f"{key}_scalar", _replace(key, _data(lambda v: 1.0)), ds),
             (f"{key}_nan", _replace(key, _data(lambda v: np.full(v.shape, np.nan))), ds),
             (f"{key}_inf", _replace(key, _data(lambda v: np.full(v.shape, np.inf))), ds),
-            (f"{key}_minus_inf", _replace(key, _data(lambda v: np.full(v.shape, -np.inf))),
-             ds),
-            (f"{key}_one_row_nan", _replace(key, _data(
-                lambda v: np.vstack([np.full(v.shape[1], np.nan), v[1:]]))), ds),
+            (f"{key}_minus_inf", _replace(key, _data(lambda v: np.full(v.shape, -np.inf))), ds),
+            (
+                f"{key}_one_row_nan",
+                _replace(key, _data(lambda v: np.vstack([np.full(v.shape[1], np.nan), v[1:]]))),
+                ds,
+            ),
             (f"{key}_1e308", _replace(key, _data(lambda v: np.full(v.shape, 1e308))), ds),
             (f"{key}_negative", _replace(key, _data(lambda v: -np.abs(v) - 1.0)), ds),
             (f"{key}_int", _replace(key, _data(lambda v: v.astype(np.int64))), ds),
             (f"{key}_bool", _replace(key, _data(lambda v: v > np.median(v))), ds),
             (f"{key}_complex", _replace(key, _data(lambda v: v + 1j)), ds),
-            (f"{key}_compound", _replace(key, _data(lambda v: np.zeros(
-                v.shape[0], dtype=[("a", "f8"), ("b", "S3")]))), ds),
+            (
+                f"{key}_compound",
+                _replace(
+                    key, _data(lambda v: np.zeros(v.shape[0], dtype=[("a", "f8"), ("b", "S3")]))
+                ),
+                ds,
+            ),
             (f"{key}_a_group", _replace(key, lambda h5, name, v, a: h5.create_group(name)), ds),
             (f"{key}_huge_declared_shape", _replace(key, _huge), ds),
             (f"{key}_names_missing", _attr(key, "names", _DELETE), ds),
             (f"{key}_units_missing", _attr(key, "units", _DELETE), ds),
             (f"{key}_names_one_more", _attr(key, "names", lambda d: _names(d, 1)), ds),
-            (f"{key}_units_one_fewer", _attr(key, "units", lambda d: np.array(
-                list(d.attrs["units"])[:-1], dtype="S")), ds),
+            (
+                f"{key}_units_one_fewer",
+                _attr(key, "units", lambda d: np.array(list(d.attrs["units"])[:-1], dtype="S")),
+                ds,
+            ),
             (f"{key}_names_empty", _attr(key, "names", np.array([], dtype="S1")), ds),
-            (f"{key}_names_ints", _attr(key, "names", lambda d: np.arange(
-                len(d.attrs["names"]))), ds),
+            (
+                f"{key}_names_ints",
+                _attr(key, "names", lambda d: np.arange(len(d.attrs["names"]))),
+                ds,
+            ),
             (f"{key}_names_scalar_string", _attr(key, "names", "RC_se"), ds),
-            (f"{key}_names_not_utf8", _attr(key, "names", lambda d: np.array(
-                [b"\xff\xfe"] * len(d.attrs["names"]), dtype="S2")), ds),
-            (f"{key}_names_2d", _attr(key, "names", lambda d: np.array(
-                [list(d.attrs["names"])], dtype="S")), ds),
+            (
+                f"{key}_names_not_utf8",
+                _attr(
+                    key,
+                    "names",
+                    lambda d: np.array([b"\xff\xfe"] * len(d.attrs["names"]), dtype="S2"),
+                ),
+                ds,
+            ),
+            (
+                f"{key}_names_2d",
+                _attr(key, "names", lambda d: np.array([list(d.attrs["names"])], dtype="S")),
+                ds,
+            ),
         ]
     # values of the right type whose content is odd but possible (failed or infeasible
     # designs): the commands may reject them, without a dataset being at fault
-    plausible = {"F_nan", "F_inf", "F_minus_inf", "F_one_row_nan", "F_1e308", "F_negative",
-                 "F_int", "F_bool", "G_nan", "G_inf", "G_minus_inf", "G_one_row_nan", "G_1e308",
-                 "G_negative", "G_int", "G_bool", "X_1e308", "X_negative", "X_int", "X_bool"}
+    plausible = {
+        "F_nan",
+        "F_inf",
+        "F_minus_inf",
+        "F_one_row_nan",
+        "F_1e308",
+        "F_negative",
+        "F_int",
+        "F_bool",
+        "G_nan",
+        "G_inf",
+        "G_minus_inf",
+        "G_one_row_nan",
+        "G_1e308",
+        "G_negative",
+        "G_int",
+        "G_bool",
+        "X_1e308",
+        "X_negative",
+        "X_int",
+        "X_bool",
+    }
     out = [(name, build, None if name in plausible else ds) for name, build, ds in out]
     out += [
         ("X_names_not_in_config", _attr("X", "names", np.array([b"foo", b"bar"])), "/pareto/X"),
-        ("X_names_duplicated", _attr("X", "names", lambda d: np.array(
-            [d.attrs["names"][0]] * len(d.attrs["names"]), dtype="S")), "/pareto/X"),
-        ("X_names_swapped", _attr("X", "names", lambda d: np.array(
-            list(d.attrs["names"])[::-1], dtype="S")), None),
+        (
+            "X_names_duplicated",
+            _attr(
+                "X",
+                "names",
+                lambda d: np.array([d.attrs["names"][0]] * len(d.attrs["names"]), dtype="S"),
+            ),
+            "/pareto/X",
+        ),
+        (
+            "X_names_swapped",
+            _attr("X", "names", lambda d: np.array(list(d.attrs["names"])[::-1], dtype="S")),
+            None,
+        ),
         ("F_names_not_in_config", _attr("F", "names", np.array([b"a", b"b"])), "/pareto/F"),
         ("X_outside_bounds", _replace("X", _data(lambda v: v * 1e6)), None),
         ("X_zero", _replace("X", _data(lambda v: np.zeros_like(v))), None),
         ("config_missing", _root_config(_DELETE), "config"),
         ("config_not_utf8", _root_config(np.bytes_(b"vehicle: \xff\xfe\n")), "config"),
         ("config_yaml_error", _root_config("vehicle: [\n"), "config"),
-        ("config_alias_bomb", _root_config(lambda t: header + str(t) + f"metrics: {alias}\n"),
-         "config"),
-        ("config_self_reference", _root_config(lambda t: str(t) + "metrics: &m [*m]\n"),
-         "config"),
-        ("config_deep_nesting", _root_config(lambda t: str(t).replace(
-            "road:", "zz: " + "[" * 5000 + "]" * 5000 + "\nroad:", 1)), "config"),
+        (
+            "config_alias_bomb",
+            _root_config(lambda t: header + str(t) + f"metrics: {alias}\n"),
+            "config",
+        ),
+        ("config_self_reference", _root_config(lambda t: str(t) + "metrics: &m [*m]\n"), "config"),
+        (
+            "config_deep_nesting",
+            _root_config(
+                lambda t: str(t).replace("road:", "zz: " + "[" * 5000 + "]" * 5000 + "\nroad:", 1)
+            ),
+            "config",
+        ),
         ("config_empty", _root_config(""), "config"),
         ("config_an_int", _root_config(42), "config"),
         ("config_a_list", _root_config(np.array([b"vehicle:", b"road:"])), "config"),
-        ("config_other_without_design_variables", _root_config(_config_of("quickstart")),
-         "config"),
+        ("config_other_without_design_variables", _root_config(_config_of("quickstart")), "config"),
         ("config_other_seat", _root_config(_config_of("ch8/pareto_nss1_class_a")), "config"),
-        ("config_other_objectives", _root_config(_edit_config(lambda d: d["objectives"][
-            "main"].reverse())), "config"),
-        ("config_supplementary_objective", _root_config(_edit_config(
-            lambda d: d["objectives"].setdefault("supplementary", []).append(
-                {"name": "travel", "metric": "max_abs", "signal": "seat.travel"}))), None),
-        ("config_bump_road", _root_config(_set_config(("road",), {
-            "kind": "bump_step", "height": 0.05, "length": 1.0, "speed": 10.0,
-            "start": 0.1})), "config"),
-        ("config_body_mass_inf", _root_config(_set_config(("vehicle", "body", "mass"),
-                                                          math.inf)), "config"),
-        ("config_seat_mass_1e308", _root_config(_set_config(("seat", "mass"), 1e308)),
-         "config"),
-        ("config_duration_1e12", _root_config(_set_config(("simulation", "duration"), 1e12)),
-         "config"),
-        ("config_dt_1e-300", _root_config(_set_config(("simulation", "dt"), 1e-300)),
-         "config"),
-        ("config_n_waves_1e12", _root_config(_set_config(("road", "n_waves"), 10 ** 12)),
-         "config"),
+        (
+            "config_other_objectives",
+            _root_config(_edit_config(lambda d: d["objectives"]["main"].reverse())),
+            "config",
+        ),
+        (
+            "config_supplementary_objective",
+            _root_config(
+                _edit_config(
+                    lambda d: (
+                        d["objectives"]
+                        .setdefault("supplementary", [])
+                        .append({"name": "travel", "metric": "max_abs", "signal": "seat.travel"})
+                    )
+                )
+            ),
+            None,
+        ),
+        (
+            "config_bump_road",
+            _root_config(
+                _set_config(
+                    ("road",),
+                    {
+                        "kind": "bump_step",
+                        "height": 0.05,
+                        "length": 1.0,
+                        "speed": 10.0,
+                        "start": 0.1,
+                    },
+                )
+            ),
+            "config",
+        ),
+        (
+            "config_body_mass_inf",
+            _root_config(_set_config(("vehicle", "body", "mass"), math.inf)),
+            "config",
+        ),
+        ("config_seat_mass_1e308", _root_config(_set_config(("seat", "mass"), 1e308)), "config"),
+        (
+            "config_duration_1e12",
+            _root_config(_set_config(("simulation", "duration"), 1e12)),
+            "config",
+        ),
+        ("config_dt_1e-300", _root_config(_set_config(("simulation", "dt"), 1e-300)), "config"),
+        ("config_n_waves_1e12", _root_config(_set_config(("road", "n_waves"), 10**12)), "config"),
         ("config_no_seat", _root_config(_edit_config(lambda d: d.pop("seat"))), "config"),
     ]
     return out
@@ -977,10 +1308,13 @@ def normalised_front(good: Path, dst: Path) -> Path:
     new file, with ``created`` and ``command`` fixed: the same bytes in every run (the
     optimiser is reproducible), so that random byte flips are reproducible too."""
     import h5py
+
     with h5py.File(good, "r") as src, h5py.File(dst, "w") as out:
         for key, value in src.attrs.items():
-            out.attrs[key] = {"created": "2000-01-01T00:00:00+00:00",
-                              "command": f"suspopt optimise {FRONT}"}.get(key, value)
+            out.attrs[key] = {
+                "created": "2000-01-01T00:00:00+00:00",
+                "command": f"suspopt optimise {FRONT}",
+            }.get(key, value)
         src.copy("pareto", out)
     return dst
 
@@ -993,6 +1327,7 @@ def h5_random_variants(n: int, seed: int = SEED) -> list[tuple[str, object, str 
     overwritten at random offsets."""
     out = []
     for i in range(n):
+
         def flip(b, i=i):
             rng = np.random.default_rng([seed, 10_000 + i])
             b = bytearray(b)
@@ -1000,14 +1335,25 @@ def h5_random_variants(n: int, seed: int = SEED) -> list[tuple[str, object, str 
                 at = int(rng.integers(len(b)))
                 b[at] = int(rng.integers(256))
             return bytes(b)
+
         out.append((f"{RANDOM_PREFIX}{i:04d}", _bytes_of(flip), None))
     return out
 
 
 def h5_cases(variants) -> list[Case]:
-    return [Case(id=_case_id("h5", name), family="h5", label=name,
-                 setup={"kind": "h5", "variant": name}, runs=H5_RUNS, source=FRONT,
-                 name=f"{name}.h5", dataset=dataset) for name, _, dataset in variants]
+    return [
+        Case(
+            id=_case_id("h5", name),
+            family="h5",
+            label=name,
+            setup={"kind": "h5", "variant": name},
+            runs=H5_RUNS,
+            source=FRONT,
+            name=f"{name}.h5",
+            dataset=dataset,
+        )
+        for name, _, dataset in variants
+    ]
 
 
 def build_h5_cases(cases: list[Case], variants, folder: Path) -> list[Case]:
@@ -1029,6 +1375,7 @@ def build_h5_cases(cases: list[Case], variants, folder: Path) -> list[Case]:
 
 # --- judging -------------------------------------------------------------------------------
 
+
 def stderr_lines(text: str) -> list[str]:
     return [line for line in text.splitlines() if line.strip()]
 
@@ -1048,18 +1395,33 @@ def problems(case: Case, result: dict) -> list[dict]:
     found = []
     if "fatal" in result:
         running = result.get("detail", "").split(" | ")[0]
-        return [{"category": result["fatal"], "command": f"(worker) {running}", "exc": "",
-                 "where": "", "message": result.get("detail", ""),
-                 "seconds": result.get("seconds", 0.0)}]
+        return [
+            {
+                "category": result["fatal"],
+                "command": f"(worker) {running}",
+                "exc": "",
+                "where": "",
+                "message": result.get("detail", ""),
+                "seconds": result.get("seconds", 0.0),
+            }
+        ]
     for run in result["runs"]:
         cmd = run["command"]
         if run.get("skipped"):
             continue
 
-        def add(category, **more):
-            found.append({"category": category, "command": cmd, "exc": run.get("exc", ""),
-                          "where": run.get("where", ""), "message": run.get("exc_msg", ""),
-                          "seconds": run["seconds"], **more})
+        def add(category, cmd=cmd, run=run, **more):
+            found.append(
+                {
+                    "category": category,
+                    "command": cmd,
+                    "exc": run.get("exc", ""),
+                    "where": run.get("where", ""),
+                    "message": run.get("exc_msg", ""),
+                    "seconds": run["seconds"],
+                    **more,
+                }
+            )
 
         if run["timeout"]:
             add("time-out")
@@ -1072,8 +1434,9 @@ def problems(case: Case, result: dict) -> list[dict]:
             add("traceback in the output")
         if code == 2:
             if run["stderr_lines"] != 1:
-                add(f"exit 2 with {run['stderr_lines']} lines on stderr",
-                    stderr=run["stderr"][:600])
+                add(
+                    f"exit 2 with {run['stderr_lines']} lines on stderr", stderr=run["stderr"][:600]
+                )
                 continue
             line = stderr_lines(run["stderr"])[0]
             if case.name not in line:
@@ -1082,17 +1445,36 @@ def problems(case: Case, result: dict) -> list[dict]:
                 add(f"message does not name {case.dataset}", stderr=line[:300])
     runs = {r["command"]: r for r in result["runs"]}
     v, s = runs.get("validate"), runs.get("simulate")
-    if v and s and not v["timeout"] and v["exit"] == 0 and not s["timeout"] \
-            and not s.get("skipped"):
+    if (
+        v
+        and s
+        and not v["timeout"]
+        and v["exit"] == 0
+        and not s["timeout"]
+        and not s.get("skipped")
+    ):
         if s["exit"] != 0:
-            found.append({"category": "validate accepts, simulate rejects", "command": "simulate",
-                          "exc": s.get("exc", ""), "where": s.get("where", ""),
-                          "message": s.get("exc_msg") or (stderr_lines(s["stderr"]) or [""])[0],
-                          "seconds": s["seconds"]})
+            found.append(
+                {
+                    "category": "validate accepts, simulate rejects",
+                    "command": "simulate",
+                    "exc": s.get("exc", ""),
+                    "where": s.get("where", ""),
+                    "message": s.get("exc_msg") or (stderr_lines(s["stderr"]) or [""])[0],
+                    "seconds": s["seconds"],
+                }
+            )
         elif not s.get("written"):
-            found.append({"category": "simulate exit 0 but no HDF5 written",
-                          "command": "simulate", "exc": "", "where": "", "message": "",
-                          "seconds": s["seconds"]})
+            found.append(
+                {
+                    "category": "simulate exit 0 but no HDF5 written",
+                    "command": "simulate",
+                    "exc": "",
+                    "where": "",
+                    "message": "",
+                    "seconds": s["seconds"],
+                }
+            )
     return found
 
 
@@ -1108,10 +1490,12 @@ def describe(case: Case, result: dict, found: list[dict]) -> str:
     else:
         lines.append(f"input: {setup}")
     for p in found:
-        lines.append(f"- {p['command']}: {p['category']}"
-                     + (f": {p['exc']}: {p['message'][:300]}" if p.get("exc") else "")
-                     + (f" at {p['where']}" if p.get("where") else "")
-                     + (f"; stderr: {p['stderr']!r}" if p.get("stderr") else ""))
+        lines.append(
+            f"- {p['command']}: {p['category']}"
+            + (f": {p['exc']}: {p['message'][:300]}" if p.get("exc") else "")
+            + (f" at {p['where']}" if p.get("where") else "")
+            + (f"; stderr: {p['stderr']!r}" if p.get("stderr") else "")
+        )
     return "\n".join(lines)
 
 
@@ -1122,10 +1506,12 @@ def signature(p: dict) -> tuple:
 
 # --- running cases: the pool (parent side) -------------------------------------------------
 
+
 def worker_env() -> dict:
     env = dict(os.environ)
-    env["PYTHONPATH"] = str(ROOT) + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH")
-                                     else "")
+    env["PYTHONPATH"] = str(ROOT) + (
+        os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else ""
+    )
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         env[var] = "1"
     env["COLUMNS"] = "80"
@@ -1148,10 +1534,23 @@ class Worker:
         work.mkdir(parents=True, exist_ok=True)
         self.log = open(work / "stderr.log", "wb")
         self.proc = subprocess.Popen(
-            [sys.executable, str(HARNESS), "--worker", "--folder", str(work), "--memory",
-             str(self.memory), "--limit", str(self.limit)],
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.log, cwd=ROOT,
-            env=worker_env())
+            [
+                sys.executable,
+                str(HARNESS),
+                "--worker",
+                "--folder",
+                str(work),
+                "--memory",
+                str(self.memory),
+                "--limit",
+                str(self.limit),
+            ],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self.log,
+            cwd=ROOT,
+            env=worker_env(),
+        )
         self.buffer = b""
         self.starts += 1
         ready = self._read(120.0)
@@ -1220,12 +1619,21 @@ class Worker:
             tail = _last_running(self._log_tail())
             self.kill()
             if alive:
-                return {"fatal": "killed after the hard time limit (stuck outside Python)",
-                        "detail": tail, "seconds": time.monotonic() - started}
-            how = (f"signal {signal.Signals(-code).name}" if code is not None and code < 0
-                   else f"exit {code}")
-            return {"fatal": f"worker crashed ({how})", "detail": tail,
-                    "seconds": time.monotonic() - started}
+                return {
+                    "fatal": "killed after the hard time limit (stuck outside Python)",
+                    "detail": tail,
+                    "seconds": time.monotonic() - started,
+                }
+            how = (
+                f"signal {signal.Signals(-code).name}"
+                if code is not None and code < 0
+                else f"exit {code}"
+            )
+            return {
+                "fatal": f"worker crashed ({how})",
+                "detail": tail,
+                "seconds": time.monotonic() - started,
+            }
         return json.loads(line)
 
 
@@ -1235,8 +1643,13 @@ def _last_running(log: str) -> str:
     return (lines[-1].split(": running ", 1)[1] if lines else "?") + " | log: " + log[-300:]
 
 
-def run_cases(cases: list[Case], workers: int | None = None, memory: int = MEMORY,
-              limit: float = LIMIT, progress=None) -> dict[str, dict]:
+def run_cases(
+    cases: list[Case],
+    workers: int | None = None,
+    memory: int = MEMORY,
+    limit: float = LIMIT,
+    progress=None,
+) -> dict[str, dict]:
     """Run ``cases`` on ``workers`` worker processes (default: the CPU count, at most 2 unless
     ``SUSPOPT_FUZZ_WORKERS`` says otherwise); {case id: result}."""
     if workers is None:
@@ -1262,7 +1675,7 @@ def run_cases(cases: list[Case], workers: int | None = None, memory: int = MEMOR
                         results[case.id] = result
                         if progress is not None:
                             progress(case, result, len(results))
-            except BaseException as exc:     # noqa: BLE001 - reported below
+            except BaseException as exc:  # noqa: BLE001 - reported below
                 errors.append(exc)
             finally:
                 worker.stop()
@@ -1279,6 +1692,7 @@ def run_cases(cases: list[Case], workers: int | None = None, memory: int = MEMOR
 
 # --- the worker ------------------------------------------------------------------------------
 
+
 class CaseTimeout(BaseException):
     """Raised by SIGALRM when a command runs past the time limit."""
 
@@ -1290,8 +1704,13 @@ def _alarm(signum, frame):
 def _where(tb) -> str:
     """``file:function:line`` of the innermost frame in suspopt (and of the innermost frame
     overall when that is elsewhere, e.g. in yaml or numpy)."""
-    frames = [f for f in traceback.extract_tb(tb) if "fuzz_harness" not in f.filename
-              and "/click/" not in f.filename and "/typer/" not in f.filename]
+    frames = [
+        f
+        for f in traceback.extract_tb(tb)
+        if "fuzz_harness" not in f.filename
+        and "/click/" not in f.filename
+        and "/typer/" not in f.filename
+    ]
     if not frames:
         return ""
 
@@ -1305,8 +1724,11 @@ def _where(tb) -> str:
             path = re.sub(r"^.*/lib/python3\.\d+/", "", path)
         return f"{path}:{f.name}:{f.lineno}"
 
-    own = [f for f in frames if f"{os.sep}suspopt{os.sep}" in f.filename
-           and "fuzz_harness" not in f.filename]
+    own = [
+        f
+        for f in frames
+        if f"{os.sep}suspopt{os.sep}" in f.filename and "fuzz_harness" not in f.filename
+    ]
     last = frames[-1]
     if own and own[-1] is not last:
         return f"{fmt(own[-1])} -> {fmt(last)}"
@@ -1340,24 +1762,23 @@ def _clear(folder: Path) -> None:
     folder.rmdir()
 
 
-def worker_main(folder: Path, memory: int, limit: float,
-                skip_after_timeout: bool = True) -> None:
+def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: bool = True) -> None:
     """Serve cases: one JSON case per line on stdin, one JSON result per line on stdout."""
     import resource
 
     proto = os.fdopen(os.dup(1), "w", buffering=1)
     devnull = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, 1)                       # anything written to fd 1 by C code is dropped
+    os.dup2(devnull, 1)  # anything written to fd 1 by C code is dropped
     sys.setrecursionlimit(max(sys.getrecursionlimit(), 1000))
+    import h5py
     from typer.testing import CliRunner
 
-    import h5py
-
-    from suspopt.cli import app
     import suspopt.analyse
     import suspopt.optimise  # noqa: F401 - imported before the clock starts
     import suspopt.selection  # noqa: F401
     import suspopt.simulate  # noqa: F401
+    from suspopt.cli import app
+
     suspopt.analyse.analysis_kinds()
 
     if memory > 0:
@@ -1386,9 +1807,18 @@ def worker_main(folder: Path, memory: int, limit: float,
                 args = [a.replace("{path}", str(path)).replace("{out}", str(out)) for a in argv]
                 if skip_after_timeout and any(r["timeout"] for r in runs):
                     # the case has failed already; spare the budget another time-out
-                    runs.append({"command": _command_name(args), "argv": args,
-                                 "skipped": True, "timeout": False, "exit": None,
-                                 "seconds": 0.0, "stdout": "", "stderr": ""})
+                    runs.append(
+                        {
+                            "command": _command_name(args),
+                            "argv": args,
+                            "skipped": True,
+                            "timeout": False,
+                            "exit": None,
+                            "seconds": 0.0,
+                            "stdout": "",
+                            "stderr": "",
+                        }
+                    )
                     continue
                 # the log says which command was running if the worker has to be killed
                 sys.stderr.write(f"case {case['id']}: running {_command_name(args)}\n")
@@ -1397,10 +1827,13 @@ def worker_main(folder: Path, memory: int, limit: float,
                 if out.exists():
                     out.unlink()
             answer = {"id": case["id"], "runs": runs}
-        except BaseException as exc:      # noqa: BLE001 - a harness error, reported
+        except BaseException as exc:  # noqa: BLE001 - a harness error, reported
             signal.setitimer(signal.ITIMER_REAL, 0)
-            answer = {"id": case["id"], "fatal": "harness error in the worker",
-                      "detail": "".join(traceback.format_exception(exc))[-1500:]}
+            answer = {
+                "id": case["id"],
+                "fatal": "harness error in the worker",
+                "detail": "".join(traceback.format_exception(exc))[-1500:],
+            }
         try:
             _clear(work)
         except OSError:
@@ -1419,8 +1852,17 @@ def _clip(text: str, head: int = 3000, tail: int = 1000) -> str:
 
 
 def _invoke(runner, app, args, limit, out, h5py) -> dict:
-    record = {"command": _command_name(args), "argv": args, "timeout": False, "exit": None,
-              "stdout": "", "stderr": "", "exc": "", "exc_msg": "", "where": ""}
+    record = {
+        "command": _command_name(args),
+        "argv": args,
+        "timeout": False,
+        "exit": None,
+        "stdout": "",
+        "stderr": "",
+        "exc": "",
+        "exc_msg": "",
+        "where": "",
+    }
     started = time.perf_counter()
     signal.setitimer(signal.ITIMER_REAL, limit)
     try:
@@ -1430,7 +1872,7 @@ def _invoke(runner, app, args, limit, out, h5py) -> dict:
         record["timeout"] = True
         record["exc"] = "time-out"
         record["where"] = _where(exc.__traceback__)
-    except MemoryError as exc:        # raised outside the runner's catch (in its isolation)
+    except MemoryError as exc:  # raised outside the runner's catch (in its isolation)
         signal.setitimer(signal.ITIMER_REAL, 0)
         record["exit"] = 1
         record["exc"] = "MemoryError"
@@ -1466,7 +1908,10 @@ if __name__ == "__main__":
     parser.add_argument("--folder", type=Path, required=True)
     parser.add_argument("--memory", type=int, default=MEMORY)
     parser.add_argument("--limit", type=float, default=LIMIT)
-    parser.add_argument("--all-after-timeout", action="store_true",
-                        help="run a case's remaining commands after one timed out")
+    parser.add_argument(
+        "--all-after-timeout",
+        action="store_true",
+        help="run a case's remaining commands after one timed out",
+    )
     opts = parser.parse_args()
     worker_main(opts.folder, opts.memory, opts.limit, not opts.all_after_timeout)

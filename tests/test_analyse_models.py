@@ -7,19 +7,22 @@ from types import SimpleNamespace
 import h5py
 import numpy as np
 import pytest
+from conftest import CONFIGS
 from typer.testing import CliRunner
 
 from suspopt.cli import app
 from suspopt.metrics import transient_metrics, weighted_rms
 
-from conftest import CONFIGS
-
 
 def run(*args):
     """The CLI in-process: exit code, stdout, stderr."""
     result = CliRunner().invoke(app, [str(a) for a in args])
-    return SimpleNamespace(returncode=result.exit_code, stdout=result.stdout,
-                           stderr=result.stderr, exception=result.exception)
+    return SimpleNamespace(
+        returncode=result.exit_code,
+        stdout=result.stdout,
+        stderr=result.stderr,
+        exception=result.exception,
+    )
 
 
 def short(tmp_path, name: str, duration: float):
@@ -34,8 +37,9 @@ def short(tmp_path, name: str, duration: float):
 
 def datasets(h5):
     found = []
-    h5.visititems(lambda name, obj: found.append((name, obj))
-                  if isinstance(obj, h5py.Dataset) else None)
+    h5.visititems(
+        lambda name, obj: found.append((name, obj)) if isinstance(obj, h5py.Dataset) else None
+    )
     return found
 
 
@@ -87,8 +91,9 @@ def test_models_natural_frequencies_are_the_quarter_cars_closed_form(tmp_path):
         value = h5["comparison/value"]
         assert value["natural_frequency.body.heave"][0] == pytest.approx(f[0], rel=1e-9)
         assert value["natural_frequency.wheel_hop"][0] == pytest.approx(f[1], rel=1e-9)
-        np.testing.assert_allclose(np.sort(h5["models/part1a_qc_bump/modal/frequency"][()]), f,
-                                   rtol=1e-9)
+        np.testing.assert_allclose(
+            np.sort(h5["models/part1a_qc_bump/modal/frequency"][()]), f, rtol=1e-9
+        )
         assert h5["models/part1a_hc1_bump/modal/frequency"].shape == (4,)
         assert value["natural_frequency.body.roll"][1] > 0
 
@@ -112,28 +117,34 @@ def test_models_on_a_random_road_compare_ride_metrics_per_corner(tmp_path):
         vst = value["VST.F1"][0]
         for corner in ("F1", "F2", "R1", "R2"):
             assert diff[f"VST.{corner}"][1] == pytest.approx(
-                100 * (value[f"VST.{corner}"][1] - vst) / vst, rel=1e-12)
+                100 * (value[f"VST.{corner}"][1] - vst) / vst, rel=1e-12
+            )
         assert "body.roll_acc" in h5["models/part1a_fc_class_b/psd"]
         assert "body.roll_acc" not in h5["models/part1a_qc_class_b/psd"]
-        assert "var.body.roll" not in value        # QC has no roll: not compared
+        assert "var.body.roll" not in value  # QC has no roll: not compared
 
 
-@pytest.mark.parametrize("case, needle", [
-    ("one", "at least two configs"),
-    ("mixed", "one kind of road"),
-    ("reference", "not one of the configs compared"),
-    ("pareto", "not a YAML config"),
-])
+@pytest.mark.parametrize(
+    "case, needle",
+    [
+        ("one", "at least two configs"),
+        ("mixed", "one kind of road"),
+        ("reference", "not one of the configs compared"),
+        ("pareto", "not a YAML config"),
+    ],
+)
 def test_models_bad_input_exits_2_with_one_line_and_no_output(tmp_path, case, needle):
     qc = short(tmp_path, "part1a_qc_bump", 3.0)
-    other = {"one": [], "mixed": [short(tmp_path, "part1a_qc_class_b", 3.0)],
-             "reference": [short(tmp_path, "part1a_hc1_bump", 3.0)],
-             "pareto": [tmp_path / "front.h5"]}[case]
+    other = {
+        "one": [],
+        "mixed": [short(tmp_path, "part1a_qc_class_b", 3.0)],
+        "reference": [short(tmp_path, "part1a_hc1_bump", 3.0)],
+        "pareto": [tmp_path / "front.h5"],
+    }[case]
     if case == "pareto":
         with h5py.File(other[0], "w") as h5:
             h5["x"] = 1
-    extra = ["--reference", CONFIGS / "ch3" / "part1a_fc_bump.yaml"] if case == "reference" \
-        else []
+    extra = ["--reference", CONFIGS / "ch3" / "part1a_fc_bump.yaml"] if case == "reference" else []
     out = tmp_path / "out.h5"
     proc = run("analyse", "models", qc, *other, *extra, "-o", out, "--plot", tmp_path / "f.png")
     assert proc.returncode == 2, (proc.stdout, proc.stderr, proc.exception)

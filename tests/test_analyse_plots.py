@@ -20,7 +20,7 @@ def test_a_figure_that_fails_to_write_leaves_nothing(tmp_path):
     fig.savefig = broken
     with pytest.raises(OSError, match="disk full"):
         plots.save(fig, path)
-    assert list(tmp_path.iterdir()) == []       # no figure, no temporary file, no lock
+    assert list(tmp_path.iterdir()) == []  # no figure, no temporary file, no lock
 
 
 def test_the_suffix_chooses_the_format(tmp_path):
@@ -37,10 +37,15 @@ def test_pareto_fronts_draw_one_panel_per_objective_pair_and_variable(tmp_path):
     F = np.column_stack([np.linspace(0.1, 0.3, 8), np.linspace(0.09, 0.01, 8)])
     X = np.column_stack([np.linspace(1e4, 1e5, 8), np.full(8, 1000.0)])
     path = tmp_path / "front.svg"
-    plots.pareto_fronts(path, "front", [("RC_se", "m/s^2"), ("X_ST", "m")],
-                        [("optimised", F), ("class B", 2 * F)],
-                        [("K_v", "N/m", X[:, 0]), ("C_v", "N s/m", X[:, 1])],
-                        marks={"knee": 3}, comfort=[True, False])
+    plots.pareto_fronts(
+        path,
+        "front",
+        [("RC_se", "m/s^2"), ("X_ST", "m")],
+        [("optimised", F), ("class B", 2 * F)],
+        [("K_v", "N/m", X[:, 0]), ("C_v", "N s/m", X[:, 1])],
+        marks={"knee": 3},
+        comfort=[True, False],
+    )
     text = path.read_text()
     # three panels (front, K_v, C_v) and the mark's label
     assert text.count('id="axes_') == 3 and "knee" in text

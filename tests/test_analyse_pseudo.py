@@ -17,6 +17,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
+from conftest import CONFIGS, optimised_front
 from typer.testing import CliRunner
 
 import suspopt
@@ -28,13 +29,15 @@ from suspopt.params import ParamView
 from suspopt.seat import build_seat
 from suspopt.selection import evaluate_pareto, read_pareto
 
-from conftest import CONFIGS, optimised_front
-
 
 def run(*args):
     result = CliRunner().invoke(app, [str(a) for a in args])
-    return SimpleNamespace(returncode=result.exit_code, stdout=result.stdout,
-                           stderr=result.stderr, exception=result.exception)
+    return SimpleNamespace(
+        returncode=result.exit_code,
+        stdout=result.stdout,
+        stderr=result.stderr,
+        exception=result.exception,
+    )
 
 
 def front(folder, name: str, duration: float, **budget):
@@ -68,8 +71,21 @@ def datasets(h5):
 def test_roads_on_the_original_road_reproduce_the_stored_objectives_exactly(tmp_path, ps_front):
     config, pareto = ps_front
     out, fig = tmp_path / "roads.h5", tmp_path / "roads.png"
-    proc = run("analyse", "roads", pareto, "--road", "A", "--road", config, "--road", "B",
-               "-o", out, "--plot", fig)
+    proc = run(
+        "analyse",
+        "roads",
+        pareto,
+        "--road",
+        "A",
+        "--road",
+        config,
+        "--road",
+        "B",
+        "-o",
+        out,
+        "--plot",
+        fig,
+    )
     assert proc.returncode == 0, proc.stderr
     assert "class B" in proc.stdout and fig.stat().st_size > 10_000
     ref = stored(pareto)
@@ -77,10 +93,9 @@ def test_roads_on_the_original_road_reproduce_the_stored_objectives_exactly(tmp_
     with h5py.File(out) as h5:
         assert all("units" in ds.attrs for ds in datasets(h5))
         assert h5.attrs["analysis"] == "roads" and h5.attrs["config"] == config.read_text()
-        assert list(h5["pseudo"].attrs["labels"].astype(str)) == ["class A", config.stem,
-                                                                 "class B"]
+        assert list(h5["pseudo"].attrs["labels"].astype(str)) == ["class A", config.stem, "class B"]
         assert np.array_equal(h5["pareto/F"][()], ref["F"])
-        for label in ("class A", config.stem):       # the stored road, two ways
+        for label in ("class A", config.stem):  # the stored road, two ways
             g = h5[f"pseudo/{label}"]
             assert np.array_equal(g["F"][()], ref["F"])
             assert np.array_equal(g["feasible"][()].astype(bool), ref["feasible"])
@@ -92,7 +107,7 @@ def test_roads_on_the_original_road_reproduce_the_stored_objectives_exactly(tmp_
         assert load_config_text(b.attrs["config"]).road.road_class == "B"
         # a linear seat on the same realisation: class B doubles every amplitude (G_d(n0) x 4)
         np.testing.assert_allclose(b["F"][:, 0], 2 * ref["F"][:, 0], rtol=1e-9)
-        assert np.array_equal(b["F"][:, 1], ref["F"][:, 1])        # X_ST: no road in it
+        assert np.array_equal(b["F"][:, 1], ref["F"][:, 1])  # X_ST: no road in it
         np.testing.assert_allclose(b["change"][:, 0], 100.0, rtol=1e-7)
 
 
@@ -108,7 +123,7 @@ def test_roads_from_a_config_take_its_road_and_simulation(tmp_path, ps_front):
         g = h5["pseudo/slow_b"]
         cfg = load_config_text(g.attrs["config"])
         assert cfg.road.speed == other["road"]["speed"] and cfg.simulation.duration == 1.0
-        assert cfg.seat == read_pareto(pareto).config().seat     # only road and run change
+        assert cfg.seat == read_pareto(pareto).config().seat  # only road and run change
         assert np.all(g["F"][:, 0] > stored(pareto)["F"][:, 0])
 
 
@@ -128,14 +143,13 @@ def test_masses_follow_the_k_v_rule_of_sec_8_4_3(tmp_path, ps_front):
             np.testing.assert_allclose(g["F"][:, 1], ref["F"][:, 1] * load / 95.0, rtol=1e-12)
             assert np.all(g["F"][:, 0] != ref["F"][:, 0])
             assert load_config_text(g.attrs["config"]).seat.mass == load
-            assert "X" not in g                        # PS: the designs' own values unchanged
+            assert "X" not in g  # PS: the designs' own values unchanged
 
 
 def test_masses_keep_x_st_and_k_h_of_nss1_designs(tmp_path):
     """NSS1: K_v = m g / X_ST follows the load, the design's own α is rescaled so that
     K_h = α K_v stays as built (Sec 8.4.3)."""
-    _, path = front(tmp_path, "ch8/pareto_nss1_class_a", 1.0, population=16,
-                    generations=4)
+    _, path = front(tmp_path, "ch8/pareto_nss1_class_a", 1.0, population=16, generations=4)
     pareto = read_pareto(path)
     cfg = pareto.config()
     params = {v.path: pareto.X[:, j] for j, v in enumerate(cfg.design_variables)}
@@ -147,12 +161,16 @@ def test_masses_keep_x_st_and_k_h_of_nss1_designs(tmp_path):
         after = build_seat(new, ParamView(new, changed))
         np.testing.assert_allclose(after.isolator["load_mass"], variant.attrs["load_mass"])
         np.testing.assert_allclose(after.static_deflection, before.static_deflection, rtol=1e-12)
-        np.testing.assert_allclose(after.isolator["horizontal_stiffness"],
-                                   before.isolator["horizontal_stiffness"], rtol=1e-12)
-        assert not np.allclose(after.isolator["vertical_stiffness"],
-                               before.isolator["vertical_stiffness"])
+        np.testing.assert_allclose(
+            after.isolator["horizontal_stiffness"],
+            before.isolator["horizontal_stiffness"],
+            rtol=1e-12,
+        )
+        assert not np.allclose(
+            after.isolator["vertical_stiffness"], before.isolator["vertical_stiffness"]
+        )
         values = evaluate_pareto(replace(pareto, X=variant.X), new)
-        assert np.array_equal(values.F[:, 1], pareto.F[:, 1])      # X_ST kept
+        assert np.array_equal(values.F[:, 1], pareto.F[:, 1])  # X_ST kept
 
 
 def test_controllers_with_the_stored_control_reproduce_the_front(tmp_path, sh2_front):
@@ -160,15 +178,45 @@ def test_controllers_with_the_stored_control_reproduce_the_front(tmp_path, sh2_f
     same = tmp_path / "same.yaml"
     same.write_text("control: {sample_time: 0.004}\n")
     cdf = tmp_path / "cdf.yaml"
-    cdf.write_text((CONFIGS / "ch7" / "sh_2_cdf.yaml").read_text()
-                   .replace("learn_time: 2.0", "learn_time: 1.0"))
+    cdf.write_text(
+        (CONFIGS / "ch7" / "sh_2_cdf.yaml")
+        .read_text()
+        .replace("learn_time: 2.0", "learn_time: 1.0")
+    )
     add = tmp_path / "add.yaml"
-    add.write_text(yaml.safe_dump({"vehicle": {"corner_defaults": {"damper": {
-        "kind": "semi_active", "c_min": 1500, "c_max": 3500, "law": "sh_add_2",
-        "crossover_frequency": 39}}}}))
+    add.write_text(
+        yaml.safe_dump(
+            {
+                "vehicle": {
+                    "corner_defaults": {
+                        "damper": {
+                            "kind": "semi_active",
+                            "c_min": 1500,
+                            "c_max": 3500,
+                            "law": "sh_add_2",
+                            "crossover_frequency": 39,
+                        }
+                    }
+                }
+            }
+        )
+    )
     out = tmp_path / "ctl.h5"
-    proc = run("analyse", "controllers", pareto, "--with", same, "--with", cdf, "--with", add,
-               "-o", out, "--plot", tmp_path / "ctl.png")
+    proc = run(
+        "analyse",
+        "controllers",
+        pareto,
+        "--with",
+        same,
+        "--with",
+        cdf,
+        "--with",
+        add,
+        "-o",
+        out,
+        "--plot",
+        tmp_path / "ctl.png",
+    )
     assert proc.returncode == 0, proc.stderr
     ref = stored(pareto)
     with h5py.File(out) as h5:
@@ -194,7 +242,8 @@ def test_controllers_with_the_stored_control_reproduce_the_front(tmp_path, sh2_f
 
 
 def test_controller_files_without_a_controller_or_with_unknown_corners_are_rejected(
-        tmp_path, sh2_front):
+    tmp_path, sh2_front
+):
     _, pareto = sh2_front
     p = read_pareto(pareto)
     empty, stranger = tmp_path / "empty.yaml", tmp_path / "stranger.yaml"
@@ -212,14 +261,17 @@ def seatless_front(tmp_path):
     text = (CONFIGS / "quickstart.yaml").read_text() + (
         "design_variables:\n"
         "  - {name: C_F1, path: vehicle.corners.F1.damper.c, lower: 2.0e3, upper: 1.0e4}\n"
-        "objectives:\n  main:\n    - {name: f1, metric: var, signal: body.heave_acc}\n")
+        "objectives:\n  main:\n    - {name: f1, metric: var, signal: body.heave_acc}\n"
+    )
     path = tmp_path / "seatless.h5"
     with h5py.File(path, "w") as h5:
         h5.attrs["config"] = text
         grp = h5.create_group("pareto")
-        for key, data, names, units in (("X", [[3000.0], [4000.0]], ["C_F1"], ["N s/m"]),
-                                        ("F", [[1.0], [2.0]], ["f1"], ["(m/s^2)^2"]),
-                                        ("G", [[-1.0], [-1.0]], ["simulation_failed"], ["1"])):
+        for key, data, names, units in (
+            ("X", [[3000.0], [4000.0]], ["C_F1"], ["N s/m"]),
+            ("F", [[1.0], [2.0]], ["f1"], ["(m/s^2)^2"]),
+            ("G", [[-1.0], [-1.0]], ["simulation_failed"], ["1"]),
+        ):
             ds = grp.create_dataset(key, data=np.array(data))
             ds.attrs["names"] = np.array(names, dtype="S")
             ds.attrs["units"] = np.array(units, dtype="S")
@@ -229,28 +281,35 @@ def seatless_front(tmp_path):
 def test_a_hand_written_front_on_its_own_road_gives_the_simulated_objective(seatless_front):
     pareto = read_pareto(seatless_front)
     cfg = pareto.config()
-    res = suspopt.simulate(cfg, params={"vehicle.corners.F1.damper.c": np.array([3000., 4000.])})
+    res = suspopt.simulate(cfg, params={"vehicle.corners.F1.damper.c": np.array([3000.0, 4000.0])})
     same = suspopt.analyse.pseudo.config_with(pareto, lambda data: None, "no change")
     values = evaluate_pareto(pareto, same)
     np.testing.assert_array_equal(values.F[:, 0], np.var(res.signals["body.heave_acc"], axis=1))
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["analyse", "masses", "{seatless}"], "needs a seat"),
-    (["analyse", "roads", "{seatless}", "--road", "B"], "needs an ISO 8608 road"),
-    (["analyse", "roads", "{seatless}"], "give at least one --road"),
-    (["analyse", "roads", "{seatless}", "--road", "Q"], "neither a road class (A-E) nor a file"),
-    (["analyse", "controllers", "{seatless}"], "give at least one --with"),
-    (["analyse", "controllers", "{seatless}", "--with", "{tmp}/none.yaml"], "no such file"),
-    (["analyse", "masses", "{config}"], "not an HDF5 file"),
-    (["analyse", "masses", "{tmp}/missing.h5"], "no such file"),
-    (["analyse", "histogram", "{seatless}"], "unknown kind 'histogram'"),
-    (["analyse", "masses", "{seatless}", "{seatless}"], "takes one SOURCE, got 2"),
-    (["analyse", "transmissibility", "{config}", "--road", "B"], "does not take --road"),
-    (["analyse", "masses", "{seatless}", "--plot", "{tmp}/f.jpg"], "suffix must be one of"),
-])
-def test_bad_input_exits_2_with_one_line_and_no_partial_output(tmp_path, seatless_front, args,
-                                                               needle):
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["analyse", "masses", "{seatless}"], "needs a seat"),
+        (["analyse", "roads", "{seatless}", "--road", "B"], "needs an ISO 8608 road"),
+        (["analyse", "roads", "{seatless}"], "give at least one --road"),
+        (
+            ["analyse", "roads", "{seatless}", "--road", "Q"],
+            "neither a road class (A-E) nor a file",
+        ),
+        (["analyse", "controllers", "{seatless}"], "give at least one --with"),
+        (["analyse", "controllers", "{seatless}", "--with", "{tmp}/none.yaml"], "no such file"),
+        (["analyse", "masses", "{config}"], "not an HDF5 file"),
+        (["analyse", "masses", "{tmp}/missing.h5"], "no such file"),
+        (["analyse", "histogram", "{seatless}"], "unknown kind 'histogram'"),
+        (["analyse", "masses", "{seatless}", "{seatless}"], "takes one SOURCE, got 2"),
+        (["analyse", "transmissibility", "{config}", "--road", "B"], "does not take --road"),
+        (["analyse", "masses", "{seatless}", "--plot", "{tmp}/f.jpg"], "suffix must be one of"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line_and_no_partial_output(
+    tmp_path, seatless_front, args, needle
+):
     config = tmp_path / "case.yaml"
     config.write_text((CONFIGS / "quickstart.yaml").read_text())
     fill = {"seatless": seatless_front, "config": config, "tmp": tmp_path}

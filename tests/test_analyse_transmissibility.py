@@ -8,6 +8,7 @@ from types import SimpleNamespace
 import h5py
 import numpy as np
 import pytest
+from conftest import CONFIGS, optimised_front
 from typer.testing import CliRunner
 
 import suspopt
@@ -15,15 +16,17 @@ from suspopt.cli import app
 from suspopt.kesort import pareto_picks
 from suspopt.seat import build_seat
 
-from conftest import CONFIGS, optimised_front
-
 PASSENGER = CONFIGS / "ch8" / "ps_class_a_passenger.yaml"
 
 
 def run(*args):
     result = CliRunner().invoke(app, [str(a) for a in args])
-    return SimpleNamespace(returncode=result.exit_code, stdout=result.stdout,
-                           stderr=result.stderr, exception=result.exception)
+    return SimpleNamespace(
+        returncode=result.exit_code,
+        stdout=result.stdout,
+        stderr=result.stderr,
+        exception=result.exception,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +47,7 @@ def test_front_picks_as_stored_reproduce_their_objectives(tmp_path, ps_front):
     out, fig = tmp_path / "stht.h5", tmp_path / "stht.svg"
     proc = run("analyse", "transmissibility", ps_front.path, "-o", out, "--plot", fig)
     assert proc.returncode == 0, proc.stderr
-    text = " ".join(proc.stdout.split())            # the notes, whatever the terminal width
+    text = " ".join(proc.stdout.split())  # the notes, whatever the terminal width
     assert "picks of the front" in text and "STHT needs one" in text
     assert "<svg" in fig.read_text()[:2000]
     P = len(ps_front.rows)
@@ -60,42 +63,56 @@ def test_front_picks_as_stored_reproduce_their_objectives(tmp_path, ps_front):
             assert key in labels[ps_front.rows.index(row)]
         assert h5["linear/seat"].shape == (P, 500) and "head" not in h5["linear"]
         assert np.array_equal(h5["weighted_rms/seat.acc"][()], ps_front.F[ps_front.rows, 0])
-        assert np.array_equal(h5["statics/static_deflection"][()],
-                              ps_front.F[ps_front.rows, 1])
+        assert np.array_equal(h5["statics/static_deflection"][()], ps_front.F[ps_front.rows, 1])
 
 
 def test_front_picks_with_the_passenger_give_stht(tmp_path, ps_front):
     """Sec 8.4.4: the Table 2.3 passenger on the 13.6 kg seat. PS keeps K_v, so X_ST is the
     whole load's weight over each design's K_v."""
     out = tmp_path / "stht.h5"
-    proc = run("analyse", "transmissibility", ps_front.path, "--with", PASSENGER, "-o", out,
-               "--plot", tmp_path / "stht.png")
+    proc = run(
+        "analyse",
+        "transmissibility",
+        ps_front.path,
+        "--with",
+        PASSENGER,
+        "-o",
+        out,
+        "--plot",
+        tmp_path / "stht.png",
+    )
     assert proc.returncode == 0, proc.stderr
     assert "with the passenger of" in " ".join(proc.stdout.split())
     load = build_seat(suspopt.load_config(PASSENGER)).isolator["load_mass"][0]
     K_v = ps_front.X[ps_front.rows, 0]
     with h5py.File(out) as h5:
         assert h5["linear/head"].shape == (len(ps_front.rows), 500)
-        np.testing.assert_allclose(h5["statics/static_deflection"][()], load * 9.81 / K_v,
-                                   rtol=1e-12)
-        head = h5["linear/head"][()]               # on LINEAR_FREQUENCIES, from 0.1 Hz
-        np.testing.assert_allclose(head[:, 0], 1.0, atol=0.01)      # rigid at 0.1 Hz
-        assert np.all(head.max(axis=1) > 1.5)                       # the seat resonance
+        np.testing.assert_allclose(
+            h5["statics/static_deflection"][()], load * 9.81 / K_v, rtol=1e-12
+        )
+        head = h5["linear/head"][()]  # on LINEAR_FREQUENCIES, from 0.1 Hz
+        np.testing.assert_allclose(head[:, 0], 1.0, atol=0.01)  # rigid at 0.1 Hz
+        assert np.all(head.max(axis=1) > 1.5)  # the seat resonance
         assert h5["weighted_rms/head.acc"].attrs["units"] == "m/s^2"
         cfg = suspopt.config.loader.load_config_text(h5.attrs["config"])
         assert cfg.seat.mass == 13.6 and cfg.seat.passenger is not None
 
 
-@pytest.mark.parametrize("case, needle", [
-    ("config_with", "--with is for a Pareto file"),
-    ("no_passenger", "has no seat.passenger"),
-    ("two", "takes one --with"),
-])
+@pytest.mark.parametrize(
+    "case, needle",
+    [
+        ("config_with", "--with is for a Pareto file"),
+        ("no_passenger", "has no seat.passenger"),
+        ("two", "takes one --with"),
+    ],
+)
 def test_front_bad_input_exits_2_with_one_line(tmp_path, ps_front, case, needle):
     lumped = CONFIGS / "ch8" / "ps_class_a.yaml"
-    args = {"config_with": [PASSENGER, "--with", PASSENGER],
-            "no_passenger": [ps_front.path, "--with", lumped],
-            "two": [ps_front.path, "--with", PASSENGER, "--with", PASSENGER]}[case]
+    args = {
+        "config_with": [PASSENGER, "--with", PASSENGER],
+        "no_passenger": [ps_front.path, "--with", lumped],
+        "two": [ps_front.path, "--with", PASSENGER, "--with", PASSENGER],
+    }[case]
     out = tmp_path / "out.h5"
     proc = run("analyse", "transmissibility", *args, "-o", out)
     assert proc.returncode == 2, (proc.stdout, proc.stderr, proc.exception)

@@ -10,15 +10,19 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-
 from conftest import CONFIGS
 
 GOOD = (CONFIGS / "quickstart.yaml").read_text()
 
 
 def run(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "suspopt", *map(str, args)],
-                          capture_output=True, text=True, cwd=cwd, timeout=120)
+    return subprocess.run(
+        [sys.executable, "-m", "suspopt", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=120,
+    )
 
 
 def write(tmp_path: Path, text: str, name="case.yaml") -> Path:
@@ -28,19 +32,30 @@ def write(tmp_path: Path, text: str, name="case.yaml") -> Path:
 
 
 BAD_INPUTS = {
-    "malformed_yaml": (GOOD.replace("  preset: half_pitch", "  preset: [half_pitch"),
-                       "malformed YAML", None),
-    "unknown_key": (GOOD.replace("unsprung_mass: 50", "unsprung_mas: 50"),
-                    "vehicle.corners.F1.unsprung_mas: unknown key; did you mean unsprung_mass",
-                    9),
+    "malformed_yaml": (
+        GOOD.replace("  preset: half_pitch", "  preset: [half_pitch"),
+        "malformed YAML",
+        None,
+    ),
+    "unknown_key": (
+        GOOD.replace("unsprung_mass: 50", "unsprung_mas: 50"),
+        "vehicle.corners.F1.unsprung_mas: unknown key; did you mean unsprung_mass",
+        9,
+    ),
     "negative_mass": (GOOD.replace("mass: 2210", "mass: -2210"), "vehicle.body.mass", 6),
-    "zero_mass": (GOOD.replace("unsprung_mass: 100", "unsprung_mass: 0"),
-                  "vehicle.corners.R1.unsprung_mass", 14),
-    "missing_section": (GOOD.split("simulation:")[0], "simulation: required key is missing",
-                        None),
+    "zero_mass": (
+        GOOD.replace("unsprung_mass: 100", "unsprung_mass: 0"),
+        "vehicle.corners.R1.unsprung_mass",
+        14,
+    ),
+    "missing_section": (GOOD.split("simulation:")[0], "simulation: required key is missing", None),
     "wrong_type": (GOOD.replace("height: 0.05", "height: high"), "road.height", 20),
-    "no_road_file": (GOOD.split("road:")[0] + "road: {kind: file, path: nowhere.csv, "
-                     "speed: 10}\nsimulation: {duration: 1.0}\n", "road.path", 18),
+    "no_road_file": (
+        GOOD.split("road:")[0] + "road: {kind: file, path: nowhere.csv, "
+        "speed: 10}\nsimulation: {duration: 1.0}\n",
+        "road.path",
+        18,
+    ),
 }
 
 
@@ -97,6 +112,7 @@ def test_every_bundled_config_validates():
     # in-process (typer's runner): a subprocess per config costs seconds of imports each,
     # and the command's own process behaviour is covered by test_validate_and_schema
     from typer.testing import CliRunner
+
     from suspopt.cli import app
 
     configs = sorted(CONFIGS.rglob("*.yaml"))

@@ -11,13 +11,23 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 #: What is checked: the library, configs, examples, tests, benchmarks, docs and the READMEs.
-SCANNED = ("suspopt", "configs", "examples", "tests", "benchmarks", "docs", "README.md",
-           "pyproject.toml")
+SCANNED = (
+    "suspopt",
+    "configs",
+    "examples",
+    "tests",
+    "benchmarks",
+    "docs",
+    "README.md",
+    "pyproject.toml",
+)
 #: Citations of files that live outside the repository (the character classes keep this file
 #: from matching itself): the design notes, the list of the thesis's slips, the standards'
 #: facts, the shared folder they sit in, and the slips list cited by its bare name.
-OUTSIDE = re.compile(r"\b(?:DESIG[N]|ERRAT[A]|standard[s])\.md|\.\./share[d]|\breferenc[e]/"
-                     r"|\bERRAT[A]\b")
+OUTSIDE = re.compile(
+    r"\b(?:DESIG[N]|ERRAT[A]|standard[s])\.md|\.\./share[d]|\breferenc[e]/"
+    r"|\bERRAT[A]\b"
+)
 #: A cited docs page, optionally with an anchor: ``docs/thesis-slips.md#eq-2104``.
 DOCS_CITATION = re.compile(r"\bdocs/([\w-]+\.md)(?:#([\w-]+))?")
 #: A markdown link ``[text](target)``; images too.
@@ -41,14 +51,17 @@ def _text_files() -> list[Path]:
 
 
 def _markdown_files() -> list[Path]:
-    return [ROOT / "README.md", ROOT / "configs" / "README.md",
-            *sorted((ROOT / "docs").glob("*.md"))]
+    return [
+        ROOT / "README.md",
+        ROOT / "configs" / "README.md",
+        *sorted((ROOT / "docs").glob("*.md")),
+    ]
 
 
 def github_anchor(heading: str) -> str:
     """GitHub's anchor of a heading's text: markup and punctuation dropped (letters, digits,
     ``_``, ``-`` and spaces kept), lower case, each space a hyphen."""
-    text = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", heading.strip())     # links: their text
+    text = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", heading.strip())  # links: their text
     text = re.sub(r"[^\w\- ]", "", text.lower())
     return text.replace(" ", "-")
 
@@ -95,16 +108,20 @@ def test_heading_anchors_follow_github():
     assert github_anchor("Eq 2.104") == "eq-2104"
     assert github_anchor("Sec 2.5.1") == "sec-251"
     assert github_anchor("Bad input: what is checked") == "bad-input-what-is-checked"
-    assert github_anchor("`suspopt simulate CONFIG [-o OUT.h5]`") == "suspopt-simulate-config--o-outh5"
+    assert (
+        github_anchor("`suspopt simulate CONFIG [-o OUT.h5]`") == "suspopt-simulate-config--o-outh5"
+    )
     assert github_anchor("ISO 8608 road roughness") == "iso-8608-road-roughness"
 
 
 def test_no_file_cites_a_path_outside_the_repository():
     """The design notes, the slips list and the standards' facts are docs/ pages now."""
-    found = [f"{_where(file, n)}: {line.strip()}"
-             for file in _text_files()
-             for n, line in enumerate(file.read_text(encoding="utf-8").splitlines(), 1)
-             if OUTSIDE.search(line)]
+    found = [
+        f"{_where(file, n)}: {line.strip()}"
+        for file in _text_files()
+        for n, line in enumerate(file.read_text(encoding="utf-8").splitlines(), 1)
+        if OUTSIDE.search(line)
+    ]
     assert not found, "cite docs/ instead:\n" + "\n".join(found)
 
 
@@ -131,7 +148,7 @@ def test_relative_links_resolve(markdown):
     ``#anchor`` (or a bare ``#anchor`` in the same file) an existing heading."""
     broken = []
     for n, target in _links(markdown):
-        if re.match(r"[a-z][a-z0-9+.-]*:", target):          # http:, https:, mailto:
+        if re.match(r"[a-z][a-z0-9+.-]*:", target):  # http:, https:, mailto:
             continue
         path_part, _, anchor = target.partition("#")
         path = (markdown.parent / path_part).resolve() if path_part else markdown

@@ -9,9 +9,9 @@ import re
 import h5py
 import numpy as np
 import pytest
+from conftest import CONFIGS, optimised_front
 
 import suspopt
-from conftest import CONFIGS, optimised_front
 from suspopt._entry import main
 
 
@@ -33,8 +33,7 @@ def kesort_file(tmp_path_factory):
     return front, out
 
 
-def test_a_kesort_knee_re_simulated_gives_its_stored_objectives(kesort_file, tmp_path,
-                                                                 capsys):
+def test_a_kesort_knee_re_simulated_gives_its_stored_objectives(kesort_file, tmp_path, capsys):
     _, ke = kesort_file
     out = tmp_path / "knee.h5"
     code, stdout, err = cli(capsys, "simulate", ke, "--pick", "knee,chosen", "-o", out)
@@ -48,7 +47,7 @@ def test_a_kesort_knee_re_simulated_gives_its_stored_objectives(kesort_file, tmp
         assert h5["designs/row"][()].tolist() == rows
         assert h5["designs"].attrs["source"] == str(ke)
         F = h5["objectives/F"]
-        assert list(F.attrs["names"]) == names                  # main then supplementary
+        assert list(F.attrs["names"]) == names  # main then supplementary
         np.testing.assert_allclose(F[()], stored, rtol=1e-9)
         assert h5["designs/X"].shape == (2, 6) and (F[()] < 1e10).all()
     assert "knee" in stdout and "chosen" in stdout
@@ -92,47 +91,76 @@ def test_unknown_picks_list_the_choices(kesort_file, capsys):
     assert code == 2 and "name the designs to simulate with --pick" in err
 
 
-def test_a_sweep_of_3_by_4_values_is_one_batch_of_12_named_designs(tmp_path, capsys,
-                                                                   monkeypatch):
+def test_a_sweep_of_3_by_4_values_is_one_batch_of_12_named_designs(tmp_path, capsys, monkeypatch):
     import importlib
 
     simulate_module = importlib.import_module("suspopt.simulate")
 
     batches = []
     real = simulate_module._run
-    monkeypatch.setattr(simulate_module, "_run", lambda cfg, pv, *a: batches.append(pv.P)
-                        or real(cfg, pv, *a))
+    monkeypatch.setattr(
+        simulate_module, "_run", lambda cfg, pv, *a: batches.append(pv.P) or real(cfg, pv, *a)
+    )
     out = tmp_path / "sweep.h5"
-    code, _, err = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", out,
-                       "--sweep", "vehicle.corners.F1.damper.c=1000:4000:3",
-                       "--sweep", "vehicle.corners.R1.spring.linear=4e4:7e4:4",
-                       "--set", "simulation.duration=1.0")
+    code, _, err = cli(
+        capsys,
+        "simulate",
+        CONFIGS / "quickstart.yaml",
+        "-o",
+        out,
+        "--sweep",
+        "vehicle.corners.F1.damper.c=1000:4000:3",
+        "--sweep",
+        "vehicle.corners.R1.spring.linear=4e4:7e4:4",
+        "--set",
+        "simulation.duration=1.0",
+    )
     assert code == 0, err
     assert batches == [12]
     with h5py.File(out) as h5:
         X = h5["designs/X"]
         assert X.shape == (12, 2)
-        assert list(X.attrs["names"]) == ["vehicle.corners.F1.damper.c",
-                                          "vehicle.corners.R1.spring.linear"]
+        assert list(X.attrs["names"]) == [
+            "vehicle.corners.F1.damper.c",
+            "vehicle.corners.R1.spring.linear",
+        ]
         np.testing.assert_array_equal(X[:, 0], np.repeat([1000.0, 2500.0, 4000.0], 4))
         np.testing.assert_array_equal(X[:, 1], np.tile([4e4, 5e4, 6e4, 7e4], 3))
-        assert h5["signals/body.heave"].shape == (12, 1001)     # --set: 1 s
-    code, _, err = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "--zip",
-                       "--sweep", "vehicle.corners.F1.damper.c=1000:4000:3",
-                       "--sweep", "vehicle.corners.R1.damper.c=1000:2000:4")
+        assert h5["signals/body.heave"].shape == (12, 1001)  # --set: 1 s
+    code, _, err = cli(
+        capsys,
+        "simulate",
+        CONFIGS / "quickstart.yaml",
+        "--zip",
+        "--sweep",
+        "vehicle.corners.F1.damper.c=1000:4000:3",
+        "--sweep",
+        "vehicle.corners.R1.damper.c=1000:2000:4",
+    )
     assert code == 2 and "zipped sweeps need the same N" in err
 
 
-@pytest.mark.parametrize("args, needle", [
-    (("--set", "vehicle.body.mas=3"), "--set vehicle.body.mas: not a numeric field of this "
-                                      "config; did you mean vehicle.body.mass"),
-    (("--set", "vehicle.body.mass=heavy"), "'heavy' is not a number"),
-    (("--set", "vehicle.body.mass=-3"), "vehicle.body.mass: Input should be greater than or "
-                                        "equal to 0.001"),
-    (("--sweep", "road.speed=1:2:3"), "--sweep road.speed: cannot vary between the designs "
-                                      "of one run: the road is one per run; use --set"),
-    (("--sweep", "vehicle.body.mass=1:2"), "expected PATH=START:STOP:N"),
-])
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (
+            ("--set", "vehicle.body.mas=3"),
+            "--set vehicle.body.mas: not a numeric field of this "
+            "config; did you mean vehicle.body.mass",
+        ),
+        (("--set", "vehicle.body.mass=heavy"), "'heavy' is not a number"),
+        (
+            ("--set", "vehicle.body.mass=-3"),
+            "vehicle.body.mass: Input should be greater than or equal to 0.001",
+        ),
+        (
+            ("--sweep", "road.speed=1:2:3"),
+            "--sweep road.speed: cannot vary between the designs "
+            "of one run: the road is one per run; use --set",
+        ),
+        (("--sweep", "vehicle.body.mass=1:2"), "expected PATH=START:STOP:N"),
+    ],
+)
 def test_bad_sets_and_sweeps_are_one_line(capsys, args, needle):
     code, _, err = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", *args)
     assert code == 2 and needle in err and len(err.strip().splitlines()) == 1, err
@@ -144,7 +172,7 @@ def test_init_writes_a_config_that_validates(tmp_path, capsys, kind):
     code, out, _ = cli(capsys, "init", kind, "-o", path)
     assert code == 0 and f"suspopt validate {path}" in out
     assert cli(capsys, "validate", path)[0] == 0
-    assert cli(capsys, "init", kind, "-o", path)[0] == 0        # its own file: replaced
+    assert cli(capsys, "init", kind, "-o", path)[0] == 0  # its own file: replaced
     code, _, err = cli(capsys, "init", "quater", "-o", tmp_path / "other.yaml")
     assert code == 2 and "did you mean quarter" in err
 
@@ -154,6 +182,7 @@ def test_the_command_follows_the_conventions(capsys):
     assert code == 0 and out.strip() == f"suspopt {suspopt.__version__}"
     code, out, _ = cli(capsys, "analyse", "--help")
     from suspopt.analyse import SUMMARIES, analysis_kinds
+
     assert set(SUMMARIES) == set(analysis_kinds())
     help_text = " ".join(out.split())
     assert all(f"{kind}:" in help_text for kind in SUMMARIES)
@@ -169,14 +198,21 @@ def test_tables_fit_80_columns_without_cutting_a_cell(kesort_file, monkeypatch, 
     from rich.console import Console
 
     narrow = Console(width=80, markup=False, emoji=False, highlight=False)
-    for name, module in list(sys.modules.items()):      # every command module prints to it
+    for name, module in list(sys.modules.items()):  # every command module prints to it
         if name.startswith("suspopt.cli") and hasattr(module, "out"):
             monkeypatch.setattr(module, "out", narrow)
     front, ke = kesort_file
-    for args in (("simulate", CONFIGS / "ch3/part1a_fc_bump.yaml"), ("kesort", front),
-                 ("simulate", ke, "--pick", "knee,best_f1,best_f2,best_f3"),
-                 ("analyse", "models", CONFIGS / "ch3/part1a_qc_bump.yaml",
-                  CONFIGS / "ch3/part1a_fc_bump.yaml")):
+    for args in (
+        ("simulate", CONFIGS / "ch3/part1a_fc_bump.yaml"),
+        ("kesort", front),
+        ("simulate", ke, "--pick", "knee,best_f1,best_f2,best_f3"),
+        (
+            "analyse",
+            "models",
+            CONFIGS / "ch3/part1a_qc_bump.yaml",
+            CONFIGS / "ch3/part1a_fc_bump.yaml",
+        ),
+    ):
         code, out, err = cli(capsys, *args)
         assert code == 0, err
         lines = out.splitlines()
@@ -185,8 +221,7 @@ def test_tables_fit_80_columns_without_cutting_a_cell(kesort_file, monkeypatch, 
 
 
 def test_the_hypervolume_of_a_run_never_falls(tmp_path):
-    _, front = optimised_front(tmp_path, "ch8/pareto_ps_class_a", 1.0, population=10,
-                               generations=6)
+    _, front = optimised_front(tmp_path, "ch8/pareto_ps_class_a", 1.0, population=10, generations=6)
     with h5py.File(front) as h5:
         hv = h5["history/hypervolume"][()]
     hv = hv[np.isfinite(hv)]
@@ -197,12 +232,18 @@ def test_startup_does_not_import_the_heavy_modules():
     import subprocess
     import sys
 
-    code = ("import sys, suspopt.cli\n"
-            "heavy = [m for m in ('scipy', 'pymoo', 'matplotlib', 'h5py', 'numpy', 'pydantic')"
-            " if m in sys.modules]\n"
-            "print(heavy)\n")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          env={**os.environ, "PYTHONPATH": str(CONFIGS.parent)})
+    code = (
+        "import sys, suspopt.cli\n"
+        "heavy = [m for m in ('scipy', 'pymoo', 'matplotlib', 'h5py', 'numpy', 'pydantic')"
+        " if m in sys.modules]\n"
+        "print(heavy)\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(CONFIGS.parent)},
+    )
     assert proc.stdout.strip() == "[]", proc.stdout + proc.stderr
 
 

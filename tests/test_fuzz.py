@@ -17,9 +17,8 @@ Long runs with a summary table: ``python benchmarks/fuzz_configs.py --cases 2000
 
 from __future__ import annotations
 
-import pytest
-
 import fuzz_harness as fh
+import pytest
 
 DEFAULT_CASES = 500
 CASES = fh.config_cases(fh.case_count(DEFAULT_CASES))
@@ -28,9 +27,13 @@ CASES = fh.config_cases(fh.case_count(DEFAULT_CASES))
 @pytest.fixture(scope="module")
 def results(request):
     """Run the selected cases (all of them unless -k deselects some) in one worker pool."""
-    wanted = {item.callspec.params["case"].id for item in request.session.items
-              if getattr(item, "callspec", None) and "case" in item.callspec.params
-              and item.module is request.module}
+    wanted = {
+        item.callspec.params["case"].id
+        for item in request.session.items
+        if getattr(item, "callspec", None)
+        and "case" in item.callspec.params
+        and item.module is request.module
+    }
     return fh.run_cases([c for c in CASES if c.id in wanted])
 
 

@@ -17,22 +17,27 @@ from __future__ import annotations
 
 import os
 
+import fuzz_harness as fh
 import pytest
 
-import fuzz_harness as fh
-
 VARIANTS = fh.h5_variants() + fh.h5_random_variants(
-    int(os.environ.get("SUSPOPT_FUZZ_H5_CASES", "48")))
+    int(os.environ.get("SUSPOPT_FUZZ_H5_CASES", "48"))
+)
 CASES = fh.h5_cases(VARIANTS)
 
 
 @pytest.fixture(scope="module")
 def results(request, tmp_path_factory):
-    wanted = {item.callspec.params["case"].id for item in request.session.items
-              if getattr(item, "callspec", None) and "case" in item.callspec.params
-              and item.module is request.module}
-    cases = fh.build_h5_cases([c for c in CASES if c.id in wanted], VARIANTS,
-                              tmp_path_factory.mktemp("fuzz_h5"))
+    wanted = {
+        item.callspec.params["case"].id
+        for item in request.session.items
+        if getattr(item, "callspec", None)
+        and "case" in item.callspec.params
+        and item.module is request.module
+    }
+    cases = fh.build_h5_cases(
+        [c for c in CASES if c.id in wanted], VARIANTS, tmp_path_factory.mktemp("fuzz_h5")
+    )
     return fh.run_cases(cases)
 
 

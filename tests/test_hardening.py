@@ -15,10 +15,10 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from conftest import CONFIGS
 
 import suspopt
 import suspopt.cli  # noqa: F401  (imported before any timing)
-from conftest import CONFIGS
 from suspopt._entry import main
 from suspopt.config.loader import load_config_text
 
@@ -56,16 +56,23 @@ def edited(old: str, new: str, text: str = GOOD) -> str:
 # --- bounded YAML ---------------------------------------------------------------------------
 
 BOMB = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
-    f"{b}: &{b} [{', '.join([f'*{a}'] * 9)}]\n" for a, b in zip("abcdefgh", "bcdefghi"))
+    f"{b}: &{b} [{', '.join([f'*{a}'] * 9)}]\n" for a, b in zip("abcdefgh", "bcdefghi")
+)
 
 
-@pytest.mark.parametrize("text, needle", [
-    (BOMB, "expands to more than 100,000 nodes"),
-    ("[" * 5000 + "]" * 5000, "nested more than 64 levels deep"),
-    ("a: &a [*a]\n", "refers to the node that contains it"),
-    (GOOD + "simulation: {duration: 1.0}\n", "key 'simulation' appears twice in one mapping "
-                                             "(first on line 24)"),
-], ids=["alias_bomb", "deep_nesting", "recursive_alias", "duplicate_key"])
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        (BOMB, "expands to more than 100,000 nodes"),
+        ("[" * 5000 + "]" * 5000, "nested more than 64 levels deep"),
+        ("a: &a [*a]\n", "refers to the node that contains it"),
+        (
+            GOOD + "simulation: {duration: 1.0}\n",
+            "key 'simulation' appears twice in one mapping (first on line 24)",
+        ),
+    ],
+    ids=["alias_bomb", "deep_nesting", "recursive_alias", "duplicate_key"],
+)
 def test_hostile_yaml_is_refused_fast_and_small(tmp_path, capsys, text, needle):
     path = write(tmp_path, text)
     tracemalloc.start()
@@ -78,28 +85,38 @@ def test_hostile_yaml_is_refused_fast_and_small(tmp_path, capsys, text, needle):
     assert elapsed < 1.0 and peak < 100e6, (elapsed, peak)
 
 
-@pytest.mark.parametrize("make, needle", [
-    (lambda d: os.symlink("/dev/zero", d / "zero.yaml") or d / "zero.yaml", "is a device"),
-    (lambda d: os.mkfifo(d / "fifo.yaml") or d / "fifo.yaml", "is a FIFO"),
-    (lambda d: d, "is a directory"),
-    (lambda d: write(d, b"vehicle: \x00\x01\x02"), "holds NUL bytes"),
-    (lambda d: write(d, b"vehicle: \xff\xfe"), "is not UTF-8 text"),
-    (lambda d: write(d, "# " + "x" * (1 << 20) + "\n"), "is larger than 1024 kB"),
-])
+@pytest.mark.parametrize(
+    "make, needle",
+    [
+        (lambda d: os.symlink("/dev/zero", d / "zero.yaml") or d / "zero.yaml", "is a device"),
+        (lambda d: os.mkfifo(d / "fifo.yaml") or d / "fifo.yaml", "is a FIFO"),
+        (lambda d: d, "is a directory"),
+        (lambda d: write(d, b"vehicle: \x00\x01\x02"), "holds NUL bytes"),
+        (lambda d: write(d, b"vehicle: \xff\xfe"), "is not UTF-8 text"),
+        (lambda d: write(d, "# " + "x" * (1 << 20) + "\n"), "is larger than 1024 kB"),
+    ],
+)
 def test_config_files_that_are_no_config_are_refused(tmp_path, capsys, make, needle):
     message = one_error(capsys, "validate", make(tmp_path))
     assert needle in message
 
 
-@pytest.mark.parametrize("old, new, needle, line", [
-    ("mass: 2210", "mass: true", "vehicle.body.mass: Input should be a valid number", 6),
-    ("mass: 2210", "mass: '2210'", "vehicle.body.mass: Input should be a valid number", 6),
-    ("mass: 2210", "mass: .inf", "vehicle.body.mass: Input should be a finite number", 6),
-    ("mass: 2210", "mass: 1.0e308", "vehicle.body.mass: Input should be less than or equal to "
-                                    "1000000", 6),
-    ("stiffness: 4.0e5}", "stiffness: -4.0e5}", "greater than or equal to 0.001", 10),
-    ("preset: half_pitch", "preset: yes", "vehicle.preset: Input should be 'quarter'", 5),
-])
+@pytest.mark.parametrize(
+    "old, new, needle, line",
+    [
+        ("mass: 2210", "mass: true", "vehicle.body.mass: Input should be a valid number", 6),
+        ("mass: 2210", "mass: '2210'", "vehicle.body.mass: Input should be a valid number", 6),
+        ("mass: 2210", "mass: .inf", "vehicle.body.mass: Input should be a finite number", 6),
+        (
+            "mass: 2210",
+            "mass: 1.0e308",
+            "vehicle.body.mass: Input should be less than or equal to 1000000",
+            6,
+        ),
+        ("stiffness: 4.0e5}", "stiffness: -4.0e5}", "greater than or equal to 0.001", 10),
+        ("preset: half_pitch", "preset: yes", "vehicle.preset: Input should be 'quarter'", 5),
+    ],
+)
 def test_values_are_strict_finite_and_in_range(tmp_path, capsys, old, new, needle, line):
     message = one_error(capsys, "validate", write(tmp_path, edited(old, new)))
     assert needle in message and f"case.yaml:{line}:" in message, message
@@ -108,40 +125,79 @@ def test_values_are_strict_finite_and_in_range(tmp_path, capsys, old, new, needl
 def test_yaml_1_2_numbers():
     cfg = load_config_text(edited("stiffness: 4.0e5}", "stiffness: 4e5}"))
     assert cfg.vehicle.corners["F1"].tyre.stiffness == 4e5
-    with pytest.raises(suspopt.ConfigError, match=r"road.seed: Input should be less than or "
-                                                  r"equal to 9223372036854775807"):
-        load_config_text((CONFIGS / "ch8/ps_class_a.yaml").read_text().replace(
-            "seed: 1", f"seed: {2 ** 70}"))
+    with pytest.raises(
+        suspopt.ConfigError,
+        match=r"road.seed: Input should be less than or "
+        r"equal to 9223372036854775807",
+    ):
+        load_config_text(
+            (CONFIGS / "ch8/ps_class_a.yaml").read_text().replace("seed: 1", f"seed: {2**70}")
+        )
 
 
 # --- validate finds what a run would reject ------------------------------------------------
 
-@pytest.mark.parametrize("old, new, needle, line", [
-    ("simulation: {duration: 3.0, dt: 1.0e-3}", "simulation: {duration: 3.0005, dt: 1.0e-3}",
-     "simulation.duration: 3.0005 s is not a whole number of steps", 24),
-    ("start: 0.5 ", "start: 3.5 ", "road.start: the bump starts at 3.5 s, after the run ends",
-     23),
-    ("simulation: {duration: 3.0, dt: 1.0e-3}", "simulation: {duration: 3.0, dt: 0.02}",
-     "simulation.dt: 0.02 s steps over the bump: a wheel crosses it in 0.09 s", 24),
-    ("tyre: {stiffness: 4.0e5}", "tyre: {stiffness: 4.0e9}",
-     "simulation.dt: 0.001 s exceeds classical RK4's stability limit 0.000", 24),
-    ("simulation: {duration: 3.0, dt: 1.0e-3}",
-     "simulation: {duration: 3.0, dt: 1.0e-3, output_dt: 2.0e-2}\nmetrics:\n  - {metric: "
-     "rms_weighted, signal: body.heave_acc, weighting: Wk}",
-     "metrics[0].metric: rms_weighted needs signals sampled at 100 Hz or more", 26),
-    ("simulation: {duration: 3.0, dt: 1.0e-3}",
-     "simulation: {duration: 3.0, dt: 1.0e-3}\noutput: {signals: [body.heave, body.hiev]}",
-     "output.signals[1]: unknown signal 'body.hiev'; did you mean body.heave", 25),
-    ("simulation: {duration: 3.0, dt: 1.0e-3}",
-     "simulation: {duration: 3.0, dt: 1.0e-3}\ncontrol: {sample_time: .inf}",
-     "control.sample_time: Input should be a finite number", 25),
-    ("simulation: {duration: 3.0, dt: 1.0e-3}",
-     "simulation: {duration: 0.001, dt: 1.0e-3, output_dt: 2.0e-3}",
-     "simulation: output_dt (0.002) must not exceed duration (0.001)", 24),
-    ("simulation: {duration: 3.0, dt: 1.0e-3}",
-     "simulation: {duration: 3.0, dt: 1.0e-3}\nmetrics:\n  - {metric: null, signal: body.heave}",
-     "metrics[0].metric: Input should be a valid string", 26),
-])
+
+@pytest.mark.parametrize(
+    "old, new, needle, line",
+    [
+        (
+            "simulation: {duration: 3.0, dt: 1.0e-3}",
+            "simulation: {duration: 3.0005, dt: 1.0e-3}",
+            "simulation.duration: 3.0005 s is not a whole number of steps",
+            24,
+        ),
+        (
+            "start: 0.5 ",
+            "start: 3.5 ",
+            "road.start: the bump starts at 3.5 s, after the run ends",
+            23,
+        ),
+        (
+            "simulation: {duration: 3.0, dt: 1.0e-3}",
+            "simulation: {duration: 3.0, dt: 0.02}",
+            "simulation.dt: 0.02 s steps over the bump: a wheel crosses it in 0.09 s",
+            24,
+        ),
+        (
+            "tyre: {stiffness: 4.0e5}",
+            "tyre: {stiffness: 4.0e9}",
+            "simulation.dt: 0.001 s exceeds classical RK4's stability limit 0.000",
+            24,
+        ),
+        (
+            "simulation: {duration: 3.0, dt: 1.0e-3}",
+            "simulation: {duration: 3.0, dt: 1.0e-3, output_dt: 2.0e-2}\nmetrics:\n  - {metric: "
+            "rms_weighted, signal: body.heave_acc, weighting: Wk}",
+            "metrics[0].metric: rms_weighted needs signals sampled at 100 Hz or more",
+            26,
+        ),
+        (
+            "simulation: {duration: 3.0, dt: 1.0e-3}",
+            "simulation: {duration: 3.0, dt: 1.0e-3}\noutput: {signals: [body.heave, body.hiev]}",
+            "output.signals[1]: unknown signal 'body.hiev'; did you mean body.heave",
+            25,
+        ),
+        (
+            "simulation: {duration: 3.0, dt: 1.0e-3}",
+            "simulation: {duration: 3.0, dt: 1.0e-3}\ncontrol: {sample_time: .inf}",
+            "control.sample_time: Input should be a finite number",
+            25,
+        ),
+        (
+            "simulation: {duration: 3.0, dt: 1.0e-3}",
+            "simulation: {duration: 0.001, dt: 1.0e-3, output_dt: 2.0e-3}",
+            "simulation: output_dt (0.002) must not exceed duration (0.001)",
+            24,
+        ),
+        (
+            "simulation: {duration: 3.0, dt: 1.0e-3}",
+            "simulation: {duration: 3.0, dt: 1.0e-3}\nmetrics:\n  - {metric: null, signal: body.heave}",
+            "metrics[0].metric: Input should be a valid string",
+            26,
+        ),
+    ],
+)
 def test_validate_rejects_what_simulate_would(tmp_path, capsys, old, new, needle, line):
     path = write(tmp_path, edited(old, new))
     message = one_error(capsys, "validate", path)
@@ -170,13 +226,20 @@ def test_the_stability_limit_is_rk4s():
         assert bool(suspopt.simulate(cfg).diverged[0]) == diverges
 
 
-@pytest.mark.parametrize("options, needle", [
-    ("{eliminate_duplicates: 'yes'}", "option 'eliminate_duplicates' takes true or false, got "
-                                      "'yes'"),
-    ("{sampling: lhs}", "NSGA2's option 'sampling' takes a pymoo object, which a config cannot "
-                        "give"),
-    ("{n_offsprings: 0}", "option 'n_offsprings' takes a whole number from 1 to 1000000"),
-])
+@pytest.mark.parametrize(
+    "options, needle",
+    [
+        (
+            "{eliminate_duplicates: 'yes'}",
+            "option 'eliminate_duplicates' takes true or false, got 'yes'",
+        ),
+        (
+            "{sampling: lhs}",
+            "NSGA2's option 'sampling' takes a pymoo object, which a config cannot give",
+        ),
+        ("{n_offsprings: 0}", "option 'n_offsprings' takes a whole number from 1 to 1000000"),
+    ],
+)
 def test_optimiser_options_are_checked_data(tmp_path, capsys, options, needle):
     text = (CONFIGS / "ch8/pareto_ps_class_a.yaml").read_text()
     path = write(tmp_path, text.rstrip() + f"\n  options: {options}\n")
@@ -197,17 +260,21 @@ def test_an_optimiser_seed_must_be_a_seed(tmp_path, capsys):
 SECRET = "root:x:0:0:root:/root:/bin/bash"
 
 
-@pytest.mark.parametrize("content, needle", [
-    (b"distance,height\n0,0\n", "needs at least two rows of 'distance,height', found 1"),
-    (b"0,0\n1,nan\n2,0\n", "road.csv:2: values must be finite"),
-    (f"0,0\n{SECRET}\n".encode(), "road.csv:2: expected two numbers 'distance,height'"),
-    (b"0,0\n1,0\n\xff\xfe\x00", "not UTF-8 text"),
-    (b"0,0\n2,0\n1,0\n", "road.csv:3: distances must increase strictly"),
-])
+@pytest.mark.parametrize(
+    "content, needle",
+    [
+        (b"distance,height\n0,0\n", "needs at least two rows of 'distance,height', found 1"),
+        (b"0,0\n1,nan\n2,0\n", "road.csv:2: values must be finite"),
+        (f"0,0\n{SECRET}\n".encode(), "road.csv:2: expected two numbers 'distance,height'"),
+        (b"0,0\n1,0\n\xff\xfe\x00", "not UTF-8 text"),
+        (b"0,0\n2,0\n1,0\n", "road.csv:3: distances must increase strictly"),
+    ],
+)
 def test_road_files_are_checked_on_load_and_never_echoed(tmp_path, capsys, content, needle):
     (tmp_path / "road.csv").write_bytes(content)
-    text = GOOD.split("road:")[0] + ("road: {kind: file, path: road.csv, speed: 10}\n"
-                                     "simulation: {duration: 1.0}\n")
+    text = GOOD.split("road:")[0] + (
+        "road: {kind: file, path: road.csv, speed: 10}\nsimulation: {duration: 1.0}\n"
+    )
     message = one_error(capsys, "validate", write(tmp_path, text))
     assert needle in message and "road.path" in message and "case.yaml:18:" in message
     assert SECRET not in message and "/bin/bash" not in message
@@ -215,19 +282,26 @@ def test_road_files_are_checked_on_load_and_never_echoed(tmp_path, capsys, conte
 
 # --- memory -----------------------------------------------------------------------------------
 
-ISO_ROAD = ("road: {kind: iso8608, road_class: A, convention: iso8608, n_max: 100.0, "
-            "speed: 200.0}\n")
+ISO_ROAD = "road: {kind: iso8608, road_class: A, convention: iso8608, n_max: 100.0, speed: 200.0}\n"
 
 
-@pytest.mark.parametrize("text, needle", [
-    (edited("simulation: {duration: 3.0, dt: 1.0e-3}", "simulation: {duration: 9.0e4, "
-                                                        "dt: 1.0e-5}"),
-     "simulating 1 design for 90000 s at dt = 1e-05 s needs about"),
-    (GOOD.split("road:")[0] + ISO_ROAD + "simulation: {duration: 9.0e4, dt: 1.0e-5}\n",
-     "lower road.n_max or set road.n_waves"),          # waves down to 1 cm over 18,000 km
-])
-def test_a_run_larger_than_memory_is_refused_before_allocating(tmp_path, capsys, text,
-                                                               needle):
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        (
+            edited(
+                "simulation: {duration: 3.0, dt: 1.0e-3}",
+                "simulation: {duration: 9.0e4, dt: 1.0e-5}",
+            ),
+            "simulating 1 design for 90000 s at dt = 1e-05 s needs about",
+        ),
+        (
+            GOOD.split("road:")[0] + ISO_ROAD + "simulation: {duration: 9.0e4, dt: 1.0e-5}\n",
+            "lower road.n_max or set road.n_waves",
+        ),  # waves down to 1 cm over 18,000 km
+    ],
+)
+def test_a_run_larger_than_memory_is_refused_before_allocating(tmp_path, capsys, text, needle):
     tracemalloc.start()
     message = one_error(capsys, "validate", write(tmp_path, text))
     peak = tracemalloc.get_traced_memory()[1]
@@ -240,7 +314,8 @@ def test_max_memory_caps_a_run(tmp_path, capsys):
     message = one_error(capsys, "simulate", CONFIGS / "quickstart.yaml", "--max-memory", "1M")
     assert "simulating 1 design for 3 s" in message and "the --max-memory limit (1 MB)" in message
     assert "--max-memory: '4Q' is not a size" in one_error(
-        capsys, "simulate", CONFIGS / "quickstart.yaml", "--max-memory", "4Q")
+        capsys, "simulate", CONFIGS / "quickstart.yaml", "--max-memory", "4Q"
+    )
     code, _, _ = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "--max-memory", "2G")
     assert code == 0
 
@@ -251,8 +326,7 @@ def test_large_evaluations_run_in_batches_of_bounded_memory(monkeypatch):
     cfg = suspopt.load_config(CONFIGS / "ch5/case1_s1.yaml")
     cfg.simulation.duration = 0.6
     problem = suspopt.Problem.from_config(cfg)
-    X = problem.xl + np.random.default_rng(0).random((9, problem.n_var)) \
-        * (problem.xu - problem.xl)
+    X = problem.xl + np.random.default_rng(0).random((9, problem.n_var)) * (problem.xu - problem.xl)
     whole = problem.evaluate(X, return_values_of=["F", "G"])
     batched = suspopt.Problem.from_config(cfg)
     width = batched.batch_width()
@@ -261,9 +335,11 @@ def test_large_evaluations_run_in_batches_of_bounded_memory(monkeypatch):
     assert batched.batch_width() == 4
     calls = []
     real = problem_module.simulate
-    monkeypatch.setattr(problem_module, "simulate",
-                        lambda cfg, params: calls.append(len(next(iter(params.values()))))
-                        or real(cfg, params))
+    monkeypatch.setattr(
+        problem_module,
+        "simulate",
+        lambda cfg, params: calls.append(len(next(iter(params.values())))) or real(cfg, params),
+    )
     parts = batched.evaluate(X, return_values_of=["F", "G"])
     assert calls == [4, 4, 1]
     for a, b in zip(whole, parts):
@@ -272,23 +348,33 @@ def test_large_evaluations_run_in_batches_of_bounded_memory(monkeypatch):
 
 # --- outputs ----------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("make, needle", [
-    (lambda d: os.mkfifo(d / "out.h5") or d / "out.h5", "is a FIFO; an output must be a "
-                                                          "regular file or a new name"),
-    (lambda d: d, "is a directory"),
-    (lambda d: os.symlink(d / "elsewhere.h5", d / "out.h5") or d / "out.h5",
-     "is a symbolic link"),
-    (lambda d: d / "no" / "out.h5", "does not exist"),
-    (lambda d: "", "-o .: names a folder, not a file"),       # (typer makes '' a '.')
-    (lambda d: write(d, "my notes\n", "out.h5"), "exists and was not written by suspopt; give "
-                                                  "--force"),
-])
+
+@pytest.mark.parametrize(
+    "make, needle",
+    [
+        (
+            lambda d: os.mkfifo(d / "out.h5") or d / "out.h5",
+            "is a FIFO; an output must be a regular file or a new name",
+        ),
+        (lambda d: d, "is a directory"),
+        (
+            lambda d: os.symlink(d / "elsewhere.h5", d / "out.h5") or d / "out.h5",
+            "is a symbolic link",
+        ),
+        (lambda d: d / "no" / "out.h5", "does not exist"),
+        (lambda d: "", "-o .: names a folder, not a file"),  # (typer makes '' a '.')
+        (
+            lambda d: write(d, "my notes\n", "out.h5"),
+            "exists and was not written by suspopt; give --force",
+        ),
+    ],
+)
 def test_outputs_must_be_regular_files_or_new_names(tmp_path, capsys, make, needle):
     target = make(tmp_path)
     before = sorted(p.name for p in tmp_path.iterdir())
     message = one_error(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", target)
     assert needle in message, message
-    assert sorted(p.name for p in tmp_path.iterdir()) == before      # nothing written
+    assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written
 
 
 def test_force_replaces_a_foreign_file_and_suspopt_replaces_its_own(tmp_path, capsys):
@@ -303,8 +389,9 @@ def test_force_replaces_a_foreign_file_and_suspopt_replaces_its_own(tmp_path, ca
 
 
 def test_a_killed_writers_temporary_files_are_removed(tmp_path, capsys):
-    stale = [write(tmp_path, b"half a file", f".out.h5.{tag}.suspopt-tmp")
-             for tag in ("a1b2c3", "zz")]
+    stale = [
+        write(tmp_path, b"half a file", f".out.h5.{tag}.suspopt-tmp") for tag in ("a1b2c3", "zz")
+    ]
     other = write(tmp_path, b"not ours", ".other.h5.x.suspopt-tmp")
     assert cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", tmp_path / "out.h5")[0] == 0
     assert not any(p.exists() for p in stale) and other.exists()
@@ -315,13 +402,25 @@ def test_a_second_writer_is_refused(tmp_path):
 
     target = tmp_path / "out.h5"
     with claim(target):
-        proc = subprocess.run([sys.executable, "-m", "suspopt", "simulate",
-                               str(CONFIGS / "quickstart.yaml"), "-o", str(target)],
-                              capture_output=True, text=True, timeout=120, cwd=ROOT)
+        proc = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "suspopt",
+                "simulate",
+                str(CONFIGS / "quickstart.yaml"),
+                "-o",
+                str(target),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            cwd=ROOT,
+        )
     assert proc.returncode == 2
     assert f"another suspopt run (process {os.getpid()}) is writing it" in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1 and not target.exists()
-    assert list(tmp_path.iterdir()) == []                   # the lock went with its holder
+    assert list(tmp_path.iterdir()) == []  # the lock went with its holder
 
 
 def test_a_failed_write_leaves_the_old_file(tmp_path, capsys, monkeypatch):
@@ -333,6 +432,7 @@ def test_a_failed_write_leaves_the_old_file(tmp_path, capsys, monkeypatch):
 
     def broken(*args, **kwargs):
         raise OSError("disk full")
+
     monkeypatch.setattr(io, "write_dataset", broken)
     with pytest.raises(OSError, match="disk full"):
         cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", target)
@@ -381,27 +481,45 @@ def test_a_crafted_checkpoint_runs_no_code(front, capsys, tmp_path):
         del h5["checkpoint"]
         h5.create_dataset("checkpoint/state", data=np.void(pickle.dumps(_Payload())))
     message = one_error(capsys, "optimise", config, "-o", out, "--resume")
-    assert "/checkpoint/state: an old checkpoint (a pickle), which suspopt no longer loads" \
-        in message
+    assert (
+        "/checkpoint/state: an old checkpoint (a pickle), which suspopt no longer loads" in message
+    )
     assert not _Payload.marker.exists()
 
 
-@pytest.mark.parametrize("damage, needle", [
-    (lambda h5: h5.__delitem__("checkpoint/X"), "/checkpoint/X: missing"),
-    (lambda h5: (h5.__delitem__("checkpoint/F"),
-                 h5.create_dataset("checkpoint/F", data=np.array([b"x"] * 18))),
-     "/checkpoint/F: holds |S1 values, not numbers"),
-    (lambda h5: h5["checkpoint/batches"].__setitem__(0, 5), "/checkpoint: batches of 17 "
-                                                            "designs"),
-    (lambda h5: h5["checkpoint/F"].__setitem__((17, 0), 0.0),   # the last generation's
-     "/history: replaying the checkpoint does not give the stored run"),   # best changes
-    (lambda h5: h5["checkpoint/F"].__setitem__((3, 0), 1.0),       # an earlier generation
-     "/checkpoint/X: batch 2 holds other designs"),              # changes the later ones
-    (lambda h5: h5["checkpoint/X"].__setitem__((7, 1), 0.5),
-     "/checkpoint/X: batch 1 holds other designs than the run asks for"),
-    (lambda h5: h5["checkpoint"].attrs.__setitem__("generations", -3), "attribute "
-                                                                       "'generations'"),
-])
+@pytest.mark.parametrize(
+    "damage, needle",
+    [
+        (lambda h5: h5.__delitem__("checkpoint/X"), "/checkpoint/X: missing"),
+        (
+            lambda h5: (
+                h5.__delitem__("checkpoint/F"),
+                h5.create_dataset("checkpoint/F", data=np.array([b"x"] * 18)),
+            ),
+            "/checkpoint/F: holds |S1 values, not numbers",
+        ),
+        (
+            lambda h5: h5["checkpoint/batches"].__setitem__(0, 5),
+            "/checkpoint: batches of 17 designs",
+        ),
+        (
+            lambda h5: h5["checkpoint/F"].__setitem__((17, 0), 0.0),  # the last generation's
+            "/history: replaying the checkpoint does not give the stored run",
+        ),  # best changes
+        (
+            lambda h5: h5["checkpoint/F"].__setitem__((3, 0), 1.0),  # an earlier generation
+            "/checkpoint/X: batch 2 holds other designs",
+        ),  # changes the later ones
+        (
+            lambda h5: h5["checkpoint/X"].__setitem__((7, 1), 0.5),
+            "/checkpoint/X: batch 1 holds other designs than the run asks for",
+        ),
+        (
+            lambda h5: h5["checkpoint"].attrs.__setitem__("generations", -3),
+            "attribute 'generations'",
+        ),
+    ],
+)
 def test_a_damaged_checkpoint_is_a_clear_error(front, capsys, damage, needle):
     config, out = front
     with h5py.File(out, "a") as h5:
@@ -421,14 +539,21 @@ def test_a_finished_run_resumes_to_itself(front, capsys):
 
 
 def test_a_run_whose_every_design_failed_says_so(tmp_path, capsys):
-    text = TINY_RUN.replace("body: {mass: 285}", "body: {mass: 285}\n  tyre_lift_off: false") \
-        .replace("  - {name: c, path: vehicle.corners.F1.damper.c, lower: 500, upper: 5000}\n",
-                 "  - {name: c, path: vehicle.corners.F1.damper.c, lower: 500, upper: 5000}\n"
-                 "  - {name: b, path: seat.bar_length, lower: 0.001, upper: 0.005}\n") \
-        .replace("road:", "seat: {kind: nss2, mass: 95, damping: 1000, stiffness_ratio: 0.4, "
-                          "spring_free_length: 0.15, wall_distance: 0.16, bar_length: 0.06}\n"
-                          "road:") \
+    text = (
+        TINY_RUN.replace("body: {mass: 285}", "body: {mass: 285}\n  tyre_lift_off: false")
+        .replace(
+            "  - {name: c, path: vehicle.corners.F1.damper.c, lower: 500, upper: 5000}\n",
+            "  - {name: c, path: vehicle.corners.F1.damper.c, lower: 500, upper: 5000}\n"
+            "  - {name: b, path: seat.bar_length, lower: 0.001, upper: 0.005}\n",
+        )
+        .replace(
+            "road:",
+            "seat: {kind: nss2, mass: 95, damping: 1000, stiffness_ratio: 0.4, "
+            "spring_free_length: 0.15, wall_distance: 0.16, bar_length: 0.06}\n"
+            "road:",
+        )
         .replace("signal: travel.F1}", "signal: seat.acc}")
+    )
     out = tmp_path / "failed.h5"
     code, _, err = cli(capsys, "optimise", write(tmp_path, text), "-o", out)
     assert code == 3 and "error: every design of the optimum failed to simulate" in err
@@ -438,22 +563,37 @@ def test_a_run_whose_every_design_failed_says_so(tmp_path, capsys):
 
 # --- broken HDF5 inputs -----------------------------------------------------------------------
 
-@pytest.mark.parametrize("damage, needle", [
-    (lambda h5: h5.attrs.__setitem__("config", np.bytes_(b"vehicle: \xff\xfe")),
-     "attribute 'config': not UTF-8 text"),
-    (lambda h5: h5.attrs.__setitem__("config", "vehicle: [unclosed"),
-     "front.h5:config:1: malformed YAML"),
-    (lambda h5: h5.attrs.__setitem__("config", BOMB), "front.h5:config:"),
-    (lambda h5: (h5.__delitem__("pareto/F"), h5.create_dataset("pareto/F", data=[[b"a"]])),
-     "/pareto/F: holds object values, not numbers"),
-    (lambda h5: h5["pareto/X"].attrs.__setitem__("names", np.array([b"k", b"zz"])),
-     "/pareto/X holds k, zz;"),
-    (lambda h5: h5.create_dataset("pareto/huge", shape=(10 ** 12, 3), chunks=(1000, 3),
-                                  dtype="f8")
-     and (h5.__delitem__("pareto/G"), h5.move("pareto/huge", "pareto/G")),
-     "/pareto/G: shape (1000000000000, 3) is larger than 1024 MB"),
-    (lambda h5: h5.__delitem__("pareto"), "/pareto/X: missing"),
-])
+
+@pytest.mark.parametrize(
+    "damage, needle",
+    [
+        (
+            lambda h5: h5.attrs.__setitem__("config", np.bytes_(b"vehicle: \xff\xfe")),
+            "attribute 'config': not UTF-8 text",
+        ),
+        (
+            lambda h5: h5.attrs.__setitem__("config", "vehicle: [unclosed"),
+            "front.h5:config:1: malformed YAML",
+        ),
+        (lambda h5: h5.attrs.__setitem__("config", BOMB), "front.h5:config:"),
+        (
+            lambda h5: (h5.__delitem__("pareto/F"), h5.create_dataset("pareto/F", data=[[b"a"]])),
+            "/pareto/F: holds object values, not numbers",
+        ),
+        (
+            lambda h5: h5["pareto/X"].attrs.__setitem__("names", np.array([b"k", b"zz"])),
+            "/pareto/X holds k, zz;",
+        ),
+        (
+            lambda h5: (
+                h5.create_dataset("pareto/huge", shape=(10**12, 3), chunks=(1000, 3), dtype="f8")
+                and (h5.__delitem__("pareto/G"), h5.move("pareto/huge", "pareto/G"))
+            ),
+            "/pareto/G: shape (1000000000000, 3) is larger than 1024 MB",
+        ),
+        (lambda h5: h5.__delitem__("pareto"), "/pareto/X: missing"),
+    ],
+)
 def test_broken_pareto_files_are_clear_errors(front, capsys, damage, needle):
     config, out = front
     with h5py.File(out, "a") as h5:
@@ -466,13 +606,17 @@ def test_broken_pareto_files_are_clear_errors(front, capsys, damage, needle):
 
 
 def test_files_that_are_no_hdf5_are_clear_errors(tmp_path, capsys):
-    for name, content in (("empty.h5", b""), ("text.h5", b"hello"),
-                          ("truncated.h5", b"\x89HDF\r\n\x1a\n" + b"\0" * 100)):
+    for name, content in (
+        ("empty.h5", b""),
+        ("text.h5", b"hello"),
+        ("truncated.h5", b"\x89HDF\r\n\x1a\n" + b"\0" * 100),
+    ):
         path = write(tmp_path, content, name)
         assert f"{path}: not an HDF5 file" in one_error(capsys, "kesort", path)
 
 
 # --- messages -----------------------------------------------------------------------------
+
 
 def test_names_are_printed_as_they_are(tmp_path, capsys):
     message = one_error(capsys, "validate", tmp_path / "no:x:such[bold].yaml")
@@ -480,8 +624,10 @@ def test_names_are_printed_as_they_are(tmp_path, capsys):
 
 
 def test_usage_errors_are_one_line(capsys):
-    assert one_error(capsys, "simulate") == \
-        "error: Missing argument 'source'. (see suspopt simulate --help)"
+    assert (
+        one_error(capsys, "simulate")
+        == "error: Missing argument 'source'. (see suspopt simulate --help)"
+    )
     assert "No such command 'simulat'" in one_error(capsys, "simulat")
 
 
@@ -490,11 +636,19 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
     """Interrupted during the start-up imports (as soon as numpy is being loaded, which
     suspopt's own code does) or during the run. (Before suspopt's first line runs, the
     interpreter's own start-up is Python's.)"""
-    long = write(tmp_path, edited("simulation: {duration: 3.0, dt: 1.0e-3}",
-                                  "simulation: {duration: 300.0, dt: 1.0e-3}"))
-    proc = subprocess.Popen([sys.executable, "-m", "suspopt", "simulate", str(long), "-o",
-                             str(tmp_path / "out.h5")], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    long = write(
+        tmp_path,
+        edited(
+            "simulation: {duration: 3.0, dt: 1.0e-3}", "simulation: {duration: 300.0, dt: 1.0e-3}"
+        ),
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "suspopt", "simulate", str(long), "-o", str(tmp_path / "out.h5")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
     maps = Path(f"/proc/{proc.pid}/maps")
     deadline = time.monotonic() + 30
     while "numpy" not in maps.read_text() and time.monotonic() < deadline:
@@ -508,26 +662,31 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
 
 
 def test_numpy_warnings_are_one_line_each():
-    code = ("import numpy as np, suspopt.cli.configs as cli\n"
-            "from suspopt._entry import main\n"
-            "def noisy(path):\n"
-            "    for _ in range(3):\n"
-            "        np.log(np.zeros(2))\n"
-            "    raise SystemExit(0)\n"
-            "cli.read_config = noisy\n"
-            "raise SystemExit(main(['validate', 'x.yaml']))\n")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          cwd=ROOT, timeout=120)
+    code = (
+        "import numpy as np, suspopt.cli.configs as cli\n"
+        "from suspopt._entry import main\n"
+        "def noisy(path):\n"
+        "    for _ in range(3):\n"
+        "        np.log(np.zeros(2))\n"
+        "    raise SystemExit(0)\n"
+        "cli.read_config = noisy\n"
+        "raise SystemExit(main(['validate', 'x.yaml']))\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=120
+    )
     assert proc.returncode == 0 and proc.stderr.splitlines() == [
-        "warning: divide by zero encountered in log (at <string>:5)"], proc.stderr
+        "warning: divide by zero encountered in log (at <string>:5)"
+    ], proc.stderr
 
 
 # --- modes ------------------------------------------------------------------------------------
 
+
 def test_mode_labels_say_what_a_mode_is(load):
     half = suspopt.modal_analysis(suspopt.build_vehicle(load("ch3/part1a_hc1_bump.yaml")))
     np.testing.assert_allclose(half.energy.sum(axis=1), 1.0)
-    labels = sorted(half.label[0][2:])                 # the two wheel hops: in and out of phase
+    labels = sorted(half.label[0][2:])  # the two wheel hops: in and out of phase
     assert labels[0].startswith("wheel.F1 ") and labels[1].startswith("wheel.F2 ")
     assert {label.split()[1] for label in labels} == {"+", "-"}
     assert list(half.label[0][:2]) == ["body.roll", "body.heave"]
@@ -535,5 +694,6 @@ def test_mode_labels_say_what_a_mode_is(load):
     assert list(quarter.label[0]) == ["body.heave", "wheel.F1"]
     full = suspopt.modal_analysis(suspopt.build_vehicle(load("ch3/part1a_fc_bump.yaml")))
     wheel_modes = full.label[0][3:]
-    assert all(sum(f"wheel.{c}" in label for c in ("F1", "F2", "R1", "R2")) >= 2
-               for label in wheel_modes), wheel_modes
+    assert all(
+        sum(f"wheel.{c}" in label for c in ("F1", "F2", "R1", "R2")) >= 2 for label in wheel_modes
+    ), wheel_modes

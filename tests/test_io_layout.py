@@ -11,6 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import xarray as xr
+from conftest import CONFIGS, optimised_front
 
 import suspopt
 from suspopt.analyse import models, transmissibility
@@ -21,9 +22,7 @@ from suspopt.export import write_csv
 from suspopt.io import is_suspopt_output, open_dataset, write_dataset, write_simulation
 from suspopt.selection import load_design_sets, read_pareto, select, write_selection
 
-from conftest import CONFIGS, optimised_front
-
-K = [4.0e4, 6.0e4]                     # two designs: the design axis is not a single row
+K = [4.0e4, 6.0e4]  # two designs: the design axis is not a single row
 
 
 @pytest.fixture(scope="module")
@@ -32,23 +31,36 @@ def files(tmp_path_factory):
     cases, and ``analyse roads``, ``transmissibility`` and ``models`` files."""
     d = tmp_path_factory.mktemp("layout")
     text = (CONFIGS / "quickstart.yaml").read_text().replace("duration: 3.0", "duration: 1.0")
-    text += ("metrics:\n  - {name: RC, metric: rms_weighted, signal: body.heave_acc, "
-             "weighting: Wk}\n  - {name: peak_heave, metric: max_abs, signal: body.heave}\n")
-    res = suspopt.simulate(load_config_text(text),
-                           params={"vehicle.corners.F1.spring.linear": np.array(K)})
+    text += (
+        "metrics:\n  - {name: RC, metric: rms_weighted, signal: body.heave_acc, "
+        "weighting: Wk}\n  - {name: peak_heave, metric: max_abs, signal: body.heave}\n"
+    )
+    res = suspopt.simulate(
+        load_config_text(text), params={"vehicle.corners.F1.spring.linear": np.array(K)}
+    )
     sim = write_simulation(d / "sim.h5", res)
     _, optimised = optimised_front(d, "ch8/pareto_ps_class_a", 2.0)
     front = optimised.rename(d / "front.h5")
-    ke = write_selection(d / "ke.h5", select(load_design_sets([front, front],
-                                                              labels=["A", "B"]), P="auto"))
+    ke = write_selection(
+        d / "ke.h5", select(load_design_sets([front, front], labels=["A", "B"]), P="auto")
+    )
     pareto = read_pareto(front)
-    roads = write_pseudo_fronts(d / "roads.h5",
-                                pseudo_fronts("roads", pareto, road_variants(pareto, ["B"])))
+    roads = write_pseudo_fronts(
+        d / "roads.h5", pseudo_fronts("roads", pareto, road_variants(pareto, ["B"]))
+    )
     transmissibility.run(front, output=d / "stht.h5")
-    models.run([CONFIGS / "ch3/part1a_qc_bump.yaml", CONFIGS / "ch3/part1a_hc1_bump.yaml"],
-               output=d / "models.h5")
-    return {"sim": sim, "front": front, "ke": ke, "roads": roads, "stht": d / "stht.h5",
-            "models": d / "models.h5"}
+    models.run(
+        [CONFIGS / "ch3/part1a_qc_bump.yaml", CONFIGS / "ch3/part1a_hc1_bump.yaml"],
+        output=d / "models.h5",
+    )
+    return {
+        "sim": sim,
+        "front": front,
+        "ke": ke,
+        "roads": roads,
+        "stht": d / "stht.h5",
+        "models": d / "models.h5",
+    }
 
 
 def groups(path) -> list[str | None]:
@@ -66,12 +78,23 @@ def datasets(path) -> list[tuple[str, tuple, dict]]:
     """(path, dims (its own name for a scale), dtype, attributes' dtypes) of every dataset."""
     out = []
     with h5py.File(path) as h5:
+
         def visit(name, obj):
             if isinstance(obj, h5py.Dataset):
-                dims = (name.rsplit("/", 1)[-1],) if obj.is_scale else \
-                    tuple(d[0].name.rsplit("/", 1)[-1] if len(d) else None for d in obj.dims)
-                out.append((name, dims, obj.dtype, {k: obj.attrs.get_id(k).dtype
-                                                    for k in obj.attrs if k not in H5DS}))
+                dims = (
+                    (name.rsplit("/", 1)[-1],)
+                    if obj.is_scale
+                    else tuple(d[0].name.rsplit("/", 1)[-1] if len(d) else None for d in obj.dims)
+                )
+                out.append(
+                    (
+                        name,
+                        dims,
+                        obj.dtype,
+                        {k: obj.attrs.get_id(k).dtype for k in obj.attrs if k not in H5DS},
+                    )
+                )
+
         h5.visititems(visit)
     return out
 
@@ -87,7 +110,7 @@ def test_every_group_opens_in_xarray_with_named_dimensions(files, kind):
         assert all(d in mine.coords for d in mine.sizes), (group, mine.sizes)
     assert xr.open_datatree(path, engine="h5netcdf").groups
     for name, dims, _, _ in datasets(path):
-        assert None not in dims, name                        # every axis has its scale
+        assert None not in dims, name  # every axis has its scale
 
 
 def test_simulate_file_has_time_and_design(files):
@@ -106,7 +129,7 @@ def test_simulate_file_has_time_and_design(files):
     ds = open_dataset(path, "signals")
     assert np.array_equal(ds["time"].values, time) and list(ds["design"].values) == [0, 1]
     assert ds["body.heave_acc"].attrs["units"] == "m/s^2"
-    frame = open_dataset(path, "signals").to_dataframe()            # the one-liner
+    frame = open_dataset(path, "signals").to_dataframe()  # the one-liner
     assert list(frame.index.names) == ["design", "time"] and len(frame) == 2 * len(time)
     assert np.array_equal(frame["body.heave_acc"].to_numpy().reshape(2, -1), acc)
     metrics = open_dataset(path, "metrics").to_dataframe()
@@ -126,12 +149,12 @@ def test_pareto_file_has_names_as_coordinates(files):
     assert ds["F"].dims == ("design", "objective") and ds["X"].dims == ("design", "variable")
     assert ds["G"].dims == ("design", "constraint")
     assert list(ds["constraint"].values) == pareto.constraint_names
-    F = ds["F"].to_pandas()                                         # the one-liner
+    F = ds["F"].to_pandas()  # the one-liner
     assert list(F.columns) == pareto.obj_names == ["RC_se", "X_ST"]
     assert list(F.index) == list(range(len(pareto.F))) and np.array_equal(F.to_numpy(), pareto.F)
     X = ds["X"].to_pandas()
     assert list(X.columns) == pareto.var_names and np.array_equal(X.to_numpy(), pareto.X)
-    assert list(ds["X"].attrs["units"]) == pareto.var_units       # per column, as before
+    assert list(ds["X"].attrs["units"]) == pareto.var_units  # per column, as before
     history = open_dataset(path, "history")
     assert history["best"].dims == ("generation", "objective")
     checkpoint = open_dataset(path, "checkpoint")
@@ -171,7 +194,7 @@ def test_names_and_text_are_variable_length_utf8(files):
             roots = {k: h5.attrs.get_id(k).dtype for k in h5.attrs}
         for name, _, dtype, attrs in datasets(path) + [("/", (), np.dtype(float), roots)]:
             for key, kind in [("data", dtype), *attrs.items()]:
-                assert kind.kind != "S", (path.name, name, key)    # no fixed-length bytes
+                assert kind.kind != "S", (path.name, name, key)  # no fixed-length bytes
                 info = h5py.check_string_dtype(kind)
                 if info is not None:
                     assert info.encoding == "utf-8" and info.length is None, (name, key)
@@ -193,11 +216,13 @@ def test_write_dataset_keeps_one_length_per_dimension(tmp_path):
         sub = g.create_group("sub")
         with pytest.raises(ValueError, match="'time' of length 5"):
             write_dataset(sub, "time", np.arange(5.0), "s", dims=("time",))
-        write_dataset(g, "F", np.zeros((2, 2)), ["m", "s"], dims=("design", "objective"),
-                      names=["f1", "f2"])
+        write_dataset(
+            g, "F", np.zeros((2, 2)), ["m", "s"], dims=("design", "objective"), names=["f1", "f2"]
+        )
         with pytest.raises(ValueError, match="are not the values"):
-            write_dataset(g, "S", np.zeros((2, 2)), "m", dims=("design", "objective"),
-                          names=["f3", "f4"])
+            write_dataset(
+                g, "S", np.zeros((2, 2)), "m", dims=("design", "objective"), names=["f3", "f4"]
+            )
 
 
 def test_open_dataset_names_the_extra_when_xarray_is_missing(files, monkeypatch):
@@ -216,13 +241,26 @@ def read_table(path):
 
 def test_csv_export_has_units_in_the_header_and_round_trips(files, tmp_path):
     folder = tmp_path / "csv"
-    written = {p.name: p for kind in ("sim", "front", "ke", "roads")
-               for p in write_csv(files[kind], folder)}
-    assert {"sim.signals.csv", "sim.csv", "sim.metrics.csv", "sim.modal.energy_share.csv",
-            "front.pareto.X.csv", "front.pareto.F.csv", "front.pareto.G.csv",
-            "front.history.csv", "ke.kesort.F.csv", "ke.kesort.design.csv",
-            "ke.kesort.cases.A.rows.csv", "roads.pseudo.class_B.F.csv",
-            "roads.pseudo.class_B.change.csv"} <= set(written)
+    written = {
+        p.name: p
+        for kind in ("sim", "front", "ke", "roads")
+        for p in write_csv(files[kind], folder)
+    }
+    assert {
+        "sim.signals.csv",
+        "sim.csv",
+        "sim.metrics.csv",
+        "sim.modal.energy_share.csv",
+        "front.pareto.X.csv",
+        "front.pareto.F.csv",
+        "front.pareto.G.csv",
+        "front.history.csv",
+        "ke.kesort.F.csv",
+        "ke.kesort.design.csv",
+        "ke.kesort.cases.A.rows.csv",
+        "roads.pseudo.class_B.F.csv",
+        "roads.pseudo.class_B.change.csv",
+    } <= set(written)
     assert not [n for n in written if "checkpoint" in n]
     for path in written.values():
         assert is_suspopt_output(path) and path.read_text().startswith("# written by suspopt")
@@ -234,9 +272,9 @@ def test_csv_export_has_units_in_the_header_and_round_trips(files, tmp_path):
         assert header[:2] == ["design [1]", "time [s]"] and "body.heave_acc [m/s^2]" in header
         assert len(header) == 2 + len(h5["signals"]) and len(rows) == 2 * T
         col = header.index("body.heave_acc [m/s^2]")
-        assert np.array_equal([float(r[col]) for r in rows], acc.ravel())     # bit for bit
+        assert np.array_equal([float(r[col]) for r in rows], acc.ravel())  # bit for bit
         assert [float(r[1]) for r in rows[:T]] == time.tolist()
-        assert [int(r[0]) for r in rows[T - 1:T + 1]] == [0, 1]
+        assert [int(r[0]) for r in rows[T - 1 : T + 1]] == [0, 1]
         frame = pd.read_csv(written["sim.metrics.csv"], skiprows=1)
         assert list(frame.columns) == ["design [1]", "RC [m/s^2]", "peak_heave [m]"]
         assert np.array_equal(frame["RC [m/s^2]"].to_numpy(), h5["metrics/RC"][()])
@@ -245,8 +283,7 @@ def test_csv_export_has_units_in_the_header_and_round_trips(files, tmp_path):
     assert list(F.columns) == ["design [1]", "RC_se [m/s^2]", "X_ST [m]"]
     assert np.array_equal(F.iloc[:, 1:].to_numpy(), pareto.F)
     X = pd.read_csv(written["front.pareto.X.csv"], skiprows=1)
-    assert list(X.columns)[1:] == [f"{n} [{u}]" for n, u in zip(pareto.var_names,
-                                                                 pareto.var_units)]
+    assert list(X.columns)[1:] == [f"{n} [{u}]" for n, u in zip(pareto.var_names, pareto.var_units)]
     assert np.array_equal(X.iloc[:, 1:].to_numpy(), pareto.X)
     G = pd.read_csv(written["front.pareto.G.csv"], skiprows=1)
     assert list(G.columns)[-1] == "simulation_failed [1]"
@@ -270,8 +307,8 @@ def test_csv_export_replaces_only_its_own_files(files, tmp_path):
     assert sorted(p.name for p in folder.iterdir()) == ["sim.signals.csv"]  # nothing written
     written = write_csv(files["sim"], folder, force=True)
     assert foreign in written and foreign.read_text().startswith("# written by suspopt")
-    assert write_csv(files["sim"], folder) == written            # its own files: replaced
-    assert not [p for p in folder.iterdir() if p.name.startswith(".")]   # no temporary left
+    assert write_csv(files["sim"], folder) == written  # its own files: replaced
+    assert not [p for p in folder.iterdir() if p.name.startswith(".")]  # no temporary left
 
 
 def test_csv_export_needs_a_suspopt_file(tmp_path):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import h5py
 import numpy as np
 import pytest
+from test_optimise import TINY
 from typer.testing import CliRunner
 
 import suspopt
@@ -14,17 +15,19 @@ from suspopt.kesort import k_eps_levels, kesort, normalise_objectives, pareto_pi
 from suspopt.optimise import optimise
 from suspopt.selection import load_design_sets, select
 
-from test_optimise import TINY
-
 # --- the levels, by hand ------------------------------------------------------------------------
 
 # Four solutions, three objectives. Counting the objectives where each is not worse than the
 # least favourable other (Eq 6.10-6.11): A, B and D are not worse than any other in two
 # objectives (k = 1); C is worse than every other in f1 and f2 (k = 0).
-HAND = np.array([[1.0, 2.0, 3.0],      # A
-                 [2.0, 1.0, 3.0],      # B
-                 [3.0, 3.0, 1.0],      # C
-                 [2.0, 2.0, 2.0]])     # D
+HAND = np.array(
+    [
+        [1.0, 2.0, 3.0],  # A
+        [2.0, 1.0, 3.0],  # B
+        [3.0, 3.0, 1.0],  # C
+        [2.0, 2.0, 2.0],
+    ]
+)  # D
 
 
 def test_k_optimality_levels_of_a_hand_made_set():
@@ -46,14 +49,14 @@ def test_k_eps_levels_of_a_hand_made_set():
 
 
 def test_a_dominated_solution_is_level_minus_one_and_changes_no_front_level():
-    with_e = np.vstack([HAND, [3.0, 3.0, 3.0]])           # E: dominated by D
+    with_e = np.vstack([HAND, [3.0, 3.0, 3.0]])  # E: dominated by D
     np.testing.assert_array_equal(k_eps_levels(with_e, 0.0), [1, 1, 0, 1, -1])
 
 
 def front(rng, n, m):
     """n non-dominated points of m objectives (on the simplex sum f = 1)."""
     F = rng.dirichlet(np.ones(m), size=n)
-    return F + 1.0                                          # positive, for Eq 7.12
+    return F + 1.0  # positive, for Eq 7.12
 
 
 @pytest.mark.parametrize("eps", [0.0, 0.05, 0.3])
@@ -61,7 +64,7 @@ def test_dominated_solutions_added_to_a_front_change_no_level_of_the_front(eps):
     rng = np.random.default_rng(3)
     F = front(rng, 40, 4)
     dominated = F[rng.integers(0, 40, 25)] + rng.uniform(0.0, 0.2, (25, 4))
-    dominated[:, 0] += 0.01                                 # strictly worse somewhere
+    dominated[:, 0] += 0.01  # strictly worse somewhere
     before = k_eps_levels(F, eps)
     after = k_eps_levels(np.vstack([F, dominated]), eps)
     np.testing.assert_allclose(after[:40], before, rtol=0, atol=1e-12)
@@ -74,7 +77,7 @@ def test_k_eps_tends_to_k_optimality_as_eps_goes_to_zero():
     gaps = []
     for eps in (0.3, 0.1, 0.03, 0.01, 1e-3, 1e-9):
         levels = k_eps_levels(F, eps)
-        assert (levels >= k - 1e-12).all()                  # the soft merit is never below
+        assert (levels >= k - 1e-12).all()  # the soft merit is never below
         gaps.append(np.abs(levels - k).max())
     assert all(a >= b for a, b in zip(gaps, gaps[1:])) and gaps[0] > 0.1
     assert gaps[-1] == 0.0
@@ -95,7 +98,7 @@ def test_a_solution_better_in_every_objective_gets_level_m_minus_one(eps):
 
 def test_max_normalisation_makes_the_sort_invariant_to_units():
     F = front(np.random.default_rng(2), 80, 4)
-    scaled = F * np.array([1e3, 1e-6, 7.0, 1.0])            # mm, km^2, ... any units
+    scaled = F * np.array([1e3, 1e-6, 7.0, 1.0])  # mm, km^2, ... any units
     for P in (0.05, 0.3, "auto"):
         a, b = kesort(F, P=P), kesort(scaled, P=P)
         np.testing.assert_allclose(b.k_eps, a.k_eps, rtol=1e-12, atol=1e-12)
@@ -107,9 +110,11 @@ def test_max_normalisation_makes_the_sort_invariant_to_units():
 
 def test_min_max_normalisation_ignores_an_offset_and_max_does_not():
     F = front(np.random.default_rng(4), 50, 3)
-    shifted = F + [0.0, 100.0, 0.0]                         # f2 in a narrow band far from 0
-    mm, mm_shifted = kesort(F, P=0.2, normalise="minmax"), \
-        kesort(shifted, P=0.2, normalise="minmax")
+    shifted = F + [0.0, 100.0, 0.0]  # f2 in a narrow band far from 0
+    mm, mm_shifted = (
+        kesort(F, P=0.2, normalise="minmax"),
+        kesort(shifted, P=0.2, normalise="minmax"),
+    )
     np.testing.assert_allclose(mm_shifted.k_eps, mm.k_eps, atol=1e-9)
     assert not np.allclose(kesort(shifted, P=0.2).k_eps, kesort(F, P=0.2).k_eps, atol=1e-3)
 
@@ -118,8 +123,9 @@ def test_absolute_eps_is_in_the_objectives_units():
     F = front(np.random.default_rng(5), 30, 3)
     eps = np.array([0.05, 0.02, 0.1])
     np.testing.assert_allclose(kesort(F, eps).k_eps, k_eps_levels(F, eps), atol=1e-12)
-    np.testing.assert_allclose(kesort(F, eps, normalise="minmax").k_eps,
-                               k_eps_levels(F, eps), atol=1e-12)
+    np.testing.assert_allclose(
+        kesort(F, eps, normalise="minmax").k_eps, k_eps_levels(F, eps), atol=1e-12
+    )
 
 
 def test_auto_P_is_the_smallest_that_leaves_one_best_solution():
@@ -134,10 +140,10 @@ def test_auto_P_is_the_smallest_that_leaves_one_best_solution():
 
 
 def test_ties_are_reported_when_no_P_separates_them():
-    F = np.array([[1.0, 2.0], [1.0, 2.0], [2.0, 1.5]])     # two identical designs
+    F = np.array([[1.0, 2.0], [1.0, 2.0], [2.0, 1.5]])  # two identical designs
     result = kesort(F)
     assert not result.unique and list(result.ties) == [0, 1]
-    assert result.P == pytest.approx(1.0)                  # the grid ran out
+    assert result.P == pytest.approx(1.0)  # the grid ran out
 
 
 def test_blocks_of_rows_give_the_same_levels():
@@ -161,18 +167,23 @@ def test_one_solution_and_bad_input():
 
 def test_pareto_picks_edges_and_knee():
     theta = np.linspace(0.0, np.pi / 2, 21)
-    F = np.column_stack([1 - np.cos(theta), 1 - np.sin(theta)])    # convex towards utopia
-    F = np.vstack([F, [0.0, 2.0]])                          # dominated twin of the f1 edge
+    F = np.column_stack([1 - np.cos(theta), 1 - np.sin(theta)])  # convex towards utopia
+    F = np.vstack([F, [0.0, 2.0]])  # dominated twin of the f1 edge
     assert pareto_picks(F) == {"best_f1": 0, "best_f2": 20, "knee": 10}
-    assert pareto_picks(F * [1e3, 1.0], names=["RC", "X_ST"]) == \
-        {"best_RC": 0, "best_X_ST": 20, "knee": 10}
+    assert pareto_picks(F * [1e3, 1.0], names=["RC", "X_ST"]) == {
+        "best_RC": 0,
+        "best_X_ST": 20,
+        "knee": 10,
+    }
 
 
 # --- Pareto files: re-simulation, pooling, the command -------------------------------------------
 
-FEASIBLE = TINY.replace("min: 0.1, max: 0.3", "min: 0.0, max: 1.0") \
-    .replace("weighting: Wk, max: 1.4", "weighting: Wk, max: 3.0") \
+FEASIBLE = (
+    TINY.replace("min: 0.1, max: 0.3", "min: 0.0, max: 1.0")
+    .replace("weighting: Wk, max: 1.4", "weighting: Wk, max: 3.0")
     .replace("generations: 4", "generations: 2")
+)
 
 
 @pytest.fixture(scope="module")
@@ -198,7 +209,7 @@ def test_supplementary_objectives_are_the_problems_own_in_one_batch(pareto):
 
 
 def test_another_config_gives_a_pseudo_front_and_pooling_keeps_the_case(pareto, tmp_path):
-    stiff = tmp_path / "stiff_rear.yaml"          # same designs, another rear damper
+    stiff = tmp_path / "stiff_rear.yaml"  # same designs, another rear damper
     stiff.write_text(FEASIBLE.replace("damper: {c: 3500}", "damper: {c: 8000}"))
     own, other = load_design_sets([pareto, pareto], [pareto.with_suffix(".yaml"), stiff])
     assert (own.label, other.label) == ("tiny", "stiff_rear")
@@ -208,14 +219,30 @@ def test_another_config_gives_a_pseudo_front_and_pooling_keeps_the_case(pareto, 
     N = len(own.X)
     assert sel.F.shape == (2 * N, 3) and list(sel.case) == ["tiny"] * N + ["stiff_rear"] * N
     assert set(sel.case_sorts) == {"tiny", "stiff_rear"}
-    assert sel.case_sorts["stiff_rear"].chosen >= N          # indices in the pool
+    assert sel.case_sorts["stiff_rear"].chosen >= N  # indices in the pool
     np.testing.assert_array_equal(sel.row, np.tile(np.arange(N), 2))
 
 
 def test_cli_kesort_writes_the_layout(pareto, tmp_path):
     out, fig = tmp_path / "ke.h5", tmp_path / "ke.png"
-    result = CliRunner().invoke(app, ["kesort", str(pareto), str(pareto), "-l", "A", "-l", "A",
-                                      "--P", "0.3", "-o", str(out), "--plot", str(fig)])
+    result = CliRunner().invoke(
+        app,
+        [
+            "kesort",
+            str(pareto),
+            str(pareto),
+            "-l",
+            "A",
+            "-l",
+            "A",
+            "--P",
+            "0.3",
+            "-o",
+            str(out),
+            "--plot",
+            str(fig),
+        ],
+    )
     assert result.exit_code == 0, result.output
     assert "k-ε optimum" in result.stdout and "knee" in result.stdout
     assert fig.stat().st_size > 0
@@ -228,7 +255,7 @@ def test_cli_kesort_writes_the_layout(pareto, tmp_path):
         assert h5.attrs["config"] == config
         g = h5["kesort"]
         assert g["F"].shape == (2 * N, 3)
-        assert list(g["F"].attrs["names"]) == ["f1", "f3", "f2"]          # UTF-8 text
+        assert list(g["F"].attrs["names"]) == ["f1", "f3", "f2"]  # UTF-8 text
         assert list(g["F"].attrs["units"]) == ["(m/s^2)^2", "m^2", "m^2"]
         assert list(g["X"].attrs["names"]) == ["k_F1", "c_F1", "knl_F1"]
         assert g["k_eps"].shape == (2 * N,) and 0 <= g["chosen"][()] < 2 * N
@@ -236,10 +263,11 @@ def test_cli_kesort_writes_the_layout(pareto, tmp_path):
         np.testing.assert_allclose(g.attrs["epsilon"], 0.3 * g["F"][()].max(axis=0))
         assert {k.decode() for k in g["case"][()]} == {"A"} and "cases" not in g
         assert set(g["picks"]) == {"best_f1", "best_f3", "best_f2", "knee"}
-        assert not g.attrs["unique"] and len(g["ties"]) == 2     # each design twice
+        assert not g.attrs["unique"] and len(g["ties"]) == 2  # each design twice
         datasets = []
-        h5.visititems(lambda name, obj: datasets.append(obj)
-                      if isinstance(obj, h5py.Dataset) else None)
+        h5.visititems(
+            lambda name, obj: datasets.append(obj) if isinstance(obj, h5py.Dataset) else None
+        )
         assert datasets and all("units" in ds.attrs for ds in datasets)
 
 
@@ -249,27 +277,37 @@ def _pareto_without_F(path, pareto):
         src.copy("pareto/X", h5, "pareto/X")
 
 
-@pytest.mark.parametrize("case, needle", [
-    ("missing", "nowhere.h5: no such file"),
-    ("not_hdf5", "notes.h5: not an HDF5 file"),
-    ("no_F", "noF.h5: /pareto/F: missing"),
-    ("other_variables", "do not fit its design_variables"),
-    ("eps", "--eps 1,x: expected numbers"),
-    ("plot", "fig.jpg: give a .png or .svg file"),
-    ("normalise", "unknown normalisation 'range'"),
-    ("configs", "--config: give one config for every file, or one per file (1); got 2"),
-])
+@pytest.mark.parametrize(
+    "case, needle",
+    [
+        ("missing", "nowhere.h5: no such file"),
+        ("not_hdf5", "notes.h5: not an HDF5 file"),
+        ("no_F", "noF.h5: /pareto/F: missing"),
+        ("other_variables", "do not fit its design_variables"),
+        ("eps", "--eps 1,x: expected numbers"),
+        ("plot", "fig.jpg: give a .png or .svg file"),
+        ("normalise", "unknown normalisation 'range'"),
+        ("configs", "--config: give one config for every file, or one per file (1); got 2"),
+    ],
+)
 def test_cli_kesort_bad_input_exits_2_with_one_line(pareto, tmp_path, case, needle):
     out = tmp_path / "ke.h5"
-    args = {"missing": [str(tmp_path / "nowhere.h5")],
-            "not_hdf5": [str(tmp_path / "notes.h5")],
-            "no_F": [str(tmp_path / "noF.h5")],
-            "other_variables": [str(pareto), "--config", str(tmp_path / "other.yaml")],
-            "eps": [str(pareto), "--eps", "1,x"],
-            "plot": [str(pareto), "--plot", str(tmp_path / "fig.jpg")],
-            "normalise": [str(pareto), "--normalise", "range"],
-            "configs": [str(pareto), "-c", str(pareto.with_suffix(".yaml")),
-                        "-c", str(pareto.with_suffix(".yaml"))]}[case]
+    args = {
+        "missing": [str(tmp_path / "nowhere.h5")],
+        "not_hdf5": [str(tmp_path / "notes.h5")],
+        "no_F": [str(tmp_path / "noF.h5")],
+        "other_variables": [str(pareto), "--config", str(tmp_path / "other.yaml")],
+        "eps": [str(pareto), "--eps", "1,x"],
+        "plot": [str(pareto), "--plot", str(tmp_path / "fig.jpg")],
+        "normalise": [str(pareto), "--normalise", "range"],
+        "configs": [
+            str(pareto),
+            "-c",
+            str(pareto.with_suffix(".yaml")),
+            "-c",
+            str(pareto.with_suffix(".yaml")),
+        ],
+    }[case]
     (tmp_path / "notes.h5").write_text("not HDF5")
     _pareto_without_F(tmp_path / "noF.h5", pareto)
     (tmp_path / "other.yaml").write_text(FEASIBLE.replace("name: c_F1", "name: c_front"))

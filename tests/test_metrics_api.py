@@ -12,15 +12,30 @@ import pytest
 
 import suspopt.metrics as metrics
 
-MODULES = [importlib.import_module(f"suspopt.metrics.{info.name}")
-           for info in pkgutil.iter_modules(metrics.__path__)]
-LOOPS = (ast.For, ast.While, ast.AsyncFor, ast.ListComp, ast.SetComp, ast.DictComp,
-         ast.GeneratorExp)
+MODULES = [
+    importlib.import_module(f"suspopt.metrics.{info.name}")
+    for info in pkgutil.iter_modules(metrics.__path__)
+]
+LOOPS = (
+    ast.For,
+    ast.While,
+    ast.AsyncFor,
+    ast.ListComp,
+    ast.SetComp,
+    ast.DictComp,
+    ast.GeneratorExp,
+)
 
 
 def test_every_module_declares_all_and_the_package_reexports_it():
     assert {module.__name__.rsplit(".", 1)[1] for module in MODULES} == {
-        "iso2631", "stats", "energy", "transient", "spectral", "springs"}
+        "iso2631",
+        "stats",
+        "energy",
+        "transient",
+        "spectral",
+        "springs",
+    }
     for module in MODULES:
         for name in module.__all__:
             assert hasattr(module, name), (module.__name__, name)
@@ -32,10 +47,15 @@ def test_every_module_declares_all_and_the_package_reexports_it():
 def test_no_python_loop_inside_any_function(module):
     """Batching is numpy's job: a loop in a metric would run per design (or per sample)."""
     tree = ast.parse(inspect.getsource(module))
-    functions = [node for node in ast.walk(tree)
-                 if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))]
-    loops = [f"{function.name}:{node.lineno}" for function in functions
-             for node in ast.walk(function) if isinstance(node, LOOPS)]
+    functions = [
+        node for node in ast.walk(tree) if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
+    ]
+    loops = [
+        f"{function.name}:{node.lineno}"
+        for function in functions
+        for node in ast.walk(function)
+        if isinstance(node, LOOPS)
+    ]
     assert not loops, f"loops in {module.__name__}: {loops}"
 
 

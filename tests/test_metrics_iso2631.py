@@ -10,8 +10,18 @@ import pytest
 from scipy import signal
 
 from suspopt.metrics import iso2631
-from suspopt.metrics.iso2631 import (WEIGHTINGS, comfort_reaction, crest_factor, mtvv, ratio_tests,
-                                     running_rms, vdv, weight, weighted_rms, weighting_response)
+from suspopt.metrics.iso2631 import (
+    WEIGHTINGS,
+    comfort_reaction,
+    crest_factor,
+    mtvv,
+    ratio_tests,
+    running_rms,
+    vdv,
+    weight,
+    weighted_rms,
+    weighting_response,
+)
 
 FS = 1000.0
 THIRD_OCTAVES = 10.0 ** (np.arange(-3, 20) / 10.0)  # exact 1/3-octave centres 0.5 ... 80 Hz
@@ -40,27 +50,140 @@ def test_effective_magnitude_within_half_percent_of_analogue(name):
     sines = _smooth_step(t / ramp) * np.sin(2 * np.pi * THIRD_OCTAVES[:, None] * t)
     weighted = weight(sines, FS, name)
     window = t >= ramp + settle
-    gains = np.array([_amplitude(t[window], row[window], f)
-                      for row, f in zip(weighted, THIRD_OCTAVES, strict=True)])
+    gains = np.array(
+        [
+            _amplitude(t[window], row[window], f)
+            for row, f in zip(weighted, THIRD_OCTAVES, strict=True)
+        ]
+    )
     analogue = np.abs(weighting_response(THIRD_OCTAVES, name))
     np.testing.assert_allclose(gains, analogue, rtol=0.005)
 
 
 # ISO 2631-1:1997 Table 3 (identical in ISO 8041), weighting factors x 1000 at the nominal
 # one-third-octave frequencies, as printed (3 significant figures).
-NOMINAL = [0.1, 0.125, 0.16, 0.2, 0.25, 0.315, 0.4, 0.5, 0.63, 0.8, 1.0, 1.25, 1.6, 2.0, 2.5,
-           3.15, 4.0, 5.0, 6.3, 8.0, 10.0, 12.5, 16.0, 20.0, 25.0, 31.5, 40.0, 50.0, 63.0, 80.0]
+NOMINAL = [
+    0.1,
+    0.125,
+    0.16,
+    0.2,
+    0.25,
+    0.315,
+    0.4,
+    0.5,
+    0.63,
+    0.8,
+    1.0,
+    1.25,
+    1.6,
+    2.0,
+    2.5,
+    3.15,
+    4.0,
+    5.0,
+    6.3,
+    8.0,
+    10.0,
+    12.5,
+    16.0,
+    20.0,
+    25.0,
+    31.5,
+    40.0,
+    50.0,
+    63.0,
+    80.0,
+]
 ISO_TABLE_3 = {
-    "Wk": (NOMINAL, ["31.2", "48.6", "79.0", "121", "182", "263", "352", "418", "459", "477",
-                     "482", "484", "494", "531", "631", "804", "967", "1039", "1054", "1036",
-                     "988", "902", "768", "636", "513", "405", "314", "246", "186", "132"]),
-    "Wd": (NOMINAL, ["62.4", "97.3", "158", "243", "365", "530", "713", "853", "944", "992",
-                     "1011", "1008", "968", "890", "776", "642", "512", "409", "323", "253",
-                     "202", "161", "125", "100", "80.0", "63.2", "49.4", "38.8", "29.5",
-                     "21.1"]),
-    "Wf": ([0.1, 0.125, 0.16, 0.2, 0.25, 0.315, 0.4, 0.5, 0.63, 0.8, 1.0, 1.25, 1.6, 2.0],
-           ["695", "895", "1006", "992", "854", "619", "384", "224", "116", "53.0", "23.5",
-            "9.98", "3.77", "1.55"]),
+    "Wk": (
+        NOMINAL,
+        [
+            "31.2",
+            "48.6",
+            "79.0",
+            "121",
+            "182",
+            "263",
+            "352",
+            "418",
+            "459",
+            "477",
+            "482",
+            "484",
+            "494",
+            "531",
+            "631",
+            "804",
+            "967",
+            "1039",
+            "1054",
+            "1036",
+            "988",
+            "902",
+            "768",
+            "636",
+            "513",
+            "405",
+            "314",
+            "246",
+            "186",
+            "132",
+        ],
+    ),
+    "Wd": (
+        NOMINAL,
+        [
+            "62.4",
+            "97.3",
+            "158",
+            "243",
+            "365",
+            "530",
+            "713",
+            "853",
+            "944",
+            "992",
+            "1011",
+            "1008",
+            "968",
+            "890",
+            "776",
+            "642",
+            "512",
+            "409",
+            "323",
+            "253",
+            "202",
+            "161",
+            "125",
+            "100",
+            "80.0",
+            "63.2",
+            "49.4",
+            "38.8",
+            "29.5",
+            "21.1",
+        ],
+    ),
+    "Wf": (
+        [0.1, 0.125, 0.16, 0.2, 0.25, 0.315, 0.4, 0.5, 0.63, 0.8, 1.0, 1.25, 1.6, 2.0],
+        [
+            "695",
+            "895",
+            "1006",
+            "992",
+            "854",
+            "619",
+            "384",
+            "224",
+            "116",
+            "53.0",
+            "23.5",
+            "9.98",
+            "3.77",
+            "1.55",
+        ],
+    ),
 }
 
 
@@ -77,6 +200,7 @@ def test_weighting_response_matches_iso_table_3(name):
 
 def _analogue_system(params: iso2631.WeightingParameters) -> signal.lti:
     """The Annex A product as one rational transfer function in s (polynomial coefficients)."""
+
     def quadratic(f: float, q: float) -> np.ndarray:
         w = 2 * np.pi * f
         return np.array([1 / w**2, 1 / (q * w), 1.0]) if np.isfinite(f) else np.array([1.0])
@@ -99,6 +223,7 @@ def test_weighted_shocks_match_causal_analogue_filter(name):
     """Time domain: the weighted record equals the analogue filter integrated by lsim (phase and
     causality included) and a shock at the very end does not wrap onto the record's start."""
     t = np.arange(int(20 * FS)) / FS
+
     def half_sine(t0: float, d: float) -> np.ndarray:
         return np.where((t >= t0) & (t <= t0 + d), np.sin(np.pi * (t - t0) / d), 0.0)
 
@@ -112,8 +237,9 @@ def test_weight_batches_rows_like_single_calls():
     rng = np.random.default_rng(1)
     a = rng.standard_normal((3, 4000))
     batched = weight(a, 200.0, "Wk")
-    np.testing.assert_allclose(batched, np.stack([weight(row, 200.0, "Wk") for row in a]),
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        batched, np.stack([weight(row, 200.0, "Wk") for row in a]), atol=1e-12
+    )
 
 
 @pytest.mark.parametrize("unweighted", [None, "none", "None"])
@@ -142,17 +268,19 @@ def test_sine_closed_forms():
     a = amplitude[:, None] * np.sin(2 * np.pi * f0 * t)
     np.testing.assert_allclose(weighted_rms(a, FS, None), amplitude / np.sqrt(2), rtol=1e-12)
     np.testing.assert_allclose(crest_factor(a, FS, None), np.sqrt(2), rtol=1e-12)
-    np.testing.assert_allclose(vdv(a, FS, None), amplitude * (3 * duration / 8) ** 0.25,
-                               rtol=1e-12)
+    np.testing.assert_allclose(vdv(a, FS, None), amplitude * (3 * duration / 8) ** 0.25, rtol=1e-12)
     running = running_rms(a, FS, None, tau)
     full = t >= tau - 0.5 / FS
-    np.testing.assert_allclose(running[:, full], np.broadcast_to(amplitude[:, None] / np.sqrt(2),
-                                                                 running[:, full].shape),
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        running[:, full],
+        np.broadcast_to(amplitude[:, None] / np.sqrt(2), running[:, full].shape),
+        rtol=1e-9,
+    )
     w, elapsed = 2 * np.pi * f0, t[~full] + 1 / FS
     ramp = np.sqrt((elapsed / 2 - np.sin(2 * w * elapsed) / (4 * w)) / tau)
-    np.testing.assert_allclose(running[:, ~full], amplitude[:, None] * ramp,
-                               atol=2e-3 * amplitude.max())
+    np.testing.assert_allclose(
+        running[:, ~full], amplitude[:, None] * ramp, atol=2e-3 * amplitude.max()
+    )
     np.testing.assert_allclose(mtvv(a, FS, None, tau), amplitude / np.sqrt(2), rtol=1e-9)
     ratios = ratio_tests(a, FS, None, tau)
     np.testing.assert_allclose(ratios["mtvv_ratio"], 1.0, rtol=1e-9)
@@ -167,16 +295,19 @@ def test_half_sine_shock_closed_forms():
     t = np.arange(int(duration * FS)) / FS
     inside = (t >= 1.0) & (t <= 1.0 + d + 1e-9)
     a = np.where(inside, amplitude * np.sin(np.pi * (t - 1.0) / d), 0.0)
-    np.testing.assert_allclose(weighted_rms(a, FS, None), amplitude * np.sqrt(d / (2 * duration)),
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        weighted_rms(a, FS, None), amplitude * np.sqrt(d / (2 * duration)), rtol=1e-9
+    )
     np.testing.assert_allclose(vdv(a, FS, None), amplitude * (3 * d / 8) ** 0.25, rtol=1e-9)
-    np.testing.assert_allclose(mtvv(a, FS, None, tau), amplitude * np.sqrt(d / (2 * tau)),
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        mtvv(a, FS, None, tau), amplitude * np.sqrt(d / (2 * tau)), rtol=1e-9
+    )
     np.testing.assert_allclose(crest_factor(a, FS, None), np.sqrt(2 * duration / d), rtol=1e-9)
     ratios = ratio_tests(a, FS, None, tau)
     np.testing.assert_allclose(ratios["mtvv_ratio"], np.sqrt(duration / tau), rtol=1e-9)
-    np.testing.assert_allclose(ratios["vdv_ratio"],
-                               (3 / 8) ** 0.25 * np.sqrt(2) * (duration / d) ** 0.25, rtol=1e-9)
+    np.testing.assert_allclose(
+        ratios["vdv_ratio"], (3 / 8) ** 0.25 * np.sqrt(2) * (duration / d) ** 0.25, rtol=1e-9
+    )
     assert not ratios["basic_method_sufficient"]
     assert ratios["mtvv_limit"] == 1.5 and ratios["vdv_limit"] == 1.75
 
@@ -190,20 +321,23 @@ def test_weighted_rms_of_two_sines_adds_weighted_powers():
     assert weighted_rms(a, FS, "Wk") == pytest.approx(expected, rel=0.005)
 
 
-@pytest.mark.parametrize("value, label", [
-    (0.0, "not uncomfortable"),
-    (0.3, "not uncomfortable"),
-    (0.315, "a little uncomfortable"),
-    (0.55, "a little uncomfortable / fairly uncomfortable"),
-    (0.63, "fairly uncomfortable"),
-    (0.9, "fairly uncomfortable / uncomfortable"),
-    (1.1, "uncomfortable"),
-    (1.5, "uncomfortable / very uncomfortable"),
-    (1.8, "very uncomfortable"),
-    (2.2, "very uncomfortable / extremely uncomfortable"),
-    (2.5, "extremely uncomfortable"),
-    (9.0, "extremely uncomfortable"),
-])
+@pytest.mark.parametrize(
+    "value, label",
+    [
+        (0.0, "not uncomfortable"),
+        (0.3, "not uncomfortable"),
+        (0.315, "a little uncomfortable"),
+        (0.55, "a little uncomfortable / fairly uncomfortable"),
+        (0.63, "fairly uncomfortable"),
+        (0.9, "fairly uncomfortable / uncomfortable"),
+        (1.1, "uncomfortable"),
+        (1.5, "uncomfortable / very uncomfortable"),
+        (1.8, "very uncomfortable"),
+        (2.2, "very uncomfortable / extremely uncomfortable"),
+        (2.5, "extremely uncomfortable"),
+        (9.0, "extremely uncomfortable"),
+    ],
+)
 def test_comfort_reaction_follows_iso_bands(value, label):
     assert comfort_reaction(value) == label
 
@@ -224,5 +358,6 @@ def test_matches_independent_implementation_phonometry():
     phonometry = pytest.importorskip("phonometry")
     f = np.geomspace(0.1, 400.0, 200)
     for name in WEIGHTINGS:
-        np.testing.assert_allclose(np.abs(weighting_response(f, name)),
-                                   phonometry.weighting_factors(name, f), rtol=1e-9)
+        np.testing.assert_allclose(
+            np.abs(weighting_response(f, name)), phonometry.weighting_factors(name, f), rtol=1e-9
+        )

@@ -44,8 +44,9 @@ def test_h1_recovers_a_known_filter_despite_output_noise():
     assert np.all(error <= 0.03 * gains[:, None]), error.max(axis=1)
     _, tr = transmissibility(x, y, FS, nperseg=1024)
     np.testing.assert_allclose(tr, np.abs(h))
-    np.testing.assert_allclose(tr[:, band], gains[:, None] * np.abs(expected[band]), rtol=0.05,
-                               atol=0.02)
+    np.testing.assert_allclose(
+        tr[:, band], gains[:, None] * np.abs(expected[band]), rtol=0.05, atol=0.02
+    )
 
 
 def test_coherence_separates_related_from_unrelated_signals():

@@ -6,12 +6,27 @@ import numpy as np
 import pytest
 
 from suspopt.metrics import stats
-from suspopt.metrics.stats import (STATISTICS, dynamic_tyre_load_ratio, max_abs, maximum, mean,
-                                   minimum, peak_dynamic_tyre_load_ratio, peak_to_peak,
-                                   peak_tyre_force, pitch_variance, rms, std,
-                                   suspension_travel_max, suspension_travel_max_abs,
-                                   suspension_travel_variance, tyre_deflection_max,
-                                   tyre_deflection_max_abs, tyre_deflection_variance, var)
+from suspopt.metrics.stats import (
+    STATISTICS,
+    dynamic_tyre_load_ratio,
+    max_abs,
+    maximum,
+    mean,
+    minimum,
+    peak_dynamic_tyre_load_ratio,
+    peak_to_peak,
+    peak_tyre_force,
+    pitch_variance,
+    rms,
+    std,
+    suspension_travel_max,
+    suspension_travel_max_abs,
+    suspension_travel_variance,
+    tyre_deflection_max,
+    tyre_deflection_max_abs,
+    tyre_deflection_variance,
+    var,
+)
 
 SIGNALS = np.array([[1.0, 2.0, 3.0, 4.0], [-5.0, 2.0, 3.0, 0.0]])
 
@@ -33,8 +48,7 @@ def test_generic_statistics_by_hand():
 
 
 def test_registry_names_every_statistic():
-    assert set(STATISTICS) == {"var", "std", "rms", "max", "min", "max_abs", "mean",
-                               "peak_to_peak"}
+    assert set(STATISTICS) == {"var", "std", "rms", "max", "min", "max_abs", "mean", "peak_to_peak"}
     assert STATISTICS["max"] is maximum and STATISTICS["min"] is minimum
     for name, function in STATISTICS.items():
         assert function(SIGNALS).shape == (2,), name
@@ -60,11 +74,14 @@ def test_dynamic_tyre_load_ratios_of_a_sinusoidal_load():
     amplitude = np.array([600.0, 2000.0])
     dynamic = amplitude[:, None] * np.sin(2 * np.pi * 5 * t)
     total = static[:, None] + dynamic
-    np.testing.assert_allclose(dynamic_tyre_load_ratio(total, static),
-                               amplitude / (np.sqrt(2) * static))
-    np.testing.assert_allclose(dynamic_tyre_load_ratio(dynamic, static),
-                               amplitude / (np.sqrt(2) * static))
+    np.testing.assert_allclose(
+        dynamic_tyre_load_ratio(total, static), amplitude / (np.sqrt(2) * static)
+    )
+    np.testing.assert_allclose(
+        dynamic_tyre_load_ratio(dynamic, static), amplitude / (np.sqrt(2) * static)
+    )
     np.testing.assert_allclose(peak_dynamic_tyre_load_ratio(dynamic, static), amplitude / static)
-    np.testing.assert_allclose(peak_dynamic_tyre_load_ratio(total, static, includes_static=True),
-                               amplitude / static)
+    np.testing.assert_allclose(
+        peak_dynamic_tyre_load_ratio(total, static, includes_static=True), amplitude / static
+    )
     np.testing.assert_allclose(peak_tyre_force(total), static + amplitude)

@@ -13,8 +13,14 @@ STEP_AT = 2.0
 T = np.arange(int(30.0 * FS)) / FS
 
 # (natural frequency ω_n in rad/s, damping ratio ζ) of the batch of designs
-DESIGNS = np.array([[2 * np.pi * 1.0, 0.1], [2 * np.pi * 1.5, 0.25], [2 * np.pi * 0.8, 0.5],
-                    [2 * np.pi * 2.0, 0.7]])
+DESIGNS = np.array(
+    [
+        [2 * np.pi * 1.0, 0.1],
+        [2 * np.pi * 1.5, 0.25],
+        [2 * np.pi * 0.8, 0.5],
+        [2 * np.pi * 2.0, 0.7],
+    ]
+)
 
 
 def _step_response(tau: np.ndarray, wn: float, zeta: float) -> np.ndarray:
@@ -37,8 +43,12 @@ def _exact_step_metrics(wn: float, zeta: float, band: float) -> dict[str, float]
     t_k, t_next = k * np.pi / wd, (k + 1) * np.pi / wd
     sign = 1.0 if k % 2 else -1.0  # odd k: overshoot above 1, even k: undershoot
     settling = brentq(lambda s: (y(s) - 1) - sign * band, t_k, t_next)
-    return {"peak_time": t_peak, "overshoot": 100 * np.exp(-np.pi * zeta / np.sqrt(1 - zeta**2)),
-            "rise_time": rise, "settling_time": settling}
+    return {
+        "peak_time": t_peak,
+        "overshoot": 100 * np.exp(-np.pi * zeta / np.sqrt(1 - zeta**2)),
+        "rise_time": rise,
+        "settling_time": settling,
+    }
 
 
 @pytest.fixture(scope="module")
@@ -57,8 +67,7 @@ def test_second_order_step_matches_closed_forms(step_batch):
         assert got["peak"][i] == pytest.approx(1 + exact["overshoot"] / 100, abs=1e-4)
         assert got["rise_time"][i] == pytest.approx(exact["rise_time"], abs=2e-4)
         # interpolated crossing of the band edge: a fraction of a sample
-        assert got["settling_time_from_start"][i] == pytest.approx(exact["settling_time"],
-                                                                   abs=1e-3)
+        assert got["settling_time_from_start"][i] == pytest.approx(exact["settling_time"], abs=1e-3)
         assert got["settling_time"][i] == pytest.approx(STEP_AT + exact["settling_time"], abs=1e-3)
     np.testing.assert_allclose(got["steady_state"], 1.0, atol=1e-6)
     np.testing.assert_array_equal(got["initial_value"], 0.0)
@@ -102,8 +111,9 @@ def test_first_order_response_closed_forms():
     got = transient_metrics(T, y, start=STEP_AT)
     np.testing.assert_allclose(got["overshoot"], 0.0, atol=1e-9)
     np.testing.assert_allclose(got["rise_time"], time_constant * np.log(9), atol=1e-5)
-    np.testing.assert_allclose(got["settling_time_from_start"], time_constant * np.log(50),
-                               atol=1e-5)
+    np.testing.assert_allclose(
+        got["settling_time_from_start"], time_constant * np.log(50), atol=1e-5
+    )
 
 
 def test_response_returning_to_zero_settles_relative_to_its_peak():
@@ -142,7 +152,9 @@ def test_band_and_final_window_are_honoured():
     y = _step_response(T - STEP_AT, wn, zeta)
     wide = transient_metrics(T, y, band=0.05, start=STEP_AT)
     assert wide["settling_time_from_start"] == pytest.approx(
-        _exact_step_metrics(wn, zeta, 0.05)["settling_time"], abs=1e-3)
+        _exact_step_metrics(wn, zeta, 0.05)["settling_time"], abs=1e-3
+    )
     ramp = np.linspace(0.0, 1.0, T.size)
     assert transient_metrics(T, ramp, final_fraction=0.5)["steady_state"] == pytest.approx(
-        0.75, abs=1e-3)
+        0.75, abs=1e-3
+    )

@@ -19,12 +19,21 @@ import suspopt
 from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
 from suspopt.config.optimise import ALGORITHMS
-from suspopt.optimise import (PENALTY, Gradient, Hybrid, PymooOptimiser, WeightedSum,
-                              balanced_weights, build_optimiser, minimize, optimise)
+from suspopt.optimise import (
+    PENALTY,
+    Gradient,
+    Hybrid,
+    PymooOptimiser,
+    WeightedSum,
+    balanced_weights,
+    build_optimiser,
+    minimize,
+    optimise,
+)
 from suspopt.optimise.algorithms import pymoo_algorithm, termination
 
-
 # --- analytic problems: the algorithm layer needs no vehicle -----------------------------------
+
 
 class Quadratic(PymooProblem):
     """f = |x - (1, -2, 0.5)|^2 on [-5, 5]^3; records the batch sizes it is asked for."""
@@ -47,7 +56,7 @@ class Disc(PymooProblem):
         super().__init__(n_var=2, n_obj=1, n_ieq_constr=1, xl=-2.0, xu=2.0)
 
     def _evaluate(self, X, out, *args, **kwargs):
-        out["F"] = (X ** 2).sum(axis=1)
+        out["F"] = (X**2).sum(axis=1)
         out["G"] = 1.0 - X.sum(axis=1)
 
 
@@ -59,7 +68,7 @@ class TwoObjectives(PymooProblem):
 
     def _evaluate(self, X, out, *args, **kwargs):
         f1 = ((X - Quadratic.optimum) ** 2).sum(axis=1)
-        out["F"] = np.column_stack([f1, (X ** 2).sum(axis=1)])[:, :self.n_obj]
+        out["F"] = np.column_stack([f1, (X**2).sum(axis=1)])[:, : self.n_obj]
         out["G"] = 1.0 - X[:, 0] - X[:, 1]
 
 
@@ -91,14 +100,15 @@ def test_gradient_and_hybrid_hold_a_constraint():
     assert hybrid.ga.n_gen == 5 and hybrid.gradient.n_gen >= 1
     np.testing.assert_allclose(best.X[0], [0.5, 0.5], atol=1e-4)
     assert best.G[0, 0] <= 1e-8
-    lo, hi = hybrid.gradient.box                 # the GA best +- 0.2/2 of the range, cut by bounds
+    lo, hi = hybrid.gradient.box  # the GA best +- 0.2/2 of the range, cut by bounds
     assert np.all(hi - lo <= 0.2 * 4.0 + 1e-12)
 
 
 def test_nsga2_approaches_the_zdt1_front():
     zdt1 = get_problem("zdt1")
-    front = minimize(zdt1, PymooOptimiser(NSGA2(pop_size=100),
-                                          termination(2, 150, None, 1e-9, 50)), seed=1)
+    front = minimize(
+        zdt1, PymooOptimiser(NSGA2(pop_size=100), termination(2, 150, None, 1e-9, 50)), seed=1
+    )
     assert len(front.F) > 50
     assert IGD(zdt1.pareto_front())(front.F) < 0.01
 
@@ -106,13 +116,18 @@ def test_nsga2_approaches_the_zdt1_front():
 def test_same_seed_same_run_and_no_global_random_state():
     np.random.seed(123)
     before = np.random.get_state()[1].copy()
-    runs = [minimize(TwoObjectives(), PymooOptimiser(NSGA2(pop_size=20),
-                                                     termination(2, 10, None, 1e-9, 50)),
-                     seed=seed) for seed in (7, 7, 8)]
+    runs = [
+        minimize(
+            TwoObjectives(),
+            PymooOptimiser(NSGA2(pop_size=20), termination(2, 10, None, 1e-9, 50)),
+            seed=seed,
+        )
+        for seed in (7, 7, 8)
+    ]
     np.testing.assert_array_equal(runs[0].X, runs[1].X)
     np.testing.assert_array_equal(runs[0].F, runs[1].F)
     assert not np.array_equal(runs[0].F, runs[2].F)
-    np.testing.assert_array_equal(np.random.get_state()[1], before)   # global RNG untouched
+    np.testing.assert_array_equal(np.random.get_state()[1], before)  # global RNG untouched
 
 
 def test_weighted_sum_with_one_unit_weight_is_the_single_objective():
@@ -139,9 +154,10 @@ def test_balanced_weights_are_inverse_medians():
 
 
 def test_pymoo_algorithms_by_name_with_checked_options():
-    gde3 = pymoo_algorithm(ALGORITHMS["gde3"].target, {"CR": 0.5}, 20, 2)     # a DE variant option
-    front = minimize(TwoObjectives(), PymooOptimiser(gde3, termination(2, 10, None, 1e-9, 50)),
-                     seed=1)
+    gde3 = pymoo_algorithm(ALGORITHMS["gde3"].target, {"CR": 0.5}, 20, 2)  # a DE variant option
+    front = minimize(
+        TwoObjectives(), PymooOptimiser(gde3, termination(2, 10, None, 1e-9, 50)), seed=1
+    )
     assert front.feasible.all()
     with pytest.raises(ValueError, match="did you mean eliminate_duplicates"):
         pymoo_algorithm(ALGORITHMS["ga"].target, {"eliminate_duplicate": True}, 10, 1)
@@ -156,8 +172,9 @@ class Mixed(PymooProblem):
         super().__init__(n_var=3, n_obj=n_obj, n_ieq_constr=1, xl=0.0, xu=1.0)
 
     def _evaluate(self, X, out, *args, **kwargs):
-        out["F"] = np.column_stack([((X - 0.3) ** 2).sum(axis=1), ((X - 0.7) ** 2).sum(axis=1),
-                                    (X ** 2).sum(axis=1)])[:, :self.n_obj]
+        out["F"] = np.column_stack(
+            [((X - 0.3) ** 2).sum(axis=1), ((X - 0.7) ** 2).sum(axis=1), (X**2).sum(axis=1)]
+        )[:, : self.n_obj]
         out["G"] = 0.2 - X[:, 0]
 
 
@@ -171,22 +188,25 @@ def test_every_registered_pymoo_algorithm_is_seeded_and_resumes_by_replay(name, 
     problem = Mixed(n_obj)
 
     def optimiser():
-        return PymooOptimiser(pymoo_algorithm(ALGORITHMS[name].target, {}, 12, n_obj),
-                              termination(n_obj, 8, None, 1e-12, 30))
+        return PymooOptimiser(
+            pymoo_algorithm(ALGORITHMS[name].target, {}, 12, n_obj),
+            termination(n_obj, 8, None, 1e-12, 30),
+        )
+
     default_rng = np.random.default_rng
 
-    def seeded_only(seed=None, *args):            # pymoo's fallback for a missing random_state
+    def seeded_only(seed=None, *args):  # pymoo's fallback for a missing random_state
         assert seed is not None, f"{name} draws from an unseeded Generator"
         return default_rng(seed, *args)
 
     first, recorder = optimiser(), _Recorder(problem)
     resumed, replay = optimiser(), _Recorder(problem)
-    first.setup(recorder, default_rng(1))          # (pymoo's setup makes a Generator of its
-    resumed.setup(replay, default_rng(1))          # own, which the run's replaces)
+    first.setup(recorder, default_rng(1))  # (pymoo's setup makes a Generator of its
+    resumed.setup(replay, default_rng(1))  # own, which the run's replaces)
     monkeypatch.setattr(np.random, "default_rng", seeded_only)
     for _ in range(3):
         first.next()
-    replay._stored.extend(recorder.batches)       # what the checkpoint holds
+    replay._stored.extend(recorder.batches)  # what the checkpoint holds
     evaluated = []
     monkeypatch.setattr(problem, "_evaluate", lambda X, out, *a, **k: evaluated.append(X))
     for _ in range(3):
@@ -248,27 +268,36 @@ def test_problem_names_units_and_one_batch_equal_to_single_designs():
     assert problem.var_names == ["k_F1", "c_F1", "knl_F1"]
     assert problem.var_units == ["N/m", "N s/m", "N/m^3"]
     assert problem.obj_names == ["f1", "f3"] and problem.obj_units == ["(m/s^2)^2", "m^2"]
-    assert problem.constraint_names == ["RC <= 1.4", "ratio.F1 >= 0.1", "ratio.F1 <= 0.3",
-                                        "ratio.R1 >= 0.1", "ratio.R1 <= 0.3",
-                                        "simulation_failed"]
+    assert problem.constraint_names == [
+        "RC <= 1.4",
+        "ratio.F1 >= 0.1",
+        "ratio.F1 <= 0.3",
+        "ratio.R1 >= 0.1",
+        "ratio.R1 <= 0.3",
+        "simulation_failed",
+    ]
     assert problem.supplementary_names == ["f2"]
     np.testing.assert_allclose(problem.xu[2], np.log10(3.0e7))
     X = problem.xl + np.random.default_rng(0).random((4, 3)) * (problem.xu - problem.xl)
     F, G, S = problem.evaluate(X, return_values_of=["F", "G", "S"])
     assert F.shape == (4, 2) and G.shape == (4, 6) and S.shape == (4, 1)
-    single = np.vstack([np.hstack(problem.evaluate(x[None], return_values_of=["F", "G"]))
-                        for x in X])
+    single = np.vstack(
+        [np.hstack(problem.evaluate(x[None], return_values_of=["F", "G"])) for x in X]
+    )
     np.testing.assert_allclose(np.hstack([F, G]), single, rtol=1e-12)
     assert (G[:, -1] == -1).all()
     np.testing.assert_allclose(problem.to_physical(X)[:, 2], 10 ** X[:, 2])
 
 
 def test_a_diverging_design_is_penalised_and_the_batch_survives():
-    cfg = tiny(**{"dt: 1.0e-3": "dt: 5.0e-3",
-                  "path: vehicle.corners.F1.damper.c, lower: 2.0e3, upper: 1.0e4":
-                  "path: vehicle.corners.F1.tyre.stiffness, lower: 2.0e5, upper: 2.0e7"})
+    cfg = tiny(
+        **{
+            "dt: 1.0e-3": "dt: 5.0e-3",
+            "path: vehicle.corners.F1.damper.c, lower: 2.0e3, upper: 1.0e4": "path: vehicle.corners.F1.tyre.stiffness, lower: 2.0e5, upper: 2.0e7",
+        }
+    )
     problem = suspopt.Problem.from_config(cfg)
-    X = np.array([[5e4, 4e5, 7.0], [5e4, 2e7, 7.0]])     # the stiff tyre blows up RK4 at 5 ms
+    X = np.array([[5e4, 4e5, 7.0], [5e4, 2e7, 7.0]])  # the stiff tyre blows up RK4 at 5 ms
     F, G = problem.evaluate(X, return_values_of=["F", "G"])
     assert np.isfinite(F).all() and np.isfinite(G).all()
     assert (F[1] == PENALTY).all() and G[1, -1] == PENALTY
@@ -276,24 +305,49 @@ def test_a_diverging_design_is_penalised_and_the_batch_survives():
 
 
 BAD = {
-    "path": ({"path: vehicle.corners.F1.spring.linear": "path: vehicle.corners.F1.spring.linaer"},
-             "did you mean vehicle.corners.F1.spring.linear", 18),
-    "swapped": ({"lower: 3.2e4, upper: 1.5e5": "lower: 1.5e5, upper: 3.2e4"},
-                "did you swap the bounds", 18),
-    "per_corner_objective": ({"signal: tyre_deflection, reduce: mean}": "signal: tyre_deflection}"},
-                             "objectives.main[1].reduce: f3 gives one value per corner", 24),
-    "one_per_run": ({"path: vehicle.corners.F1.damper.c,": "path: road.speed,"},
-                    "road is one per run", 19),
-    "bound_rejected": ({"path: vehicle.corners.F1.damper.c, lower: 2.0e3":
-                        "path: vehicle.corners.F1.unsprung_mass, lower: 0"},
-                       "vehicle.corners.F1.unsprung_mass: must be in [0.001, 1e+06], got 0", 19),
-    "signal": ({"signal: body.heave_acc}": "signal: body.heave_ac}"},
-               "did you mean body.heave_acc", 23),
+    "path": (
+        {"path: vehicle.corners.F1.spring.linear": "path: vehicle.corners.F1.spring.linaer"},
+        "did you mean vehicle.corners.F1.spring.linear",
+        18,
+    ),
+    "swapped": (
+        {"lower: 3.2e4, upper: 1.5e5": "lower: 1.5e5, upper: 3.2e4"},
+        "did you swap the bounds",
+        18,
+    ),
+    "per_corner_objective": (
+        {"signal: tyre_deflection, reduce: mean}": "signal: tyre_deflection}"},
+        "objectives.main[1].reduce: f3 gives one value per corner",
+        24,
+    ),
+    "one_per_run": (
+        {"path: vehicle.corners.F1.damper.c,": "path: road.speed,"},
+        "road is one per run",
+        19,
+    ),
+    "bound_rejected": (
+        {
+            "path: vehicle.corners.F1.damper.c, lower: 2.0e3": "path: vehicle.corners.F1.unsprung_mass, lower: 0"
+        },
+        "vehicle.corners.F1.unsprung_mass: must be in [0.001, 1e+06], got 0",
+        19,
+    ),
+    "signal": (
+        {"signal: body.heave_acc}": "signal: body.heave_ac}"},
+        "did you mean body.heave_acc",
+        23,
+    ),
     "ga_two_objectives": ({"algorithm: nsga2": "algorithm: ga"}, "add optimiser.weighted_sum", 30),
-    "weights": ({"algorithm: nsga2,": "algorithm: ga, weighted_sum: {weights: [1, 2, 3]},"},
-                "3 weights for 2 main objectives", 30),
-    "option": ({"seed: 1}": "seed: 1, options: {n_offspring: 4}}"},
-               "did you mean n_offsprings", 30),
+    "weights": (
+        {"algorithm: nsga2,": "algorithm: ga, weighted_sum: {weights: [1, 2, 3]},"},
+        "3 weights for 2 main objectives",
+        30,
+    ),
+    "option": (
+        {"seed: 1}": "seed: 1, options: {n_offspring: 4}}"},
+        "did you mean n_offsprings",
+        30,
+    ),
     "algorithm": ({"algorithm: nsga2": "algorithm: nsga"}, "nsga2", 30),
 }
 
@@ -310,12 +364,19 @@ def test_bad_optimisation_input_names_key_and_line(case):
 
 # --- runs: reproducible, resumable, written as docs/architecture.md#public-contract says --------
 
+
 @pytest.mark.parametrize("variant", ["nsga2", "hybrid_weighted"])
 def test_resume_equals_an_uninterrupted_run(tmp_path, variant):
-    cfg = tiny() if variant == "nsga2" else tiny(**{
-        "{algorithm: nsga2, population: 8, generations: 4, seed: 1}":
-        "{algorithm: hybrid, population: 8, generations: 5, seed: 1, hybrid: {ga_generations: "
-        "2}, weighted_sum: {balance: {samples: 8, dominant: f1}}}"})
+    cfg = (
+        tiny()
+        if variant == "nsga2"
+        else tiny(
+            **{
+                "{algorithm: nsga2, population: 8, generations: 4, seed: 1}": "{algorithm: hybrid, population: 8, generations: 5, seed: 1, hybrid: {ga_generations: "
+                "2}, weighted_sum: {balance: {samples: 8, dominant: f1}}}"
+            }
+        )
+    )
     whole = optimise(cfg, tmp_path / "whole.h5")
     again = optimise(cfg, tmp_path / "again.h5")
 
@@ -332,8 +393,7 @@ def test_resume_equals_an_uninterrupted_run(tmp_path, variant):
     for other in (again, resumed):
         for key in ("X", "F", "G"):
             np.testing.assert_array_equal(getattr(whole, key), getattr(other, key))
-        np.testing.assert_array_equal(whole.history["evaluations"],
-                                      other.history["evaluations"])
+        np.testing.assert_array_equal(whole.history["evaluations"], other.history["evaluations"])
     if variant == "hybrid_weighted":
         assert whole.F.shape == (1, 2) and whole.weights.shape == (2,)
     with pytest.raises(ConfigError, match="another config"):
@@ -341,8 +401,13 @@ def test_resume_equals_an_uninterrupted_run(tmp_path, variant):
 
 
 def run_cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "suspopt", *map(str, args)],
-                          capture_output=True, text=True, cwd=cwd, timeout=120)
+    return subprocess.run(
+        [sys.executable, "-m", "suspopt", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=120,
+    )
 
 
 def test_cli_optimise_writes_the_design_md_layout(tmp_path):
@@ -359,13 +424,13 @@ def test_cli_optimise_writes_the_design_md_layout(tmp_path):
         X, F, G = (h5[f"pareto/{k}"] for k in "XFG")
         N = X.shape[0]
         assert X.shape == (N, 3) and F.shape == (N, 2) and G.shape == (N, 6) and N >= 1
-        assert list(X.attrs["names"]) == ["k_F1", "c_F1", "knl_F1"]      # UTF-8 text
+        assert list(X.attrs["names"]) == ["k_F1", "c_F1", "knl_F1"]  # UTF-8 text
         assert list(F.attrs["units"]) == ["(m/s^2)^2", "m^2"]
         assert G.attrs["names"][-1] == "simulation_failed"
         for key in ("best", "hypervolume", "evaluations", "time", "generation", "feasible"):
             assert h5[f"history/{key}"].shape[0] == 2 and "units" in h5[f"history/{key}"].attrs
         assert h5["history/evaluations"][-1] == 16
-        checkpoint = h5["checkpoint"]                   # data only: every evaluated batch
+        checkpoint = h5["checkpoint"]  # data only: every evaluated batch
         assert checkpoint.attrs["format"] == "replay-1" and checkpoint.attrs["generations"] == 2
         assert checkpoint["batches"][()].tolist() == [8, 8]
         assert checkpoint["X"].shape == (16, 3) and checkpoint["F"].shape == (16, 2)
@@ -374,14 +439,23 @@ def test_cli_optimise_writes_the_design_md_layout(tmp_path):
         assert "state" not in checkpoint
 
 
-@pytest.mark.parametrize("change, needle", [
-    ({"upper: 1.5e5}": "upper: 1.5e4}"},
-     "case.yaml:18: design_variables[0]: lower (32000) > upper (15000): did you swap"),
-    ({"name: f1, metric: var, signal": "name: f1, metric: vra, signal"},
-     "case.yaml:23: objectives.main[0].metric: unknown metric 'vra'; did you mean var"),
-    ({"seed: 1}": "seed: 1, max_evals: 10}"},
-     "case.yaml:30: optimiser.max_evals: unknown key; did you mean max_evaluations"),
-])
+@pytest.mark.parametrize(
+    "change, needle",
+    [
+        (
+            {"upper: 1.5e5}": "upper: 1.5e4}"},
+            "case.yaml:18: design_variables[0]: lower (32000) > upper (15000): did you swap",
+        ),
+        (
+            {"name: f1, metric: var, signal": "name: f1, metric: vra, signal"},
+            "case.yaml:23: objectives.main[0].metric: unknown metric 'vra'; did you mean var",
+        ),
+        (
+            {"seed: 1}": "seed: 1, max_evals: 10}"},
+            "case.yaml:30: optimiser.max_evals: unknown key; did you mean max_evaluations",
+        ),
+    ],
+)
 def test_cli_optimise_bad_input_exits_2_with_one_line(tmp_path, change, needle):
     from typer.testing import CliRunner
 

@@ -9,11 +9,10 @@ from itertools import combinations, pairwise
 
 import numpy as np
 import pytest
+from conftest import CONFIGS, ROOT, tiny
 
 import suspopt
 from suspopt import plots
-
-from conftest import CONFIGS, ROOT, tiny
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -45,9 +44,12 @@ def texts(fig):
             found += [axis.label, axis.get_offset_text()]
             low, high = sorted(axis.get_view_interval())
             span = (high - low) * 1e-9
-            found += [label for tick in axis.get_major_ticks() + axis.get_minor_ticks()
-                      if low - span <= tick.get_loc() <= high + span
-                      for label in (tick.label1, tick.label2)]
+            found += [
+                label
+                for tick in axis.get_major_ticks() + axis.get_minor_ticks()
+                if low - span <= tick.get_loc() <= high + span
+                for label in (tick.label1, tick.label2)
+            ]
         if ax.get_legend() is not None:
             found += ax.get_legend().get_texts()
     return [t for t in found if t.get_visible() and t.get_text().strip()]
@@ -57,10 +59,15 @@ def overlapping_texts(fig):
     """Pairs of texts of ``fig`` whose boxes overlap (more than a pixel)."""
     fig = drawn(fig)
     renderer = fig.canvas.get_renderer()
-    boxes = [(t.get_text(), t.get_window_extent(renderer).expanded(1.0, 1.0).padded(-1.0))
-             for t in texts(fig)]
-    return [(a, b) for (a, box_a), (b, box_b) in combinations(boxes, 2)
-            if box_a.width > 0 and box_b.width > 0 and box_a.overlaps(box_b)]
+    boxes = [
+        (t.get_text(), t.get_window_extent(renderer).expanded(1.0, 1.0).padded(-1.0))
+        for t in texts(fig)
+    ]
+    return [
+        (a, b)
+        for (a, box_a), (b, box_b) in combinations(boxes, 2)
+        if box_a.width > 0 and box_b.width > 0 and box_a.overlaps(box_b)
+    ]
 
 
 def data_axes(fig):
@@ -71,8 +78,9 @@ def legend_outside_the_panels(fig):
     """The figure's one legend, checked to lie outside every panel with data."""
     fig = drawn(fig)
     renderer = fig.canvas.get_renderer()
-    legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes
-                                   if ax.get_legend() is not None]
+    legends = list(fig.legends) + [
+        ax.get_legend() for ax in fig.axes if ax.get_legend() is not None
+    ]
     assert len(legends) == 1
     box = legends[0].get_window_extent(renderer)
     for ax in data_axes(fig):
@@ -83,24 +91,37 @@ def legend_outside_the_panels(fig):
 
 # --- simulate ------------------------------------------------------------------------------
 
+
 @pytest.fixture(scope="module")
 def sweep():
     """The quickstart half car with three damper settings (P = 3)."""
     cfg = suspopt.load_config(CONFIGS / "quickstart.yaml")
-    return suspopt.simulate(cfg, params={
-        "vehicle.corners.F1.damper.c": np.array([1500.0, 3000.0, 6000.0]),
-        "vehicle.corners.R1.damper.c": np.array([2000.0, 3500.0, 7000.0])})
+    return suspopt.simulate(
+        cfg,
+        params={
+            "vehicle.corners.F1.damper.c": np.array([1500.0, 3000.0, 6000.0]),
+            "vehicle.corners.R1.damper.c": np.array([2000.0, 3500.0, 7000.0]),
+        },
+    )
 
 
-def test_the_simulation_figure_has_time_psd_and_comfort_panels_for_every_design(
-        sweep, tmp_path):
+def test_the_simulation_figure_has_time_psd_and_comfort_panels_for_every_design(sweep, tmp_path):
     signals = plots.default_signals(sweep)
-    assert signals == ["body.heave_acc", "travel.F1", "travel.R1", "tyre_deflection.F1",
-                       "tyre_deflection.R1"]
+    assert signals == [
+        "body.heave_acc",
+        "travel.F1",
+        "travel.R1",
+        "tyre_deflection.F1",
+        "tyre_deflection.R1",
+    ]
     labels = plots.design_labels(sweep.designs, [0, 1, 2], 3, sweep.diverged_at)
     assert labels[1] == "#1 F1.damper.c=3000, R1.damper.c=3500"
-    fig = plots.simulation_figure(sweep.time, {n: sweep.signals[n] for n in signals},
-                                  {n: sweep.signal_unit(n) for n in signals}, labels)
+    fig = plots.simulation_figure(
+        sweep.time,
+        {n: sweep.signals[n] for n in signals},
+        {n: sweep.signal_unit(n) for n in signals},
+        labels,
+    )
     axes = fig.axes
     assert len(axes) == 2 * len(signals) + 1
     for r, name in enumerate(signals):
@@ -118,8 +139,11 @@ def test_the_simulation_figure_has_time_psd_and_comfort_panels_for_every_design(
     assert [t.get_text() for t in comfort.get_xticklabels()] == ["body.heave_acc"]
     assert comfort.get_ylabel() == "Wk-weighted r.m.s. [m/s^2]"
     rms = suspopt.metrics.iso2631.weighted_rms(sweep.signals["body.heave_acc"], 1000.0, "Wk")
-    points = [line.get_ydata()[0] for line in comfort.get_lines() if line.get_marker() != "None"
-              and line.get_linestyle() == "None"]
+    points = [
+        line.get_ydata()[0]
+        for line in comfort.get_lines()
+        if line.get_marker() != "None" and line.get_linestyle() == "None"
+    ]
     np.testing.assert_allclose(points, rms)
     (second,) = comfort.child_axes
     bands = [t.get_text() for t in second.get_yticklabels()]
@@ -135,13 +159,14 @@ def test_plot_simulation_writes_png_and_svg(sweep, tmp_path):
     assert png.read_bytes()[:8] == PNG
     text = svg.read_text()
     assert "<svg" in text[:1000] and "#2 F1.damper.c=6000" in text and "#1 F1" not in text
-    assert text.count('id="axes_') == 2 * 5 + 2          # and the comfort bands' axis
+    assert text.count('id="axes_') == 2 * 5 + 2  # and the comfort bands' axis
 
 
 def test_bad_signals_and_designs_are_value_errors_before_anything_is_written(sweep, tmp_path):
     path = tmp_path / "sim.png"
-    with pytest.raises(ValueError, match="unknown signal 'body.heave_ac'; did you mean "
-                                         "body.heave_acc"):
+    with pytest.raises(
+        ValueError, match="unknown signal 'body.heave_ac'; did you mean body.heave_acc"
+    ):
         plots.plot_simulation(sweep, path, signals=["body.heave_ac"])
     with pytest.raises(ValueError, match="3 out of range: the result has 3 designs"):
         plots.plot_simulation(sweep, path, designs=[0, 3])
@@ -154,8 +179,9 @@ def test_bad_signals_and_designs_are_value_errors_before_anything_is_written(swe
 
 def test_more_designs_than_fit_are_thinned_evenly_and_the_title_says_so(tmp_path):
     cfg = suspopt.load_config(CONFIGS / "quickstart.yaml")
-    res = suspopt.simulate(cfg, params={"vehicle.corners.F1.damper.c":
-                                        np.linspace(1000.0, 8000.0, 20)})
+    res = suspopt.simulate(
+        cfg, params={"vehicle.corners.F1.damper.c": np.linspace(1000.0, 8000.0, 20)}
+    )
     chosen, note = plots.chosen_designs(20, None)
     assert chosen == [0, 3, 5, 8, 11, 14, 16, 19] and note.startswith("8 of 20 designs drawn")
     assert plots.chosen_designs(5, None) == ([0, 1, 2, 3, 4], "")
@@ -169,9 +195,12 @@ def test_a_signal_every_design_shares_is_one_curve_and_one_design_has_no_legend(
     t = np.arange(0, 2.0, 0.005)
     body = np.tile(np.sin(2 * np.pi * t), (3, 1))
     seat = body * np.array([[0.5], [1.0], [2.0]])
-    fig = plots.simulation_figure(t, {"body.heave_acc": body, "seat.acc": seat},
-                                  {"body.heave_acc": "m/s^2", "seat.acc": "m/s^2"},
-                                  ["a", "b", "c"])
+    fig = plots.simulation_figure(
+        t,
+        {"body.heave_acc": body, "seat.acc": seat},
+        {"body.heave_acc": "m/s^2", "seat.acc": "m/s^2"},
+        ["a", "b", "c"],
+    )
     body_ax, _, seat_ax, _, comfort = fig.axes
     assert len(body_ax.get_lines()) == 1 and body_ax.get_title() == "the same for all 3 designs"
     assert len(seat_ax.get_lines()) == 3
@@ -181,29 +210,37 @@ def test_a_signal_every_design_shares_is_one_curve_and_one_design_has_no_legend(
 
 
 def test_the_comfort_panel_says_why_it_is_empty_below_100_hz():
-    t = np.arange(0, 10.0, 0.02)                     # 50 Hz
-    fig = plots.simulation_figure(t, {"body.heave_acc": np.sin(t)[None]},
-                                  {"body.heave_acc": "m/s^2"}, ["design"])
+    t = np.arange(0, 10.0, 0.02)  # 50 Hz
+    fig = plots.simulation_figure(
+        t, {"body.heave_acc": np.sin(t)[None]}, {"body.heave_acc": "m/s^2"}, ["design"]
+    )
     comfort = fig.axes[-1]
     assert not comfort.axison and "needs 100 Hz or more" in comfort.texts[0].get_text()
 
 
 def test_design_labels_show_what_varies_and_where_a_design_diverged():
-    designs = {"vehicle.corners.F1.spring.linear": np.array([1e4, 2e4]),
-               "vehicle.corners.R1.spring.linear": np.array([1e4, 3e4]),
-               "vehicle.body.mass": np.array([300.0, 300.0])}
+    designs = {
+        "vehicle.corners.F1.spring.linear": np.array([1e4, 2e4]),
+        "vehicle.corners.R1.spring.linear": np.array([1e4, 3e4]),
+        "vehicle.body.mass": np.array([300.0, 300.0]),
+    }
     assert plots.design_labels(designs, [0, 1], 2, np.array([np.nan, 1.25])) == [
         "#0 F1.spring.linear=1e+04, R1.spring.linear=1e+04",
-        "#1 F1.spring.linear=2e+04, R1.spring.linear=3e+04 (diverged at 1.25 s)"]
+        "#1 F1.spring.linear=2e+04, R1.spring.linear=3e+04 (diverged at 1.25 s)",
+    ]
     assert plots.design_labels({}, [0], 1, np.array([np.nan])) == ["design"]
 
 
 # --- optimise ------------------------------------------------------------------------------
 
-HISTORY = {"generation": np.arange(1.0, 5.0), "evaluations": np.arange(1.0, 5.0) * 10,
-           "time": np.arange(1.0, 5.0), "feasible": np.array([0.0, 0.2, 0.5, 0.9]),
-           "hypervolume": np.array([np.nan, 0.2, 0.3, 0.35]),
-           "best": np.array([[np.nan], [3.0], [2.5], [2.0]])}
+HISTORY = {
+    "generation": np.arange(1.0, 5.0),
+    "evaluations": np.arange(1.0, 5.0) * 10,
+    "time": np.arange(1.0, 5.0),
+    "feasible": np.array([0.0, 0.2, 0.5, 0.9]),
+    "hypervolume": np.array([np.nan, 0.2, 0.3, 0.35]),
+    "best": np.array([[np.nan], [3.0], [2.5], [2.0]]),
+}
 
 
 def test_two_objectives_draw_the_front_and_the_history(tmp_path):
@@ -213,7 +250,7 @@ def test_two_objectives_draw_the_front_and_the_history(tmp_path):
     front, hv, share = fig.axes
     feasible, infeasible = front.collections
     np.testing.assert_array_equal(feasible.get_offsets(), F[:3])
-    np.testing.assert_array_equal(infeasible.get_offsets(), F[3:4])    # the failed one: none
+    np.testing.assert_array_equal(infeasible.get_offsets(), F[3:4])  # the failed one: none
     assert (front.get_xlabel(), front.get_ylabel()) == ("RC [m/s^2]", "X_ST [m]")
     assert hv.get_ylabel() == "hypervolume (normalised) [-]"
     np.testing.assert_array_equal(hv.get_lines()[0].get_ydata(), HISTORY["hypervolume"])
@@ -222,32 +259,44 @@ def test_two_objectives_draw_the_front_and_the_history(tmp_path):
     assert fig._suptitle.get_text() == "run (1 failed design not drawn)"
     legend = legend_outside_the_panels(fig)
     assert [t.get_text() for t in legend.get_texts()] == [
-        "feasible", "infeasible (a constraint G > 0)"]
+        "feasible",
+        "infeasible (a constraint G > 0)",
+    ]
     assert overlapping_texts(fig) == []
 
 
 def test_three_objectives_draw_every_pair():
     F = np.random.default_rng(1).random((12, 3))
-    fig = plots.optimisation_figure(F, np.zeros((12, 0)), ["f1", "f2", "f3"],
-                                    ["(m/s^2)^2", "m^2", "1"], HISTORY)
+    fig = plots.optimisation_figure(
+        F, np.zeros((12, 0)), ["f1", "f2", "f3"], ["(m/s^2)^2", "m^2", "1"], HISTORY
+    )
     panels = data_axes(fig)
     assert [(ax.get_xlabel(), ax.get_ylabel()) for ax in panels[:3]] == [
-        ("f1 [(m/s^2)^2]", "f2 [m^2]"), ("f1 [(m/s^2)^2]", "f3 [-]"), ("f2 [m^2]", "f3 [-]")]
+        ("f1 [(m/s^2)^2]", "f2 [m^2]"),
+        ("f1 [(m/s^2)^2]", "f3 [-]"),
+        ("f2 [m^2]", "f3 [-]"),
+    ]
     assert len(panels) == 5 and len(panels[0].collections[0].get_offsets()) == 12
-    legend_outside_the_panels(fig)           # in the grid's spare cell
+    legend_outside_the_panels(fig)  # in the grid's spare cell
     assert overlapping_texts(fig) == []
 
 
 def test_one_objective_or_a_weighted_sum_draws_the_best_value():
-    fig = plots.optimisation_figure(np.array([[2.0]]), np.array([[-1.0]]), ["f1"],
-                                    ["(m/s^2)^2"], HISTORY)
+    fig = plots.optimisation_figure(
+        np.array([[2.0]]), np.array([[-1.0]]), ["f1"], ["(m/s^2)^2"], HISTORY
+    )
     best, _share = fig.axes
     assert best.get_ylabel() == "best f1 [(m/s^2)^2]"
     assert best.get_title() == "best design: f1 = 2 (m/s^2)^2"
     np.testing.assert_array_equal(best.get_lines()[0].get_ydata(), HISTORY["best"][:, 0])
-    weighted = plots.optimisation_figure(np.array([[2.0, 0.01]]), np.array([[-1.0]]),
-                                         ["f1", "f3"], ["(m/s^2)^2", "m^2"], HISTORY,
-                                         weights=np.array([1.0, 100.0]))
+    weighted = plots.optimisation_figure(
+        np.array([[2.0, 0.01]]),
+        np.array([[-1.0]]),
+        ["f1", "f3"],
+        ["(m/s^2)^2", "m^2"],
+        HISTORY,
+        weights=np.array([1.0, 100.0]),
+    )
     best, _ = weighted.axes
     assert best.get_ylabel() == "best weighted sum [-]"
     assert best.get_title() == "best design: f1 = 2 (m/s^2)^2, f3 = 0.01 m^2"
@@ -269,13 +318,16 @@ def test_plot_optimisation_draws_a_run(tmp_path):
 
 # --- the models figure (Figs. 3.2-3.24) -----------------------------------------------------
 
+
 def coinciding(n: int = 4):
     t = np.linspace(0.0, 5.0, 2000)
     y = np.exp(-t) * np.sin(2 * np.pi * t)
     f = np.linspace(0.1, 30.0, 300)
-    return ({"body.heave_acc": [(f"model {i}", t, y) for i in range(n)]},
-            {"body.heave_acc": [(f"model {i}", f, 1 / f) for i in range(n)]},
-            {"body.heave_acc": "m/s^2", "PSD of body.heave_acc": "(m/s^2)^2/Hz"})
+    return (
+        {"body.heave_acc": [(f"model {i}", t, y) for i in range(n)]},
+        {"body.heave_acc": [(f"model {i}", f, 1 / f) for i in range(n)]},
+        {"body.heave_acc": "m/s^2", "PSD of body.heave_acc": "(m/s^2)^2/Hz"},
+    )
 
 
 def test_coinciding_model_curves_get_distinct_styles_and_interleaved_markers():
@@ -306,9 +358,11 @@ def test_coinciding_model_curves_all_show_their_colour():
     image = np.asarray(fig.canvas.buffer_rgba())[..., :3] / 255.0
     ax = fig.axes[0]
     x0, y0, x1, y1 = ax.get_window_extent().extents.astype(int)
-    panel = image[image.shape[0] - y1:image.shape[0] - y0, x0:x1]
-    shown = [int((np.abs(panel - to_rgb(line.get_color())).max(axis=-1) < 0.08).sum())
-             for line in ax.get_lines()]
+    panel = image[image.shape[0] - y1 : image.shape[0] - y0, x0:x1]
+    shown = [
+        int((np.abs(panel - to_rgb(line.get_color())).max(axis=-1) < 0.08).sum())
+        for line in ax.get_lines()
+    ]
     assert min(shown) >= 150, shown
 
 
@@ -317,8 +371,9 @@ def test_analyse_models_figure_uses_the_styles(tmp_path):
 
     paths = []
     for name in ("part1a_qc_bump", "part1a_hc1_bump"):
-        text = (CONFIGS / "ch3" / f"{name}.yaml").read_text().replace("duration: 9.0",
-                                                                      "duration: 3.0")
+        text = (
+            (CONFIGS / "ch3" / f"{name}.yaml").read_text().replace("duration: 9.0", "duration: 3.0")
+        )
         paths.append(tmp_path / f"{name}.yaml")
         paths[-1].write_text(text)
     svg = plot_models(compare_models(paths), tmp_path / "m.svg", "QC and HC1")
@@ -328,6 +383,7 @@ def test_analyse_models_figure_uses_the_styles(tmp_path):
 
 
 # --- labels and the matplotlib dependency --------------------------------------------------
+
 
 def test_comfort_labels_that_would_touch_are_left_out_and_their_lines_stay():
     fig, (ax,) = plots.new_figure(1)
@@ -342,24 +398,32 @@ def test_comfort_labels_that_would_touch_are_left_out_and_their_lines_stay():
     plots.draw_comfort_levels(ax, "y", outside=True)
     (second,) = ax.child_axes
     assert [t.get_text() for t in second.get_yticklabels()] == [
-        label for _, _, label in suspopt.metrics.COMFORT_REACTIONS[1:]]
+        label for _, _, label in suspopt.metrics.COMFORT_REACTIONS[1:]
+    ]
 
 
 def test_without_matplotlib_every_figure_is_a_clear_value_error(sweep, tmp_path, monkeypatch):
-    monkeypatch.setitem(sys.modules, "matplotlib.figure", None)       # import fails
+    monkeypatch.setitem(sys.modules, "matplotlib.figure", None)  # import fails
     history = dict(HISTORY)
-    for draw in (lambda p: plots.plot_simulation(sweep, p),
-                 lambda p: plots.model_comparison(p, "m", *coinciding()),
-                 lambda p: plots.save(plots.optimisation_figure(
-                     np.ones((1, 1)), np.zeros((1, 1)), ["f"], ["m"], history), p)):
-        with pytest.raises(ValueError, match=r"--plot needs matplotlib: pip install "
-                                             r"'suspopt\[plot\]'"):
+    for draw in (
+        lambda p: plots.plot_simulation(sweep, p),
+        lambda p: plots.model_comparison(p, "m", *coinciding()),
+        lambda p: plots.save(
+            plots.optimisation_figure(np.ones((1, 1)), np.zeros((1, 1)), ["f"], ["m"], history), p
+        ),
+    ):
+        with pytest.raises(
+            ValueError,
+            match=r"--plot needs matplotlib: pip install "
+            r"'suspopt\[plot\]'",
+        ):
             draw(tmp_path / "f.png")
     assert list(tmp_path.iterdir()) == []
 
 
 def test_importing_the_plots_module_does_not_import_matplotlib():
     code = "import sys, suspopt.plots; print('matplotlib' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
-                         text=True, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True
+    )
     assert out.stdout.strip() == "False"

@@ -39,8 +39,10 @@ def test_thesis_values_are_complete():
     for case in ch5["cases"].values():
         assert set(case["variables"]) == set(ch5["variables"])
         assert set(case["metrics"]) == set(ch5["metrics"])
-        assert all(len(v) == 5 for v in [*case["variables"].values(),
-                                         *case["metrics"].values(), case["time"]])
+        assert all(
+            len(v) == 5
+            for v in [*case["variables"].values(), *case["metrics"].values(), case["time"]]
+        )
     assert set(THESIS["ch6"]["objectives"]) == {f"f{i}" for i in range(1, 7)}
     assert all(len(v["values"]) == 5 for v in THESIS["ch7"]["objectives"].values())
     assert set(THESIS["ch8"]["table_8_12"]) == set(THESIS["ch8"]["seats"])
@@ -55,9 +57,17 @@ def test_number_cells():
 
 def test_budget_copies(tmp_path):
     cfg = Path(__file__).resolve().parents[1] / "configs" / "ch5" / "case1_s2.yaml"
-    run = lambda env: subprocess.run([str(EXAMPLES / "budget_config.sh"), str(cfg),  # noqa: E731
-                                      str(tmp_path)], capture_output=True, text=True,
-                                     env={"PATH": "/usr/bin:/bin", **env}, check=True).stdout
+
+    def run(env):
+        command = [str(EXAMPLES / "budget_config.sh"), str(cfg), str(tmp_path)]
+        return subprocess.run(
+            command,
+            capture_output=True,
+            text=True,
+            env={"PATH": "/usr/bin:/bin", **env},
+            check=True,
+        ).stdout
+
     assert run({}).strip() == str(cfg)
     copy = Path(run({"SUSPOPT_MAX_EVALUATIONS": "5000", "SUSPOPT_GENERATIONS": "7"}).strip())
     text = copy.read_text()
@@ -93,13 +103,25 @@ def _chapter3_files(tmp_path: Path) -> None:
     rng = np.random.default_rng(0)
     d = tmp_path / "ch3"
     (d / "checks").mkdir(parents=True)
-    models = {"part1a": ["qc", "hc1", "hc2", "fc"], "part1b": ["qc", "hc1", "hc2", "fc"],
-              "part2a": ["fc_no_arb", "fc_arb"], "part2b": ["qc_ct0", "qc_ct49"]}
-    for (part, road) in set(report.CH3_FILES.values()):
-        metrics = {r["quantity"] for n, (p, rd) in report.CH3_FILES.items() if (p, rd) == (part, road)
-                   for r in THESIS["ch3"]["tables"][n]["rows"]}
-        _models_file(d / f"{part}_models_{road}.h5",
-                     [f"{part}_{m}_{road}" for m in models[part]], metrics, rng)
+    models = {
+        "part1a": ["qc", "hc1", "hc2", "fc"],
+        "part1b": ["qc", "hc1", "hc2", "fc"],
+        "part2a": ["fc_no_arb", "fc_arb"],
+        "part2b": ["qc_ct0", "qc_ct49"],
+    }
+    for part, road in set(report.CH3_FILES.values()):
+        metrics = {
+            r["quantity"]
+            for n, (p, rd) in report.CH3_FILES.items()
+            if (p, rd) == (part, road)
+            for r in THESIS["ch3"]["tables"][n]["rows"]
+        }
+        _models_file(
+            d / f"{part}_models_{road}.h5",
+            [f"{part}_{m}_{road}" for m in models[part]],
+            metrics,
+            rng,
+        )
     transient = {"peak.body.heave_acc"}
     random_road = {"RC", "max_body_acc", "VST.F1", "MST.F1", "VTD.F1", "MTD.F1"}
     configs = Path(__file__).resolve().parents[1] / "configs" / "ch3"
@@ -107,7 +129,7 @@ def _chapter3_files(tmp_path: Path) -> None:
     _metrics_file(d / "part2a_fc_arb_bump.h5", set(), rng, configs / "part2a_fc_arb_bump.yaml")
     _metrics_file(d / "checks" / "part1a_qc_bump_dt_half.h5", transient, rng)
     _metrics_file(d / "checks" / "part1a_qc_class_b_double_length.h5", random_road, rng)
-    for m in ("qc", "fc"):                 # seed 1 is the config's own run
+    for m in ("qc", "fc"):  # seed 1 is the config's own run
         _metrics_file(d / f"part1a_{m}_class_b.h5", random_road, rng)
         for seed in range(2, 6):
             _metrics_file(d / "checks" / f"part1a_{m}_class_b_seed_{seed}.h5", random_road, rng)
@@ -126,8 +148,11 @@ def test_chapter3_tables_from_synthetic_files(tmp_path):
 
 # --- the conclusions follow their measurements (thresholds: report.CONVERGED, AGREE, ...) ----
 
-@pytest.mark.parametrize("factor, verdict", [(1.003, "the peak is converged in the step size"),
-                                             (1.086, "the peak is not converged")])
+
+@pytest.mark.parametrize(
+    "factor, verdict",
+    [(1.003, "the peak is converged in the step size"), (1.086, "the peak is not converged")],
+)
 def test_chapter3_step_size_conclusion_follows_the_dt_check(tmp_path, factor, verdict):
     _chapter3_files(tmp_path)
     d = tmp_path / "ch3"
@@ -151,7 +176,7 @@ def test_dt_sentence_turns_at_the_threshold():
     bad = report.dt_sentence(8.6, -12.0, "7.92 m/s²")
     assert "not converged in the step size (8.6 % ≥ 1 %)" in bad
     assert "integration error may be part of" in bad and "no integration error" not in bad
-    assert "not converged" in report.dt_sentence(-1.0, -12.0, "x")   # the threshold itself
+    assert "not converged" in report.dt_sentence(-1.0, -12.0, "x")  # the threshold itself
 
 
 def test_side_and_placed():
@@ -211,8 +236,12 @@ def test_a_partial_output_names_what_is_missing(tmp_path):
     says which file is missing, and the rest is written."""
     out, folder = tmp_path / "out", tmp_path / "report"
     (out / "ch3").mkdir(parents=True)
-    proc = subprocess.run([sys.executable, str(EXAMPLES / "report.py"), str(out),
-                           str(folder)], capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, str(EXAMPLES / "report.py"), str(out), str(folder)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr
     assert "not built: chapter 8:" in proc.stderr and "no such file" in proc.stderr
     readme = (folder / "README.md").read_text()

@@ -11,29 +11,30 @@ from scipy.integrate import quad
 from scipy.signal import welch
 
 from suspopt.config.road import RoadConfig
-from suspopt.road import (iso8608_harmonics, iso8608_level, profile, road_edges,
-                          road_inputs)
+from suspopt.road import iso8608_harmonics, iso8608_level, profile, road_edges, road_inputs
 
 ROAD = TypeAdapter(RoadConfig)
 # dyadic numbers keep the bump edges exactly on grid points
 DT = 1.0 / 1024
 T = np.arange(0, 2048) * DT
 SPEED = 8.0
-WHEELBASE = 2.0           # delay 0.25 s
+WHEELBASE = 2.0  # delay 0.25 s
 START = 0.5
-LENGTH = 2.0              # 0.25 s on the bump
+LENGTH = 2.0  # 0.25 s on the bump
 HEIGHT = 0.05
 FOUR_WHEELS = (np.array([0.0, 0.0, WHEELBASE, WHEELBASE]), ["right", "left", "right", "left"])
 
 
 def bump(kind: str, **changes) -> RoadConfig:
-    return ROAD.validate_python(dict(kind=kind, height=HEIGHT, length=LENGTH, speed=SPEED,
-                                     start=START) | changes)
+    return ROAD.validate_python(
+        dict(kind=kind, height=HEIGHT, length=LENGTH, speed=SPEED, start=START) | changes
+    )
 
 
 def iso(**changes) -> RoadConfig:
-    return ROAD.validate_python(dict(kind="iso8608", road_class="B", convention="iso8608",
-                                     speed=20.0) | changes)
+    return ROAD.validate_python(
+        dict(kind="iso8608", road_class="B", convention="iso8608", speed=20.0) | changes
+    )
 
 
 def window(delay: float) -> np.ndarray:
@@ -42,6 +43,7 @@ def window(delay: float) -> np.ndarray:
 
 
 # --- bumps -----------------------------------------------------------------------------------
+
 
 def test_step_bump_height_start_duration_and_rear_delay():
     z, _ = road_inputs(bump("bump_step"), *FOUR_WHEELS, T)
@@ -65,8 +67,9 @@ def test_bump_edges_are_where_the_road_jumps(kind):
     times, jumps = road_edges(bump(kind), offsets, sides)
     delay = WHEELBASE / SPEED
     duration = LENGTH / SPEED
-    np.testing.assert_array_equal(times, np.unique([START, START + duration, START + delay,
-                                                    START + delay + duration]))
+    np.testing.assert_array_equal(
+        times, np.unique([START, START + duration, START + delay, START + delay + duration])
+    )
     right, right_rate = road_inputs(bump(kind), offsets, sides, times)
     left, left_rate = road_inputs(bump(kind), offsets, sides, times, left=True)
     if kind == "bump_step":
@@ -83,12 +86,15 @@ def test_bump_edges_are_where_the_road_jumps(kind):
         slope = HEIGHT * math.pi * SPEED / LENGTH
         np.testing.assert_allclose(np.abs(right_rate - left_rate).max(axis=1), slope)
     between = 0.5 * (times[1:] + times[:-1])
-    np.testing.assert_array_equal(road_inputs(bump(kind), offsets, sides, between, left=True),
-                                  road_inputs(bump(kind), offsets, sides, between))
+    np.testing.assert_array_equal(
+        road_inputs(bump(kind), offsets, sides, between, left=True),
+        road_inputs(bump(kind), offsets, sides, between),
+    )
     # a flat side has no edges; a road other than a bump has none at all
     assert road_edges(bump(kind, tracks="right_only"), offsets, ["left"] * 4)[0].size == 0
-    np.testing.assert_array_equal(road_edges(bump(kind, tracks="right_only"), offsets, sides)[0],
-                                  times)
+    np.testing.assert_array_equal(
+        road_edges(bump(kind, tracks="right_only"), offsets, sides)[0], times
+    )
     assert road_edges(iso(), offsets, sides)[0].size == 0
 
 
@@ -104,10 +110,9 @@ def test_half_sine_shape_and_rear_delay():
 
 def test_half_sine_derivative_matches_finite_differences():
     fine = np.linspace(0, 1.5, 150001)
-    z, zdot = road_inputs(bump("bump_half_sine"), np.array([0.0, WHEELBASE]), ["right"] * 2,
-                          fine)
+    z, zdot = road_inputs(bump("bump_half_sine"), np.array([0.0, WHEELBASE]), ["right"] * 2, fine)
     numeric = np.gradient(z, fine, axis=1)
-    inside = np.abs(np.gradient(zdot, fine, axis=1)) < 1e3     # away from the kinks at the ends
+    inside = np.abs(np.gradient(zdot, fine, axis=1)) < 1e3  # away from the kinks at the ends
     np.testing.assert_allclose(zdot[inside], numeric[inside], atol=1e-6)
     assert np.abs(zdot).max() == pytest.approx(HEIGHT * math.pi * SPEED / LENGTH, rel=1e-6)
 
@@ -127,11 +132,12 @@ def test_bump_tracks(kind):
 
 # --- ISO 8608 --------------------------------------------------------------------------------
 
+
 def welch_level_and_slope(road, length=6000.0, spacing=0.05):
     """Fitted G(n0) [m^3] and slope of the Welch PSD of a generated profile."""
     s = np.arange(0.0, length, spacing)
     f, psd = welch(profile(road, s), fs=1.0 / spacing, nperseg=8192)
-    band = (f >= 5 * road.n_min) & (f <= 0.9 * road.n_max)     # clear of the band edges
+    band = (f >= 5 * road.n_min) & (f <= 0.9 * road.n_max)  # clear of the band edges
     slope, intercept = np.polyfit(np.log(f[band]), np.log(psd[band]), 1)
     return math.exp(intercept + slope * math.log(0.1)), slope
 
@@ -159,20 +165,32 @@ def test_convention_levels_and_amplitudes():
 def band_integral(road) -> float:
     """Integral of the generated profile's one-sided PSD over [n_min, n_max] [m^2], by quad."""
     level = iso8608_level(road)
-    value, error = quad(lambda n: level * (n / 0.1) ** -road.waviness, road.n_min, road.n_max,
-                        epsabs=0.0, epsrel=1e-13, limit=200)
+    value, error = quad(
+        lambda n: level * (n / 0.1) ** -road.waviness,
+        road.n_min,
+        road.n_max,
+        epsabs=0.0,
+        epsrel=1e-13,
+        limit=200,
+    )
     assert error < 1e-12 * value
     return value
 
 
 @pytest.mark.parametrize("length", [100.0, 1000.0, 4000.0])
 @pytest.mark.parametrize("convention", ["iso8608", "thesis"])
-@pytest.mark.parametrize("changes", [{}, dict(waviness=3.0, road_class="C"),
-                                     dict(waviness=1.0, n_waves=37, n_min=0.05, n_max=10.0)])
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {},
+        dict(waviness=3.0, road_class="C"),
+        dict(waviness=1.0, n_waves=37, n_min=0.05, n_max=10.0),
+    ],
+)
 def test_iso8608_variance_is_the_integral_of_the_psd(length, convention, changes):
     road = iso(convention=convention, **changes)
     harmonics = iso8608_harmonics(road, length)
-    assert np.sum(harmonics.amplitude ** 2 / 2) == pytest.approx(band_integral(road), rel=1e-10)
+    assert np.sum(harmonics.amplitude**2 / 2) == pytest.approx(band_integral(road), rel=1e-10)
 
 
 # Realised mean square of z over s = 0..L / band integral - 1, class B, ISO band, seeds
@@ -210,9 +228,10 @@ def test_default_number_of_waves_spacing_and_band():
 def test_phases_do_not_depend_on_the_grid():
     # the phase stream is the same SeedSequence draw, so a longer road extends it
     short, long = (iso8608_harmonics(iso(seed=5), length) for length in (100.0, 1000.0))
-    np.testing.assert_array_equal(short.phase, long.phase[:short.phase.size])
+    np.testing.assert_array_equal(short.phase, long.phase[: short.phase.size])
     expected = np.random.default_rng(np.random.SeedSequence(5).spawn(2)[0]).uniform(
-        0.0, 2 * math.pi, short.phase.size)
+        0.0, 2 * math.pi, short.phase.size
+    )
     np.testing.assert_array_equal(short.phase, expected)
 
 
@@ -222,8 +241,9 @@ def test_harmonic_sum_matches_the_direct_sum():
     z = profile(road, s)
     harmonics = iso8608_harmonics(road, np.ptp(s))
     pick = np.random.default_rng(3).choice(s.size, 500, replace=False)
-    direct = (harmonics.amplitude * np.sin(np.outer(s[pick], harmonics.omega)
-                                           - harmonics.phase)).sum(axis=1)
+    direct = (
+        harmonics.amplitude * np.sin(np.outer(s[pick], harmonics.omega) - harmonics.phase)
+    ).sum(axis=1)
     np.testing.assert_allclose(z[pick], direct, atol=1e-6 * z.std())
 
 
@@ -262,6 +282,7 @@ def test_tracks_identical_independent_and_one_sided():
 
 # --- CSV profiles ----------------------------------------------------------------------------
 
+
 def write_profile(path, header=True):
     rows = "0,0\n1,0.02\n3,-0.02\n4,0.01\n"
     path.write_text(("distance_m,height_m\n" if header else "") + rows)
@@ -272,9 +293,12 @@ def test_file_profile_interpolation_scale_and_outside_range(tmp_path, header):
     write_profile(tmp_path / "bumps.csv", header)
     road = ROAD.validate_python(dict(kind="file", path="bumps.csv", speed=2.0, scale=0.5))
     s = np.array([-1.0, 0.5, 1.0, 2.0, 2.5, 4.0, 5.0])
-    np.testing.assert_allclose(profile(road, s, base_dir=tmp_path),
-                               0.5 * np.array([0, 0.01, 0.02, 0.0, -0.01, 0.01, 0]), atol=1e-15)
-    t = np.array([0.25, 1.0, 2.5])                  # road positions 0.5, 2, 5 m
+    np.testing.assert_allclose(
+        profile(road, s, base_dir=tmp_path),
+        0.5 * np.array([0, 0.01, 0.02, 0.0, -0.01, 0.01, 0]),
+        atol=1e-15,
+    )
+    t = np.array([0.25, 1.0, 2.5])  # road positions 0.5, 2, 5 m
     z, zdot = road_inputs(road, np.zeros(1), ["right"], t, base_dir=tmp_path)
     np.testing.assert_allclose(z[0], 0.5 * np.array([0.01, 0.0, 0.0]), atol=1e-15)
     # V dz/ds: 2 m/s x 0.5 x slopes 0.02/1 and -0.04/2, flat beyond the last point
@@ -290,8 +314,10 @@ def test_missing_file_is_named(tmp_path):
         road: RoadConfig
 
     with pytest.raises(ValidationError) as error:
-        Config.model_validate({"road": dict(kind="file", path="nowhere.csv", speed=2.0)},
-                              context={"base_dir": tmp_path})
+        Config.model_validate(
+            {"road": dict(kind="file", path="nowhere.csv", speed=2.0)},
+            context={"base_dir": tmp_path},
+        )
     (detail,) = error.value.errors()
     assert detail["loc"][0] == "road" and detail["loc"][-1] == "path"
     assert str(tmp_path / "nowhere.csv") in detail["msg"]
@@ -299,23 +325,31 @@ def test_missing_file_is_named(tmp_path):
 
 # --- config errors ---------------------------------------------------------------------------
 
-@pytest.mark.parametrize("data, key", [
-    (dict(kind="bump_step", height=0.05, length=1, speed=0.0, start=0), "speed"),
-    (dict(kind="bump_step", height=0.05, length=1, speed=-3, start=0), "speed"),
-    (dict(kind="bump_half_sine", height=0.05, length=0, speed=1, start=0), "length"),
-    (dict(kind="bump_half_sine", height=0.05, length=1, speed=1, start=-1), "start"),
-    (dict(kind="speed_bump", height=0.05, length=1, speed=1, start=0), None),
-    (dict(kind="bump_step", height=0.05, length=1, speed=1, start=0, lenght=2), "lenght"),
-    (dict(kind="iso8608", road_class="B", convention="iso8608", speed=10, n_min=3.0), "n_max"),
-    (dict(kind="iso8608", road_class="B", convention="iso8608", speed=10, n_max=0.011),
-     "n_max"),
-    (dict(kind="iso8608", road_class="B", speed=10), "convention"),
-    (dict(kind="iso8608", convention="thesis", speed=10), None),
-    (dict(kind="iso8608", road_class="F", convention="thesis", speed=10), "road_class"),
-    (dict(kind="bump_step", height=0.05, length=1, speed=1, start=0, tracks="independent"),
-     "tracks"),
-    (dict(kind="file", path="a.csv", speed=1, tracks="independent"), "tracks"),
-])
+
+@pytest.mark.parametrize(
+    "data, key",
+    [
+        (dict(kind="bump_step", height=0.05, length=1, speed=0.0, start=0), "speed"),
+        (dict(kind="bump_step", height=0.05, length=1, speed=-3, start=0), "speed"),
+        (dict(kind="bump_half_sine", height=0.05, length=0, speed=1, start=0), "length"),
+        (dict(kind="bump_half_sine", height=0.05, length=1, speed=1, start=-1), "start"),
+        (dict(kind="speed_bump", height=0.05, length=1, speed=1, start=0), None),
+        (dict(kind="bump_step", height=0.05, length=1, speed=1, start=0, lenght=2), "lenght"),
+        (dict(kind="iso8608", road_class="B", convention="iso8608", speed=10, n_min=3.0), "n_max"),
+        (
+            dict(kind="iso8608", road_class="B", convention="iso8608", speed=10, n_max=0.011),
+            "n_max",
+        ),
+        (dict(kind="iso8608", road_class="B", speed=10), "convention"),
+        (dict(kind="iso8608", convention="thesis", speed=10), None),
+        (dict(kind="iso8608", road_class="F", convention="thesis", speed=10), "road_class"),
+        (
+            dict(kind="bump_step", height=0.05, length=1, speed=1, start=0, tracks="independent"),
+            "tracks",
+        ),
+        (dict(kind="file", path="a.csv", speed=1, tracks="independent"), "tracks"),
+    ],
+)
 def test_bad_road_values_are_rejected_on_their_key(data, key):
     with pytest.raises(ValidationError) as error:
         ROAD.validate_python(data)

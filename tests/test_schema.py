@@ -16,7 +16,7 @@ from suspopt.templates import template_names, template_text
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 BUNDLED = sorted(CONFIGS.rglob("*.yaml"))
 QUICKSTART = (CONFIGS / "quickstart.yaml").read_text()
-CH7 = (CONFIGS / "ch7" / "sh_2.yaml").read_text()     # corners given by corner_defaults
+CH7 = (CONFIGS / "ch7" / "sh_2.yaml").read_text()  # corners given by corner_defaults
 
 
 @pytest.fixture(scope="module")
@@ -26,13 +26,15 @@ def validator():
     assert schema["$id"] == SCHEMA_ID
     cls = jsonschema.validators.validator_for(schema)
     assert cls is jsonschema.Draft202012Validator
-    cls.check_schema(schema)                            # a valid draft 2020-12 schema
+    cls.check_schema(schema)  # a valid draft 2020-12 schema
     return cls(schema)
 
 
 def _errors(validator, text: str) -> list[str]:
-    return [f"{'.'.join(map(str, e.absolute_path))}: {e.message}"
-            for e in validator.iter_errors(parse_yaml(text)[0])]
+    return [
+        f"{'.'.join(map(str, e.absolute_path))}: {e.message}"
+        for e in validator.iter_errors(parse_yaml(text)[0])
+    ]
 
 
 def test_the_bundled_configs_are_all_there():
@@ -53,13 +55,16 @@ WRONG = {
     "unknown key": QUICKSTART + "outptu: {float32: true}\n",
     "a string for a number": QUICKSTART.replace("damper: {c: 3000}", 'damper: {c: "3000"}'),
     "a negative mass": QUICKSTART.replace("mass: 2210", "mass: -2210"),
-    "a corner without its mass and no corner_defaults":
-        QUICKSTART.replace("      unsprung_mass: 100\n", ""),
+    "a corner without its mass and no corner_defaults": QUICKSTART.replace(
+        "      unsprung_mass: 100\n", ""
+    ),
     "an unknown corner": QUICKSTART.replace("    R1:\n", "    RR:\n"),
-    "a misspelt key in corner_defaults": CH7.replace("tyre: {stiffness: 2.0e5}",
-                                                     "tyre: {stifness: 2.0e5}"),
-    "a misspelt key in a corner over corner_defaults":
-        CH7.replace("corners: {F1: {}, R1: {}}", "corners: {F1: {unsprung_mas: 30}, R1: {}}"),
+    "a misspelt key in corner_defaults": CH7.replace(
+        "tyre: {stiffness: 2.0e5}", "tyre: {stifness: 2.0e5}"
+    ),
+    "a misspelt key in a corner over corner_defaults": CH7.replace(
+        "corners: {F1: {}, R1: {}}", "corners: {F1: {unsprung_mas: 30}, R1: {}}"
+    ),
 }
 # (the schema cannot see the kind a part of a damper takes from corner_defaults, so it lets
 # a passive key over a semi-active default pass, which the loader refuses)
@@ -67,19 +72,21 @@ RIGHT = {
     "corners left empty": CH7.replace("corners: {F1: {}, R1: {}}", "corners: {F1: , R1: }"),
     "no corners at all": CH7.replace("  corners: {F1: {}, R1: {}}\n", ""),
     # without kind a part of a damper is of the default's kind
-    "a semi-active key without kind over corner_defaults":
-        CH7.replace("corners: {F1: {}, R1: {}}",
-                    "corners: {F1: {damper: {c_max: 4000}}, R1: {}}"),
-    "a corner overriding part of corner_defaults":
-        CH7.replace("corners: {F1: {}, R1: {}}", "corners: {F1: {damper: {kind: semi_active, "
-                    "c_max: 4000}, spring: {cubic: 1.0e6}}, R1: {unsprung_mass: 30}}"),
+    "a semi-active key without kind over corner_defaults": CH7.replace(
+        "corners: {F1: {}, R1: {}}", "corners: {F1: {damper: {c_max: 4000}}, R1: {}}"
+    ),
+    "a corner overriding part of corner_defaults": CH7.replace(
+        "corners: {F1: {}, R1: {}}",
+        "corners: {F1: {damper: {kind: semi_active, "
+        "c_max: 4000}, spring: {cubic: 1.0e6}}, R1: {unsprung_mass: 30}}",
+    ),
 }
 
 
 @pytest.mark.parametrize("case", WRONG)
 def test_the_schema_refuses_what_the_loader_refuses(validator, case):
     text = WRONG[case]
-    assert text not in (QUICKSTART, CH7)                # the edit took
+    assert text not in (QUICKSTART, CH7)  # the edit took
     assert _errors(validator, text)
     with pytest.raises(ConfigError):
         load_config_text(text)

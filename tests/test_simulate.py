@@ -4,37 +4,50 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import corner, make_config
 
 import suspopt
 
-from conftest import corner, make_config
-
 
 def bump(height=0.05, length=1.0, speed=10.0, start=0.1, kind="bump_half_sine", **extra):
-    return {"kind": kind, "height": height, "length": length, "speed": speed, "start": start,
-            **extra}
+    return {
+        "kind": kind,
+        "height": height,
+        "length": length,
+        "speed": speed,
+        "start": start,
+        **extra,
+    }
 
 
 def test_energy_is_conserved_in_undamped_free_vibration():
     """After a half-sine bump has passed, an undamped Duffing half car keeps its energy:
     E = ½ q'ᵀ M q' + ½ qᵀ K q + ¼ Σ k_nl ST⁴ (road back at zero)."""
-    cfg = make_config({
-        "vehicle": {"preset": "half_pitch",
-                    "body": {"mass": 600, "pitch_inertia": 700, "a_front": 1.2, "a_rear": 1.4},
-                    "corner_defaults": corner(k=2e4, k_nl=2e6, c=0.0, c_t=0.0)},
-        "road": bump(start=0.05),
-        "simulation": {"duration": 3.0, "dt": 1e-3}})
+    cfg = make_config(
+        {
+            "vehicle": {
+                "preset": "half_pitch",
+                "body": {"mass": 600, "pitch_inertia": 700, "a_front": 1.2, "a_rear": 1.4},
+                "corner_defaults": corner(k=2e4, k_nl=2e6, c=0.0, c_t=0.0),
+            },
+            "road": bump(start=0.05),
+            "simulation": {"duration": 3.0, "dt": 1e-3},
+        }
+    )
     res = suspopt.simulate(cfg)
     m = res.model
     q, v = res.q[0], res.v[0]
     M = m.mass[0, 0]
     K = m.stiffness[0]
     st = res.deformation("suspension")[:, 0].T
-    energy = 0.5 * np.einsum("ti,i,ti->t", v, M, v) + 0.5 * np.einsum("ti,ij,tj->t", q, K, q) \
-        + 0.25 * np.sum(m.spring_cubic[0] * st ** 4, axis=-1)
-    after = res.time > 0.05 + (1.0 + 2.6) / 10.0 + 0.01   # rear wheel off the bump
+    energy = (
+        0.5 * np.einsum("ti,i,ti->t", v, M, v)
+        + 0.5 * np.einsum("ti,ij,tj->t", q, K, q)
+        + 0.25 * np.sum(m.spring_cubic[0] * st**4, axis=-1)
+    )
+    after = res.time > 0.05 + (1.0 + 2.6) / 10.0 + 0.01  # rear wheel off the bump
     e = energy[after]
-    assert e[0] > 1.0                                       # the bump did put energy in
+    assert e[0] > 1.0  # the bump did put energy in
     # RK4 loses ~(ω dt)^6/72 of a mode's energy per step: ~1e-9 for the 10 Hz wheel hop at
     # dt = 1 ms, ~3e-6 over these 2600 steps; any modelling slip is orders larger.
     assert np.ptp(e) / e[0] < 1e-5
@@ -44,17 +57,36 @@ def test_full_car_with_equal_tracks_equals_half_pitch():
     """FC with b1 = b2 and identical left/right roads equals HC2 of half its mass/inertia."""
     c = corner(k=1.2e4, k_nl=5e6)
     road = bump(kind="bump_step", length=5.0, start=0.2)
-    fc = make_config({"vehicle": {"preset": "full",
-                                  "body": {"mass": 1200, "roll_inertia": 500,
-                                           "pitch_inertia": 1400, "a_front": 1.3,
-                                           "a_rear": 1.5, "b_right": 0.75, "b_left": 0.75},
-                                  "corner_defaults": c},
-                      "road": road, "simulation": {"duration": 2.0}})
-    hc = make_config({"vehicle": {"preset": "half_pitch",
-                                  "body": {"mass": 600, "pitch_inertia": 700, "a_front": 1.3,
-                                           "a_rear": 1.5},
-                                  "corner_defaults": c},
-                      "road": road, "simulation": {"duration": 2.0}})
+    fc = make_config(
+        {
+            "vehicle": {
+                "preset": "full",
+                "body": {
+                    "mass": 1200,
+                    "roll_inertia": 500,
+                    "pitch_inertia": 1400,
+                    "a_front": 1.3,
+                    "a_rear": 1.5,
+                    "b_right": 0.75,
+                    "b_left": 0.75,
+                },
+                "corner_defaults": c,
+            },
+            "road": road,
+            "simulation": {"duration": 2.0},
+        }
+    )
+    hc = make_config(
+        {
+            "vehicle": {
+                "preset": "half_pitch",
+                "body": {"mass": 600, "pitch_inertia": 700, "a_front": 1.3, "a_rear": 1.5},
+                "corner_defaults": c,
+            },
+            "road": road,
+            "simulation": {"duration": 2.0},
+        }
+    )
     a, b = suspopt.simulate(fc), suspopt.simulate(hc)
     for name in ("body.heave", "body.pitch_acc", "travel.F1", "travel.R1", "tyre_force.R1"):
         scale = np.max(np.abs(b.signals[name]))
@@ -66,14 +98,24 @@ def test_full_car_with_equal_tracks_equals_half_pitch():
 def test_symmetric_half_pitch_without_delay_equals_quarter_car():
     c = corner(k=1.5e4, k_nl=3e6, c=1000, c_t=50)
     road = bump(kind="bump_step", length=8.0, start=0.2, wheelbase_delay=False)
-    hc = make_config({"vehicle": {"preset": "half_pitch",
-                                  "body": {"mass": 560, "pitch_inertia": 650, "a_front": 1.4,
-                                           "a_rear": 1.4},
-                                  "corner_defaults": c},
-                      "road": road, "simulation": {"duration": 2.0}})
-    qc = make_config({"vehicle": {"preset": "quarter", "body": {"mass": 280},
-                                  "corners": {"F1": c}},
-                      "road": road, "simulation": {"duration": 2.0}})
+    hc = make_config(
+        {
+            "vehicle": {
+                "preset": "half_pitch",
+                "body": {"mass": 560, "pitch_inertia": 650, "a_front": 1.4, "a_rear": 1.4},
+                "corner_defaults": c,
+            },
+            "road": road,
+            "simulation": {"duration": 2.0},
+        }
+    )
+    qc = make_config(
+        {
+            "vehicle": {"preset": "quarter", "body": {"mass": 280}, "corners": {"F1": c}},
+            "road": road,
+            "simulation": {"duration": 2.0},
+        }
+    )
     a, b = suspopt.simulate(hc), suspopt.simulate(qc)
     for name in ("body.heave", "body.heave_acc", "travel.F1", "tyre_deflection.F1"):
         scale = np.max(np.abs(b.signals[name]))
@@ -87,14 +129,23 @@ def test_batch_equals_single_runs(load):
     k = np.array([3.5e4, 8.0e4, 1.4e5])
     c = np.array([2.2e3, 5.0e3, 9.0e3])
     knl = np.array([6e5, 4e6, 2.5e7])
-    params = {"vehicle.corners.F1.spring.linear": k, "vehicle.corners.R1.damper.c": c,
-              "vehicle.corners.F1.spring.cubic": knl}
+    params = {
+        "vehicle.corners.F1.spring.linear": k,
+        "vehicle.corners.R1.damper.c": c,
+        "vehicle.corners.F1.spring.cubic": knl,
+    }
     batch = suspopt.simulate(cfg, params=params)
     assert batch.P == 3
     for p in range(3):
-        one = suspopt.simulate(cfg, params={key: v[p:p + 1] for key, v in params.items()})
-        for name in ("body.heave_acc", "body.pitch", "travel.F1", "tyre_force.R1",
-                     "damper_force.R1", "spring_force.F1"):
+        one = suspopt.simulate(cfg, params={key: v[p : p + 1] for key, v in params.items()})
+        for name in (
+            "body.heave_acc",
+            "body.pitch",
+            "travel.F1",
+            "tyre_force.R1",
+            "damper_force.R1",
+            "spring_force.F1",
+        ):
             ref = one.signals[name][0]
             assert np.max(np.abs(batch.signals[name][p] - ref)) <= 1e-12 * np.max(np.abs(ref))
 
@@ -137,13 +188,15 @@ def test_tyre_lift_off_never_pulls(load):
     cfg = load("quickstart.yaml")
     cfg.road.height = 0.25
     plain = suspopt.simulate(cfg)
-    assert plain.signals["tyre_force.F1"].min() < 0          # a linear tyre pulls the wheel
+    assert plain.signals["tyre_force.F1"].min() < 0  # a linear tyre pulls the wheel
     cfg.vehicle.tyre_lift_off = True
     lifted = suspopt.simulate(cfg)
     assert lifted.signals["tyre_force.F1"].min() == 0.0
     # a wheel that may leave the ground flies higher above the road than one held to it
-    assert lifted.signals["tyre_deflection.F1"].max() > \
-        plain.signals["tyre_deflection.F1"].max() + 1e-3
+    assert (
+        lifted.signals["tyre_deflection.F1"].max()
+        > plain.signals["tyre_deflection.F1"].max() + 1e-3
+    )
 
 
 def test_output_rate_subsamples_the_same_trajectory(load):
@@ -157,10 +210,22 @@ def test_output_rate_subsamples_the_same_trajectory(load):
 
 def test_every_design_md_signal_is_there(load):
     res = suspopt.simulate(load("ch3/part1a_fc_bump.yaml"))
-    for name in ("body.heave", "body.heave_vel", "body.heave_acc", "body.roll_acc",
-                 "body.pitch_vel", "wheel.R2.heave_acc", "travel.F2", "travel_vel.R1",
-                 "tyre_deflection.R2", "tyre_force.F1", "spring_force.F1", "damper_force.R1",
-                 "damping.F2", "road.R1"):
+    for name in (
+        "body.heave",
+        "body.heave_vel",
+        "body.heave_acc",
+        "body.roll_acc",
+        "body.pitch_vel",
+        "wheel.R2.heave_acc",
+        "travel.F2",
+        "travel_vel.R1",
+        "tyre_deflection.R2",
+        "tyre_force.F1",
+        "spring_force.F1",
+        "damper_force.R1",
+        "damping.F2",
+        "road.R1",
+    ):
         assert res.signals[name].shape == (1, res.time.size)
     with pytest.raises(KeyError, match="did you mean"):
         res.signals["body.heave_accel"]
@@ -171,8 +236,12 @@ def test_signals_obey_the_equations(load):
     res = suspopt.simulate(load("part2b" and "ch3/part2b_qc_ct49_bump.yaml"))
     s = res.signals
     m = 1085 / 4
-    assert np.allclose(m * s["body.heave_acc"], -(s["spring_force.F1"] + s["damper_force.F1"]),
-                       rtol=1e-9, atol=1e-9)
+    assert np.allclose(
+        m * s["body.heave_acc"],
+        -(s["spring_force.F1"] + s["damper_force.F1"]),
+        rtol=1e-9,
+        atol=1e-9,
+    )
     assert np.allclose(s["tyre_deflection.F1"], s["wheel.F1.heave"] - s["road.F1"])
 
 
@@ -181,10 +250,18 @@ def test_bad_params_are_config_errors(load):
     with pytest.raises(suspopt.ConfigError, match="did you mean"):
         suspopt.simulate(cfg, params={"vehicle.corners.F1.spring.linar": [1e4]})
     with pytest.raises(suspopt.ConfigError, match="same length"):
-        suspopt.simulate(cfg, params={"vehicle.corners.F1.spring.linear": [1e4, 2e4],
-                                      "vehicle.corners.R1.damper.c": [1e3]})
-    with pytest.raises(suspopt.ConfigError, match=r"mass: must be in \[0.001, 1e\+06\], got -1 "
-                       r"\(designs \[1\]\)"):
+        suspopt.simulate(
+            cfg,
+            params={
+                "vehicle.corners.F1.spring.linear": [1e4, 2e4],
+                "vehicle.corners.R1.damper.c": [1e3],
+            },
+        )
+    with pytest.raises(
+        suspopt.ConfigError,
+        match=r"mass: must be in \[0.001, 1e\+06\], got -1 "
+        r"\(designs \[1\]\)",
+    ):
         suspopt.simulate(cfg, params={"vehicle.body.mass": [1000.0, -1.0]})
     with pytest.raises(suspopt.ConfigError, match=r"cubic: must be in .* got 1e\+300"):
         suspopt.simulate(cfg, params={"vehicle.corners.F1.spring.cubic": [1e300]})

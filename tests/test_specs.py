@@ -4,18 +4,18 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import CONFIGS
+from test_cli import run, write
 
 import suspopt
 from suspopt.metrics import iso2631, stats
-
-from conftest import CONFIGS
-from test_cli import run, write
 
 GOOD = (CONFIGS / "quickstart.yaml").read_text()
 
 
 def with_metrics(text: str) -> suspopt.Config:
     from suspopt.config.loader import load_config_text
+
     return load_config_text(GOOD + "metrics:\n" + text)
 
 
@@ -26,14 +26,16 @@ def test_specs_equal_direct_computation():
         "  - {name: f2, metric: var, signal: travel, corners: [F1, R1], reduce: mean}\n"
         "  - {metric: spring_usage}\n"
         "  - {metric: dissipated_power, corners: [R1]}\n"
-        "  - {metric: peak_time, signal: body.heave}\n")
+        "  - {metric: peak_time, signal: body.heave}\n"
+    )
     res = suspopt.simulate(cfg)
     s = res.signals
     fs = 1 / (res.time[1] - res.time[0])
     assert np.array_equal(res.metrics["RC"], iso2631.weighted_rms(s["body.heave_acc"], fs, "Wk"))
     assert np.array_equal(res.metrics["var.travel.F1"], stats.var(s["travel.F1"]))
     assert res.metrics["f2"] == pytest.approx(
-        0.5 * (stats.var(s["travel.F1"]) + stats.var(s["travel.R1"])), rel=1e-14)
+        0.5 * (stats.var(s["travel.F1"]) + stats.var(s["travel.R1"])), rel=1e-14
+    )
     assert 0 < res.metrics["spring_usage.F1"][0] < 1
     de = np.trapezoid(s["damper_force.R1"] * s["travel_vel.R1"], res.time) / res.time[-1]
     assert res.metrics["dissipated_power.R1"] == pytest.approx(de, rel=1e-12)
@@ -48,13 +50,16 @@ def test_batched_metrics_have_one_value_per_design(load):
     assert res.metrics["max_abs.tyre_deflection"].shape == (3,)
 
 
-@pytest.mark.parametrize("entry,needle", [
-    ("  - {metric: rms_wieghted, signal: body.heave_acc}\n", "did you mean rms_weighted"),
-    ("  - {metric: var, signal: body.heave_accel}\n", "did you mean body.heave_acc"),
-    ("  - {metric: var, signal: travl}\n", "did you mean travel"),
-    ("  - {metric: var, signal: travel, corners: [F2]}\n", "travel.F2"),
-    ("  - {metric: spring_usage, signal: travel}\n", "takes no signal"),
-])
+@pytest.mark.parametrize(
+    "entry,needle",
+    [
+        ("  - {metric: rms_wieghted, signal: body.heave_acc}\n", "did you mean rms_weighted"),
+        ("  - {metric: var, signal: body.heave_accel}\n", "did you mean body.heave_acc"),
+        ("  - {metric: var, signal: travl}\n", "did you mean travel"),
+        ("  - {metric: var, signal: travel, corners: [F2]}\n", "travel.F2"),
+        ("  - {metric: spring_usage, signal: travel}\n", "takes no signal"),
+    ],
+)
 def test_bad_specs_are_config_errors_with_line(tmp_path, entry, needle):
     cfg = write(tmp_path, GOOD + "metrics:\n" + entry)
     proc = run("validate", cfg)

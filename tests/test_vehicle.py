@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import corner, make_config
 
 import suspopt
 from suspopt.vehicle import build_vehicle, modal_analysis
-
-from conftest import corner, make_config
 
 
 def quarter_car_frequencies(m_s, m_u, k, k_t):
@@ -36,8 +35,9 @@ TABLE_TOL = 0.01
 
 def test_quarter_car_matches_table_3_5_and_closed_form(load):
     res = modes(load, "ch3/part1a_qc_bump.yaml")
-    assert np.allclose(res.frequency[0], quarter_car_frequencies(1085 / 4, 40, 1e4, 1.5e5),
-                       rtol=1e-10)
+    assert np.allclose(
+        res.frequency[0], quarter_car_frequencies(1085 / 4, 40, 1e4, 1.5e5), rtol=1e-10
+    )
     assert abs(freq_of(res, "body.heave") - 0.93) <= TABLE_TOL
     assert abs(freq_of(res, "wheel.F1") - 10.07) <= TABLE_TOL
 
@@ -54,18 +54,27 @@ def test_half_roll_and_half_pitch_match_table_3_5(load):
         assert abs(freq_of(fc, dof) - table) <= TABLE_TOL
 
 
-@pytest.mark.parametrize("preset,inertia,geom", [
-    ("half_pitch", "pitch_inertia", {"a_front": 1.2, "a_rear": 1.2}),
-    ("half_roll", "roll_inertia", {"b_right": 0.8, "b_left": 0.8}),
-])
+@pytest.mark.parametrize(
+    "preset,inertia,geom",
+    [
+        ("half_pitch", "pitch_inertia", {"a_front": 1.2, "a_rear": 1.2}),
+        ("half_roll", "roll_inertia", {"b_right": 0.8, "b_left": 0.8}),
+    ],
+)
 def test_symmetric_half_car_rotation_closed_form(preset, inertia, geom):
     """With equal lever arms a, the rotation mode is a quarter car of mass I/(2 a²)."""
     m, I, a = 600.0, 700.0, 1.2 if preset == "half_pitch" else 0.8
-    cfg = make_config({
-        "vehicle": {"preset": preset, "body": {"mass": m, inertia: I, **geom},
-                    "corner_defaults": corner(m_u=45, k_t=2e5, k=2.5e4)},
-        "road": {"kind": "bump_step", "height": 0.01, "length": 1, "speed": 10, "start": 0},
-        "simulation": {"duration": 1.0}})
+    cfg = make_config(
+        {
+            "vehicle": {
+                "preset": preset,
+                "body": {"mass": m, inertia: I, **geom},
+                "corner_defaults": corner(m_u=45, k_t=2e5, k=2.5e4),
+            },
+            "road": {"kind": "bump_step", "height": 0.01, "length": 1, "speed": 10, "start": 0},
+            "simulation": {"duration": 1.0},
+        }
+    )
     f = modal_analysis(build_vehicle(cfg)).frequency[0]
     heave = quarter_car_frequencies(m / 2, 45, 2.5e4, 2e5)
     rotation = quarter_car_frequencies(I / (2 * a * a), 45, 2.5e4, 2e5)
@@ -102,8 +111,12 @@ def test_travel_sign_convention(load):
     q[2] = 0.02  # pitch
     st = model.network.group("suspension").deformation(q, None)[:, 0, 0]
     b1, b2, aF, aR = 0.7, 0.75, 1.4, 1.47
-    expect = [b1 * .01 - aF * .02, -b2 * .01 - aF * .02, b1 * .01 + aR * .02,
-              -b2 * .01 + aR * .02]
+    expect = [
+        b1 * 0.01 - aF * 0.02,
+        -b2 * 0.01 - aF * 0.02,
+        b1 * 0.01 + aR * 0.02,
+        -b2 * 0.01 + aR * 0.02,
+    ]
     assert np.allclose(st, expect, rtol=1e-14)
 
 
@@ -113,4 +126,4 @@ def test_frequency_response_peaks_at_body_mode(load):
     f = np.linspace(0.2, 3, 2000)
     H = suspopt.frequency_response(model, f)[0, :, 0]
     assert f[np.argmax(np.abs(H))] == pytest.approx(0.93, abs=0.05)
-    assert abs(H[0]) == pytest.approx(1.0, rel=0.05)   # body follows the road at low frequency
+    assert abs(H[0]) == pytest.approx(1.0, rel=0.05)  # body follows the road at low frequency

@@ -69,16 +69,19 @@ SUMMARIES = {
     "masses": "a Pareto file's designs with another passenger mass (Sec 8.4.3, Table 8.13)",
     "controllers": "a Pareto file's designs with another controller (Fig. 7.4b)",
     "transmissibility": "seat-to-head and seat transmissibility of a config or of a front's "
-                        "edges and knee (Eq 2.86, Fig. 8.26)",
+    "edges and knee (Eq 2.86, Fig. 8.26)",
     "cdf-sensitivity": "the C_max share of an adaptive CDF threshold swept from 20 to 70 % "
-                       "(Figs. 4.7, 4.10)",
+    "(Figs. 4.7, 4.10)",
 }
 
 
 def analysis_kinds() -> dict[str, Kind]:
     """Every available analysis kind, importing the modules that provide them."""
-    from . import cdf  # noqa: F401  (registers cdf-sensitivity)
-    from . import models  # noqa: F401  (registers models)
-    from . import pseudo  # noqa: F401  (registers roads, masses, controllers)
-    from . import transmissibility  # noqa: F401  (registers transmissibility)
+    from . import (
+        cdf,  # noqa: F401  (registers cdf-sensitivity)
+        models,  # noqa: F401  (registers models)
+        pseudo,  # noqa: F401  (registers roads, masses, controllers)
+        transmissibility,  # noqa: F401  (registers transmissibility)
+    )
+
     return dict(KINDS)

@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import load_config
 from .. import plots
+from ..config import load_config
 from ..io import atomic_h5, write_dataset
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..simulate import simulate
@@ -44,11 +44,11 @@ def c_max_share(result, share_after: float = 0.0) -> np.ndarray:
     """The mean damper state (the C_max share of the on-off laws) over the samples at
     ``t >= share_after``, averaged over the semi-active corners, (P,)."""
     cfg, sig = result.config, result.signals
-    active = [c for c in result.model.corners
-              if cfg.vehicle.corners[c].damper.kind == "semi_active"]
+    active = [
+        c for c in result.model.corners if cfg.vehicle.corners[c].damper.kind == "semi_active"
+    ]
     late = result.time >= share_after - 0.5 * cfg.simulation.dt
-    return np.mean([np.mean(sig[f"damper_state.{c}"][:, late], axis=-1) for c in active],
-                   axis=0)
+    return np.mean([np.mean(sig[f"damper_state.{c}"][:, late], axis=-1) for c in active], axis=0)
 
 
 def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarray]:
@@ -64,12 +64,19 @@ def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarra
     return {
         "SW": np.sum([damper_switches(sig[f"damper_state.{c}"]) for c in active], axis=0),
         "RC": weighted_rms(sig["body.heave_acc"], cfg.simulation.output_rate, "Wk"),
-        "ST": np.mean([np.sqrt(np.mean(sig[f"travel.{c}"] ** 2, axis=-1)) for c in corners],
-                      axis=0),
-        "TD": np.mean([np.sqrt(np.mean(sig[f"tyre_deflection.{c}"] ** 2, axis=-1))
-                       for c in corners], axis=0),
-        "DE": np.sum([mean_dissipated_power(sig[f"damper_force.{c}"], sig[f"travel_vel.{c}"], t)
-                      for c in corners], axis=0),
+        "ST": np.mean(
+            [np.sqrt(np.mean(sig[f"travel.{c}"] ** 2, axis=-1)) for c in corners], axis=0
+        ),
+        "TD": np.mean(
+            [np.sqrt(np.mean(sig[f"tyre_deflection.{c}"] ** 2, axis=-1)) for c in corners], axis=0
+        ),
+        "DE": np.sum(
+            [
+                mean_dissipated_power(sig[f"damper_force.{c}"], sig[f"travel_vel.{c}"], t)
+                for c in corners
+            ],
+            axis=0,
+        ),
         "share": c_max_share(result, share_after),
     }
 
@@ -77,17 +84,24 @@ def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarra
 def _check(cfg) -> None:
     spec = cfg.control.threshold if cfg.control is not None else None
     if spec is None or spec.mode != "adaptive":
-        raise cfg.error(("control", "threshold"), "cdf-sensitivity needs an adaptive threshold "
-                        "(control.threshold.mode: adaptive, with c_max_share)")
+        raise cfg.error(
+            ("control", "threshold"),
+            "cdf-sensitivity needs an adaptive threshold "
+            "(control.threshold.mode: adaptive, with c_max_share)",
+        )
     if not any(cfg.vehicle.corners[c].damper.kind == "semi_active" for c in cfg.vehicle.corners):
         raise cfg.error(("vehicle", "corners"), "cdf-sensitivity needs a semi-active damper")
     sim = cfg.simulation
     if sim.dt * sim.output_every > cfg.control.sample_time * (1 + 1e-9):
-        raise cfg.error(("simulation", "output_dt"), "must not exceed control.sample_time, or "
-                        "the switch count SW misses switches")
+        raise cfg.error(
+            ("simulation", "output_dt"),
+            "must not exceed control.sample_time, or the switch count SW misses switches",
+        )
     if spec.learn_time >= sim.duration:
-        raise cfg.error(("control", "threshold", "learn_time"), "must be shorter than "
-                        "simulation.duration: the threshold is never fitted")
+        raise cfg.error(
+            ("control", "threshold", "learn_time"),
+            "must be shorter than simulation.duration: the threshold is never fitted",
+        )
 
 
 def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
@@ -108,11 +122,12 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
     corners = result.model.corners
     active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]
     laws = sorted({cfg.vehicle.corners[c].damper.law for c in active})
-    threshold = np.stack([result.signals[f"control_threshold.{c}"][1:, -1] for c in active],
-                         axis=1)
+    threshold = np.stack([result.signals[f"control_threshold.{c}"][1:, -1] for c in active], axis=1)
     unit = result.signal_unit(f"control_threshold.{active[0]}")
-    title = (f"CDF sensitivity: {' / '.join(laws)} on {source.name} "
-             f"({spec.distribution} fit, T_learn {spec.learn_time:g} s)")
+    title = (
+        f"CDF sensitivity: {' / '.join(laws)} on {source.name} "
+        f"({spec.distribution} fit, T_learn {spec.learn_time:g} s)"
+    )
 
     if output is not None:
         with atomic_h5(output, cfg) as h5:
@@ -125,26 +140,53 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
             write_dataset(grp, "c_max_share", SHARES, "1", dims=share)
             write_dataset(grp, "achieved_share", values["share"][1:], "1", dims=share)
             write_dataset(grp, "base_share", values["share"][0], "1")
-            write_dataset(grp, "final_threshold", threshold, unit,
-                          dims=("c_max_share", "corner"), coords={"corner": active})
-            for key, group in (("base", grp.create_group("base")),
-                               ("cdf", grp.create_group("cdf")),
-                               ("reduction", grp.create_group("reduction"))):
+            write_dataset(
+                grp,
+                "final_threshold",
+                threshold,
+                unit,
+                dims=("c_max_share", "corner"),
+                coords={"corner": active},
+            )
+            for key, group in (
+                ("base", grp.create_group("base")),
+                ("cdf", grp.create_group("cdf")),
+                ("reduction", grp.create_group("reduction")),
+            ):
                 for name, m_unit in METRIC_UNITS.items():
-                    data = {"base": base[name], "cdf": values[name][1:],
-                            "reduction": reduction[name]}[key]
-                    write_dataset(group, name, data, "%" if key == "reduction" else m_unit,
-                                  dims=() if key == "base" else share)
+                    data = {
+                        "base": base[name],
+                        "cdf": values[name][1:],
+                        "reduction": reduction[name],
+                    }[key]
+                    write_dataset(
+                        group,
+                        name,
+                        data,
+                        "%" if key == "reduction" else m_unit,
+                        dims=() if key == "base" else share,
+                    )
     if plot is not None:
-        plots.sensitivity(plot, title, 100 * SHARES, "C_max share requested (1 - N) [%]",
-                          [{"SW": reduction["SW"]},
-                           {k: reduction[k] for k in ("RC", "ST", "TD", "DE")}],
-                          "reduction vs base law [%]", marker=100 * base["share"],
-                          marker_label="base law's share")
+        plots.sensitivity(
+            plot,
+            title,
+            100 * SHARES,
+            "C_max share requested (1 - N) [%]",
+            [{"SW": reduction["SW"]}, {k: reduction[k] for k in ("RC", "ST", "TD", "DE")}],
+            "reduction vs base law [%]",
+            marker=100 * base["share"],
+            marker_label="base law's share",
+        )
 
-    rows = [[f"{100 * s:.0f}", f"{100 * a:.1f}", " ".join(f"{x:.3g}" for x in thr),
-             *(f"{reduction[k][i]:+.1f}" for k in METRIC_UNITS)]
-            for i, (s, a, thr) in enumerate(zip(SHARES, values["share"][1:], threshold))]
+    rows = [
+        [
+            f"{100 * s:.0f}",
+            f"{100 * a:.1f}",
+            " ".join(f"{x:.3g}" for x in thr),
+            *(f"{reduction[k][i]:+.1f}" for k in METRIC_UNITS),
+        ]
+        for i, (s, a, thr) in enumerate(zip(SHARES, values["share"][1:], threshold))
+    ]
     notes = [
         f"base law ({' / '.join(laws)}): C_max share {100 * base['share']:.1f} %, "
         f"SW {base['SW']:.0f}, RC {base['RC']:.4g} m/s^2, ST {1e3 * base['ST']:.4g} mm, "
@@ -152,10 +194,17 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
         "reduction = (X_base - X_CDF) / X_base * 100 % (thesis Sec 4.3): positive = smaller "
         "with the CDF threshold; shares counted after the first fit",
     ]
-    return Report(title=title,
-                  columns=["C_max share [%]", "achieved [%]", f"final T [{unit}]",
-                           *(f"{k} [%]" for k in METRIC_UNITS)],
-                  rows=rows, notes=notes)
+    return Report(
+        title=title,
+        columns=[
+            "C_max share [%]",
+            "achieved [%]",
+            f"final T [{unit}]",
+            *(f"{k} [%]" for k in METRIC_UNITS),
+        ],
+        rows=rows,
+        notes=notes,
+    )
 
 
 KINDS["cdf-sensitivity"] = Kind(run)

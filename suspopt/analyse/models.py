@@ -58,12 +58,20 @@ from ..specs import METRICS, evaluate_spec
 from ..vehicle import modal_analysis
 from . import KINDS, Kind, Report, relative_change
 
-__all__ = ["ModelResponse", "ModelComparison", "compare_models", "write_models",
-           "plot_models", "run", "TIME_SIGNALS", "PSD_SIGNALS", "PSD_SEGMENT"]
+__all__ = [
+    "ModelResponse",
+    "ModelComparison",
+    "compare_models",
+    "write_models",
+    "plot_models",
+    "run",
+    "TIME_SIGNALS",
+    "PSD_SIGNALS",
+    "PSD_SEGMENT",
+]
 
 #: Signals kept for the time-response figures and the HDF5 file, where the model has them.
-TIME_SIGNALS = ("body.heave_acc", "body.heave", "body.roll", "wheel.F1.heave_acc",
-                "wheel.F1.heave")
+TIME_SIGNALS = ("body.heave_acc", "body.heave", "body.roll", "wheel.F1.heave_acc", "wheel.F1.heave")
 #: Signals whose Welch PSD is computed, where the model has them.
 PSD_SIGNALS = ("body.heave_acc", "body.roll_acc")
 #: Welch segment of the PSDs [s] (at most the record).
@@ -83,8 +91,10 @@ _RIDE = (
     {"name": "VTD", "metric": "var", "signal": "tyre_deflection"},
     {"name": "MTD", "metric": "max", "signal": "tyre_deflection"},
 )
-_RIDE_ROLL = ({"metric": "var", "signal": "body.roll"},
-              {"metric": "max_abs", "signal": "body.roll"})
+_RIDE_ROLL = (
+    {"metric": "var", "signal": "body.roll"},
+    {"metric": "max_abs", "signal": "body.roll"},
+)
 
 
 @dataclass
@@ -108,7 +118,7 @@ class ModelResponse:
     units: dict[str, str]
     diverged: bool
     corners: tuple[str, ...]
-    order: dict[str, tuple[int, int]]    # table position: (spec, corner)
+    order: dict[str, tuple[int, int]]  # table position: (spec, corner)
 
 
 @dataclass
@@ -136,23 +146,29 @@ def _specs(configs: Sequence[Config], all_roll: bool) -> list[MetricSpec]:
     kinds = {cfg.road.kind for cfg in configs}
     bump = kinds <= set(_BUMPS)
     if not bump and kinds & set(_BUMPS):
-        names = ", ".join(f"{cfg.source.name if cfg.source else '?'} ({cfg.road.kind})"
-                          for cfg in configs)
-        raise ConfigError(f"analyse models compares models on one kind of road, bumps or "
-                          f"random roads, not both: {names}")
+        names = ", ".join(
+            f"{cfg.source.name if cfg.source else '?'} ({cfg.road.kind})" for cfg in configs
+        )
+        raise ConfigError(
+            f"analyse models compares models on one kind of road, bumps or "
+            f"random roads, not both: {names}"
+        )
     if bump:
         signals = ["body.heave_acc", "body.heave"] + (["body.roll"] if all_roll else [])
-        return [MetricSpec(metric=m, signal=s) for s in signals
-                for m in (_TRANSIENT_ACC if s.endswith("_acc") else _TRANSIENT)]
+        return [
+            MetricSpec(metric=m, signal=s)
+            for s in signals
+            for m in (_TRANSIENT_ACC if s.endswith("_acc") else _TRANSIENT)
+        ]
     return [MetricSpec(**d) for d in _RIDE + (_RIDE_ROLL if all_roll else ())]
 
 
-def _response(label: str, source: Path, cfg: Config, result: Result,
-              specs: Sequence[MetricSpec]) -> ModelResponse:
+def _response(
+    label: str, source: Path, cfg: Config, result: Result, specs: Sequence[MetricSpec]
+) -> ModelResponse:
     sig = result.signals
     fs = cfg.simulation.output_rate
-    units = {name: result.signal_unit(name) for name in TIME_SIGNALS + PSD_SIGNALS
-             if name in sig}
+    units = {name: result.signal_unit(name) for name in TIME_SIGNALS + PSD_SIGNALS if name in sig}
     spectra = {}
     frequency = np.empty(0)
     for name in PSD_SIGNALS:
@@ -170,8 +186,7 @@ def _response(label: str, source: Path, cfg: Config, result: Result,
     modes = modal_analysis(result.model)
     dominant = [str(d) for d in modes.dominant[0]]
     wheels = [f for f, d in zip(modes.frequency[0], dominant) if d.startswith("wheel.")]
-    natural = {dof: modes.frequency[0, dominant.index(dof)] for dof in _NATURAL
-               if dof in dominant}
+    natural = {dof: modes.frequency[0, dominant.index(dof)] for dof in _NATURAL if dof in dominant}
     natural["wheel_hop"] = min(wheels)
     for k, dof in enumerate(_NATURAL):
         if dof in natural:
@@ -179,13 +194,23 @@ def _response(label: str, source: Path, cfg: Config, result: Result,
             metrics[name] = float(natural[dof])
             units[name] = "Hz"
             order[name] = (len(specs) + k, -1)
-    return ModelResponse(label=label, source=source, config=cfg, time=result.time,
-                         signals={n: sig[n][0] for n in TIME_SIGNALS if n in sig},
-                         psd_frequency=frequency, psd=spectra, metrics=metrics,
-                         natural_frequency=modes.frequency[0], dominant=dominant,
-                         mode_label=[str(x) for x in modes.label[0]], units=units,
-                         diverged=bool(result.diverged[0]), corners=result.model.corners,
-                         order=order)
+    return ModelResponse(
+        label=label,
+        source=source,
+        config=cfg,
+        time=result.time,
+        signals={n: sig[n][0] for n in TIME_SIGNALS if n in sig},
+        psd_frequency=frequency,
+        psd=spectra,
+        metrics=metrics,
+        natural_frequency=modes.frequency[0],
+        dominant=dominant,
+        mode_label=[str(x) for x in modes.label[0]],
+        units=units,
+        diverged=bool(result.diverged[0]),
+        corners=result.model.corners,
+        order=order,
+    )
 
 
 def _reference_value(ref: ModelResponse, name: str) -> float:
@@ -199,8 +224,9 @@ def _reference_value(ref: ModelResponse, name: str) -> float:
     return np.nan
 
 
-def compare_models(sources: Sequence[str | Path], reference: str | Path | None = None
-                   ) -> ModelComparison:
+def compare_models(
+    sources: Sequence[str | Path], reference: str | Path | None = None
+) -> ModelComparison:
     """Simulate every config of ``sources`` and compare them with ``reference`` (one of
     them; default the first), as the module docstring says."""
     sources = [Path(s) for s in sources]
@@ -218,16 +244,19 @@ def compare_models(sources: Sequence[str | Path], reference: str | Path | None =
     results = [simulate(cfg) for cfg in configs]
     all_roll = all("body.roll" in r.signals for r in results)
     specs = _specs(configs, all_roll)
-    models = [_response(label, s, cfg, r, specs)
-              for label, s, cfg, r in zip(_labels(sources), sources, configs, results)]
+    models = [
+        _response(label, s, cfg, r, specs)
+        for label, s, cfg, r in zip(_labels(sources), sources, configs, results)
+    ]
     order, units = {}, {}
     for model in models:
         for name in model.metrics:
             order.setdefault(name, model.order[name])
             units.setdefault(name, model.units[name])
     names = sorted(order, key=order.get)
-    comparison = ModelComparison(models=models, reference=ref, metric_names=names,
-                                 metric_units=units)
+    comparison = ModelComparison(
+        models=models, reference=ref, metric_names=names, metric_units=units
+    )
     for name in names:
         value = np.array([m.metrics.get(name, np.nan) for m in models])
         comparison.value[name] = value
@@ -235,8 +264,7 @@ def compare_models(sources: Sequence[str | Path], reference: str | Path | None =
     return comparison
 
 
-def write_models(path: str | Path, comparison: ModelComparison,
-                 command: str | None = None) -> Path:
+def write_models(path: str | Path, comparison: ModelComparison, command: str | None = None) -> Path:
     """Write ``comparison`` with the layout of the module docstring (atomically)."""
     models = comparison.models
     ref = models[comparison.reference]
@@ -246,8 +274,13 @@ def write_models(path: str | Path, comparison: ModelComparison,
         top = h5.create_group("models")
         for m in models:
             g = top.create_group(m.label.replace("/", "_"))
-            write_attrs(g, source=str(m.source), config=m.config.text,
-                        preset=m.config.vehicle.preset, road=m.config.road.kind)
+            write_attrs(
+                g,
+                source=str(m.source),
+                config=m.config.text,
+                preset=m.config.vehicle.preset,
+                road=m.config.road.kind,
+            )
             write_dataset(g, "time", m.time, "s", dims=("time",))
             sig = g.create_group("signals")
             for name, values in m.signals.items():
@@ -255,19 +288,32 @@ def write_models(path: str | Path, comparison: ModelComparison,
             spectra = g.create_group("psd")
             write_dataset(spectra, "frequency", m.psd_frequency, "Hz", dims=("frequency",))
             for name, values in m.psd.items():
-                write_dataset(spectra, name, values, m.units[f"PSD of {name}"],
-                              dims=("frequency",))
-            write_dataset(g.create_group("modal"), "frequency", m.natural_frequency, "Hz",
-                          dims=("mode",), dominant=list(m.dominant), label=list(m.mode_label))
+                write_dataset(spectra, name, values, m.units[f"PSD of {name}"], dims=("frequency",))
+            write_dataset(
+                g.create_group("modal"),
+                "frequency",
+                m.natural_frequency,
+                "Hz",
+                dims=("mode",),
+                dominant=list(m.dominant),
+                label=list(m.mode_label),
+            )
         comparison_group = h5.create_group("comparison")
         write_dataset(comparison_group, "model", labels, "1", dims=("model",))
         value = comparison_group.create_group("value")
         difference = comparison_group.create_group("difference")
         for name in comparison.metric_names:
-            write_dataset(value, name, comparison.value[name],
-                          comparison.metric_units[name], dims=("model",), models=labels)
-            write_dataset(difference, name, comparison.difference[name], "%", dims=("model",),
-                          models=labels)
+            write_dataset(
+                value,
+                name,
+                comparison.value[name],
+                comparison.metric_units[name],
+                dims=("model",),
+                models=labels,
+            )
+            write_dataset(
+                difference, name, comparison.difference[name], "%", dims=("model",), models=labels
+            )
     return Path(path)
 
 
@@ -276,10 +322,16 @@ def plot_models(comparison: ModelComparison, path: str | Path, title: str) -> Pa
     (:func:`suspopt.plots.model_comparison`)."""
     models = comparison.models
     units = models[comparison.reference].units
-    time_series = {name: [(m.label, m.time, m.signals[name]) for m in models]
-                   for name in TIME_SIGNALS if all(name in m.signals for m in models)}
-    spectra = {name: [(m.label, m.psd_frequency, m.psd[name]) for m in models]
-               for name in PSD_SIGNALS if all(name in m.psd for m in models)}
+    time_series = {
+        name: [(m.label, m.time, m.signals[name]) for m in models]
+        for name in TIME_SIGNALS
+        if all(name in m.signals for m in models)
+    }
+    spectra = {
+        name: [(m.label, m.psd_frequency, m.psd[name]) for m in models]
+        for name in PSD_SIGNALS
+        if all(name in m.psd for m in models)
+    }
     return plots.model_comparison(path, title, time_series, spectra, units)
 
 
@@ -287,8 +339,12 @@ def _cell(value: float) -> str:
     return "-" if np.isnan(value) else f"{value:.4g}"
 
 
-def run(sources: Sequence[Path], output: Path | None = None, plot: Path | None = None,
-        reference: Path | None = None) -> Report:
+def run(
+    sources: Sequence[Path],
+    output: Path | None = None,
+    plot: Path | None = None,
+    reference: Path | None = None,
+) -> Report:
     """``suspopt analyse models A.yaml B.yaml ... [--reference A.yaml]``."""
     if plot is not None:
         plots.check_path(plot)
@@ -305,18 +361,27 @@ def run(sources: Sequence[Path], output: Path | None = None, plot: Path | None =
         row = [name, comparison.metric_units[name]]
         for i, value in enumerate(comparison.value[name]):
             d = comparison.difference[name][i]
-            row.append(_cell(value) + ("" if np.isnan(value) else " (ref)"
-                                       if i == comparison.reference else
-                                       "" if np.isnan(d) else f" ({d:+.1f})"))
+            row.append(
+                _cell(value)
+                + (
+                    ""
+                    if np.isnan(value)
+                    else " (ref)"
+                    if i == comparison.reference
+                    else ""
+                    if np.isnan(d)
+                    else f" ({d:+.1f})"
+                )
+            )
         rows.append(row)
-    notes = [f"Δ = (X - X_ref)/X_ref · 100 % against {ref.label} (Sec 3.2.1; Tables 3.3-3.21 "
-             f"print the opposite sign); a quarter car's only corner stands for every corner",
-             "times are absolute (t_p, t_s); settling band 2 %; natural frequencies undamped; "
-             "SI units"]
+    notes = [
+        f"Δ = (X - X_ref)/X_ref · 100 % against {ref.label} (Sec 3.2.1; Tables 3.3-3.21 "
+        f"print the opposite sign); a quarter car's only corner stands for every corner",
+        "times are absolute (t_p, t_s); settling band 2 %; natural frequencies undamped; SI units",
+    ]
     diverged = [m.label for m in models if m.diverged]
     if diverged:
-        notes.append(f"diverged (NaN samples; try a smaller simulation.dt): "
-                     f"{', '.join(diverged)}")
+        notes.append(f"diverged (NaN samples; try a smaller simulation.dt): {', '.join(diverged)}")
     return Report(title=title, columns=columns, rows=rows, notes=notes)
 
 

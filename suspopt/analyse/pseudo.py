@@ -64,9 +64,22 @@ from ..seat import build_seat, passenger_mass_change
 from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
 from . import KINDS, Kind, Report, relative_change
 
-__all__ = ["Variant", "PseudoFronts", "config_with", "read_sections", "road_variants",
-           "mass_variants", "controller_variants", "pseudo_fronts", "write_pseudo_fronts",
-           "plot_pseudo_fronts", "MASS_CHANGES", "run_roads", "run_masses", "run_controllers"]
+__all__ = [
+    "Variant",
+    "PseudoFronts",
+    "config_with",
+    "read_sections",
+    "road_variants",
+    "mass_variants",
+    "controller_variants",
+    "pseudo_fronts",
+    "write_pseudo_fronts",
+    "plot_pseudo_fronts",
+    "MASS_CHANGES",
+    "run_roads",
+    "run_masses",
+    "run_controllers",
+]
 
 #: Passenger changes of Sec 8.4.3 [kg]: 20 kg lighter and heavier.
 MASS_CHANGES = (-20.0, 20.0)
@@ -111,7 +124,7 @@ class PseudoFronts:
     @property
     def reference(self) -> np.ndarray:
         """(N, m + s): the file's main objectives, then the re-simulated supplementary ones."""
-        return np.hstack([self.pareto.F, self.stored.F[:, self.m:]])
+        return np.hstack([self.pareto.F, self.stored.F[:, self.m :]])
 
     def values(self, i: int) -> np.ndarray:
         """(N, m + s) objectives under variant ``i`` (NaN where the simulation failed)."""
@@ -132,8 +145,7 @@ def read_sections(path: Path, option: str) -> dict:
     except FileNotFoundError:
         raise ConfigError(f"{option} {path}: no such file") from None
     except YamlError as exc:
-        raise ConfigError(f"{option} {path}{f':{exc.line}' if exc.line else ''}: "
-                          f"{exc}") from None
+        raise ConfigError(f"{option} {path}{f':{exc.line}' if exc.line else ''}: {exc}") from None
     if not isinstance(data, dict):
         raise ConfigError(f"{option} {path}: must be a YAML mapping of config sections")
     return data
@@ -141,34 +153,41 @@ def read_sections(path: Path, option: str) -> dict:
 
 # --- changes -------------------------------------------------------------------------------
 
+
 def config_with(pareto: ParetoSet, edit: Callable[[dict], None], what: str) -> Config:
     """The stored config with ``edit`` applied to its YAML data
     (:func:`suspopt.config.loader.edit_config`); errors refer to the lines of the edited
     text, written to the analysis's HDF5 as ``config``."""
-    return edit_config(pareto.config_text, edit,
-                       pareto.path.with_name(pareto.path.name + ":config"),
-                       f"{what}; the config of {pareto.path.name}")
+    return edit_config(
+        pareto.config_text,
+        edit,
+        pareto.path.with_name(pareto.path.name + ":config"),
+        f"{what}; the config of {pareto.path.name}",
+    )
 
 
 def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
     """One variant per road: an ISO 8608 class letter (A-E: the stored road with that class)
     or a config file whose ``road`` and ``simulation`` sections replace the stored ones."""
     if not roads:
-        raise ConfigError("analyse roads: give at least one --road CLASS (A-E) or "
-                          "--road CONFIG.yaml")
+        raise ConfigError(
+            "analyse roads: give at least one --road CLASS (A-E) or --road CONFIG.yaml"
+        )
     variants = []
     for road in roads:
         if road.upper() in _ROAD_CLASSES:
             letter = road.upper()
             kind = pareto.config().road.kind
             if kind != "iso8608":
-                raise ConfigError(f"--road {road}: a road class needs an ISO 8608 road; the "
-                                  f"road of {pareto.path.name} is {kind} (give a config file "
-                                  f"instead)")
+                raise ConfigError(
+                    f"--road {road}: a road class needs an ISO 8608 road; the "
+                    f"road of {pareto.path.name} is {kind} (give a config file "
+                    f"instead)"
+                )
 
             def set_class(data, letter=letter):
                 data["road"]["road_class"] = letter
-                data["road"].pop("level", None)     # a level would override the class
+                data["road"].pop("level", None)  # a level would override the class
 
             cfg = config_with(pareto, set_class, f"road class {letter}")
             variants.append(Variant(f"class {letter}", cfg, attrs={"road_class": letter}))
@@ -201,13 +220,17 @@ def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) ->
     each design's own takes the factor the rule gives a ratio of 1."""
     cfg = pareto.config()
     if cfg.seat is None:
-        raise ConfigError(f"{pareto.path}: analyse masses needs a seat, and the optimised "
-                          f"config has no seat: section")
+        raise ConfigError(
+            f"{pareto.path}: analyse masses needs a seat, and the optimised "
+            f"config has no seat: section"
+        )
     paths = {v.label: v.path for v in cfg.design_variables}
     for path in paths.values():
         if path == "seat.mass" or path.startswith("seat.passenger."):
-            raise ConfigError(f"{pareto.path}: analyse masses changes the passenger, and "
-                              f"{path} is a design variable")
+            raise ConfigError(
+                f"{pareto.path}: analyse masses changes the passenger, and "
+                f"{path} is a design variable"
+            )
     if not changes:
         raise ConfigError("analyse masses: give at least one --mass-change KG")
     load = float(build_seat(cfg).isolator["load_mass"][0])
@@ -218,14 +241,16 @@ def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) ->
     for delta in changes:
         new = load + float(delta)
         if not new > lowest:
-            raise ConfigError(f"--mass-change {delta:g}: the load would be {new:g} kg, not "
-                              f"above the {'seat mass' if lowest else 'zero'} ({lowest:g} kg)")
-        changed = {path: float(value[0]) for path, value in
-                   passenger_mass_change(cfg, new).items()}
+            raise ConfigError(
+                f"--mass-change {delta:g}: the load would be {new:g} kg, not "
+                f"above the {'seat mass' if lowest else 'zero'} ({lowest:g} kg)"
+            )
+        changed = {path: float(value[0]) for path, value in passenger_mass_change(cfg, new).items()}
         X = None
         if ratio in changed and designed:
-            unit = cfg.model_copy(update={"seat": cfg.seat.model_copy(
-                update={"stiffness_ratio": 1.0})})
+            unit = cfg.model_copy(
+                update={"seat": cfg.seat.model_copy(update={"stiffness_ratio": 1.0})}
+            )
             X = pareto.X.copy()
             X[:, designed] *= passenger_mass_change(unit, new)[ratio][0]
 
@@ -233,9 +258,14 @@ def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) ->
             for path, value in changed.items():
                 set_path(data, path, value)
 
-        variants.append(Variant(f"{new:g} kg",
-                                config_with(pareto, seat_passenger, f"a {new:g} kg load"),
-                                X, attrs={"load_mass": new, "mass_change": float(delta)}))
+        variants.append(
+            Variant(
+                f"{new:g} kg",
+                config_with(pareto, seat_passenger, f"a {new:g} kg load"),
+                X,
+                attrs={"load_mass": new, "mass_change": float(delta)},
+            )
+        )
     return variants
 
 
@@ -253,16 +283,23 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
         vehicle = other.get("vehicle") or {}
         control = other.get("control")
         default = (vehicle.get("corner_defaults") or {}).get("damper")
-        own = {c: v["damper"] for c, v in (vehicle.get("corners") or {}).items()
-               if isinstance(v, dict) and "damper" in v}
+        own = {
+            c: v["damper"]
+            for c, v in (vehicle.get("corners") or {}).items()
+            if isinstance(v, dict) and "damper" in v
+        }
         if control is None and default is None and not own:
-            raise ConfigError(f"--with {source}: the file has no control: section and no "
-                              f"damper (vehicle.corner_defaults.damper or "
-                              f"vehicle.corners.<corner>.damper)")
+            raise ConfigError(
+                f"--with {source}: the file has no control: section and no "
+                f"damper (vehicle.corner_defaults.damper or "
+                f"vehicle.corners.<corner>.damper)"
+            )
         unknown = sorted(set(own) - corners)
         if unknown:
-            raise ConfigError(f"--with {source}: corner(s) {', '.join(unknown)} are not in "
-                              f"{pareto.path.name} (it has {', '.join(sorted(corners))})")
+            raise ConfigError(
+                f"--with {source}: corner(s) {', '.join(unknown)} are not in "
+                f"{pareto.path.name} (it has {', '.join(sorted(corners))})"
+            )
 
         def controller(data, control=control, default=default, own=own):
             if control is not None:
@@ -286,6 +323,7 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
 
 # --- evaluation, output ----------------------------------------------------------------------
 
+
 def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> PseudoFronts:
     """Evaluate the stored designs under every variant, one batch each; the stored designs
     are simulated too when the config has supplementary objectives (the file has none)."""
@@ -293,14 +331,17 @@ def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> 
     if len(set(labels)) != len(labels):
         raise ConfigError(f"analyse {kind}: the changes must differ (got {', '.join(labels)})")
     stored = evaluate_pareto(pareto)
-    sets = [evaluate_pareto(pareto if v.X is None else replace(pareto, X=v.X), v.config,
-                            v.label) for v in variants]
+    sets = [
+        evaluate_pareto(pareto if v.X is None else replace(pareto, X=v.X), v.config, v.label)
+        for v in variants
+    ]
     for v, s in zip(variants, sets):
         if s.names != stored.names:
-            raise ConfigError(f"{pareto.path}: with {v.label} the objectives are "
-                              f"{', '.join(s.names)}, not {', '.join(stored.names)}")
-    return PseudoFronts(kind=kind, pareto=pareto, stored=stored, variants=list(variants),
-                        sets=sets)
+            raise ConfigError(
+                f"{pareto.path}: with {v.label} the objectives are "
+                f"{', '.join(s.names)}, not {', '.join(stored.names)}"
+            )
+    return PseudoFronts(kind=kind, pareto=pareto, stored=stored, variants=list(variants), sets=sets)
 
 
 def _columns(group, name: str, data, dim: str, names, units) -> None:
@@ -308,8 +349,7 @@ def _columns(group, name: str, data, dim: str, names, units) -> None:
     write_dataset(group, name, data, list(units), dims=("design", dim), names=names)
 
 
-def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
-                        command: str | None = None) -> Path:
+def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts, command: str | None = None) -> Path:
     """Write ``fronts`` with the layout of the module docstring (atomically)."""
     p, m = fronts.pareto, fronts.m
     names, units = fronts.stored.names, fronts.stored.units
@@ -319,8 +359,9 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
         grp = h5.create_group("pareto")
         _columns(grp, "X", p.X, "variable", p.var_names, p.var_units)
         _columns(grp, "F", p.F, "objective", names[:m], units[:m])
-        write_dataset(grp, "feasible", fronts.stored.feasible.astype(np.int8), "1",
-                      dims=("design",))
+        write_dataset(
+            grp, "feasible", fronts.stored.feasible.astype(np.int8), "1", dims=("design",)
+        )
         picks = grp.create_group("picks")
         for key, row in fronts.picks.items():
             write_dataset(picks, key, row, "1")
@@ -336,8 +377,14 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts,
             _columns(g, "change", change[:, :m], "objective", names[:m], ["%"] * m)
             if len(names) > m:
                 _columns(g, "S", values[:, m:], "supplementary", names[m:], units[m:])
-                _columns(g, "S_change", change[:, m:], "supplementary", names[m:],
-                         ["%"] * (len(names) - m))
+                _columns(
+                    g,
+                    "S_change",
+                    change[:, m:],
+                    "supplementary",
+                    names[m:],
+                    ["%"] * (len(names) - m),
+                )
             if variant.X is not None:
                 _columns(g, "X", variant.X, "variable", p.var_names, p.var_units)
             write_dataset(g, "feasible", s.feasible.astype(np.int8), "1", dims=("design",))
@@ -351,20 +398,28 @@ def _is_comfort(cfg: Config) -> list[bool]:
     return [spec.metric == "rms_weighted" for spec in cfg.objectives.main]
 
 
-def plot_pseudo_fronts(fronts: PseudoFronts, path: str | Path, title: str,
-                       marks: Mapping[str, int] | None = None) -> Path:
+def plot_pseudo_fronts(
+    fronts: PseudoFronts, path: str | Path, title: str, marks: Mapping[str, int] | None = None
+) -> Path:
     """The stored front and its pseudo-fronts, and the design variables along the stored
     front (:func:`suspopt.plots.pareto_fronts`); ``marks`` (name -> design, default the
     picks) are starred."""
     p, m = fronts.pareto, fronts.m
     curves = [(f"optimised ({p.path.name})", p.F)]
     curves += [(v.label, fronts.values(i)[:, :m]) for i, v in enumerate(fronts.variants)]
-    variables = [(name, unit, p.X[:, j]) for j, (name, unit)
-                 in enumerate(zip(p.var_names, p.var_units))]
+    variables = [
+        (name, unit, p.X[:, j]) for j, (name, unit) in enumerate(zip(p.var_names, p.var_units))
+    ]
     objectives = list(zip(fronts.stored.names[:m], fronts.stored.units[:m]))
-    return plots.pareto_fronts(path, title, objectives, curves, variables,
-                               marks=fronts.picks if marks is None else marks,
-                               comfort=_is_comfort(p.config()))
+    return plots.pareto_fronts(
+        path,
+        title,
+        objectives,
+        curves,
+        variables,
+        marks=fronts.picks if marks is None else marks,
+        comfort=_is_comfort(p.config()),
+    )
 
 
 def _spread(N: int, rows: int = _TABLE_ROWS) -> np.ndarray:
@@ -386,23 +441,39 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
     for k in sorted(set(_spread(len(p.X)).tolist()) | set(picked)):
         row = [str(k), ", ".join(picked.get(k, []))] + [f"{f:.4g}" for f in p.F[k]]
         for s, value, change in zip(fronts.sets, values, changes):
-            row += ["failed" if s.failed[k] else f"{f:.4g} ({c:+.0f} %)"
-                    for f, c in zip(value[k, :m], change[k, :m])]
+            row += [
+                "failed" if s.failed[k] else f"{f:.4g} ({c:+.0f} %)"
+                for f, c in zip(value[k, :m], change[k, :m])
+            ]
         rows.append(row)
-    notes = [f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}, with "
-             f"the edges and knee of the front (suspopt.kesort.pareto_picks, Fig. 8.21); "
-             f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)", *fronts.stored.notes]
+    notes = [
+        f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}, with "
+        f"the edges and knee of the front (suspopt.kesort.pareto_picks, Fig. 8.21); "
+        f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)",
+        *fronts.stored.notes,
+    ]
     for v, s, change in zip(fronts.variants, fronts.sets, changes):
         change = change[~s.failed]
-        spans = [f"{name} {np.min(c):+.1f} to {np.max(c):+.1f} % (median {np.median(c):+.1f} %)"
-                 for name, c in zip(names, change.T) if c.size]
-        notes.append(f"{v.label}: {int(s.feasible.sum())} of {len(p.X)} designs feasible, "
-                     f"{int(s.failed.sum())} failed; " + "; ".join(spans))
+        spans = [
+            f"{name} {np.min(c):+.1f} to {np.max(c):+.1f} % (median {np.median(c):+.1f} %)"
+            for name, c in zip(names, change.T)
+            if c.size
+        ]
+        notes.append(
+            f"{v.label}: {int(s.feasible.sum())} of {len(p.X)} designs feasible, "
+            f"{int(s.failed.sum())} failed; " + "; ".join(spans)
+        )
     return Report(title=title, columns=columns, rows=rows, notes=notes)
 
 
-def _run(kind: str, source: Path, output: Path | None, plot: Path | None,
-         variants: Callable[[ParetoSet], list[Variant]], what: str) -> Report:
+def _run(
+    kind: str,
+    source: Path,
+    output: Path | None,
+    plot: Path | None,
+    variants: Callable[[ParetoSet], list[Variant]],
+    what: str,
+) -> Report:
     if plot is not None:
         plots.check_path(plot)
     pareto = read_pareto(source)
@@ -415,26 +486,50 @@ def _run(kind: str, source: Path, output: Path | None, plot: Path | None,
     return _report(fronts, title)
 
 
-def run_roads(source: Path, output: Path | None = None, plot: Path | None = None,
-              road: Sequence[str] = ()) -> Report:
+def run_roads(
+    source: Path, output: Path | None = None, plot: Path | None = None, road: Sequence[str] = ()
+) -> Report:
     """``suspopt analyse roads PARETO.h5 --road B --road C`` (Sec 8.4.2, Table 8.12)."""
-    return _run("roads", source, output, plot, lambda p: road_variants(p, road),
-                "on other roads (Sec 8.4.2)")
+    return _run(
+        "roads",
+        source,
+        output,
+        plot,
+        lambda p: road_variants(p, road),
+        "on other roads (Sec 8.4.2)",
+    )
 
 
-def run_masses(source: Path, output: Path | None = None, plot: Path | None = None,
-               mass_change: Sequence[float] = MASS_CHANGES) -> Report:
+def run_masses(
+    source: Path,
+    output: Path | None = None,
+    plot: Path | None = None,
+    mass_change: Sequence[float] = MASS_CHANGES,
+) -> Report:
     """``suspopt analyse masses PARETO.h5 [--mass-change -20 --mass-change 20]`` (Sec 8.4.3,
     Table 8.13)."""
-    return _run("masses", source, output, plot, lambda p: mass_variants(p, mass_change),
-                "with other passengers (Sec 8.4.3)")
+    return _run(
+        "masses",
+        source,
+        output,
+        plot,
+        lambda p: mass_variants(p, mass_change),
+        "with other passengers (Sec 8.4.3)",
+    )
 
 
-def run_controllers(source: Path, output: Path | None = None, plot: Path | None = None,
-                    with_: Sequence[Path] = ()) -> Report:
+def run_controllers(
+    source: Path, output: Path | None = None, plot: Path | None = None, with_: Sequence[Path] = ()
+) -> Report:
     """``suspopt analyse controllers PARETO.h5 --with OTHER.yaml`` (Sec 7.3, Fig. 7.4b)."""
-    return _run("controllers", source, output, plot,
-                lambda p: controller_variants(p, with_), "with other controllers (Fig. 7.4b)")
+    return _run(
+        "controllers",
+        source,
+        output,
+        plot,
+        lambda p: controller_variants(p, with_),
+        "with other controllers (Fig. 7.4b)",
+    )
 
 
 KINDS["roads"] = Kind(run_roads, options=("road",))

@@ -56,19 +56,35 @@ from .. import plots
 from ..config import Config, ConfigError, load_config
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..kesort import pareto_picks
-from ..metrics import transmissibility, coherence, weighted_rms
+from ..metrics import coherence, transmissibility, weighted_rms
 from ..optimise import Problem
 from ..params import ParamView
-from ..seat import (CONSTRAINT_UNITS, base_transmissibility, build_seat, linearise,
-                    natural_frequencies, seat_constraints)
+from ..seat import (
+    CONSTRAINT_UNITS,
+    base_transmissibility,
+    build_seat,
+    linearise,
+    natural_frequencies,
+    seat_constraints,
+)
 from ..selection import ParetoSet, read_pareto
 from ..simulate import simulate
 from . import KINDS, Kind, Report
 from .pseudo import config_with, read_sections
 
-__all__ = ["SeatTransmissibility", "FrontDesigns", "seat_transmissibility", "front_designs",
-           "with_passenger", "write_transmissibility", "plot_transmissibility",
-           "plot_front_transmissibility", "run", "LINEAR_FREQUENCIES", "SEGMENT"]
+__all__ = [
+    "SeatTransmissibility",
+    "FrontDesigns",
+    "seat_transmissibility",
+    "front_designs",
+    "with_passenger",
+    "write_transmissibility",
+    "plot_transmissibility",
+    "plot_front_transmissibility",
+    "run",
+    "LINEAR_FREQUENCIES",
+    "SEGMENT",
+]
 
 #: Frequency grid of the linear spectra [Hz].
 LINEAR_FREQUENCIES = np.geomspace(0.1, 50.0, 500)
@@ -122,17 +138,18 @@ class FrontDesigns:
         return {path: self.X[:, j] for j, path in enumerate(self.paths)}
 
 
-def seat_transmissibility(cfg: Config, segment: float = SEGMENT,
-                          params: Mapping[str, np.ndarray] | None = None
-                          ) -> SeatTransmissibility:
+def seat_transmissibility(
+    cfg: Config, segment: float = SEGMENT, params: Mapping[str, np.ndarray] | None = None
+) -> SeatTransmissibility:
     """Linear and simulated transmissibility of ``cfg``'s seat (see the module docstring),
     for one design or, with ``params`` (dotted path -> (P,)), for P designs in one batch.
 
     ``segment`` is the Welch segment length [s] of the simulated estimate (at most the run).
     """
     if cfg.seat is None:
-        raise ConfigError(f"{cfg.source or '<config>'}: analyse transmissibility needs a seat: "
-                          f"section")
+        raise ConfigError(
+            f"{cfg.source or '<config>'}: analyse transmissibility needs a seat: section"
+        )
     seat = build_seat(cfg, ParamView(cfg, params))
     lin = linearise(seat)
     linear = np.abs(base_transmissibility(lin, LINEAR_FREQUENCIES))
@@ -143,14 +160,24 @@ def seat_transmissibility(cfg: Config, segment: float = SEGMENT,
     outputs = np.stack([result.signals[_acc_signal(name)] for name in seat.dof_names], axis=1)
     f_sim, tr = transmissibility(floor[:, None, :], outputs, fs, nperseg)
     _, coh = coherence(floor[:, None, :], outputs, fs, nperseg)
-    rms = {name: weighted_rms(result.signals[name], fs, "Wk")
-           for name in ("seat.acc", "head.acc") if name in result.signals}
+    rms = {
+        name: weighted_rms(result.signals[name], fs, "Wk")
+        for name in ("seat.acc", "head.acc")
+        if name in result.signals
+    }
     return SeatTransmissibility(
-        kind=seat.kind, dof_names=seat.dof_names, linear_frequency=LINEAR_FREQUENCIES,
-        linear=linear, simulated_frequency=f_sim, simulated=np.swapaxes(tr, 1, 2),
-        coherence=np.swapaxes(coh, 1, 2), static_deflection=seat.static_deflection,
-        natural_frequency=natural_frequencies(lin), constraints=seat_constraints(cfg, params),
-        weighted_rms=rms)
+        kind=seat.kind,
+        dof_names=seat.dof_names,
+        linear_frequency=LINEAR_FREQUENCIES,
+        linear=linear,
+        simulated_frequency=f_sim,
+        simulated=np.swapaxes(tr, 1, 2),
+        coherence=np.swapaxes(coh, 1, 2),
+        static_deflection=seat.static_deflection,
+        natural_frequency=natural_frequencies(lin),
+        constraints=seat_constraints(cfg, params),
+        weighted_rms=rms,
+    )
 
 
 def front_designs(pareto: ParetoSet) -> FrontDesigns:
@@ -164,14 +191,22 @@ def front_designs(pareto: ParetoSet) -> FrontDesigns:
     rows = np.array(list(picks))
     path_of = {v.label: v.path for v in cfg.design_variables}
     if sorted(path_of) != sorted(pareto.var_names):
-        raise ConfigError(f"{pareto.path}: /pareto/X holds {', '.join(pareto.var_names)}; its "
-                          f"config varies {', '.join(path_of)}: the designs do not fit its "
-                          f"design_variables")
-    return FrontDesigns(rows=rows, picks=list(picks.values()), X=pareto.X[rows],
-                        F=pareto.F[rows], var_names=pareto.var_names,
-                        var_units=pareto.var_units, obj_names=pareto.obj_names,
-                        obj_units=problem.obj_units,
-                        paths=[path_of[name] for name in pareto.var_names])
+        raise ConfigError(
+            f"{pareto.path}: /pareto/X holds {', '.join(pareto.var_names)}; its "
+            f"config varies {', '.join(path_of)}: the designs do not fit its "
+            f"design_variables"
+        )
+    return FrontDesigns(
+        rows=rows,
+        picks=list(picks.values()),
+        X=pareto.X[rows],
+        F=pareto.F[rows],
+        var_names=pareto.var_names,
+        var_units=pareto.var_units,
+        obj_names=pareto.obj_names,
+        obj_units=problem.obj_units,
+        paths=[path_of[name] for name in pareto.var_names],
+    )
 
 
 def with_passenger(pareto: ParetoSet, source: str | Path) -> Config:
@@ -184,8 +219,10 @@ def with_passenger(pareto: ParetoSet, source: str | Path) -> Config:
 
     def seat_passenger(data):
         if not isinstance(data.get("seat"), dict):
-            raise ConfigError(f"{pareto.path}: analyse transmissibility needs a seat, and the "
-                              f"optimised config has no seat: section")
+            raise ConfigError(
+                f"{pareto.path}: analyse transmissibility needs a seat, and the "
+                f"optimised config has no seat: section"
+            )
         data["seat"]["passenger"] = seat["passenger"]
         if "mass" in seat:
             data["seat"]["mass"] = seat["mass"]
@@ -199,15 +236,18 @@ def _acc_signal(dof: str) -> str:
     return "seat.inner_acc" if dof == "seat.inner" else f"{dof}.acc"
 
 
-def write_transmissibility(path: str | Path, data: SeatTransmissibility, cfg: Config,
-                           command: str | None = None,
-                           designs: FrontDesigns | None = None) -> Path:
+def write_transmissibility(
+    path: str | Path,
+    data: SeatTransmissibility,
+    cfg: Config,
+    command: str | None = None,
+    designs: FrontDesigns | None = None,
+) -> Path:
     """Write ``data`` with the layout of the module docstring (atomically); ``designs`` when
     they were picked from a front."""
     with atomic_h5(path, cfg, command) as h5:
         h5.attrs["seat_kind"] = data.kind
-        write_dataset(h5, "design", np.arange(len(data.static_deflection)), "1",
-                      dims=("design",))
+        write_dataset(h5, "design", np.arange(len(data.static_deflection)), "1", dims=("design",))
         lin, sim = h5.create_group("linear"), h5.create_group("simulated")
         write_dataset(lin, "frequency", data.linear_frequency, "Hz", dims=("frequency",))
         write_dataset(sim, "frequency", data.simulated_frequency, "Hz", dims=("frequency",))
@@ -217,10 +257,21 @@ def write_transmissibility(path: str | Path, data: SeatTransmissibility, cfg: Co
             write_dataset(lin, name, data.linear[..., j], "-", dims=spectrum)
             write_dataset(sim, name, data.simulated[..., j], "-", dims=spectrum)
             write_dataset(coh, name, data.coherence[..., j], "-", dims=spectrum)
-        write_dataset(h5.create_group("statics"), "static_deflection", data.static_deflection,
-                      "m", dims=("design",))
-        write_dataset(h5.create_group("modal"), "frequency", data.natural_frequency, "Hz",
-                      dims=("design", "mode"), dof_names=list(data.dof_names))
+        write_dataset(
+            h5.create_group("statics"),
+            "static_deflection",
+            data.static_deflection,
+            "m",
+            dims=("design",),
+        )
+        write_dataset(
+            h5.create_group("modal"),
+            "frequency",
+            data.natural_frequency,
+            "Hz",
+            dims=("design", "mode"),
+            dof_names=list(data.dof_names),
+        )
         con = h5.create_group("constraints")
         for name, values in data.constraints.items():
             write_dataset(con, name, values, CONSTRAINT_UNITS[name], dims=("design",))
@@ -231,10 +282,22 @@ def write_transmissibility(path: str | Path, data: SeatTransmissibility, cfg: Co
             grp = h5.create_group("designs")
             write_attrs(grp, picks=[", ".join(p) for p in designs.picks])
             write_dataset(grp, "row", designs.rows, "1", dims=("design",))
-            write_dataset(grp, "X", designs.X, list(designs.var_units),
-                          dims=("design", "variable"), names=designs.var_names)
-            write_dataset(grp, "F", designs.F, list(designs.obj_units),
-                          dims=("design", "objective"), names=designs.obj_names)
+            write_dataset(
+                grp,
+                "X",
+                designs.X,
+                list(designs.var_units),
+                dims=("design", "variable"),
+                names=designs.var_names,
+            )
+            write_dataset(
+                grp,
+                "F",
+                designs.F,
+                list(designs.obj_units),
+                dims=("design", "objective"),
+                names=designs.obj_names,
+            )
     return Path(path)
 
 
@@ -252,33 +315,54 @@ def _curves(data: SeatTransmissibility, curves: Sequence[tuple[int, int, str, st
     return lines, points
 
 
-def plot_transmissibility(data: SeatTransmissibility, path: str | Path,
-                          design: int = 0) -> Path:
+def plot_transmissibility(data: SeatTransmissibility, path: str | Path, design: int = 0) -> Path:
     """Figure of the seat transmissibility and (with a passenger) STHT of one design: linear
     model as lines, simulation (H1) as dots where the coherence is at least 0.8."""
-    lines, points = _curves(data, [
-        (design, data.dof_names.index(name), f"{label} (linearised)", f"{label} (simulated, H1)")
-        for name, label in (("seat", "seat  z̈_seat/z̈_s"), ("head", "STHT  z̈_head/z̈_s"))
-        if name in data.dof_names])
-    title = (f"{data.kind.upper()} seat, X_ST = {1e3 * data.static_deflection[design]:.1f} mm "
-             f"(Eq 2.86)")
-    return plots.transmissibilities(path, title, lines, points,
-                                    f_range=(data.linear_frequency[0], 30.0))
+    lines, points = _curves(
+        data,
+        [
+            (
+                design,
+                data.dof_names.index(name),
+                f"{label} (linearised)",
+                f"{label} (simulated, H1)",
+            )
+            for name, label in (("seat", "seat  z̈_seat/z̈_s"), ("head", "STHT  z̈_head/z̈_s"))
+            if name in data.dof_names
+        ],
+    )
+    title = (
+        f"{data.kind.upper()} seat, X_ST = {1e3 * data.static_deflection[design]:.1f} mm (Eq 2.86)"
+    )
+    return plots.transmissibilities(
+        path, title, lines, points, f_range=(data.linear_frequency[0], 30.0)
+    )
 
 
-def plot_front_transmissibility(data: SeatTransmissibility, designs: FrontDesigns,
-                                path: str | Path, title: str) -> Path:
+def plot_front_transmissibility(
+    data: SeatTransmissibility, designs: FrontDesigns, path: str | Path, title: str
+) -> Path:
     """STHT (or, without a passenger, the seat transmissibility) of each picked design
     (Fig. 8.26): linearised as lines, simulated (H1) as dots where coherent."""
     name = "head" if "head" in data.dof_names else "seat"
     j = data.dof_names.index(name)
-    lines, points = _curves(data, [
-        (p, j, f"{' = '.join(picks)} (#{designs.rows[p]}, X_ST "
-               f"{1e3 * data.static_deflection[p]:.1f} mm)",
-         f"{' = '.join(picks)} (simulated, H1)") for p, picks in enumerate(designs.picks)])
+    lines, points = _curves(
+        data,
+        [
+            (
+                p,
+                j,
+                f"{' = '.join(picks)} (#{designs.rows[p]}, X_ST "
+                f"{1e3 * data.static_deflection[p]:.1f} mm)",
+                f"{' = '.join(picks)} (simulated, H1)",
+            )
+            for p, picks in enumerate(designs.picks)
+        ],
+    )
     what = "STHT z̈_head/z̈_s" if name == "head" else "seat TR z̈_seat/z̈_s"
-    return plots.transmissibilities(path, f"{title}: {what} (Eq 2.86)", lines, points,
-                                    f_range=(data.linear_frequency[0], 30.0))
+    return plots.transmissibilities(
+        path, f"{title}: {what} (Eq 2.86)", lines, points, f_range=(data.linear_frequency[0], 30.0)
+    )
 
 
 def _peak(f: np.ndarray, values: np.ndarray, valid: np.ndarray | None = None):
@@ -292,8 +376,9 @@ def _peak(f: np.ndarray, values: np.ndarray, valid: np.ndarray | None = None):
     return values[i], f[i]
 
 
-def _run_front(source: Path, output: Path | None, plot: Path | None,
-               with_: Sequence[Path]) -> Report:
+def _run_front(
+    source: Path, output: Path | None, plot: Path | None, with_: Sequence[Path]
+) -> Report:
     """The picks of a Pareto file (module docstring)."""
     if len(with_) > 1:
         raise ConfigError("analyse transmissibility takes one --with FILE.yaml")
@@ -302,7 +387,7 @@ def _run_front(source: Path, output: Path | None, plot: Path | None,
     designs = front_designs(pareto)
     try:
         data = seat_transmissibility(cfg, params=designs.params())
-    except ConfigError as exc:               # a stored value the config's field cannot take
+    except ConfigError as exc:  # a stored value the config's field cannot take
         if not str(exc).startswith("params:"):
             raise
         raise ConfigError(f"{pareto.path}: /pareto/X: {exc}") from None
@@ -317,32 +402,50 @@ def _run_front(source: Path, output: Path | None, plot: Path | None,
     rows = []
     for p, picks in enumerate(designs.picks):
         lin = _peak(data.linear_frequency, data.linear[p, :, j])
-        sim = _peak(data.simulated_frequency, data.simulated[p, :, j],
-                    data.coherence[p, :, j] >= _MIN_COHERENCE)
+        sim = _peak(
+            data.simulated_frequency,
+            data.simulated[p, :, j],
+            data.coherence[p, :, j] >= _MIN_COHERENCE,
+        )
         rms = data.weighted_rms.get(f"{name}.acc")
-        rows.append([" = ".join(picks), str(designs.rows[p]),
-                     *(f"{f:.4g}" for f in designs.F[p]),
-                     f"{1e3 * data.static_deflection[p]:.2f}",
-                     f"{lin[0]:.3f} @ {lin[1]:.2f}", f"{sim[0]:.3f} @ {sim[1]:.2f}",
-                     "-" if rms is None else f"{rms[p]:.4f}"])
-    columns = ["design", "#", *(f"{n} [{u}]" for n, u in zip(designs.obj_names,
-                                                             designs.obj_units)),
-               "X_ST simulated [mm]", f"{label} peak, linear [- @ Hz]",
-               f"{label} peak, simulated [- @ Hz]", f"Wk r.m.s. {name}.acc [m/s^2]"]
-    notes = [f"picks of the front (suspopt.kesort.pareto_picks, Fig. 8.21): the edges "
-             f"best_<objective> and the knee; objectives as stored; X_ST, peaks and r.m.s. "
-             f"{'with the passenger of ' + str(with_[0]) if with_ else 'as stored'}",
-             "TR = |z̈_i / z̈_s| from the floor z_s (Eq 2.86); peaks in 0.5-20 Hz, simulated "
-             f"where the coherence is >= {_MIN_COHERENCE}"]
+        rows.append(
+            [
+                " = ".join(picks),
+                str(designs.rows[p]),
+                *(f"{f:.4g}" for f in designs.F[p]),
+                f"{1e3 * data.static_deflection[p]:.2f}",
+                f"{lin[0]:.3f} @ {lin[1]:.2f}",
+                f"{sim[0]:.3f} @ {sim[1]:.2f}",
+                "-" if rms is None else f"{rms[p]:.4f}",
+            ]
+        )
+    columns = [
+        "design",
+        "#",
+        *(f"{n} [{u}]" for n, u in zip(designs.obj_names, designs.obj_units)),
+        "X_ST simulated [mm]",
+        f"{label} peak, linear [- @ Hz]",
+        f"{label} peak, simulated [- @ Hz]",
+        f"Wk r.m.s. {name}.acc [m/s^2]",
+    ]
+    notes = [
+        f"picks of the front (suspopt.kesort.pareto_picks, Fig. 8.21): the edges "
+        f"best_<objective> and the knee; objectives as stored; X_ST, peaks and r.m.s. "
+        f"{'with the passenger of ' + str(with_[0]) if with_ else 'as stored'}",
+        "TR = |z̈_i / z̈_s| from the floor z_s (Eq 2.86); peaks in 0.5-20 Hz, simulated "
+        f"where the coherence is >= {_MIN_COHERENCE}",
+    ]
     if name != "head":
-        notes.append("no passenger: STHT needs one, e.g. --with "
-                     "configs/ch8/<seat>_class_a_passenger.yaml (Sec 8.4.4)")
-    return Report(title=f"transmissibility - {title}", columns=columns, rows=rows,
-                  notes=notes)
+        notes.append(
+            "no passenger: STHT needs one, e.g. --with "
+            "configs/ch8/<seat>_class_a_passenger.yaml (Sec 8.4.4)"
+        )
+    return Report(title=f"transmissibility - {title}", columns=columns, rows=rows, notes=notes)
 
 
-def run(source: Path, output: Path | None = None, plot: Path | None = None,
-        with_: Sequence[Path] = ()) -> Report:
+def run(
+    source: Path, output: Path | None = None, plot: Path | None = None, with_: Sequence[Path] = ()
+) -> Report:
     """The ``transmissibility`` analysis of ``source``: a YAML config with a seat, or a Pareto
     file (then ``with_`` may give the passenger, module docstring)."""
     if plot is not None:
@@ -357,28 +460,38 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None,
         write_transmissibility(output, data, cfg)
     if plot is not None:
         plot_transmissibility(data, plot)
-    rows = [["static deflection X_ST", "mm", f"{1e3 * data.static_deflection[0]:.2f}"],
-            ["natural frequencies", "Hz",
-             ", ".join(f"{f:.2f}" for f in data.natural_frequency[0])]]
+    rows = [
+        ["static deflection X_ST", "mm", f"{1e3 * data.static_deflection[0]:.2f}"],
+        ["natural frequencies", "Hz", ", ".join(f"{f:.2f}" for f in data.natural_frequency[0])],
+    ]
     for name, label in (("seat", "seat TR"), ("head", "STHT")):
         if name not in data.dof_names:
             continue
         j = data.dof_names.index(name)
         tr, f = _peak(data.linear_frequency, data.linear[0, :, j])
         rows.append([f"{label} peak (linear)", "- @ Hz", f"{tr:.3f} @ {f:.2f}"])
-        tr, f = _peak(data.simulated_frequency, data.simulated[0, :, j],
-                      data.coherence[0, :, j] >= _MIN_COHERENCE)
+        tr, f = _peak(
+            data.simulated_frequency,
+            data.simulated[0, :, j],
+            data.coherence[0, :, j] >= _MIN_COHERENCE,
+        )
         rows.append([f"{label} peak (simulated)", "- @ Hz", f"{tr:.3f} @ {f:.2f}"])
     for name, values in data.weighted_rms.items():
         rows.append([f"Wk r.m.s. {name}", "m/s^2", f"{values[0]:.4f}"])
     for name, values in data.constraints.items():
         rows.append([f"g {name}", CONSTRAINT_UNITS[name], f"{values[0]:.4g}"])
-    notes = ["TR = |z̈_i / z̈_s| from the floor z_s (Eq 2.86); peaks in 0.5-20 Hz, simulated "
-             f"where the coherence is >= {_MIN_COHERENCE}; g: constraint values, <= 0 feasible"]
+    notes = [
+        "TR = |z̈_i / z̈_s| from the floor z_s (Eq 2.86); peaks in 0.5-20 Hz, simulated "
+        f"where the coherence is >= {_MIN_COHERENCE}; g: constraint values, <= 0 feasible"
+    ]
     if "head" not in data.dof_names:
         notes.append("no passenger: STHT needs seat.passenger (e.g. passenger: {})")
-    return Report(title=f"transmissibility - {data.kind.upper()} seat ({Path(source).name})",
-                  columns=["quantity", "unit", "value"], rows=rows, notes=notes)
+    return Report(
+        title=f"transmissibility - {data.kind.upper()} seat ({Path(source).name})",
+        columns=["quantity", "unit", "value"],
+        rows=rows,
+        notes=notes,
+    )
 
 
 KINDS["transmissibility"] = Kind(run, options=("with_",))

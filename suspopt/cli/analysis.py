@@ -4,14 +4,28 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 from pathlib import Path
-from typing import Optional
+
 import typer
+
 from ..errors import ConfigError
-from .base import (app, out, FORCE_HELP, MEMORY_HELP, new_table, show_table, fail, set_memory_limit, claim_output)
+from .base import (
+    FORCE_HELP,
+    MEMORY_HELP,
+    app,
+    claim_output,
+    fail,
+    new_table,
+    out,
+    set_memory_limit,
+    show_table,
+)
 
-
-_ANALYSE_OPTIONS = {"reference": "--reference", "road": "--road", "with_": "--with",
-                    "mass_change": "--mass-change"}
+_ANALYSE_OPTIONS = {
+    "reference": "--reference",
+    "road": "--road",
+    "with_": "--with",
+    "mass_change": "--mass-change",
+}
 
 
 def _analysis_help() -> str:
@@ -27,29 +41,38 @@ def _analysis_kinds(incomplete: str) -> list[str]:
 
 
 @app.command()
-def analyse(kind: str = typer.Argument(..., help=_analysis_help(),
-                                       autocompletion=_analysis_kinds),
-            sources: list[Path] = typer.Argument(
-                ..., help="YAML config, or Pareto HDF5 file; models takes several configs"),
-            output: Optional[Path] = typer.Option(None, "-o", "--output",
-                                                  help="HDF5 file for the numbers"),
-            plot: Optional[Path] = typer.Option(None, "--plot",
-                                                help="figure file (.png or .svg)"),
-            reference: Optional[Path] = typer.Option(
-                None, "--reference", help="models: the config the others are compared with "
-                "(default the first)"),
-            road: Optional[list[str]] = typer.Option(
-                None, "--road", help="roads: an ISO 8608 class (A-E), or a config whose road "
-                "and simulation sections replace the stored ones; repeatable"),
-            with_: Optional[list[Path]] = typer.Option(
-                None, "--with", help="controllers: YAML whose control: section and dampers "
-                "replace the stored ones; repeatable"),
-            mass_change: Optional[list[float]] = typer.Option(
-                None, "--mass-change", help="masses: change of the load on the seat, in kg; "
-                "repeatable (default -20 and +20)"),
-            force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-            max_memory: Optional[str] = typer.Option(None, "--max-memory",
-                                                     help=MEMORY_HELP)) -> None:
+def analyse(
+    kind: str = typer.Argument(..., help=_analysis_help(), autocompletion=_analysis_kinds),
+    sources: list[Path] = typer.Argument(
+        ..., help="YAML config, or Pareto HDF5 file; models takes several configs"
+    ),
+    output: Path | None = typer.Option(None, "-o", "--output", help="HDF5 file for the numbers"),
+    plot: Path | None = typer.Option(None, "--plot", help="figure file (.png or .svg)"),
+    reference: Path | None = typer.Option(
+        None,
+        "--reference",
+        help="models: the config the others are compared with (default the first)",
+    ),
+    road: list[str] | None = typer.Option(
+        None,
+        "--road",
+        help="roads: an ISO 8608 class (A-E), or a config whose road "
+        "and simulation sections replace the stored ones; repeatable",
+    ),
+    with_: list[Path] | None = typer.Option(
+        None,
+        "--with",
+        help="controllers: YAML whose control: section and dampers "
+        "replace the stored ones; repeatable",
+    ),
+    mass_change: list[float] | None = typer.Option(
+        None,
+        "--mass-change",
+        help="masses: change of the load on the seat, in kg; repeatable (default -20 and +20)",
+    ),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+) -> None:
     """Run an analysis of configs or of a Pareto file and print its table: models, roads,
     masses, controllers, transmissibility or cdf-sensitivity (see KIND below)."""
     from ..analyse import analysis_kinds
@@ -64,8 +87,12 @@ def analyse(kind: str = typer.Argument(..., help=_analysis_help(),
     for source in sources:
         if not source.exists():
             fail(f"{source}: no such file")
-    given = {"reference": reference, "road": road or None, "with_": with_ or None,
-             "mass_change": mass_change or None}
+    given = {
+        "reference": reference,
+        "road": road or None,
+        "with_": with_ or None,
+        "mass_change": mass_change or None,
+    }
     options = {key: value for key, value in given.items() if value is not None}
     wrong = [_ANALYSE_OPTIONS[key] for key in options if key not in spec.options]
     if wrong:

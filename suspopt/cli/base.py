@@ -6,14 +6,19 @@ import shlex
 import sys
 from contextlib import ExitStack
 from pathlib import Path
+
 import typer
 from rich.console import Console
 from rich.table import Table
+
 from ..errors import ConfigError
 
-
-app = typer.Typer(add_completion=True, no_args_is_help=True, pretty_exceptions_enable=False,
-                  help="Simulate, optimise and select vehicle and seat suspensions from YAML.")
+app = typer.Typer(
+    add_completion=True,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    help="Simulate, optimise and select vehicle and seat suspensions from YAML.",
+)
 # text from files and arguments is printed as it is: no rich markup, no emoji codes
 # (":x:" in a file name), no highlighting
 out = Console(markup=False, emoji=False, highlight=False, soft_wrap=True)
@@ -23,8 +28,10 @@ err = Console(stderr=True, markup=False, emoji=False, highlight=False, soft_wrap
 EXIT_ALL_FAILED = 3
 
 FORCE_HELP = "replace an existing output that suspopt did not write"
-MEMORY_HELP = ("most memory a run may take, e.g. 4G (default: what the machine has free); "
-                "evaluations of many designs run in batches of at most half of it")
+MEMORY_HELP = (
+    "most memory a run may take, e.g. 4G (default: what the machine has free); "
+    "evaluations of many designs run in batches of at most half of it"
+)
 
 
 #: ``-v``: what each step did and how long it took, on stderr.
@@ -39,23 +46,35 @@ def verbose_info(message: str) -> None:
 def _show_version(value: bool) -> None:
     if value:
         from .. import __version__
+
         out.print(f"suspopt {__version__}")
         raise typer.Exit()
 
 
 @app.callback()
-def _main(version: bool = typer.Option(False, "--version", callback=_show_version,
-                                       is_eager=True, help="print the version and exit"),
-          quiet: bool = typer.Option(False, "-q", "--quiet", help="print nothing but warnings "
-                                     "and errors (no tables, no progress)"),
-          verbose: bool = typer.Option(False, "-v", "--verbose", help="also print, on stderr, "
-                                       "what each step did and how long it took")) -> None:
+def _main(
+    version: bool = typer.Option(
+        False, "--version", callback=_show_version, is_eager=True, help="print the version and exit"
+    ),
+    quiet: bool = typer.Option(
+        False,
+        "-q",
+        "--quiet",
+        help="print nothing but warnings and errors (no tables, no progress)",
+    ),
+    verbose: bool = typer.Option(
+        False,
+        "-v",
+        "--verbose",
+        help="also print, on stderr, what each step did and how long it took",
+    ),
+) -> None:
     """Simulate, optimise and select vehicle and seat suspensions from YAML."""
     from ..memory import reuse_memory
 
     out.quiet = quiet
     VERBOSE[0] = verbose and not quiet
-    reuse_memory()          # a command's repeated batches reuse their memory (suspopt.memory)
+    reuse_memory()  # a command's repeated batches reuse their memory (suspopt.memory)
 
 
 class FoldingTable(Table):
@@ -64,7 +83,7 @@ class FoldingTable(Table):
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
-        self.cells: list[tuple[str, ...]] = []      # the rows as given, for show_table
+        self.cells: list[tuple[str, ...]] = []  # the rows as given, for show_table
 
     def add_column(self, *args, **kwargs) -> None:
         kwargs.setdefault("overflow", "fold")
@@ -83,9 +102,12 @@ def show_table(table: FoldingTable, keys: int = 1) -> None:
     """Print ``table``; when it is wider than the terminal (a CI log's 80 columns), as several
     tables of the columns that fit, each with the first ``keys`` columns again, so that no
     number is cut or broken across lines."""
-    def needs(j: int) -> int:             # column j's widest cell and the border and padding
-        return max(len(str(c)) for c in [table.columns[j].header,
-                                          *(row[j] for row in table.cells)]) + 3
+
+    def needs(j: int) -> int:  # column j's widest cell and the border and padding
+        return (
+            max(len(str(c)) for c in [table.columns[j].header, *(row[j] for row in table.cells)])
+            + 3
+        )
 
     width, count = out.width, len(table.columns)
     if 1 + sum(needs(j) for j in range(count)) <= width or count <= keys + 1:

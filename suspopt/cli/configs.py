@@ -6,16 +6,28 @@ import sys
 import time
 from contextlib import ExitStack
 from pathlib import Path
-from typing import Optional
+
 import typer
+
 from ..errors import ConfigError
-from .base import (app, out, FORCE_HELP, MEMORY_HELP, verbose_info, fail, set_memory_limit, claim_output, read_config)
+from .base import (
+    FORCE_HELP,
+    MEMORY_HELP,
+    app,
+    claim_output,
+    fail,
+    out,
+    read_config,
+    set_memory_limit,
+    verbose_info,
+)
 
 
 @app.command()
-def validate(config: Path = typer.Argument(..., help="YAML config file"),
-             max_memory: Optional[str] = typer.Option(None, "--max-memory",
-                                                      help=MEMORY_HELP)) -> None:
+def validate(
+    config: Path = typer.Argument(..., help="YAML config file"),
+    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+) -> None:
     """Check a config and report its first problem with its line (what any command would
     reject about it)."""
     from ..checks import check_config
@@ -28,9 +40,11 @@ def validate(config: Path = typer.Argument(..., help="YAML config file"),
         check_config(cfg)
     except ConfigError as exc:
         fail(str(exc))
-    verbose_info(f"checked the run (steps, road, RK4 stability, memory"
-          f"{', the optimisation' if cfg.design_variables else ''}) in "
-          f"{time.perf_counter() - started:.3g} s")
+    verbose_info(
+        f"checked the run (steps, road, RK4 stability, memory"
+        f"{', the optimisation' if cfg.design_variables else ''}) in "
+        f"{time.perf_counter() - started:.3g} s"
+    )
     out.print(f"{config}: valid ({cfg.vehicle.preset}, road {cfg.road.kind})")
 
 
@@ -57,10 +71,11 @@ def _template_kinds(incomplete: str) -> list[str]:
 
 
 @app.command()
-def init(kind: str = typer.Argument(..., help=_template_help(),
-                                    autocompletion=_template_kinds),
-         output: Path = typer.Option(..., "-o", "--output", help="the new config (YAML)"),
-         force: bool = typer.Option(False, "--force", help=FORCE_HELP)) -> None:
+def init(
+    kind: str = typer.Argument(..., help=_template_help(), autocompletion=_template_kinds),
+    output: Path = typer.Option(..., "-o", "--output", help="the new config (YAML)"),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+) -> None:
     """Write a commented starter config of one kind of study, ready to validate and run."""
     from ..io import atomic_file
     from ..templates import template_text
@@ -74,20 +89,28 @@ def init(kind: str = typer.Argument(..., help=_template_help(),
         with atomic_file(output) as stream:
             stream.write(text.encode())
     command = "optimise" if kind in ("optimise", "kesort") else "simulate"
-    out.print(f"wrote {output}; next: suspopt validate {output}, then suspopt {command} "
-              f"{output} -o {Path(output).with_suffix('.h5')}")
+    out.print(
+        f"wrote {output}; next: suspopt validate {output}, then suspopt {command} "
+        f"{output} -o {Path(output).with_suffix('.h5')}"
+    )
 
 
 @app.command()
-def export(source: Path = typer.Argument(..., help="result file of optimise, kesort or "
-                                         "analyse"),
-           pick: list[str] = typer.Option([], "--pick", help="the design to write as a config: "
-                                          "knee, best_<objective>, chosen or a row number"),
-           output: Optional[Path] = typer.Option(None, "-o", "--output",
-                                                 help="YAML file for the picked design"),
-           csv: Optional[Path] = typer.Option(None, "--csv", help="folder for the file's "
-                                              "tables as CSV, units in the headers"),
-           force: bool = typer.Option(False, "--force", help=FORCE_HELP)) -> None:
+def export(
+    source: Path = typer.Argument(..., help="result file of optimise, kesort or analyse"),
+    pick: list[str] = typer.Option(
+        [],
+        "--pick",
+        help="the design to write as a config: knee, best_<objective>, chosen or a row number",
+    ),
+    output: Path | None = typer.Option(
+        None, "-o", "--output", help="YAML file for the picked design"
+    ),
+    csv: Path | None = typer.Option(
+        None, "--csv", help="folder for the file's tables as CSV, units in the headers"
+    ),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+) -> None:
     """Write a picked design as a standalone config (-o design.yaml), or a result file's
     tables as CSV (--csv DIR)."""
     if (output is None) == (csv is None):
@@ -96,6 +119,7 @@ def export(source: Path = typer.Argument(..., help="result file of optimise, kes
         try:
             if csv is not None:
                 from ..export import write_csv
+
                 if pick:
                     fail("--csv writes every table of the file; --pick is for -o")
                 for path in write_csv(source, csv, force=force):
@@ -114,5 +138,4 @@ def export(source: Path = typer.Argument(..., help="result file of optimise, kes
                 stream.write(text.encode())
         except ConfigError as exc:
             fail(str(exc))
-    out.print(f"wrote {output} (design {names[0]!r}, row {int(picked.rows[0])} of "
-              f"{source})")
+    out.print(f"wrote {output} (design {names[0]!r}, row {int(picked.rows[0])} of {source})")

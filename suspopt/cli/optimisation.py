@@ -4,11 +4,26 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 from pathlib import Path
-from typing import Optional
+
 import typer
 from rich.table import Table
+
 from ..errors import ConfigError
-from .base import (app, out, err, EXIT_ALL_FAILED, FORCE_HELP, MEMORY_HELP, new_table, show_table, fail, set_memory_limit, claim_output, read_config, command_line)
+from .base import (
+    EXIT_ALL_FAILED,
+    FORCE_HELP,
+    MEMORY_HELP,
+    app,
+    claim_output,
+    command_line,
+    err,
+    fail,
+    new_table,
+    out,
+    read_config,
+    set_memory_limit,
+    show_table,
+)
 
 
 def _progress_line(p) -> str:
@@ -21,8 +36,10 @@ def _progress_line(p) -> str:
     else:
         score = f"HV {p.hypervolume:.4g}" if p.best.size > 1 else f"best {p.best[0]:.4g}"
     left = f", {p.time_left:.0f} s left" if p.time_left is not None else ""
-    return (f"{p.phase} {gen}, {p.evaluations} evaluations, {score}, "
-            f"{100 * p.feasible:.0f} % feasible{left}")
+    return (
+        f"{p.phase} {gen}, {p.evaluations} evaluations, {score}, "
+        f"{100 * p.feasible:.0f} % feasible{left}"
+    )
 
 
 def _optimum_table(result, rows: int = 12) -> Table:
@@ -56,18 +73,26 @@ def _optimum_table(result, rows: int = 12) -> Table:
 
 
 @app.command()
-def optimise(config: Path = typer.Argument(..., help="YAML config file"),
-             output: Optional[Path] = typer.Option(
-                 None, "-o", "--output", help="HDF5 file (default CONFIG's name with .h5 in "
-                 "the current folder), rewritten every generation"),
-             resume: bool = typer.Option(False, "--resume",
-                                         help="continue from the checkpoint in OUT.h5"),
-             plot: Optional[Path] = typer.Option(None, "--plot", help="figure of the front "
-                                                 "(or the best value) and the history per "
-                                                 "generation (.png or .svg)"),
-             force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-             max_memory: Optional[str] = typer.Option(None, "--max-memory",
-                                                      help=MEMORY_HELP)) -> None:
+def optimise(
+    config: Path = typer.Argument(..., help="YAML config file"),
+    output: Path | None = typer.Option(
+        None,
+        "-o",
+        "--output",
+        help="HDF5 file (default CONFIG's name with .h5 in "
+        "the current folder), rewritten every generation",
+    ),
+    resume: bool = typer.Option(False, "--resume", help="continue from the checkpoint in OUT.h5"),
+    plot: Path | None = typer.Option(
+        None,
+        "--plot",
+        help="figure of the front "
+        "(or the best value) and the history per "
+        "generation (.png or .svg)",
+    ),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+) -> None:
     """Optimise the config's design variables; write the optimum or Pareto set to HDF5.
 
     The progress line's HV is the hypervolume of every feasible non-dominated design found so
@@ -78,6 +103,7 @@ def optimise(config: Path = typer.Argument(..., help="YAML config file"),
         set_memory_limit(max_memory)
         if plot is not None:
             from ..plots import check_path
+
             try:
                 check_path(plot)
             except ValueError as exc:
@@ -99,8 +125,12 @@ def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> No
     except ConfigError as exc:
         fail(str(exc))
     total = cfg.optimiser.generations if cfg.optimiser is not None else None
-    bar = Progress(TextColumn("{task.description}"), BarColumn(), console=err,
-                   disable=not err.is_terminal or out.quiet)
+    bar = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        console=err,
+        disable=not err.is_terminal or out.quiet,
+    )
     task = bar.add_task("starting", total=total)
 
     def report(p) -> None:
@@ -115,25 +145,33 @@ def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> No
         fail(str(exc))
     except KeyboardInterrupt:
         err.print("the first generation had not completed: nothing written")
-        raise typer.Exit(code=130)
+        raise typer.Exit(code=130) from None
     show_table(_optimum_table(result))
     if result.weights is not None:
-        out.print("weighted sum (Eq 5.7): " + " + ".join(
-            f"{w:.4g} {name}" for w, name in zip(result.weights, result.obj_names)))
+        out.print(
+            "weighted sum (Eq 5.7): "
+            + " + ".join(f"{w:.4g} {name}" for w, name in zip(result.weights, result.obj_names))
+        )
     if result.status == "interrupted":
-        err.print(f"wrote the designs found so far to {output}; continue with "
-                  f"suspopt optimise {config} -o {output} --resume", soft_wrap=True)
+        err.print(
+            f"wrote the designs found so far to {output}; continue with "
+            f"suspopt optimise {config} -o {output} --resume",
+            soft_wrap=True,
+        )
         raise typer.Exit(code=130)
     out.print(f"wrote {output}")
     if plot is not None:
         from ..plots import plot_optimisation
+
         try:
             plot_optimisation(result, plot)
         except ValueError as exc:
             fail(str(exc))
         out.print(f"wrote {plot}")
     if result.status == "failed":
-        err.print(f"error: every design of the optimum failed to simulate (diverged or gave "
-                  f"NaN); {output} holds them with the penalty values and status 'failed'",
-                  soft_wrap=True)
+        err.print(
+            f"error: every design of the optimum failed to simulate (diverged or gave "
+            f"NaN); {output} holds them with the penalty values and status 'failed'",
+            soft_wrap=True,
+        )
         raise typer.Exit(code=EXIT_ALL_FAILED)

@@ -4,11 +4,23 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 from pathlib import Path
-from typing import Optional
+
 import typer
 from rich.table import Table
+
 from ..errors import ConfigError
-from .base import (app, out, FORCE_HELP, MEMORY_HELP, new_table, show_table, fail, set_memory_limit, claim_output, command_line)
+from .base import (
+    FORCE_HELP,
+    MEMORY_HELP,
+    app,
+    claim_output,
+    command_line,
+    fail,
+    new_table,
+    out,
+    set_memory_limit,
+    show_table,
+)
 
 
 def _floats(option: str, text: str) -> list[float]:
@@ -27,8 +39,7 @@ def _kesort_tables(sel) -> list[Table]:
     columns = [(f"{label} optimum", cs.chosen) for label, cs in sel.case_sorts.items()]
     columns.append(("optimum among all" if sel.case_sorts else "k-ε optimum", sel.chosen))
     columns += [(f"tie {n}", int(i)) for n, i in enumerate(sel.sort.ties[1:], start=2)]
-    table = new_table("k-ε optimum" + (" of each case and among all" if sel.case_sorts
-                                         else ""))
+    table = new_table("k-ε optimum" + (" of each case and among all" if sel.case_sorts else ""))
     table.add_column("quantity")
     table.add_column("unit")
     rows = [i for _, i in columns]
@@ -37,17 +48,23 @@ def _kesort_tables(sel) -> list[Table]:
     table.add_row("design #", "", *(str(i) for i in rows))
     table.add_row("case", "", *(str(sel.case[i]) for i in rows))
     if sel.case_sorts:
-        table.add_row("k-ε level in its case", "1",
-                      *(f"{sel.level_in_case(i):.3f}" for i in rows))
-    table.add_row("k-ε level among all" if sel.case_sorts else "k-ε level", "1",
-                  *(f"{sel.sort.k_eps[i]:.3f}" for i in rows))
-    table.add_row("k level among all" if sel.case_sorts else "k level", "1",
-                  *(f"{sel.sort.k[i]:.0f}" for i in rows))
+        table.add_row("k-ε level in its case", "1", *(f"{sel.level_in_case(i):.3f}" for i in rows))
+    table.add_row(
+        "k-ε level among all" if sel.case_sorts else "k-ε level",
+        "1",
+        *(f"{sel.sort.k_eps[i]:.3f}" for i in rows),
+    )
+    table.add_row(
+        "k level among all" if sel.case_sorts else "k level",
+        "1",
+        *(f"{sel.sort.k[i]:.0f}" for i in rows),
+    )
     for j, (name, unit) in enumerate(zip(sel.names, sel.units)):
         table.add_row(name, unit, *(f"{sel.F[i, j]:.4g}" for i in rows))
     for j, (name, unit) in enumerate(zip(sel.var_names, sel.var_units)):
-        table.add_row(name, unit, *(
-            "-" if np.isnan(sel.X[i, j]) else f"{sel.X[i, j]:.5g}" for i in rows))
+        table.add_row(
+            name, unit, *("-" if np.isnan(sel.X[i, j]) else f"{sel.X[i, j]:.5g}" for i in rows)
+        )
     table.add_row("feasible", "", *("yes" if sel.feasible[i] else "no" for i in rows))
     picks = new_table("Pareto picks among all (Fig. 8.21: edges and knee)")
     for col in ("pick", "design #", "case", "k-ε level"):
@@ -55,8 +72,13 @@ def _kesort_tables(sel) -> list[Table]:
     for name, unit in zip(sel.names, sel.units):
         picks.add_column(f"{name} [{unit}]", justify="right")
     for key, i in sel.picks.items():
-        picks.add_row(key, str(i), str(sel.case[i]), f"{sel.sort.k_eps[i]:.3f}",
-                      *(f"{v:.4g}" for v in sel.F[i]))
+        picks.add_row(
+            key,
+            str(i),
+            str(sel.case[i]),
+            f"{sel.sort.k_eps[i]:.3f}",
+            *(f"{v:.4g}" for v in sel.F[i]),
+        )
     return [table, picks]
 
 
@@ -70,46 +92,64 @@ def _threshold_line(sort, label: str) -> str:
 
 
 @app.command()
-def kesort(pareto: list[Path] = typer.Argument(..., help="Pareto HDF5 file(s) written by "
-                                               "suspopt optimise"),
-           config: list[Path] = typer.Option(
-               [], "--config", "-c", help="config whose objectives are evaluated (default: "
-               "each file's own): once for every file, or once per file"),
-           label: list[str] = typer.Option(
-               [], "--label", "-l", help="case label, once per file; files with the same "
-               "label form one case (default: the config's or the file's name)"),
-           eps: Optional[str] = typer.Option(
-               None, "--eps", help="absolute thresholds in the objectives' SI units: one "
-               "value, or one per objective separated by commas"),
-           P: Optional[str] = typer.Option(
-               None, "--P", "-P", help="ε = P·max NF (Eq 6.19, 7.13), or 'auto' (default): "
-               "the smallest P on the --P-range grid that leaves one best design"),
-           P_range: str = typer.Option("0.01,1.0", "--P-range", help="LOW,HIGH of P for "
-                                       "auto"),
-           P_step: float = typer.Option(0.01, "--P-step", help="grid step of P for auto"),
-           normalise: str = typer.Option("max", "--normalise", help="max (Eq 7.12) or "
-                                         "minmax"),
-           keep_infeasible: bool = typer.Option(False, "--keep-infeasible",
-                                                help="sort infeasible designs too"),
-           output: Optional[Path] = typer.Option(None, "-o", "--output",
-                                                 help="HDF5 file for /kesort"),
-           plot: Optional[Path] = typer.Option(None, "--plot", help="figure of the k-ε "
-                                               "levels over the front (.png or .svg)"),
-           force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-           max_memory: Optional[str] = typer.Option(None, "--max-memory",
-                                                    help=MEMORY_HELP)) -> None:
+def kesort(
+    pareto: list[Path] = typer.Argument(
+        ..., help="Pareto HDF5 file(s) written by suspopt optimise"
+    ),
+    config: list[Path] = typer.Option(
+        [],
+        "--config",
+        "-c",
+        help="config whose objectives are evaluated (default: "
+        "each file's own): once for every file, or once per file",
+    ),
+    label: list[str] = typer.Option(
+        [],
+        "--label",
+        "-l",
+        help="case label, once per file; files with the same "
+        "label form one case (default: the config's or the file's name)",
+    ),
+    eps: str | None = typer.Option(
+        None,
+        "--eps",
+        help="absolute thresholds in the objectives' SI units: one "
+        "value, or one per objective separated by commas",
+    ),
+    P: str | None = typer.Option(
+        None,
+        "--P",
+        "-P",
+        help="ε = P·max NF (Eq 6.19, 7.13), or 'auto' (default): "
+        "the smallest P on the --P-range grid that leaves one best design",
+    ),
+    P_range: str = typer.Option("0.01,1.0", "--P-range", help="LOW,HIGH of P for auto"),
+    P_step: float = typer.Option(0.01, "--P-step", help="grid step of P for auto"),
+    normalise: str = typer.Option("max", "--normalise", help="max (Eq 7.12) or minmax"),
+    keep_infeasible: bool = typer.Option(
+        False, "--keep-infeasible", help="sort infeasible designs too"
+    ),
+    output: Path | None = typer.Option(None, "-o", "--output", help="HDF5 file for /kesort"),
+    plot: Path | None = typer.Option(
+        None, "--plot", help="figure of the k-ε levels over the front (.png or .svg)"
+    ),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+) -> None:
     """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12); supplementary
     objectives are re-simulated in one batch."""
     set_memory_limit(max_memory)
     with ExitStack() as stack:
         claim_output(stack, output, force)
         claim_output(stack, plot, force, "--plot")
-        _kesort(pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible,
-                output, plot)
+        _kesort(
+            pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot
+        )
 
 
-def _kesort(pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output,
-            plot) -> None:
+def _kesort(
+    pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot
+) -> None:
     import importlib.util
 
     from ..kesort import check_options
@@ -140,13 +180,15 @@ def _kesort(pareto, config, label, eps, P, P_range, P_step, normalise, keep_infe
         write_selection(output, selection, command=command_line())
     if plot is not None:
         from ..plots import plot_kesort
+
         plot_kesort(selection, plot)
     for table, keys in zip(_kesort_tables(selection), (2, 3)):
         show_table(table, keys=keys)
     for label_, cs in selection.case_sorts.items():
         out.print(_threshold_line(cs.sort, label_))
-    out.print(_threshold_line(selection.sort, "all" if selection.case_sorts
-                              else selection.cases[0]))
+    out.print(
+        _threshold_line(selection.sort, "all" if selection.case_sorts else selection.cases[0])
+    )
     for note in selection.notes:
         out.print(f"note: {note}")
     for path in (output, plot):

@@ -5,11 +5,27 @@ from __future__ import annotations
 import time
 from contextlib import ExitStack
 from pathlib import Path
-from typing import Optional
+
 import typer
 from rich.table import Table
+
 from ..errors import ConfigError
-from .base import (app, out, err, FORCE_HELP, MEMORY_HELP, VERBOSE, verbose_info, new_table, show_table, fail, set_memory_limit, claim_output, read_config, command_line)
+from .base import (
+    FORCE_HELP,
+    MEMORY_HELP,
+    VERBOSE,
+    app,
+    claim_output,
+    command_line,
+    err,
+    fail,
+    new_table,
+    out,
+    read_config,
+    set_memory_limit,
+    show_table,
+    verbose_info,
+)
 
 
 def _summary_table(result) -> Table:
@@ -17,8 +33,10 @@ def _summary_table(result) -> Table:
     import numpy as np
 
     P = min(result.P, 5)
-    table = new_table(f"{result.model.preset} - key results"
-                  + (f" (first {P} of {result.P} designs)" if result.P > P else ""))
+    table = new_table(
+        f"{result.model.preset} - key results"
+        + (f" (first {P} of {result.P} designs)" if result.P > P else "")
+    )
     table.add_column("quantity")
     table.add_column("unit")
     for p in range(P):
@@ -33,12 +51,15 @@ def _summary_table(result) -> Table:
     row("time of peak body heave", "s", result.time[np.argmax(heave, axis=-1)])
     row("peak |body heave acc|", "m/s^2", np.max(np.abs(acc), axis=-1))
     row("time of peak |body heave acc|", "s", result.time[np.argmax(np.abs(acc), axis=-1)])
-    row("RMS body heave acc", "m/s^2", np.sqrt(np.mean(acc ** 2, axis=-1)))
+    row("RMS body heave acc", "m/s^2", np.sqrt(np.mean(acc**2, axis=-1)))
     for c in result.model.corners:
         row(f"max |travel| {c}", "mm", 1e3 * np.max(np.abs(sig[f"travel.{c}"]), axis=-1))
     for c in result.model.corners:
-        row(f"max |tyre deflection| {c}", "mm",
-            1e3 * np.max(np.abs(sig[f"tyre_deflection.{c}"]), axis=-1))
+        row(
+            f"max |tyre deflection| {c}",
+            "mm",
+            1e3 * np.max(np.abs(sig[f"tyre_deflection.{c}"]), axis=-1),
+        )
     return table
 
 
@@ -64,36 +85,49 @@ def _is_hdf5(path: Path) -> bool:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     except OSError:
         return False
-    try:                                 # (a FIFO or a device is no HDF5 file: never read it)
+    try:  # (a FIFO or a device is no HDF5 file: never read it)
         return stat.S_ISREG(os.fstat(fd).st_mode) and os.read(fd, 8) == b"\x89HDF\r\n\x1a\n"
     finally:
         os.close(fd)
 
 
-_PICK_HELP = ("designs of a result file to simulate: knee, best_<objective>, chosen (the k-ε "
-              "optimum of a kesort file) or a row number; repeatable, or separated by commas")
+_PICK_HELP = (
+    "designs of a result file to simulate: knee, best_<objective>, chosen (the k-ε "
+    "optimum of a kesort file) or a row number; repeatable, or separated by commas"
+)
 
 
 @app.command()
-def simulate(source: Path = typer.Argument(..., help="YAML config, or a result file of "
-                                           "optimise, kesort or analyse with --pick"),
-             output: Optional[Path] = typer.Option(None, "-o", "--output",
-                                                   help="HDF5 file to write"),
-             pick: list[str] = typer.Option([], "--pick", help=_PICK_HELP),
-             set_: list[str] = typer.Option([], "--set", help="PATH=VALUE: override a "
-                                            "numeric field of the config; repeatable"),
-             sweep_: list[str] = typer.Option([], "--sweep", help="PATH=START:STOP:N: N "
-                                              "designs from START to STOP; several sweeps "
-                                              "make a grid (all combinations) or, with "
-                                              "--zip, go side by side"),
-             zipped: bool = typer.Option(False, "--zip", help="pair the --sweep values "
-                                         "instead of taking every combination"),
-             plot: Optional[Path] = typer.Option(None, "--plot", help="figure of the signals "
-                                                 "over time, their PSD and the ISO 2631 "
-                                                 "comfort levels (.png or .svg)"),
-             force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-             max_memory: Optional[str] = typer.Option(None, "--max-memory",
-                                                      help=MEMORY_HELP)) -> None:
+def simulate(
+    source: Path = typer.Argument(
+        ..., help="YAML config, or a result file of optimise, kesort or analyse with --pick"
+    ),
+    output: Path | None = typer.Option(None, "-o", "--output", help="HDF5 file to write"),
+    pick: list[str] = typer.Option([], "--pick", help=_PICK_HELP),
+    set_: list[str] = typer.Option(
+        [], "--set", help="PATH=VALUE: override a numeric field of the config; repeatable"
+    ),
+    sweep_: list[str] = typer.Option(
+        [],
+        "--sweep",
+        help="PATH=START:STOP:N: N "
+        "designs from START to STOP; several sweeps "
+        "make a grid (all combinations) or, with "
+        "--zip, go side by side",
+    ),
+    zipped: bool = typer.Option(
+        False, "--zip", help="pair the --sweep values instead of taking every combination"
+    ),
+    plot: Path | None = typer.Option(
+        None,
+        "--plot",
+        help="figure of the signals "
+        "over time, their PSD and the ISO 2631 "
+        "comfort levels (.png or .svg)",
+    ),
+    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+) -> None:
     """Simulate a config (or designs picked from a result file) and write signals to HDF5."""
     set_memory_limit(max_memory)
     with ExitStack() as stack:
@@ -111,9 +145,12 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
 
     if _is_hdf5(source):
         from ..picks import read_picks, split_picks
+
         if not pick:
-            fail(f"{source} is a result file: name the designs to simulate with --pick "
-                  f"(knee, best_<objective>, chosen or a row number)")
+            fail(
+                f"{source} is a result file: name the designs to simulate with --pick "
+                f"(knee, best_<objective>, chosen or a row number)"
+            )
         if sweeps:
             fail("--sweep takes a config; with --pick the designs are the picked ones")
         picked = read_picks(source, split_picks(pick))
@@ -122,8 +159,7 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
     else:
         picked = None
         if pick:
-            fail(f"--pick takes a result file (optimise, kesort, analyse); {source} is a "
-                  f"config")
+            fail(f"--pick takes a result file (optimise, kesort, analyse); {source} is a config")
         cfg = apply_sets(read_config(source), sets)
         params = sweep(cfg, sweeps, zipped) or None
     return cfg, params, picked
@@ -141,8 +177,15 @@ def _picks_writer(picked, objectives):
         write_dataset(designs, "row", picked.rows, "1", dims=("design",))
         group = h5.create_group("objectives")
         write_dataset(group, "F", F, units, dims=("design", "objective"), names=names)
-        write_dataset(group, "stored_F", picked.F, picked.obj_units,
-                      dims=("design", "stored_objective"), names=picked.obj_names)
+        write_dataset(
+            group,
+            "stored_F",
+            picked.F,
+            picked.obj_units,
+            dims=("design", "stored_objective"),
+            names=picked.obj_names,
+        )
+
     return extra
 
 
@@ -156,31 +199,46 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
 
     if plot is not None:
         from ..plots import check_path
+
         check_path(plot)
     cfg, params, picked = _inputs(source, pick, sets, sweeps, zipped)
     check_config(cfg, optimisation=False)
     pv, model, controller, attachments = prepare(cfg, params)
     if params:
-        check_stability(cfg, pv, model, attachments,
-                        what=" for a picked design" if picked else " for a swept design")
-    written = cfg.output.signals if cfg.output.signals != "all" else signal_names(
-        model, getattr(controller, "units", {}), attachments)
+        check_stability(
+            cfg,
+            pv,
+            model,
+            attachments,
+            what=" for a picked design" if picked else " for a swept design",
+        )
+    written = (
+        cfg.output.signals
+        if cfg.output.signals != "all"
+        else signal_names(model, getattr(controller, "units", {}), attachments)
+    )
     check_memory(cfg, model, attachments, pv.P, signals=len(written) + len(cfg.metrics))
     if VERBOSE[0]:
         from ..memory import describe
         from ..simulate import run_memory
-        shared, per_design = run_memory(cfg, model, attachments, pv.P,
-                                        len(written) + len(cfg.metrics))
-        verbose_info(f"{cfg.source}: checked; {pv.P} design{'s' if pv.P > 1 else ''}, "
-              f"{cfg.simulation.n_steps} steps of {cfg.simulation.dt:g} s, about "
-              f"{describe(shared + pv.P * per_design)} of memory")
+
+        shared, per_design = run_memory(
+            cfg, model, attachments, pv.P, len(written) + len(cfg.metrics)
+        )
+        verbose_info(
+            f"{cfg.source}: checked; {pv.P} design{'s' if pv.P > 1 else ''}, "
+            f"{cfg.simulation.n_steps} steps of {cfg.simulation.dt:g} s, about "
+            f"{describe(shared + pv.P * per_design)} of memory"
+        )
     started = time.perf_counter()
     result = run(cfg, params)
     verbose_info(f"simulated in {time.perf_counter() - started:.3g} s")
     if result.diverged.any():
-        err.print(f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
-                  f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
-                  f"try a smaller simulation.dt")
+        err.print(
+            f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
+            f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
+            f"try a smaller simulation.dt"
+        )
     show_table(_summary_table(result), keys=2)
     if result.metrics:
         show_table(_metrics_table(result), keys=2)
@@ -191,13 +249,19 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
         extra = _picks_writer(picked, objectives)
     if output is not None:
         started = time.perf_counter()
-        write_simulation(output, result, signals=None if cfg.output.signals == "all"
-                         else cfg.output.signals, float32=cfg.output.float32,
-                         command=command_line(), extra=extra)
+        write_simulation(
+            output,
+            result,
+            signals=None if cfg.output.signals == "all" else cfg.output.signals,
+            float32=cfg.output.float32,
+            command=command_line(),
+            extra=extra,
+        )
         verbose_info(f"wrote {len(written)} signals in {time.perf_counter() - started:.3g} s")
         out.print(f"wrote {output}")
     if plot is not None:
         from ..plots import plot_simulation
+
         plot_simulation(result, plot)
         out.print(f"wrote {plot}")
 
@@ -211,8 +275,11 @@ def _pick_objectives(picked, cfg, result):
 
     problem = Problem.from_config(cfg)
     F, _, S = problem.values(result, picked.params(), len(picked.rows), supplementary=True)
-    return (np.hstack([F, S]), problem.obj_names + problem.supplementary_names,
-            problem.obj_units + problem.supplementary_units)
+    return (
+        np.hstack([F, S]),
+        problem.obj_names + problem.supplementary_names,
+        problem.obj_units + problem.supplementary_units,
+    )
 
 
 def _picks_table(picked, F, names, units) -> Table:
@@ -224,13 +291,24 @@ def _picks_table(picked, F, names, units) -> Table:
         table.add_column(col, justify="left" if col in ("pick", "objective") else "right")
     for i, name in enumerate(picked.names):
         for j, (objective, unit) in enumerate(zip(names, units)):
-            stored = picked.F[i, picked.obj_names.index(objective)] \
-                if objective in picked.obj_names else np.nan
-            change = "" if not np.isfinite(stored) or stored == 0 else \
-                f"{(F[i, j] - stored) / abs(stored):+.1e}"
-            table.add_row(name if j == 0 else "", str(int(picked.rows[i])) if j == 0 else "",
-                          f"{objective} [{unit}]", "" if np.isnan(stored) else f"{stored:.6g}",
-                          f"{F[i, j]:.6g}", change)
+            stored = (
+                picked.F[i, picked.obj_names.index(objective)]
+                if objective in picked.obj_names
+                else np.nan
+            )
+            change = (
+                ""
+                if not np.isfinite(stored) or stored == 0
+                else f"{(F[i, j] - stored) / abs(stored):+.1e}"
+            )
+            table.add_row(
+                name if j == 0 else "",
+                str(int(picked.rows[i])) if j == 0 else "",
+                f"{objective} [{unit}]",
+                "" if np.isnan(stored) else f"{stored:.6g}",
+                f"{F[i, j]:.6g}",
+                change,
+            )
     return table
 
 

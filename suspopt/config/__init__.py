@@ -1,5 +1,5 @@
 """Validated configuration: pydantic sections and YAML loading with line-numbered errors."""
 
-from .loader import Config, ConfigError, load_config, config_schema
+from .loader import Config, ConfigError, config_schema, load_config
 
 __all__ = ["Config", "ConfigError", "load_config", "config_schema"]

@@ -8,10 +8,27 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ..errors import check_known
 
-__all__ = ["Section", "check_known", "quantity", "Mass", "Inertia", "Stiffness",
-           "TorsionalStiffness", "CubicStiffness", "Damping", "VehicleLength", "SeatLength",
-           "RoadHeight", "RoadLength", "Speed", "Duration", "Step", "Ratio", "Seed",
-           "Finite"]
+__all__ = [
+    "Section",
+    "check_known",
+    "quantity",
+    "Mass",
+    "Inertia",
+    "Stiffness",
+    "TorsionalStiffness",
+    "CubicStiffness",
+    "Damping",
+    "VehicleLength",
+    "SeatLength",
+    "RoadHeight",
+    "RoadLength",
+    "Speed",
+    "Duration",
+    "Step",
+    "Ratio",
+    "Seed",
+    "Finite",
+]
 
 
 def quantity(low: float | None, high: float, *, closed: bool = True) -> Any:
@@ -55,7 +72,7 @@ Ratio = quantity(0.0, 1e3)
 #: [-] any finite number
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 #: a random seed (numpy SeedSequence entropy, stored in HDF5 as int64)
-Seed = Annotated[int, Field(ge=0, le=2 ** 63 - 1)]
+Seed = Annotated[int, Field(ge=0, le=2**63 - 1)]
 
 
 class Section(BaseModel):
@@ -67,5 +84,4 @@ class Section(BaseModel):
     without a point), never a boolean or a string, and a text field takes text.
     """
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False,
-                              strict=True)
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False, strict=True)

@@ -37,42 +37,58 @@ class Threshold(Section):
     """
 
     mode: Literal["fixed", "adaptive"] = Field(
-        description="fixed: T = value; adaptive: T re-fitted from the condition history")
+        description="fixed: T = value; adaptive: T re-fitted from the condition history"
+    )
     value: quantity(-1e12, 1e12) | None = Field(
         None,
         description="fixed threshold T in the unit of the laws' condition (m^2/s^2 for SH-2, "
         "SH-L, SH-ADD-1, groundhook, hybrid; m^2/s^3 for ADD; m^2/s^4 for SH-ADD-2); mode "
-        "fixed only")
+        "fixed only",
+    )
     c_max_share: float | None = Field(
-        None, gt=0, lt=1, allow_inf_nan=False,
+        None,
+        gt=0,
+        lt=1,
+        allow_inf_nan=False,
         description="share of the samples to operate at C_max, the thesis's 1 - N% (0.27 in "
-        "Tables 4.2-4.3) [-]; mode adaptive only")
+        "Tables 4.2-4.3) [-]; mode adaptive only",
+    )
     learn_time: Duration = Field(
-        5.0, description="T_learn: the base law runs until t >= learn_time, then the first fit "
-        "is made [s] (Fig. 4.4; the thesis says 'a few seconds')")
+        5.0,
+        description="T_learn: the base law runs until t >= learn_time, then the first fit "
+        "is made [s] (Fig. 4.4; the thesis says 'a few seconds')",
+    )
     refit_factor: quantity(1e-3, 1e3) = Field(
-        1.0, description="kappa: the threshold is re-fitted every refit_factor * learn_time "
-        "seconds (Fig. 4.4) [-]")
+        1.0,
+        description="kappa: the threshold is re-fitted every refit_factor * learn_time "
+        "seconds (Fig. 4.4) [-]",
+    )
     distribution: Literal["student_t", "normal", "empirical"] = Field(
-        "student_t", description="fit of the condition history: student_t (the thesis's, "
+        "student_t",
+        description="fit of the condition history: student_t (the thesis's, "
         "location-scale t by EM), normal (mean and standard deviation) or empirical (the "
-        "sample quantile)")
+        "sample quantile)",
+    )
 
     @model_validator(mode="after")
-    def _check(self) -> "Threshold":
+    def _check(self) -> Threshold:
         if self.mode == "fixed":
             if self.value is None:
                 raise ValueError("mode 'fixed' needs value (the threshold T)")
             if self.c_max_share is not None:
-                raise ValueError("c_max_share is for mode 'adaptive'; a fixed threshold is "
-                                 "given by value")
+                raise ValueError(
+                    "c_max_share is for mode 'adaptive'; a fixed threshold is given by value"
+                )
         else:
             if self.c_max_share is None:
-                raise ValueError("mode 'adaptive' needs c_max_share (share of samples at C_max, "
-                                 "e.g. 0.27)")
+                raise ValueError(
+                    "mode 'adaptive' needs c_max_share (share of samples at C_max, e.g. 0.27)"
+                )
             if self.value is not None:
-                raise ValueError("value is for mode 'fixed'; an adaptive threshold starts at 0 "
-                                 "(the base law) and is fitted from c_max_share")
+                raise ValueError(
+                    "value is for mode 'fixed'; an adaptive threshold starts at 0 "
+                    "(the base law) and is fitted from c_max_share"
+                )
         return self
 
 
@@ -86,11 +102,17 @@ class Control(Section):
     """
 
     sample_time: quantity(1e-7, 10.0) = Field(
-        DEFAULT_SAMPLE_TIME, description="controller sample time ΔT [s], a whole multiple of "
-        "simulation.dt (Sec 4.2: 4 ms)")
+        DEFAULT_SAMPLE_TIME,
+        description="controller sample time ΔT [s], a whole multiple of "
+        "simulation.dt (Sec 4.2: 4 ms)",
+    )
     actuator_lag: quantity(0.0, 10.0) = Field(
-        0.0, description="time constant τ of the damper's first-order response to a new "
-        "command [s]; 0 switches instantly")
+        0.0,
+        description="time constant τ of the damper's first-order response to a new "
+        "command [s]; 0 switches instantly",
+    )
     threshold: Threshold | None = Field(
-        None, description="CDF strategy (Ch. 4): a threshold on the condition in place of 0; "
-        "omit it for the base laws")
+        None,
+        description="CDF strategy (Ch. 4): a threshold on the condition in place of 0; "
+        "omit it for the base laws",
+    )

@@ -8,8 +8,8 @@ key they came from.
 from __future__ import annotations
 
 import difflib
-from pathlib import Path
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, get_args, get_origin
 
 import yaml
@@ -26,8 +26,17 @@ from .simulation import Output, Simulation
 from .vehicle import Vehicle, corner_defaults_schema
 from .yamlio import YamlError, parse_yaml, read_text
 
-__all__ = ["Config", "ConfigError", "load_config", "load_config_text", "config_schema",
-           "edit_config", "set_path", "SCHEMA_DIALECT", "SCHEMA_ID"]
+__all__ = [
+    "Config",
+    "ConfigError",
+    "load_config",
+    "load_config_text",
+    "config_schema",
+    "edit_config",
+    "set_path",
+    "SCHEMA_DIALECT",
+    "SCHEMA_ID",
+]
 
 #: The JSON Schema dialect of :func:`config_schema` (pydantic writes draft 2020-12).
 SCHEMA_DIALECT = "https://json-schema.org/draft/2020-12/schema"
@@ -43,26 +52,37 @@ class Config(Section):
     road: RoadConfig
     simulation: Simulation
     output: Output = Field(default_factory=Output)
-    metrics: list[MetricSpec] = Field(default_factory=list,
-                                      description="metrics computed and stored by simulate")
-    control: Control | None = Field(None, description="digital controller of the semi-active "
-                                    "dampers (sample time, actuator lag, CDF threshold)")
-    seat: SeatConfig | None = Field(None, description="seat isolator (PS, NSS1-NSS4) on the "
-                                    "body, with its optional passenger (Sec 2.2-2.3)")
+    metrics: list[MetricSpec] = Field(
+        default_factory=list, description="metrics computed and stored by simulate"
+    )
+    control: Control | None = Field(
+        None,
+        description="digital controller of the semi-active "
+        "dampers (sample time, actuator lag, CDF threshold)",
+    )
+    seat: SeatConfig | None = Field(
+        None,
+        description="seat isolator (PS, NSS1-NSS4) on the "
+        "body, with its optional passenger (Sec 2.2-2.3)",
+    )
     design_variables: list[DesignVariable] = Field(
-        default_factory=list, description="config fields the optimiser varies, with bounds")
-    objectives: Objectives | None = Field(None, description="main and supplementary "
-                                          "objectives of suspopt optimise (minimised)")
-    constraints: list[Constraint] = Field(default_factory=list,
-                                          description="constraints g <= 0 of suspopt optimise")
-    optimiser: Optimiser | None = Field(None, description="algorithm, budget and seed of "
-                                        "suspopt optimise")
+        default_factory=list, description="config fields the optimiser varies, with bounds"
+    )
+    objectives: Objectives | None = Field(
+        None, description="main and supplementary objectives of suspopt optimise (minimised)"
+    )
+    constraints: list[Constraint] = Field(
+        default_factory=list, description="constraints g <= 0 of suspopt optimise"
+    )
+    optimiser: Optimiser | None = Field(
+        None, description="algorithm, budget and seed of suspopt optimise"
+    )
 
     _source: Path | None = PrivateAttr(None)
     _text: str = PrivateAttr("")
     _lines: dict = PrivateAttr(default_factory=dict)
 
-    def error(self, loc: tuple, message: str) -> "ConfigError":
+    def error(self, loc: tuple, message: str) -> ConfigError:
         """A ConfigError for a problem found after validation, located like a load error."""
         name = str(self._source) if self._source is not None else "<config>"
         line = _line_of(loc, self._lines) if self._lines else None
@@ -76,8 +96,11 @@ class Config(Section):
     @property
     def text(self) -> str:
         """The YAML text as written (recorded in every output file)."""
-        return self._text if self._text else yaml.safe_dump(self.model_dump(mode="json"),
-                                                            sort_keys=False)
+        return (
+            self._text
+            if self._text
+            else yaml.safe_dump(self.model_dump(mode="json"), sort_keys=False)
+        )
 
     @property
     def base_dir(self) -> Path:
@@ -125,8 +148,11 @@ def _clean_loc(loc: tuple) -> tuple:
     ``semi_active`` in vehicle.corners.F1.damper.semi_active.c_max)."""
     out = []
     for i, part in enumerate(loc):
-        if i == 1 and isinstance(part, str) and (loc[0] == "seat" or loc[0] == "road"
-                                                 and len(loc) > 2):
+        if (
+            i == 1
+            and isinstance(part, str)
+            and (loc[0] == "seat" or loc[0] == "road" and len(loc) > 2)
+        ):
             continue
         if i >= 1 and loc[i - 1] == "damper" and part in _DAMPER_TAGS:
             continue
@@ -136,8 +162,9 @@ def _clean_loc(loc: tuple) -> tuple:
 
 def _dotted(loc: tuple) -> str:
     """``("metrics", 0, "signal")`` -> ``metrics[0].signal``."""
-    return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p))
-                   for i, p in enumerate(loc))
+    return "".join(
+        f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p)) for i, p in enumerate(loc)
+    )
 
 
 def _format(err: dict, lines: dict, data: Any) -> tuple[str, int | None]:
@@ -146,12 +173,17 @@ def _format(err: dict, lines: dict, data: Any) -> tuple[str, int | None]:
     msg = err["msg"]
     custom = msg.startswith("Value error, ")
     if custom:
-        msg = msg[len("Value error, "):]
+        msg = msg[len("Value error, ") :]
     if err["type"] == "extra_forbidden":
         allowed = _allowed_keys(tuple(err["loc"])[:-1])
         close = difflib.get_close_matches(str(loc[-1]), allowed, n=3)
-        msg = "unknown key" + (f"; did you mean {', '.join(close)}?" if close else
-                               f"; allowed: {', '.join(allowed)}" if allowed else "")
+        msg = "unknown key" + (
+            f"; did you mean {', '.join(close)}?"
+            if close
+            else f"; allowed: {', '.join(allowed)}"
+            if allowed
+            else ""
+        )
     elif err["type"] == "missing":
         msg = "required key is missing"
     elif not custom and "input" in err and not isinstance(err["input"], (dict, list)):
@@ -195,11 +227,11 @@ def _allowed_keys(loc: tuple) -> list[str]:
             model = _section_type(annotation)
             if get_origin(annotation) is dict:
                 model = ("dict", model)
-        elif isinstance(part, int):         # an item of a list of sections
+        elif isinstance(part, int):  # an item of a list of sections
             continue
-        elif isinstance(model, tuple):      # a key of a dict of sections
+        elif isinstance(model, tuple):  # a key of a dict of sections
             model = model[1]
-        elif _union_member(annotation, part) is not None:   # a union's tag: its member
+        elif _union_member(annotation, part) is not None:  # a union's tag: its member
             model = _union_member(annotation, part)
         else:
             return []
@@ -214,8 +246,9 @@ def _sections(text: str, name: str):
     except YamlError as exc:
         raise ConfigError(f"{name}{f':{exc.line}' if exc.line else ''}: {exc}") from None
     if not isinstance(data, dict):
-        raise ConfigError(f"{name}:1: the config must be a mapping of sections "
-                          f"(vehicle, road, simulation, ...)")
+        raise ConfigError(
+            f"{name}:1: the config must be a mapping of sections (vehicle, road, simulation, ...)"
+        )
     return data, node
 
 
@@ -232,9 +265,13 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
         cfg = Config.model_validate(data, context={"base_dir": base_dir})
     except ValidationError as exc:
         # an unknown key usually explains a 'missing' one (a typo): report it first
-        first = min(exc.errors(), key=lambda e: (e["type"] != "extra_forbidden",
-                                                 _line_of(_clean_loc(tuple(e["loc"])), lines)
-                                                 or 0))
+        first = min(
+            exc.errors(),
+            key=lambda e: (
+                e["type"] != "extra_forbidden",
+                _line_of(_clean_loc(tuple(e["loc"])), lines) or 0,
+            ),
+        )
         msg, line = _format(first, lines, data)
         more = len(exc.errors()) - 1
         tail = f" (+{more} more error{'s' if more > 1 else ''})" if more else ""
@@ -269,8 +306,9 @@ def set_path(data: dict, path: str, value: Any) -> None:
     data[key] = value
 
 
-def edit_config(text: str, edit: Callable[[dict], None], source: Path | None = None,
-                what: str = "the change") -> Config:
+def edit_config(
+    text: str, edit: Callable[[dict], None], source: Path | None = None, what: str = "the change"
+) -> Config:
     """The config of the YAML ``text`` with ``edit`` applied to its data (a dict, edited in
     place); the result's text is the edited YAML (comments are not kept) and its errors refer
     to the lines of that text under the name ``source``. ``what`` names the edit in messages.

@@ -17,16 +17,24 @@ class MetricSpec(Section):
 
     name: str | None = Field(None, description="name under /metrics (default metric.signal)")
     metric: str = Field(description="one of: " + ", ".join(METRICS))
-    signal: str | None = Field(None, description="signal name (body.heave_acc) or per-corner "
-                               "family (travel, tyre_deflection, ...)")
+    signal: str | None = Field(
+        None,
+        description="signal name (body.heave_acc) or per-corner "
+        "family (travel, tyre_deflection, ...)",
+    )
     corners: list[str] | None = Field(None, description="corners of a family (default all)")
     reduce: Literal["none", "mean", "max", "min", "sum"] = Field(
-        "none", description="combine the corners' values into one (none: one per corner)")
+        "none", description="combine the corners' values into one (none: one per corner)"
+    )
     weighting: Literal["Wk", "Wd", "Wf", "Wc", "We", "Wj"] | None = Field(
-        None, description="ISO 2631-1 frequency weighting for rms_weighted, vdv, mtvv, "
-        "crest_factor (none: unweighted)")
+        None,
+        description="ISO 2631-1 frequency weighting for rms_weighted, vdv, mtvv, "
+        "crest_factor (none: unweighted)",
+    )
     tau: Duration = Field(1.0, description="running r.m.s. integration time for mtvv [s]")
-    band: quantity(0.0, 1.0, closed=False) = Field(0.02, description="settling band for transient metrics [-]")
+    band: quantity(0.0, 1.0, closed=False) = Field(
+        0.02, description="settling band for transient metrics [-]"
+    )
 
     @field_validator("metric")
     @classmethod

@@ -27,8 +27,20 @@ from pydantic import Field, field_validator, model_validator
 from .base import Section, Seed, check_known, quantity
 from .metrics import MetricSpec
 
-__all__ = ["QUANTITIES", "Algorithm", "ALGORITHMS", "DesignVariable", "Objective", "Constraint",
-           "Objectives", "WeightedSum", "Balance", "Hybrid", "Gradient", "Optimiser"]
+__all__ = [
+    "QUANTITIES",
+    "Algorithm",
+    "ALGORITHMS",
+    "DesignVariable",
+    "Objective",
+    "Constraint",
+    "Objectives",
+    "WeightedSum",
+    "Balance",
+    "Hybrid",
+    "Gradient",
+    "Optimiser",
+]
 
 #: a bound or limit in a field's or a metric's SI unit
 _Finite = quantity(-1e15, 1e15)
@@ -38,12 +50,14 @@ def _count(high: int) -> Any:
     """A whole number from 1 to ``high``."""
     return Annotated[int, Field(ge=1, le=high)]
 
+
 #: Design quantities that need no simulation.
 QUANTITIES: dict[str, str] = {
     "seat.static_deflection": "X_ST of the seat isolator [m] (Eq 8.2, Sec 8.2.2)",
     "seat.geometry": "the seat's conditions g <= 0 of suspopt.seat.seat_constraints (Tables "
-                     "8.7, 8.9, 8.11), one value each; constraints only",
+    "8.7, 8.9, 8.11), one value each; constraints only",
 }
+
 
 @dataclass(frozen=True)
 class Algorithm:
@@ -74,25 +88,32 @@ ALGORITHMS: dict[str, Algorithm] = {
 class DesignVariable(Section):
     """One design variable: a numeric config field between bounds (Table 5.2, 7.3, 8.2-8.10)."""
 
-    path: str = Field(description="dotted path of a numeric config field, e.g. "
-                      "vehicle.corners.F1.spring.linear")
+    path: str = Field(
+        description="dotted path of a numeric config field, e.g. vehicle.corners.F1.spring.linear"
+    )
     lower: _Finite = Field(description="lower bound, in the field's SI unit")
     upper: _Finite = Field(description="upper bound, in the field's SI unit")
     scale: Literal["linear", "log"] = Field(
-        "linear", description="log: the optimiser searches log10 of the value (for ranges of "
-        "several decades, e.g. k_nl 5e5-3e7)")
+        "linear",
+        description="log: the optimiser searches log10 of the value (for ranges of "
+        "several decades, e.g. k_nl 5e5-3e7)",
+    )
     integer: bool = Field(False, description="round the value to a whole number")
-    name: str | None = Field(None, description="short label for tables and HDF5 (default: "
-                             "the path)")
+    name: str | None = Field(
+        None, description="short label for tables and HDF5 (default: the path)"
+    )
 
     @model_validator(mode="after")
-    def _check_bounds(self) -> "DesignVariable":
+    def _check_bounds(self) -> DesignVariable:
         if self.lower > self.upper:
-            raise ValueError(f"lower ({self.lower:g}) > upper ({self.upper:g}): did you swap "
-                             f"the bounds?")
+            raise ValueError(
+                f"lower ({self.lower:g}) > upper ({self.upper:g}): did you swap the bounds?"
+            )
         if self.lower == self.upper:
-            raise ValueError(f"lower = upper = {self.lower:g}: a fixed value is no design "
-                             f"variable; write it in the config instead")
+            raise ValueError(
+                f"lower = upper = {self.lower:g}: a fixed value is no design "
+                f"variable; write it in the config instead"
+            )
         if self.scale == "log" and self.lower <= 0:
             raise ValueError(f"scale 'log' needs lower > 0 (got {self.lower:g})")
         if self.integer and self.scale == "log":
@@ -109,28 +130,35 @@ class DesignVariable(Section):
 class Objective(MetricSpec):
     """A metric spec (metric of a signal) or a design ``quantity``; one value per design."""
 
-    metric: str | None = Field(None, description="metric of a signal (see metrics:); or give "
-                               "quantity")
+    metric: str | None = Field(
+        None, description="metric of a signal (see metrics:); or give quantity"
+    )
     quantity: Literal[tuple(QUANTITIES)] | None = Field(
-        None, description="design quantity computed without simulating: " + "; ".join(
-            f"{k}: {v}" for k, v in QUANTITIES.items()))
+        None,
+        description="design quantity computed without simulating: "
+        + "; ".join(f"{k}: {v}" for k, v in QUANTITIES.items()),
+    )
 
     @model_validator(mode="after")
-    def _metric_or_quantity(self) -> "Objective":
+    def _metric_or_quantity(self) -> Objective:
         if (self.metric is None) == (self.quantity is None):
             raise ValueError("give either metric (with its signal) or quantity")
         if self.quantity is not None:
             given = [k for k in ("signal", "corners", "weighting") if getattr(self, k)]
             if given or self.reduce != "none":
-                raise ValueError(f"quantity {self.quantity!r} takes no "
-                                 f"{', '.join(given or ['reduce'])}")
+                raise ValueError(
+                    f"quantity {self.quantity!r} takes no {', '.join(given or ['reduce'])}"
+                )
         return self
 
     @property
     def label(self) -> str:
         """The name in F, G and the HDF5 file (default ``metric.signal[.weighting]``)."""
-        return self.name or self.quantity or ".".join(
-            filter(None, [self.metric, self.signal, self.weighting]))
+        return (
+            self.name
+            or self.quantity
+            or ".".join(filter(None, [self.metric, self.signal, self.weighting]))
+        )
 
 
 class Constraint(Objective):
@@ -139,14 +167,18 @@ class Constraint(Objective):
     min: _Finite | None = Field(None, description="lowest allowed value (g = min - value)")
     max: _Finite | None = Field(None, description="highest allowed value (g = value - max)")
     mu: quantity(0.0, 1.0, closed=False) | None = Field(
-        None, description="μ of the NSS3 condition d < μ R (Table 8.9 #4; quantity "
-        "seat.geometry only; default 0.8, Sec 8.3.4)")
+        None,
+        description="μ of the NSS3 condition d < μ R (Table 8.9 #4; quantity "
+        "seat.geometry only; default 0.8, Sec 8.3.4)",
+    )
     conditions: list[str] | None = Field(
-        None, description="which seat conditions of quantity seat.geometry to impose "
-        "(default all; see suspopt.seat.seat_constraints)")
+        None,
+        description="which seat conditions of quantity seat.geometry to impose "
+        "(default all; see suspopt.seat.seat_constraints)",
+    )
 
     @model_validator(mode="after")
-    def _bounds(self) -> "Constraint":
+    def _bounds(self) -> Constraint:
         if self.min is None and self.max is None:
             raise ValueError("a constraint needs min, max or both")
         if self.min is not None and self.max is not None and self.min >= self.max:
@@ -161,21 +193,23 @@ class Objectives(Section):
     """Main objectives (optimised) and supplementary ones (evaluated for the selection, Sec 6.2,
     Fig. 6.5: the k-ε sorting ranks the Pareto set by main + supplementary)."""
 
-    main: list[Objective] = Field(min_length=1, description="objectives the optimiser "
-                                  "minimises")
-    supplementary: list[Objective] = Field(default_factory=list, description="objectives "
-                                           "evaluated on the designs but not optimised")
+    main: list[Objective] = Field(min_length=1, description="objectives the optimiser minimises")
+    supplementary: list[Objective] = Field(
+        default_factory=list, description="objectives evaluated on the designs but not optimised"
+    )
 
     @model_validator(mode="after")
-    def _check(self) -> "Objectives":
+    def _check(self) -> Objectives:
         seen: set[str] = set()
         for spec in self.main + self.supplementary:
             if spec.quantity == "seat.geometry":
-                raise ValueError("quantity seat.geometry gives several values: use it as a "
-                                 "constraint")
+                raise ValueError(
+                    "quantity seat.geometry gives several values: use it as a constraint"
+                )
             if spec.label in seen:
-                raise ValueError(f"two objectives are named {spec.label!r}; give them "
-                                 f"distinct names")
+                raise ValueError(
+                    f"two objectives are named {spec.label!r}; give them distinct names"
+                )
             seen.add(spec.label)
         return self
 
@@ -190,22 +224,26 @@ class Balance(Section):
     """
 
     samples: _count(1_000_000) = Field(100, description="random designs simulated to balance")
-    dominant: str | None = Field(None, description="name of the objective that dominates "
-                                 "(Case 5: f1)")
-    factor: quantity(0.0, 1e6, closed=False) = Field(10.0, description="how much the dominant term outweighs "
-                                  "the others [-] (Case 5: 10)")
+    dominant: str | None = Field(
+        None, description="name of the objective that dominates (Case 5: f1)"
+    )
+    factor: quantity(0.0, 1e6, closed=False) = Field(
+        10.0, description="how much the dominant term outweighs the others [-] (Case 5: 10)"
+    )
 
 
 class WeightedSum(Section):
     """Pseudo multi-objective optimisation, Eq 5.7: minimise ``sum_i w_i f_i``."""
 
     weights: list[quantity(0.0, 1e12)] | None = Field(
-        None, description="one weight per main objective, in the order of objectives.main")
-    balance: Balance | None = Field(None, description="derive the weights from random "
-                                    "designs instead (Cases 4-5)")
+        None, description="one weight per main objective, in the order of objectives.main"
+    )
+    balance: Balance | None = Field(
+        None, description="derive the weights from random designs instead (Cases 4-5)"
+    )
 
     @model_validator(mode="after")
-    def _one_way(self) -> "WeightedSum":
+    def _one_way(self) -> WeightedSum:
         if (self.weights is None) == (self.balance is None):
             raise ValueError("give either weights or balance")
         if self.weights is not None and not any(self.weights):
@@ -216,47 +254,72 @@ class WeightedSum(Section):
 class Hybrid(Section):
     """GA, then SLSQP from the GA's best inside a box around it (Sec 5.1.1, S3-S4)."""
 
-    ga_generations: _count(1_000_000) = Field(10, description="generations of the GA before the "
-                                        "gradient takes over (Sec 5.1.1: 10)")
-    shrink: float = Field(0.2, gt=0, le=1, description="the gradient's box: the GA best ± "
-                          "shrink/2 of each variable's range, cut by the original bounds [-]")
+    ga_generations: _count(1_000_000) = Field(
+        10, description="generations of the GA before the gradient takes over (Sec 5.1.1: 10)"
+    )
+    shrink: float = Field(
+        0.2,
+        gt=0,
+        le=1,
+        description="the gradient's box: the GA best ± "
+        "shrink/2 of each variable's range, cut by the original bounds [-]",
+    )
 
 
 class Gradient(Section):
     """SLSQP (scipy) with forward differences, each gradient one batch of n + 1 designs."""
 
-    step: float = Field(1.0e-4, gt=0, lt=0.5, description="finite-difference step, as a "
-                        "share of each variable's range [-]")
+    step: float = Field(
+        1.0e-4,
+        gt=0,
+        lt=0.5,
+        description="finite-difference step, as a share of each variable's range [-]",
+    )
 
 
 class Optimiser(Section):
     """The algorithm and its budget. ``seed`` fixes every random draw of the run."""
 
-    algorithm: str = Field(description="ga | nsga2 | gradient | hybrid, or a pymoo algorithm: "
-                           + ", ".join(k for k in ALGORITHMS if k not in
-                                       ("ga", "nsga2", "gradient", "hybrid")))
-    seed: Seed = Field(description="seed of the run's random generator (required: runs are "
-                      "reproducible bit for bit)")
-    population: _count(1_000_000) | None = Field(None, description="population size (S1/S3: 200, "
-                                           "S2/S4: 1000); not for gradient")
+    algorithm: str = Field(
+        description="ga | nsga2 | gradient | hybrid, or a pymoo algorithm: "
+        + ", ".join(k for k in ALGORITHMS if k not in ("ga", "nsga2", "gradient", "hybrid"))
+    )
+    seed: Seed = Field(
+        description="seed of the run's random generator (required: runs are "
+        "reproducible bit for bit)"
+    )
+    population: _count(1_000_000) | None = Field(
+        None, description="population size (S1/S3: 200, S2/S4: 1000); not for gradient"
+    )
     generations: _count(1_000_000) | None = Field(
-        None, description="most generations (gradient: SLSQP iterations; hybrid: GA "
-        "generations plus SLSQP iterations)")
-    max_evaluations: _count(10 ** 10) | None = Field(None, description="most designs simulated")
+        None,
+        description="most generations (gradient: SLSQP iterations; hybrid: GA "
+        "generations plus SLSQP iterations)",
+    )
+    max_evaluations: _count(10**10) | None = Field(None, description="most designs simulated")
     tolerance: quantity(0.0, 1.0, closed=False) = Field(
-        1.0e-6, description="stop when the best objective improves less than this over "
+        1.0e-6,
+        description="stop when the best objective improves less than this over "
         "stall_generations (GA; Ch. 5: 1e-6), or SLSQP's ftol on the objective scaled by its "
-        "value at the start")
-    stall_generations: _count(100_000) = Field(30, description="window of the tolerance test of "
-                                           "population algorithms")
-    weighted_sum: WeightedSum | None = Field(None, description="combine the main objectives "
-                                             "into one (Eq 5.7)")
+        "value at the start",
+    )
+    stall_generations: _count(100_000) = Field(
+        30, description="window of the tolerance test of population algorithms"
+    )
+    weighted_sum: WeightedSum | None = Field(
+        None, description="combine the main objectives into one (Eq 5.7)"
+    )
     hybrid: Hybrid | None = Field(None, description="settings of algorithm hybrid")
-    gradient: Gradient = Field(default_factory=Gradient, description="settings of the "
-                               "gradient part (algorithms gradient and hybrid)")
-    options: dict[str, Any] = Field(default_factory=dict, description="keyword arguments of "
-                                    "the pymoo algorithm's constructor (e.g. "
-                                    "eliminate_duplicates, n_offsprings)")
+    gradient: Gradient = Field(
+        default_factory=Gradient,
+        description="settings of the gradient part (algorithms gradient and hybrid)",
+    )
+    options: dict[str, Any] = Field(
+        default_factory=dict,
+        description="keyword arguments of "
+        "the pymoo algorithm's constructor (e.g. "
+        "eliminate_duplicates, n_offsprings)",
+    )
 
     @field_validator("algorithm")
     @classmethod
@@ -264,7 +327,7 @@ class Optimiser(Section):
         return check_known("algorithm", name, ALGORITHMS)
 
     @model_validator(mode="after")
-    def _check(self) -> "Optimiser":
+    def _check(self) -> Optimiser:
         if self.generations is None and self.max_evaluations is None:
             raise ValueError("give a budget: generations, max_evaluations or both")
         if self.algorithm == "gradient" and self.population is not None:

@@ -19,19 +19,26 @@ is checked when the road is generated (:func:`suspopt.road.road_inputs` raises
 
 from __future__ import annotations
 
+import math
 import os
 import stat
 from pathlib import Path
-import math
-from typing import Annotated, Literal, Union
+from typing import Annotated, Literal
 
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from .base import RoadHeight, RoadLength, Seed, Section, Speed, quantity
+from .base import RoadHeight, RoadLength, Section, Seed, Speed, quantity
 
 __all__ = [
-    "Tracks", "BumpStep", "BumpHalfSine", "Iso8608Road", "FileRoad", "RoadConfig",
-    "resolve_road_file", "read_profile", "MAX_PROFILE_BYTES",
+    "Tracks",
+    "BumpStep",
+    "BumpHalfSine",
+    "Iso8608Road",
+    "FileRoad",
+    "RoadConfig",
+    "resolve_road_file",
+    "read_profile",
+    "MAX_PROFILE_BYTES",
 ]
 
 Tracks = Literal["identical", "independent", "right_only", "left_only"]
@@ -42,7 +49,8 @@ _Start = quantity(0.0, 1e5)
 _SpatialFrequency = quantity(1e-4, 100.0)
 _TRACKS_DESCRIPTION = (
     "what the two sides see: 'identical' (left = right), 'independent' (left is an independent "
-    "realisation; iso8608 only), 'right_only' / 'left_only' (the other side is flat)")
+    "realisation; iso8608 only), 'right_only' / 'left_only' (the other side is flat)"
+)
 _SPEED_DESCRIPTION = "constant vehicle speed V [m/s]"
 
 
@@ -51,9 +59,12 @@ class _Road(Section):
 
     speed: Speed = Field(description=_SPEED_DESCRIPTION)
     tracks: Tracks = Field("identical", description=_TRACKS_DESCRIPTION)
-    wheelbase_delay: bool = Field(True, description="rear wheels meet the road (a_F + a_R)/V "
-                                  "after the front ones (Sec 2.5.2); false feeds both axles "
-                                  "at once, e.g. to compare a half car with a quarter car")
+    wheelbase_delay: bool = Field(
+        True,
+        description="rear wheels meet the road (a_F + a_R)/V "
+        "after the front ones (Sec 2.5.2); false feeds both axles "
+        "at once, e.g. to compare a half car with a quarter car",
+    )
 
 
 class _DeterministicRoad(_Road):
@@ -63,8 +74,10 @@ class _DeterministicRoad(_Road):
     @classmethod
     def _one_realisation(cls, tracks: str) -> str:
         if tracks == "independent":
-            raise ValueError("tracks 'independent' needs a random road (kind: iso8608); use "
-                             "'identical', 'right_only' or 'left_only'")
+            raise ValueError(
+                "tracks 'independent' needs a random road (kind: iso8608); use "
+                "'identical', 'right_only' or 'left_only'"
+            )
         return tracks
 
 
@@ -78,8 +91,10 @@ class BumpStep(_DeterministicRoad):
 
     kind: Literal["bump_step"] = Field(description="rectangular bump, Eq 2.103-2.104")
     height: RoadHeight = Field(description="plateau height h [m]; negative for a pothole")
-    length: RoadLength = Field(description="length of the raised plateau on the road [m] (the "
-                              "thesis's L, Fig. 2.21); a wheel stays on it for length/speed s")
+    length: RoadLength = Field(
+        description="length of the raised plateau on the road [m] (the "
+        "thesis's L, Fig. 2.21); a wheel stays on it for length/speed s"
+    )
     start: _Start = Field(description="time at which the front wheels reach the bump t0 [s]")
 
 
@@ -92,9 +107,11 @@ class BumpHalfSine(_DeterministicRoad):
 
     kind: Literal["bump_half_sine"] = Field(description="half-sine bump, Eq 2.101-2.102")
     height: RoadHeight = Field(description="crest height h [m]; negative for a dip")
-    length: RoadLength = Field(description="base length of the half-sine on the road L_b [m] "
-                              "(the thesis's L/2, slip: docs/thesis-slips.md#eq-2101); crossing "
-                              "lasts length/speed s")
+    length: RoadLength = Field(
+        description="base length of the half-sine on the road L_b [m] "
+        "(the thesis's L/2, slip: docs/thesis-slips.md#eq-2101); crossing "
+        "lasts length/speed s"
+    )
     start: _Start = Field(description="time at which the front wheels reach the bump t0 [s]")
 
 
@@ -109,30 +126,45 @@ class Iso8608Road(_Road):
 
     kind: Literal["iso8608"] = Field(description="ISO 8608 random road, Sec 2.5.1")
     road_class: Literal["A", "B", "C", "D", "E"] | None = Field(
-        None, description="ISO 8608 class; sets G_d(n0) to the class's geometric mean "
-        "(A 16, B 64, C 256, D 1024, E 4096 x 1e-6 m^3)")
+        None,
+        description="ISO 8608 class; sets G_d(n0) to the class's geometric mean "
+        "(A 16, B 64, C 256, D 1024, E 4096 x 1e-6 m^3)",
+    )
     level: quantity(1e-12, 1.0) | None = Field(
-        None, description="displacement PSD level G_d(n0) at n0 = 0.1 cycles/m [m^3]; "
-        "overrides road_class")
+        None,
+        description="displacement PSD level G_d(n0) at n0 = 0.1 cycles/m [m^3]; "
+        "overrides road_class",
+    )
     convention: Literal["iso8608", "thesis"] = Field(
         description="amplitude convention: 'iso8608' A_i = sqrt(2 G_d(n_i) dn) (one-sided PSD, "
         "the standard's meaning) or 'thesis' A_i = sqrt(Phi(Omega_i) dOmega / pi) (Eq 2.99; "
         "1/sqrt(2 pi) times smaller); G_d(n_i) dn and Phi(Omega_i) dOmega stand for the PSD's "
-        "integral over harmonic i's cell")
-    waviness: quantity(0.1, 10.0) = Field(2.0, description="waviness w, the PSD slope "
-                                          "exponent (Eq 2.93) [-]")
-    n_min: _SpatialFrequency = Field(0.011, description="lower edge of the generated band "
-                                     "[cycles/m]")
-    n_max: _SpatialFrequency = Field(2.83, validate_default=True,
-                                     description="upper edge of the generated band [cycles/m]")
+        "integral over harmonic i's cell"
+    )
+    waviness: quantity(0.1, 10.0) = Field(
+        2.0, description="waviness w, the PSD slope exponent (Eq 2.93) [-]"
+    )
+    n_min: _SpatialFrequency = Field(
+        0.011, description="lower edge of the generated band [cycles/m]"
+    )
+    n_max: _SpatialFrequency = Field(
+        2.83, validate_default=True, description="upper edge of the generated band [cycles/m]"
+    )
     n_waves: int | None = Field(
-        None, ge=2, le=10_000_000, description="number of harmonics N, at the centres of N "
+        None,
+        ge=2,
+        le=10_000_000,
+        description="number of harmonics N, at the centres of N "
         "equal cells tiling n_min..n_max (not Eq 2.100's inclusive grid, see "
         "suspopt.road.iso8608_harmonics); default: the smallest N whose spacing "
         "(n_max - n_min)/N is at most 1/L, L the length of road the wheels travel [m], so the "
-        "road does not repeat")
-    seed: Seed = Field(0, description="seed of the random phases; the same seed gives the "
-                      "same road bit for bit (default 0)")
+        "road does not repeat",
+    )
+    seed: Seed = Field(
+        0,
+        description="seed of the random phases; the same seed gives the "
+        "same road bit for bit (default 0)",
+    )
 
     @field_validator("n_max")
     @classmethod
@@ -160,8 +192,11 @@ class FileRoad(_DeterministicRoad):
     """
 
     kind: Literal["file"] = Field(description="profile read from a CSV file")
-    path: Path = Field(strict=False, description="CSV file with columns distance [m], height [m] and an "
-                       "optional header line; relative to the config file's directory")
+    path: Path = Field(
+        strict=False,
+        description="CSV file with columns distance [m], height [m] and an "
+        "optional header line; relative to the config file's directory",
+    )
     scale: quantity(-1e3, 1e3) = Field(1.0, description="factor applied to the heights [-]")
 
     @field_validator("path")
@@ -178,7 +213,8 @@ class FileRoad(_DeterministicRoad):
 
 
 RoadConfig = Annotated[
-    Union[BumpStep, BumpHalfSine, Iso8608Road, FileRoad], Field(discriminator="kind")]
+    BumpStep | BumpHalfSine | Iso8608Road | FileRoad, Field(discriminator="kind")
+]
 
 
 def _resolve(path: Path, base_dir: Path | str | None) -> Path:
@@ -212,8 +248,9 @@ def read_profile(path: Path) -> tuple:
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     except OSError as exc:
-        raise ValueError(f"road profile {path}: cannot open it "
-                         f"({exc.strerror or exc.__class__.__name__})") from None
+        raise ValueError(
+            f"road profile {path}: cannot open it ({exc.strerror or exc.__class__.__name__})"
+        ) from None
     if not stat.S_ISREG(os.fstat(fd).st_mode):
         os.close(fd)
         raise ValueError(f"road profile {path}: not a regular file")
@@ -224,7 +261,7 @@ def read_profile(path: Path) -> tuple:
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
+        line = data[: exc.start].count(b"\n") + 1
         raise ValueError(f"road profile {path}:{line}: not UTF-8 text") from None
     lines = text.splitlines()
     header = 1 if lines and _row(lines[0]) is None else 0
@@ -234,15 +271,18 @@ def read_profile(path: Path) -> tuple:
             continue
         row = _row(line)
         if row is None:
-            raise ValueError(f"road profile {path}:{number}: expected two numbers "
-                             f"'distance,height' separated by a comma")
+            raise ValueError(
+                f"road profile {path}:{number}: expected two numbers "
+                f"'distance,height' separated by a comma"
+            )
         if not (math.isfinite(row[0]) and math.isfinite(row[1])):
             raise ValueError(f"road profile {path}:{number}: values must be finite")
         rows.append(row)
         numbers.append(number)
     if len(rows) < 2:
-        raise ValueError(f"road profile {path}: needs at least two rows of "
-                         f"'distance,height', found {len(rows)}")
+        raise ValueError(
+            f"road profile {path}: needs at least two rows of 'distance,height', found {len(rows)}"
+        )
     table = np.array(rows)
     steps = np.diff(table[:, 0])
     if (steps <= 0).any():

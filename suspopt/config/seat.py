@@ -27,14 +27,25 @@ quantities SI: lengths in m, stiffnesses in N/m, dampings in N s/m, masses in kg
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
-from .base import Damping, Mass, Ratio, Section, SeatLength, Stiffness, quantity
+from .base import Damping, Mass, Ratio, SeatLength, Section, Stiffness, quantity
 
-__all__ = ["Position", "Segment", "Link", "Passenger", "PassiveSeat", "CarrellaSeat", "LeSeat",
-           "YanSeat", "KDamperSeat", "SeatConfig", "TABLE_2_3"]
+__all__ = [
+    "Position",
+    "Segment",
+    "Link",
+    "Passenger",
+    "PassiveSeat",
+    "CarrellaSeat",
+    "LeSeat",
+    "YanSeat",
+    "KDamperSeat",
+    "SeatConfig",
+    "TABLE_2_3",
+]
 
 #: [m] a point of the body relative to its centre of gravity
 _BodyPoint = quantity(-100.0, 100.0)
@@ -44,10 +55,14 @@ class Position(Section):
     """Where the seat stands on the body (x + forward, y + right of the CG:
     docs/architecture.md#conventions)."""
 
-    x: _BodyPoint = Field(0.0, description="longitudinal distance ahead of the body's centre of "
-                       "gravity [m] (Ch. 7: e = 0.4)")
-    y: _BodyPoint = Field(0.0, description="lateral distance to the right of the centre of "
-                       "gravity [m]")
+    x: _BodyPoint = Field(
+        0.0,
+        description="longitudinal distance ahead of the body's centre of "
+        "gravity [m] (Ch. 7: e = 0.4)",
+    )
+    y: _BodyPoint = Field(
+        0.0, description="lateral distance to the right of the centre of gravity [m]"
+    )
 
 
 class Segment(Section):
@@ -81,9 +96,11 @@ _TORSO_BACK = (8941.0, 298.0)
 
 def _segment(part: str):
     m, k, c, below = TABLE_2_3[part]
-    return Field(default_factory=lambda: Segment(mass=m, stiffness=k, damping=c),
-                 description=f"m, k, c (Table 2.3: {m}, {k:g}, {c:g}); k and c join it to the "
-                 f"{below}; keys not given keep the table's values")
+    return Field(
+        default_factory=lambda: Segment(mass=m, stiffness=k, damping=c),
+        description=f"m, k, c (Table 2.3: {m}, {k:g}, {c:g}); k and c join it to the "
+        f"{below}; keys not given keep the table's values",
+    )
 
 
 class Passenger(Section):
@@ -107,7 +124,8 @@ class Passenger(Section):
     head: Segment = _segment("head")
     torso_back: Link = Field(
         default_factory=lambda: Link(stiffness=_TORSO_BACK[0], damping=_TORSO_BACK[1]),
-        description="torso-back link k_4, c_4 (Table 2.3, 'Torso (3-4)': 8941, 298)")
+        description="torso-back link k_4, c_4 (Table 2.3, 'Torso (3-4)': 8941, 298)",
+    )
 
     @model_validator(mode="before")
     @classmethod
@@ -119,8 +137,11 @@ class Passenger(Section):
             if isinstance(data.get(part), dict):
                 data[part] = {"mass": m, "stiffness": k, "damping": c, **data[part]}
         if isinstance(data.get("torso_back"), dict):
-            data["torso_back"] = {"stiffness": _TORSO_BACK[0], "damping": _TORSO_BACK[1],
-                                  **data["torso_back"]}
+            data["torso_back"] = {
+                "stiffness": _TORSO_BACK[0],
+                "damping": _TORSO_BACK[1],
+                **data["torso_back"],
+            }
         return data
 
 
@@ -129,26 +150,33 @@ class _Seat(Section):
 
     mass: Mass = Field(
         description="mass moving on the isolator m_se [kg]: the seat alone (13.6) with a "
-        "passenger model, the seat and the lumped passenger (Ch. 8: 95) without one")
+        "passenger model, the seat and the lumped passenger (Ch. 8: 95) without one"
+    )
     damping: Damping = Field(
-        description="damper C_v [N s/m]: floor to seat (PS, NSS1-NSS3), seat to inner mass "
-        "(NSS4)")
-    position: Position = Field(default_factory=Position,
-                               description="where the seat stands on the body")
+        description="damper C_v [N s/m]: floor to seat (PS, NSS1-NSS3), seat to inner mass (NSS4)"
+    )
+    position: Position = Field(
+        default_factory=Position, description="where the seat stands on the body"
+    )
     coupling: Literal["one_way", "two_way"] = Field(
-        "one_way", description="one_way: the body motion drives the seat and the seat does not "
+        "one_way",
+        description="one_way: the body motion drives the seat and the seat does not "
         "act back (the thesis's way); two_way: the seat's dynamic force also acts on the body "
-        "(its weight is not added to the vehicle's statics: the body mass is as written)")
+        "(its weight is not added to the vehicle's statics: the body mass is as written)",
+    )
     passenger: Passenger | None = Field(
-        None, description="seated passenger of Sec 2.3 on the seat mass ({} for Table 2.3)")
+        None, description="seated passenger of Sec 2.3 on the seat mass ({} for Table 2.3)"
+    )
 
 
 class _NegativeStiffnessSeat(_Seat):
     """An isolator with a geometric (negative-stiffness) mechanism."""
 
     form: Literal["exact", "taylor"] = Field(
-        "exact", description="mechanism force: exact geometry (default) or its 3rd-order "
-        "Taylor series about the static equilibrium (Eq 2.45, 2.52)")
+        "exact",
+        description="mechanism force: exact geometry (default) or its 3rd-order "
+        "Taylor series about the static equilibrium (Eq 2.45, 2.52)",
+    )
 
 
 class PassiveSeat(_Seat):
@@ -168,10 +196,11 @@ class CarrellaSeat(_NegativeStiffnessSeat):
 
     kind: Literal["nss1"] = Field(description="Carrella et al. isolator, Eq 2.41-2.45")
     stiffness_ratio: Ratio = Field(description="α = K_h/K_v [-] (Table 8.4: 0-5)")
-    gamma: float = Field(gt=0, lt=1, description="γ = a_o/L_o = cos θ_o [-] (Table 8.4: "
-                         "0.01-0.99)")
-    wall_distance: SeatLength = Field(description="a_o, horizontal distance from the seat "
-                                         "axis to the springs' anchors [m] (Table 8.4: 0.1-0.3)")
+    gamma: float = Field(gt=0, lt=1, description="γ = a_o/L_o = cos θ_o [-] (Table 8.4: 0.01-0.99)")
+    wall_distance: SeatLength = Field(
+        description="a_o, horizontal distance from the seat "
+        "axis to the springs' anchors [m] (Table 8.4: 0.1-0.3)"
+    )
 
 
 class LeSeat(_NegativeStiffnessSeat):
@@ -183,21 +212,23 @@ class LeSeat(_NegativeStiffnessSeat):
 
     kind: Literal["nss2"] = Field(description="Le et al. isolator, Eq 2.46-2.52")
     stiffness_ratio: Ratio = Field(description="α = K_h/K_v [-] (Table 8.6: 0-1)")
-    spring_free_length: SeatLength = Field(description="L_o, free length of a horizontal "
-                                           "spring [m] (Table 8.6: 0.1-0.3)")
-    wall_distance: SeatLength = Field(description="a_o, distance from the seat axis to a "
-                                         "spring's anchor [m] (Table 8.6: 0.1-0.3)")
-    bar_length: SeatLength = Field(description="b, length of a bar [m] (Table 8.6: "
-                                      "0.05-0.3)")
+    spring_free_length: SeatLength = Field(
+        description="L_o, free length of a horizontal spring [m] (Table 8.6: 0.1-0.3)"
+    )
+    wall_distance: SeatLength = Field(
+        description="a_o, distance from the seat axis to a spring's anchor [m] (Table 8.6: 0.1-0.3)"
+    )
+    bar_length: SeatLength = Field(description="b, length of a bar [m] (Table 8.6: 0.05-0.3)")
 
     @model_validator(mode="after")
-    def _static_deflection_exists(self) -> "LeSeat":
+    def _static_deflection_exists(self) -> LeSeat:
         gap = abs(self.wall_distance - self.spring_free_length)
         if self.bar_length <= gap:
             raise ValueError(
                 f"NSS2 has no static deflection: bar_length b = {self.bar_length} must exceed "
                 f"|wall_distance - spring_free_length| = {gap:.6g} so that X_ST = "
-                f"sqrt(b^2 - (a_o - L_o)^2) > 0 (Table 8.7, constraint 4)")
+                f"sqrt(b^2 - (a_o - L_o)^2) > 0 (Table 8.7, constraint 4)"
+            )
         return self
 
 
@@ -211,21 +242,23 @@ class YanSeat(_NegativeStiffnessSeat):
     kind: Literal["nss3"] = Field(description="Yan et al. isolator, Eq 2.53-2.58")
     stiffness_ratio: Ratio = Field(description="α = K_h/K_v [-] (Table 8.8: 0-5)")
     cam_radius: SeatLength = Field(description="R, cam radius [m] (Table 8.8: 0.01-0.25)")
-    roller_radius: SeatLength = Field(description="r, roller radius [m] (Table 8.8: "
-                                         "0.01-0.25)")
-    cam_offset: quantity(0.0, 10.0) = Field(description="d, distance from the cam centre [m] "
-                                         "(Table 8.8: 0-0.25)")
+    roller_radius: SeatLength = Field(description="r, roller radius [m] (Table 8.8: 0.01-0.25)")
+    cam_offset: quantity(0.0, 10.0) = Field(
+        description="d, distance from the cam centre [m] (Table 8.8: 0-0.25)"
+    )
     precompression: SeatLength = Field(
         description="u_2, precompression of the horizontal springs [m]; no default on purpose: "
-        "Sec 2.2.4 uses 0.01, Ch. 8 (Sec 8.2.2) 0.001 (slip: docs/thesis-slips.md#sec-224)")
+        "Sec 2.2.4 uses 0.01, Ch. 8 (Sec 8.2.2) 0.001 (slip: docs/thesis-slips.md#sec-224)"
+    )
 
     @model_validator(mode="after")
-    def _static_deflection_exists(self) -> "YanSeat":
+    def _static_deflection_exists(self) -> YanSeat:
         if self.cam_offset >= self.cam_radius:
             raise ValueError(
                 f"NSS3 has no static deflection: cam_offset d = {self.cam_offset} must be less "
                 f"than cam_radius R = {self.cam_radius} (Eq 2.54) so that X_ST = "
-                f"sqrt((R + r)^2 - (d + r)^2) > 0")
+                f"sqrt((R + r)^2 - (d + r)^2) > 0"
+            )
         return self
 
 
@@ -239,28 +272,37 @@ class KDamperSeat(_NegativeStiffnessSeat):
     """
 
     kind: Literal["nss4"] = Field(description="KDamper, Eq 2.59-2.69")
-    support_stiffness: Stiffness = Field(description="K_S, floor to seat [N/m] (Table 8.10: "
-                                             "1e4-1.5e5)")
-    inner_stiffness: Stiffness = Field(description="K_v, seat to inner mass [N/m] "
-                                           "(Table 8.10: 2e3-7e4)")
-    horizontal_stiffness: quantity(0.0, 1e10) = Field(description="K_h, each horizontal spring "
-                                                   "[N/m] (Table 8.10: 2e3-7e4)")
-    spring_free_length: SeatLength = Field(description="L_o, free length of a horizontal "
-                                           "spring [m] (Table 8.10: 0.1-0.3)")
+    support_stiffness: Stiffness = Field(
+        description="K_S, floor to seat [N/m] (Table 8.10: 1e4-1.5e5)"
+    )
+    inner_stiffness: Stiffness = Field(
+        description="K_v, seat to inner mass [N/m] (Table 8.10: 2e3-7e4)"
+    )
+    horizontal_stiffness: quantity(0.0, 1e10) = Field(
+        description="K_h, each horizontal spring [N/m] (Table 8.10: 2e3-7e4)"
+    )
+    spring_free_length: SeatLength = Field(
+        description="L_o, free length of a horizontal spring [m] (Table 8.10: 0.1-0.3)"
+    )
     wall_distance: SeatLength = Field(description="a_o [m] (Table 8.10: 0.1-0.3)")
     bar_length: SeatLength = Field(description="b, bar length [m] (Table 8.10: 0.1-0.3)")
-    hinge_offset: quantity(-10.0, 10.0) = Field(0.001, description="u_0, the hinge's height above the "
-                                  "horizontal at rest [m] (Sec 2.2.5: 1 mm)")
+    hinge_offset: quantity(-10.0, 10.0) = Field(
+        0.001,
+        description="u_0, the hinge's height above the horizontal at rest [m] (Sec 2.2.5: 1 mm)",
+    )
     inner_mass: Mass = Field(1.0, description="m_d, inner mass [kg] (Sec 2.2.5: 1)")
 
     @model_validator(mode="after")
-    def _hinge_within_bar(self) -> "KDamperSeat":
+    def _hinge_within_bar(self) -> KDamperSeat:
         if abs(self.hinge_offset) >= self.bar_length:
-            raise ValueError(f"NSS4: |hinge_offset| u_0 = {abs(self.hinge_offset)} must be "
-                             f"less than bar_length b = {self.bar_length} (Eq 2.65 needs "
-                             f"|u| < b)")
+            raise ValueError(
+                f"NSS4: |hinge_offset| u_0 = {abs(self.hinge_offset)} must be "
+                f"less than bar_length b = {self.bar_length} (Eq 2.65 needs "
+                f"|u| < b)"
+            )
         return self
 
 
-SeatConfig = Annotated[Union[PassiveSeat, CarrellaSeat, LeSeat, YanSeat, KDamperSeat],
-                       Field(discriminator="kind")]
+SeatConfig = Annotated[
+    PassiveSeat | CarrellaSeat | LeSeat | YanSeat | KDamperSeat, Field(discriminator="kind")
+]

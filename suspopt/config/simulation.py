@@ -15,20 +15,24 @@ class Simulation(Section):
     duration: Duration = Field(description="simulated time [s]")
     dt: Step = Field(1.0e-3, description="integration step [s]")
     output_dt: Step | None = Field(
-        None, description="output sample interval [s], a whole multiple of dt (default dt)")
+        None, description="output sample interval [s], a whole multiple of dt (default dt)"
+    )
 
     @model_validator(mode="after")
-    def _check_steps(self) -> "Simulation":
+    def _check_steps(self) -> Simulation:
         if self.dt > self.duration:
             raise ValueError("dt must not exceed duration")
         if self.output_dt is not None:
             if self.output_dt > self.duration:
-                raise ValueError(f"output_dt ({self.output_dt}) must not exceed duration "
-                                 f"({self.duration}): a run needs two output samples")
+                raise ValueError(
+                    f"output_dt ({self.output_dt}) must not exceed duration "
+                    f"({self.duration}): a run needs two output samples"
+                )
             ratio = self.output_dt / self.dt
             if ratio < 1 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
-                raise ValueError(f"output_dt ({self.output_dt}) must be a whole multiple of "
-                                 f"dt ({self.dt})")
+                raise ValueError(
+                    f"output_dt ({self.output_dt}) must be a whole multiple of dt ({self.dt})"
+                )
         return self
 
     @property
@@ -51,12 +55,12 @@ class Output(Section):
     """What ``suspopt simulate`` writes to HDF5."""
 
     signals: list[str] | str = Field(
-        "all", description="signal names to store, or 'all' (every signal the model has)")
+        "all", description="signal names to store, or 'all' (every signal the model has)"
+    )
     float32: bool = Field(False, description="store signals as float32 to halve file size")
 
     @model_validator(mode="after")
-    def _check(self) -> "Output":
+    def _check(self) -> Output:
         if isinstance(self.signals, str) and self.signals != "all":
             raise ValueError("signals must be 'all' or a list of signal names")
         return self
-

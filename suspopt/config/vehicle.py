@@ -13,20 +13,44 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
-from typing import Annotated, Any, ClassVar, Literal, Union
+from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import Discriminator, Field, Tag, create_model, model_validator
 
 from ..control.laws import LAWS, PARAMETERS
-
-from .base import (CubicStiffness, Damping, Inertia, Mass, Section, Stiffness,
-                   TorsionalStiffness, VehicleLength, quantity)
+from .base import (
+    CubicStiffness,
+    Damping,
+    Inertia,
+    Mass,
+    Section,
+    Stiffness,
+    TorsionalStiffness,
+    VehicleLength,
+    quantity,
+)
 
 __all__ = [
-    "Preset", "PRESETS", "DOF_FIELDS", "CORNER_NAMES", "PRESET_CORNERS", "PRESET_BODY_DOFS", "DAMPER_LAWS", "LAW_PARAMETERS", "Spring", "Tyre",
-    "PassiveDamper", "SemiActiveDamper", "Damper", "Corner", "Body",
-    "AntiRollBars", "Vehicle", "corner_defaults_schema",
+    "Preset",
+    "PRESETS",
+    "DOF_FIELDS",
+    "CORNER_NAMES",
+    "PRESET_CORNERS",
+    "PRESET_BODY_DOFS",
+    "DAMPER_LAWS",
+    "LAW_PARAMETERS",
+    "Spring",
+    "Tyre",
+    "PassiveDamper",
+    "SemiActiveDamper",
+    "Damper",
+    "Corner",
+    "Body",
+    "AntiRollBars",
+    "Vehicle",
+    "corner_defaults_schema",
 ]
+
 
 @dataclass(frozen=True)
 class Preset:
@@ -48,16 +72,22 @@ class Preset:
 
 
 #: What each body DOF needs of the body: its inertia (or the mass) and the corners' lever arms.
-DOF_FIELDS = {"heave": ("mass",), "roll": ("roll_inertia", "b_right", "b_left"),
-              "pitch": ("pitch_inertia", "a_front", "a_rear")}
+DOF_FIELDS = {
+    "heave": ("mass",),
+    "roll": ("roll_inertia", "b_right", "b_left"),
+    "pitch": ("pitch_inertia", "a_front", "a_rear"),
+}
 #: The vehicle models, all presets of one corner-based model (Eq 2.1, 2.5-2.6, 2.13-2.14,
 #: 2.19-2.21). Adding a preset is adding one entry here.
-PRESETS: dict[str, Preset] = {p.name: p for p in (
-    Preset("quarter", "QC", ("heave",), ("F1",)),
-    Preset("half_roll", "HC1", ("heave", "roll"), ("F1", "F2")),
-    Preset("half_pitch", "HC2", ("heave", "pitch"), ("F1", "R1")),
-    Preset("full", "FC", ("heave", "roll", "pitch"), ("F1", "F2", "R1", "R2")),
-)}
+PRESETS: dict[str, Preset] = {
+    p.name: p
+    for p in (
+        Preset("quarter", "QC", ("heave",), ("F1",)),
+        Preset("half_roll", "HC1", ("heave", "roll"), ("F1", "F2")),
+        Preset("half_pitch", "HC2", ("heave", "pitch"), ("F1", "R1")),
+        Preset("full", "FC", ("heave", "roll", "pitch"), ("F1", "F2", "R1", "R2")),
+    )
+}
 #: Corners of each preset.
 PRESET_CORNERS: dict[str, tuple[str, ...]] = {k: p.corners for k, p in PRESETS.items()}
 #: Body degrees of freedom of each preset.
@@ -70,16 +100,20 @@ class Spring(Section):
     """Suspension spring, Eq 2.30 (linear) or Eq 2.31 (Duffing): F_K = k_l ST + k_nl ST^3."""
 
     linear: Stiffness = Field(description="linear stiffness k_l [N/m]")
-    cubic: CubicStiffness = Field(0.0, description="cubic (Duffing) coefficient k_nl [N/m^3]; "
-                         "positive hardens (the thesis's case), negative softens")
+    cubic: CubicStiffness = Field(
+        0.0,
+        description="cubic (Duffing) coefficient k_nl [N/m^3]; "
+        "positive hardens (the thesis's case), negative softens",
+    )
 
 
 class Tyre(Section):
     """Tyre spring and optional damper, Eq 2.28-2.29."""
 
     stiffness: Stiffness = Field(description="tyre vertical stiffness k_T [N/m]")
-    damping: Damping = Field(0.0, description="tyre damping c_T [N s/m] (Eq 2.29; "
-                                      "the thesis mostly takes 0)")
+    damping: Damping = Field(
+        0.0, description="tyre damping c_T [N s/m] (Eq 2.29; the thesis mostly takes 0)"
+    )
 
 
 class PassiveDamper(Section):
@@ -97,8 +131,8 @@ class PassiveDamper(Section):
 DAMPER_LAWS = tuple(LAWS)
 #: Law parameters of SemiActiveDamper and the laws that use them.
 LAW_PARAMETERS: dict[str, tuple[str, ...]] = {
-    name: tuple(law.name for law in LAWS.values() if name in law.parameters)
-    for name in PARAMETERS}
+    name: tuple(law.name for law in LAWS.values() if name in law.parameters) for name in PARAMETERS
+}
 
 
 class _SemiActiveFields(Section):
@@ -114,14 +148,13 @@ class _SemiActiveFields(Section):
 
     kind: Literal["semi_active"] = Field(description="damper type")
     c_min: Damping = Field(description="soft damping coefficient C_min [N s/m]")
-    c_max: Damping = Field(description="stiff damping coefficient C_max [N s/m], "
-                                    "at least c_min")
+    c_max: Damping = Field(description="stiff damping coefficient C_max [N s/m], at least c_min")
     law: Literal[DAMPER_LAWS] = Field(description="control law: " + " | ".join(DAMPER_LAWS))
 
     soft_field: ClassVar[str] = "c_min"
 
     @model_validator(mode="after")
-    def _check(self) -> "_SemiActiveFields":
+    def _check(self) -> _SemiActiveFields:
         if self.c_max < self.c_min:
             raise ValueError(f"c_max ({self.c_max}) must be at least c_min ({self.c_min})")
         for name, laws in LAW_PARAMETERS.items():
@@ -129,8 +162,10 @@ class _SemiActiveFields(Section):
             if self.law in laws and not given:
                 raise ValueError(f"law {self.law!r} needs {name}")
             if given and self.law not in laws:
-                raise ValueError(f"{name} is a parameter of law {' / '.join(laws)}, not of "
-                                 f"{self.law!r}; remove it")
+                raise ValueError(
+                    f"{name} is a parameter of law {' / '.join(laws)}, not of "
+                    f"{self.law!r}; remove it"
+                )
         return self
 
 
@@ -138,16 +173,25 @@ def _parameter_field(parameter) -> tuple:
     """The config field of a law parameter: optional, in its range, described."""
     laws = " and ".join(LAW_PARAMETERS[parameter.name])
     bound = {"gt" if parameter.low_open else "ge": parameter.low}
-    return (quantity(parameter.low, parameter.high) | None,
-            Field(None, **bound, le=parameter.high,
-                  description=f"{parameter.description} (law{'s' if ' and ' in laws else ''} "
-                              f"{laws} only)"))
+    return (
+        quantity(parameter.low, parameter.high) | None,
+        Field(
+            None,
+            **bound,
+            le=parameter.high,
+            description=f"{parameter.description} (law{'s' if ' and ' in laws else ''} "
+            f"{laws} only)",
+        ),
+    )
 
 
 SemiActiveDamper = create_model(
-    "SemiActiveDamper", __base__=_SemiActiveFields, __module__=__name__,
+    "SemiActiveDamper",
+    __base__=_SemiActiveFields,
+    __module__=__name__,
     __doc__=_SemiActiveFields.__doc__,
-    **{name: _parameter_field(p) for name, p in PARAMETERS.items()})
+    **{name: _parameter_field(p) for name, p in PARAMETERS.items()},
+)
 
 
 def _damper_kind(value: Any) -> str:
@@ -158,11 +202,13 @@ def _damper_kind(value: Any) -> str:
 
 
 Damper = Annotated[
-    Union[Annotated[PassiveDamper, Tag("passive")],
-          Annotated[SemiActiveDamper, Tag("semi_active")]],
-    Discriminator(_damper_kind, custom_error_type="damper_kind",
-                  custom_error_message="unknown damper kind; use 'passive' (default) or "
-                  "'semi_active'")]
+    Annotated[PassiveDamper, Tag("passive")] | Annotated[SemiActiveDamper, Tag("semi_active")],
+    Discriminator(
+        _damper_kind,
+        custom_error_type="damper_kind",
+        custom_error_message="unknown damper kind; use 'passive' (default) or 'semi_active'",
+    ),
+]
 
 
 class Corner(Section):
@@ -209,8 +255,11 @@ def _deep_merge(base: dict, over: dict) -> dict:
     semi-active default changes its ``c_max``)."""
     out = dict(base)
     for key, value in over.items():
-        if isinstance(value, dict) and isinstance(out.get(key), dict) and \
-                value.get("kind", _damper_kind(out[key])) == _damper_kind(out[key]):
+        if (
+            isinstance(value, dict)
+            and isinstance(out.get(key), dict)
+            and value.get("kind", _damper_kind(out[key])) == _damper_kind(out[key])
+        ):
             out[key] = _deep_merge(out[key], value)
         else:
             out[key] = value
@@ -222,15 +271,21 @@ class Vehicle(Section):
     (docs/architecture.md#conventions)."""
 
     preset: Literal[tuple(PRESETS)] = Field(
-        description=" | ".join(f"{p.name} ({p.label})" for p in PRESETS.values()))
+        description=" | ".join(f"{p.name} ({p.label})" for p in PRESETS.values())
+    )
     body: Body
     corner_defaults: dict[str, Any] | None = Field(
-        None, description="values shared by every corner; a corner's own keys override them")
-    corners: dict[str, Corner] = Field(default_factory=dict,
-                                       description="corners by thesis name: F1, F2, R1, R2")
+        None, description="values shared by every corner; a corner's own keys override them"
+    )
+    corners: dict[str, Corner] = Field(
+        default_factory=dict, description="corners by thesis name: F1, F2, R1, R2"
+    )
     anti_roll_bars: AntiRollBars = Field(default_factory=AntiRollBars)
-    tyre_lift_off: bool = Field(False, description="tyres cannot pull (no tensile force); the "
-                                "thesis assumes permanent contact, so off by default")
+    tyre_lift_off: bool = Field(
+        False,
+        description="tyres cannot pull (no tensile force); the "
+        "thesis assumes permanent contact, so off by default",
+    )
     gravity: quantity(0.1, 100.0) = Field(9.81, description="gravitational acceleration [m/s^2]")
 
     @model_validator(mode="before")
@@ -250,21 +305,25 @@ class Vehicle(Section):
         return data
 
     @model_validator(mode="after")
-    def _check_preset(self) -> "Vehicle":
+    def _check_preset(self) -> Vehicle:
         wanted = PRESET_CORNERS[self.preset]
         extra = sorted(set(self.corners) - set(wanted))
         if extra:
-            raise ValueError(f"preset {self.preset!r} has corners {list(wanted)}; "
-                             f"unexpected corner(s) {extra}")
+            raise ValueError(
+                f"preset {self.preset!r} has corners {list(wanted)}; unexpected corner(s) {extra}"
+            )
         missing = [c for c in wanted if c not in self.corners]
         if missing:
-            raise ValueError(f"preset {self.preset!r} needs corners {list(wanted)}; "
-                             f"missing {missing} (give them or corner_defaults)")
+            raise ValueError(
+                f"preset {self.preset!r} needs corners {list(wanted)}; "
+                f"missing {missing} (give them or corner_defaults)"
+            )
         need = [f for f in PRESETS[self.preset].required_body if getattr(self.body, f) is None]
         if need:
             raise ValueError(f"preset {self.preset!r} needs body.{', body.'.join(need)}")
-        if (self.anti_roll_bars.front or self.anti_roll_bars.rear) and \
-                "roll" not in PRESETS[self.preset].body_dofs:
+        if (self.anti_roll_bars.front or self.anti_roll_bars.rear) and "roll" not in PRESETS[
+            self.preset
+        ].body_dofs:
             rolling = " or ".join(k for k, p in PRESETS.items() if "roll" in p.body_dofs)
             raise ValueError(f"anti_roll_bars need a model with roll ({rolling})")
         return self
@@ -284,7 +343,8 @@ def _partial(defs: dict, name: str) -> str:
         schema["title"] = partial
         schema["description"] = (
             schema.get("description", "") + " Here every key may be missing: a corner's own "
-            "keys and vehicle.corner_defaults together must give them.").strip()
+            "keys and vehicle.corner_defaults together must give them."
+        ).strip()
         _refs_to_partial(defs, props)
         for prop in props.values():
             if "oneOf" in prop:
@@ -297,7 +357,7 @@ def _refs_to_partial(defs: dict, node: Any) -> None:
     if isinstance(node, dict):
         ref = node.get("$ref")
         if isinstance(ref, str) and ref.startswith("#/$defs/"):
-            node["$ref"] = "#/$defs/" + _partial(defs, ref[len("#/$defs/"):])
+            node["$ref"] = "#/$defs/" + _partial(defs, ref[len("#/$defs/") :])
         for value in node.values():
             _refs_to_partial(defs, value)
     elif isinstance(node, list):
@@ -320,10 +380,14 @@ def corner_defaults_schema(defs: dict) -> None:
     names = CORNER_NAMES
     props["corner_defaults"]["anyOf"] = [part, {"type": "null"}]
     props["corners"].pop("additionalProperties")
-    props["corners"]["properties"] = {name: {"anyOf": [part, {"type": "null"}]}
-                                      for name in names}
+    props["corners"]["properties"] = {name: {"anyOf": [part, {"type": "null"}]} for name in names}
     props["corners"]["additionalProperties"] = False
-    vehicle["if"] = {"required": ["corner_defaults"],
-                     "properties": {"corner_defaults": {"type": "object", "minProperties": 1}}}
-    vehicle["else"] = {"properties": {"corners": {"properties": {
-        name: {"$ref": "#/$defs/Corner"} for name in names}}}}
+    vehicle["if"] = {
+        "required": ["corner_defaults"],
+        "properties": {"corner_defaults": {"type": "object", "minProperties": 1}},
+    }
+    vehicle["else"] = {
+        "properties": {
+            "corners": {"properties": {name: {"$ref": "#/$defs/Corner"} for name in names}}
+        }
+    }

@@ -36,8 +36,7 @@ from yaml.reader import Reader
 from yaml.resolver import BaseResolver
 from yaml.scanner import Scanner
 
-__all__ = ["YamlError", "MAX_CONFIG_BYTES", "MAX_DEPTH", "MAX_NODES", "read_text",
-           "parse_yaml"]
+__all__ = ["YamlError", "MAX_CONFIG_BYTES", "MAX_DEPTH", "MAX_NODES", "read_text", "parse_yaml"]
 
 #: Largest config file read [bytes]: a config is a few kB; the largest bundled one is 5 kB.
 MAX_CONFIG_BYTES = 1 << 20
@@ -73,9 +72,17 @@ def read_text(path: str | Path, limit: int = MAX_CONFIG_BYTES, what: str = "conf
     mode = os.fstat(fd).st_mode
     if not stat.S_ISREG(mode):
         os.close(fd)
-        kind = ("a directory" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode)
-                else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
-                else "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
+        kind = (
+            "a directory"
+            if stat.S_ISDIR(mode)
+            else "a FIFO"
+            if stat.S_ISFIFO(mode)
+            else "a device"
+            if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+            else "a socket"
+            if stat.S_ISSOCK(mode)
+            else "not a regular file"
+        )
         raise YamlError(f"is {kind}, not a regular {what} file")
     with os.fdopen(fd, "rb") as stream:
         data = stream.read(limit + 1)
@@ -86,7 +93,7 @@ def read_text(path: str | Path, limit: int = MAX_CONFIG_BYTES, what: str = "conf
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
+        line = data[: exc.start].count(b"\n") + 1
         raise YamlError(f"is not UTF-8 text (byte {exc.start})", line) from None
 
 
@@ -97,11 +104,13 @@ class _CoreResolver(BaseResolver):
 _CORE = [
     ("tag:yaml.org,2002:null", r"^(?:~|null|Null|NULL|)$", list("~nN") + [""]),
     ("tag:yaml.org,2002:bool", r"^(?:true|True|TRUE|false|False|FALSE)$", list("tTfF")),
-    ("tag:yaml.org,2002:int", r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$",
-     list("-+0123456789")),
-    ("tag:yaml.org,2002:float",
-     r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
-     r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$", list("-+.0123456789")),
+    ("tag:yaml.org,2002:int", r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$", list("-+0123456789")),
+    (
+        "tag:yaml.org,2002:float",
+        r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+        r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$",
+        list("-+.0123456789"),
+    ),
 ]
 for _tag, _pattern, _first in _CORE:
     _CoreResolver.add_implicit_resolver(_tag, re.compile(_pattern), _first)
@@ -145,8 +154,7 @@ class _Loader(Reader, Scanner, Parser, Composer, _Constructor, _CoreResolver):
     def fetch_flow_collection_start(self, TokenClass):
         # the scanner's cost grows with the square of the flow nesting: stop it early
         if self.flow_level >= MAX_DEPTH:
-            raise YamlError(f"nested more than {MAX_DEPTH} levels deep",
-                            self.get_mark().line + 1)
+            raise YamlError(f"nested more than {MAX_DEPTH} levels deep", self.get_mark().line + 1)
         super().fetch_flow_collection_start(TokenClass)
 
     def compose_node(self, parent, index):
@@ -167,8 +175,11 @@ class _Loader(Reader, Scanner, Parser, Composer, _Constructor, _CoreResolver):
                 continue
             value = (key.tag, key.value)
             if value in seen:
-                raise YamlError(f"key {key.value[:60]!r} appears twice in one mapping (first "
-                                f"on line {seen[value]})", key.start_mark.line + 1)
+                raise YamlError(
+                    f"key {key.value[:60]!r} appears twice in one mapping (first "
+                    f"on line {seen[value]})",
+                    key.start_mark.line + 1,
+                )
             seen[value] = key.start_mark.line + 1
         return node
 
@@ -185,8 +196,10 @@ def _expanded_size(root: Node) -> int:
         if key in sizes:
             return sizes[key]
         if key in open_:
-            raise YamlError("an alias refers to the node that contains it (a recursive "
-                            "structure)", node.start_mark.line + 1)
+            raise YamlError(
+                "an alias refers to the node that contains it (a recursive structure)",
+                node.start_mark.line + 1,
+            )
         open_.add(key)
         total = 1
         if isinstance(node, SequenceNode):
@@ -195,8 +208,10 @@ def _expanded_size(root: Node) -> int:
             total += sum(size(k) + size(v) for k, v in node.value)
         open_.discard(key)
         if total > MAX_NODES:
-            raise YamlError(f"expands to more than {MAX_NODES:,} nodes (aliases of aliases?)",
-                            node.start_mark.line + 1)
+            raise YamlError(
+                f"expands to more than {MAX_NODES:,} nodes (aliases of aliases?)",
+                node.start_mark.line + 1,
+            )
         sizes[key] = total
         return total
 
@@ -222,15 +237,19 @@ def parse_yaml(text: str) -> tuple[Any, Node | None]:
         mark = getattr(exc, "problem_mark", None)
         line = mark.line + 1 if mark is not None else None
         if line is None and isinstance(exc, yaml.reader.ReaderError):
-            line = text[:exc.position].count("\n") + 1
-        problem = getattr(exc, "problem", None) or getattr(exc, "reason", None) \
+            line = text[: exc.position].count("\n") + 1
+        problem = (
+            getattr(exc, "problem", None)
+            or getattr(exc, "reason", None)
             or str(exc).splitlines()[0]
+        )
         raise YamlError(f"malformed YAML: {problem}", line) from None
     except (ValueError, OverflowError, TypeError, AttributeError) as exc:
         # a number Python cannot hold, an explicit tag (!!timestamp, !!binary) of a value
         # its constructor cannot read
-        raise YamlError(f"malformed YAML: a value that cannot be read "
-                        f"({exc.__class__.__name__})") from None
+        raise YamlError(
+            f"malformed YAML: a value that cannot be read ({exc.__class__.__name__})"
+        ) from None
     finally:
         if loader is not None:
             loader.dispose()

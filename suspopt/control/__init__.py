@@ -5,16 +5,35 @@ The laws and the fits sit below the config (:mod:`suspopt.config.vehicle` reads 
 the controller, built from a config, is imported when first used."""
 
 from .laws import LAWS, PARAMETERS, Law, Motion, Parameter, law_condition, stiff_coefficient
-from .stats import (StudentTSummary, distribution_quantile, fit_student_t, t_quantile,
-                    threshold_for_share)
+from .stats import (
+    StudentTSummary,
+    distribution_quantile,
+    fit_student_t,
+    t_quantile,
+    threshold_for_share,
+)
 
-__all__ = ["LAWS", "PARAMETERS", "Law", "Motion", "Parameter", "law_condition",
-           "stiff_coefficient", "fit_student_t", "distribution_quantile", "threshold_for_share",
-           "t_quantile", "StudentTSummary", "SemiActiveController", "build_controller"]
+__all__ = [
+    "LAWS",
+    "PARAMETERS",
+    "Law",
+    "Motion",
+    "Parameter",
+    "law_condition",
+    "stiff_coefficient",
+    "fit_student_t",
+    "distribution_quantile",
+    "threshold_for_share",
+    "t_quantile",
+    "StudentTSummary",
+    "SemiActiveController",
+    "build_controller",
+]
 
 
 def __getattr__(name: str):
     if name in ("SemiActiveController", "build_controller"):
         from . import controller
+
         return getattr(controller, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

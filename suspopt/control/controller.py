@@ -32,8 +32,9 @@ from .stats import StudentTSummary, distribution_quantile, t_quantile
 __all__ = ["SemiActiveController", "build_controller"]
 
 
-def _per_design(pv: ParamView, path: str, low: float, high: float | None = None,
-                low_open: bool = False) -> np.ndarray:
+def _per_design(
+    pv: ParamView, path: str, low: float, high: float | None = None, low_open: bool = False
+) -> np.ndarray:
     """``pv.get(path)``, checking every design's value lies in the field's range."""
     value = pv.get(path)
     bad = (value <= low) if low_open else (value < low)
@@ -41,8 +42,9 @@ def _per_design(pv: ParamView, path: str, low: float, high: float | None = None,
         bad |= value > high
     if bad.any():
         rng = f"{'(' if low_open else '['}{low:g}, {'inf)' if high is None else f'{high:g}]'}"
-        raise ConfigError(f"params: {path}: must be in {rng} (designs "
-                          f"{np.flatnonzero(bad)[:5].tolist()})")
+        raise ConfigError(
+            f"params: {path}: must be in {rng} (designs {np.flatnonzero(bad)[:5].tolist()})"
+        )
     return value
 
 
@@ -70,39 +72,57 @@ class SemiActiveController:
     what was in force over the integration step ending there, i.e. the latest sample before it.
     """
 
-    def __init__(self, model: VehicleModel, laws: list[str | None], c_min: np.ndarray,
-                 c_max: np.ndarray, parameters: dict[str, np.ndarray], dt: float,
-                 sample_every: int, n_steps: int, actuator_lag: np.ndarray,
-                 threshold: np.ndarray,
-                 c_max_share: np.ndarray | None = None, learn_time: np.ndarray | None = None,
-                 refit_factor: np.ndarray | None = None, distribution: str = "student_t"):
+    def __init__(
+        self,
+        model: VehicleModel,
+        laws: list[str | None],
+        c_min: np.ndarray,
+        c_max: np.ndarray,
+        parameters: dict[str, np.ndarray],
+        dt: float,
+        sample_every: int,
+        n_steps: int,
+        actuator_lag: np.ndarray,
+        threshold: np.ndarray,
+        c_max_share: np.ndarray | None = None,
+        learn_time: np.ndarray | None = None,
+        refit_factor: np.ndarray | None = None,
+        distribution: str = "student_t",
+    ):
         N = len(model.corners)
         self._passive = np.array([law is None for law in laws])
         present = sorted({law for law in laws if law is not None}, key=list(LAWS).index)
-        self._groups = [(law, None if len(present) == 1 and not self._passive.any()
-                         else np.array([x == law for x in laws])) for law in present]
+        self._groups = [
+            (
+                law,
+                None
+                if len(present) == 1 and not self._passive.any()
+                else np.array([x == law for x in laws]),
+            )
+            for law in present
+        ]
         self._needs_acc = any(LAWS[law].needs_acceleration for law in present)
         below = np.array([law is not None and LAWS[law].stiff_below for law in laws])
         self._below = below if below.any() and not below.all() else bool(below.all())
         self._c_min, self._c_max = c_min, c_max
         self._switchable = c_max > c_min
-        self._fixed = not self._switchable.all()     # some corner has C_min = C_max
+        self._fixed = not self._switchable.all()  # some corner has C_min = C_max
         self._range = np.where(self._switchable, c_max - c_min, 1.0)
-        self._parameters = parameters                    # name -> (P, 1, N)
+        self._parameters = parameters  # name -> (P, 1, N)
         # one product gives the travel rates, the body's velocities at the corners and the
         # wheels' velocities: rows [J; J_body; wheels] of the vehicle velocities
         J = model.travel_map
         body = np.zeros_like(J)
-        body[:, :, :model.n_body] = J[:, :, :model.n_body]
+        body[:, :, : model.n_body] = J[:, :, : model.n_body]
         wheels = np.zeros((1,) + J.shape[1:])
         wheels[0, np.arange(N), model.wheels.start + np.arange(N)] = 1.0
-        self._rates = _rows_map(np.concatenate([J, body, np.broadcast_to(wheels, J.shape)],
-                                               axis=1))
+        self._rates = _rows_map(np.concatenate([J, body, np.broadcast_to(wheels, J.shape)], axis=1))
         self._body = _rows_map(body)
-        self.samples = 0               # samples taken: the records change only with them
+        self.samples = 0  # samples taken: the records change only with them
         self._every = sample_every
-        self._decay = np.exp(-dt / np.where(actuator_lag > 0, actuator_lag, 1.0)) \
-            * (actuator_lag > 0)
+        self._decay = np.exp(-dt / np.where(actuator_lag > 0, actuator_lag, 1.0)) * (
+            actuator_lag > 0
+        )
         self._lagged = bool(np.any(actuator_lag > 0))
         self._threshold = threshold
         self._adaptive = c_max_share is not None
@@ -111,16 +131,22 @@ class SemiActiveController:
             self._level = np.where(below[None, None, :], share, 1.0 - share)[:, 0, :]
             self._period = refit_factor * learn_time
             self._next_fit = learn_time.astype(float).copy()
-            self._next_due = float(np.min(self._next_fit))     # the earliest of them
+            self._next_due = float(np.min(self._next_fit))  # the earliest of them
             self._history = np.empty((n_steps // sample_every + 1,) + threshold.shape[::2])
             self._n_history = 0
             self._distribution = distribution
-            self._t_summary = StudentTSummary(self._history[0].size) \
-                if distribution == "student_t" else None
+            self._t_summary = (
+                StudentTSummary(self._history[0].size) if distribution == "student_t" else None
+            )
             self._half_step = 0.5 * dt
         units = {LAWS[law].unit for law in present}
-        unit = units.pop() if len(units) == 1 else "; ".join(
-            f"{c}: {LAWS[law].unit}" for c, law in zip(model.corners, laws) if law is not None)
+        unit = (
+            units.pop()
+            if len(units) == 1
+            else "; ".join(
+                f"{c}: {LAWS[law].unit}" for c, law in zip(model.corners, laws) if law is not None
+            )
+        )
         self.units = {"damper_state": "1", "control_condition": unit, "control_threshold": unit}
         self._N = N
 
@@ -151,15 +177,19 @@ class SemiActiveController:
     def _sample(self, t: float, state) -> None:
         N = self._N
         rates = _by_rows(self._rates, state.velocity())
-        travel_vel, body_vel, wheel_vel = (rates[..., :N], rates[..., N:2 * N],
-                                           rates[..., 2 * N:])
+        travel_vel, body_vel, wheel_vel = (
+            rates[..., :N],
+            rates[..., N : 2 * N],
+            rates[..., 2 * N :],
+        )
         body_acc = _by_rows(self._body, state.acceleration()) if self._needs_acc else None
         motion = Motion(travel_vel, body_vel, wheel_vel, body_acc, self._parameters)
         condition = None
         for law, mask in self._groups:
             x = LAWS[law].condition(motion)
-            condition = x if mask is None else np.where(mask, x, 0.0 if condition is None
-                                                        else condition)
+            condition = (
+                x if mask is None else np.where(mask, x, 0.0 if condition is None else condition)
+            )
         if self._adaptive:
             self._refit(t, condition)
         if self._below is True:
@@ -167,8 +197,7 @@ class SemiActiveController:
         elif self._below is False:
             stiff = condition > self._threshold
         else:
-            stiff = np.where(self._below, condition < self._threshold,
-                             condition > self._threshold)
+            stiff = np.where(self._below, condition < self._threshold, condition > self._threshold)
         c_stiff = self._c_max
         for law, mask in self._groups:
             if LAWS[law].continuous:
@@ -187,14 +216,18 @@ class SemiActiveController:
             return
         due = t + self._half_step >= self._next_fit
         idx = np.flatnonzero(due)
-        history = self._history[:self._n_history]
-        if self._t_summary is not None:              # bounded: from the summary, see its class
+        history = self._history[: self._n_history]
+        if self._t_summary is not None:  # bounded: from the summary, see its class
             n, corners = history.shape[0], history.shape[-1]
-            columns = slice(None) if idx.size == due.size else \
-                (idx[:, None] * corners + np.arange(corners)).ravel()
+            columns = (
+                slice(None)
+                if idx.size == due.size
+                else (idx[:, None] * corners + np.arange(corners)).ravel()
+            )
             fit = self._t_summary.fit(history.reshape(n, -1), columns)
-            threshold = t_quantile(tuple(a.reshape(idx.size, corners) for a in fit),
-                                    self._level[idx])
+            threshold = t_quantile(
+                tuple(a.reshape(idx.size, corners) for a in fit), self._level[idx]
+            )
         else:
             if idx.size < due.size:
                 history = history[:, idx]
@@ -210,9 +243,12 @@ class SemiActiveController:
         the records: the command [N s/m], the condition and the threshold in force, and where
         some corner has ``C_min = C_max``, whether the law asked for the stiff state. Arrays
         the controller never writes again."""
-        out = {"command": self._cmd[:, 0], "condition": self._condition[:, 0],
-               "threshold": self._threshold[:, 0]}
-        if self._fixed:                          # only where C_min = C_max does it tell more
+        out = {
+            "command": self._cmd[:, 0],
+            "condition": self._condition[:, 0],
+            "threshold": self._threshold[:, 0],
+        }
+        if self._fixed:  # only where C_min = C_max does it tell more
             out["stiff"] = self._stiff[:, 0]
         return out
 
@@ -222,22 +258,26 @@ class SemiActiveController:
         1 stiff, fractional for the continuous laws; where ``C_min = C_max``, whether the law
         asked for the stiff state), condition and threshold; NaN at passive corners.
         Computed once for the whole run, when a record is first read."""
-        switchable, c_min, span = (a[:, 0] for a in (self._switchable, self._c_min,
-                                                      self._range))
+        switchable, c_min, span = (a[:, 0] for a in (self._switchable, self._c_min, self._range))
         state = raw["command"] - c_min
         state /= span
         if self._fixed:
             state = np.where(switchable, state, raw["stiff"])
-        records = {"damper_state": state, "control_condition": raw["condition"],
-                   "control_threshold": raw["threshold"]}
+        records = {
+            "damper_state": state,
+            "control_condition": raw["condition"],
+            "control_threshold": raw["threshold"],
+        }
         if self._passive.any():
-            records = {name: np.where(self._passive, np.nan, value)
-                       for name, value in records.items()}
+            records = {
+                name: np.where(self._passive, np.nan, value) for name, value in records.items()
+            }
         return records
 
 
-def build_controller(cfg: Config, pv: ParamView, model: VehicleModel
-                     ) -> SemiActiveController | None:
+def build_controller(
+    cfg: Config, pv: ParamView, model: VehicleModel
+) -> SemiActiveController | None:
     """The controller of ``cfg``'s semi-active dampers for the designs of ``pv``; None when
     every damper is passive. Law parameters, lag and threshold settings may vary per design
     (dotted paths in ``pv``); the sample time is one per run."""
@@ -248,15 +288,21 @@ def build_controller(cfg: Config, pv: ParamView, model: VehicleModel
     sim = cfg.simulation
     ratio = control.sample_time / sim.dt
     if ratio < 1 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
-        raise cfg.error(("control", "sample_time"), f"the controller's sample time "
-                        f"{control.sample_time:g} s must be a whole multiple of simulation.dt "
-                        f"({sim.dt:g} s)")
+        raise cfg.error(
+            ("control", "sample_time"),
+            f"the controller's sample time "
+            f"{control.sample_time:g} s must be a whole multiple of simulation.dt "
+            f"({sim.dt:g} s)",
+        )
     if pv.varies("control.sample_time"):
-        raise ConfigError("params: control.sample_time cannot vary between designs: the "
-                          "controller samples once per run")
+        raise ConfigError(
+            "params: control.sample_time cannot vary between designs: the "
+            "controller samples once per run"
+        )
 
-    def setting(path: str, default: float, low: float, high: float | None = None,
-                low_open: bool = False) -> np.ndarray:
+    def setting(
+        path: str, default: float, low: float, high: float | None = None, low_open: bool = False
+    ) -> np.ndarray:
         if cfg.control is None:
             return np.full(pv.P, default)
         return _per_design(pv, path, low, high, low_open)
@@ -264,8 +310,13 @@ def build_controller(cfg: Config, pv: ParamView, model: VehicleModel
     def corner(name: str, damper, parameter) -> np.ndarray:
         if damper.kind == "passive" or parameter.name not in LAWS[damper.law].parameters:
             return np.full(pv.P, parameter.default)
-        return _per_design(pv, f"vehicle.corners.{name}.damper.{parameter.name}",
-                           parameter.low, parameter.high, parameter.low_open)
+        return _per_design(
+            pv,
+            f"vehicle.corners.{name}.damper.{parameter.name}",
+            parameter.low,
+            parameter.high,
+            parameter.low_open,
+        )
 
     laws, c_min, c_max = [], [], []
     parameters: dict[str, list[np.ndarray]] = {name: [] for name in PARAMETERS}
@@ -280,8 +331,10 @@ def build_controller(cfg: Config, pv: ParamView, model: VehicleModel
             lo = _per_design(pv, f"vehicle.corners.{name}.damper.c_min", 0.0)
             hi = _per_design(pv, f"vehicle.corners.{name}.damper.c_max", 0.0)
             if np.any(hi < lo):
-                raise ConfigError(f"params: vehicle.corners.{name}.damper.c_max: must be at "
-                                  f"least c_min (designs {np.flatnonzero(hi < lo)[:5].tolist()})")
+                raise ConfigError(
+                    f"params: vehicle.corners.{name}.damper.c_max: must be at "
+                    f"least c_min (designs {np.flatnonzero(hi < lo)[:5].tolist()})"
+                )
             c_min.append(lo)
             c_max.append(hi)
         for parameter in PARAMETERS.values():
@@ -297,9 +350,12 @@ def build_controller(cfg: Config, pv: ParamView, model: VehicleModel
     if spec is not None and spec.mode == "fixed":
         units = {LAWS[law].unit for law in laws if law is not None}
         if len(units) > 1:
-            raise cfg.error(("control", "threshold", "value"), "one fixed threshold cannot serve "
-                            f"conditions of different units ({', '.join(sorted(units))}); "
-                            "give the corners laws of one unit or use mode adaptive")
+            raise cfg.error(
+                ("control", "threshold", "value"),
+                "one fixed threshold cannot serve "
+                f"conditions of different units ({', '.join(sorted(units))}); "
+                "give the corners laws of one unit or use mode adaptive",
+            )
         threshold = threshold + pv.get("control.threshold.value")[:, None, None]
     elif spec is not None:
         base = "control.threshold."
@@ -307,10 +363,20 @@ def build_controller(cfg: Config, pv: ParamView, model: VehicleModel
             c_max_share=_per_design(pv, base + "c_max_share", 0.0, None, True),
             learn_time=_per_design(pv, base + "learn_time", 0.0, low_open=True),
             refit_factor=_per_design(pv, base + "refit_factor", 0.0, low_open=True),
-            distribution=spec.distribution)
+            distribution=spec.distribution,
+        )
         if np.any(settings["c_max_share"] >= 1):
             raise ConfigError(f"params: {base}c_max_share: must be in (0, 1)")
     return SemiActiveController(
-        model, laws, stack(c_min), stack(c_max),
+        model,
+        laws,
+        stack(c_min),
+        stack(c_max),
         {name: stack(values) for name, values in parameters.items()},
-        sim.dt, int(round(ratio)), sim.n_steps, lag, threshold, **settings)
+        sim.dt,
+        int(round(ratio)),
+        sim.n_steps,
+        lag,
+        threshold,
+        **settings,
+    )

@@ -64,8 +64,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Parameter", "Motion", "Law", "PARAMETERS", "LAWS", "law_condition",
-           "stiff_coefficient"]
+__all__ = ["Parameter", "Motion", "Law", "PARAMETERS", "LAWS", "law_condition", "stiff_coefficient"]
 
 
 @dataclass(frozen=True)
@@ -119,22 +118,50 @@ class Law:
         return self.stiff is not None
 
 
-PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
-    Parameter("linear_weight", 0.0, 1.0, False, "-", 1.0,
-              "SH-L tuning parameter alpha of Eq 2.35 in [0, 1] [-]; 1 gives SH-2"),
-    Parameter("crossover_frequency", 1e-3, 1e5, False, "rad/s", 1.0,
-              "frequency-range selector alpha of Eq 2.37-2.39 [rad/s] (the thesis uses 39 "
-              "rad/s, about 6 Hz)"),
-    Parameter("skyhook_weight", 0.0, 1.0, False, "-", 1.0,
-              "share beta of the skyhook term in the hybrid law in [0, 1] [-]; 1 is pure "
-              "skyhook, 0 pure groundhook"),
-)}
+PARAMETERS: dict[str, Parameter] = {
+    p.name: p
+    for p in (
+        Parameter(
+            "linear_weight",
+            0.0,
+            1.0,
+            False,
+            "-",
+            1.0,
+            "SH-L tuning parameter alpha of Eq 2.35 in [0, 1] [-]; 1 gives SH-2",
+        ),
+        Parameter(
+            "crossover_frequency",
+            1e-3,
+            1e5,
+            False,
+            "rad/s",
+            1.0,
+            "frequency-range selector alpha of Eq 2.37-2.39 [rad/s] (the thesis uses 39 "
+            "rad/s, about 6 Hz)",
+        ),
+        Parameter(
+            "skyhook_weight",
+            0.0,
+            1.0,
+            False,
+            "-",
+            1.0,
+            "share beta of the skyhook term in the hybrid law in [0, 1] [-]; 1 is pure "
+            "skyhook, 0 pure groundhook",
+        ),
+    )
+}
 
 
 def _ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
     """``numerator / denominator``, 0 where the denominator is 0."""
-    return np.divide(numerator, denominator, out=np.zeros(np.broadcast_shapes(
-        numerator.shape, denominator.shape)), where=denominator != 0)
+    return np.divide(
+        numerator,
+        denominator,
+        out=np.zeros(np.broadcast_shapes(numerator.shape, denominator.shape)),
+        where=denominator != 0,
+    )
 
 
 def _selector(m: Motion) -> np.ndarray:
@@ -149,8 +176,11 @@ def _skyhook(m: Motion) -> np.ndarray:
 
 def _sh_add_1(m: Motion) -> np.ndarray:
     low = _selector(m) <= 0
-    return np.where(low, m.travel_vel * m.body_vel,
-                    m.travel_vel * m.body_acc / m.parameters["crossover_frequency"])
+    return np.where(
+        low,
+        m.travel_vel * m.body_vel,
+        m.travel_vel * m.body_acc / m.parameters["crossover_frequency"],
+    )
 
 
 def _hybrid(m: Motion) -> np.ndarray:
@@ -173,32 +203,77 @@ def _hybrid_coefficient(c_min, c_max, m: Motion, condition) -> np.ndarray:
     return np.clip(c_max * _ratio(condition, m.travel_vel * m.travel_vel), c_min, c_max)
 
 
-LAWS: dict[str, Law] = {law.name: law for law in (
-    Law("sh_2", _skyhook, "m^2/s^2", "Eq 2.34"),
-    Law("sh_l", _skyhook, "m^2/s^2", "Eq 2.35", parameters=("linear_weight",),
-        stiff=_sh_l_coefficient),
-    Law("add", lambda m: m.travel_vel * m.body_acc, "m^2/s^3", "Eq 2.36",
-        needs_acceleration=True),
-    Law("sh_add_1", _sh_add_1, "m^2/s^2", "Eq 2.37", needs_acceleration=True,
-        parameters=("crossover_frequency",)),
-    Law("sh_add_2", _selector, "m^2/s^4", "Eq 2.39", stiff_below=True,
-        needs_acceleration=True, parameters=("crossover_frequency",)),
-    Law("groundhook", lambda m: -(m.travel_vel * m.wheel_vel), "m^2/s^2", "Sec 4.4"),
-    Law("hybrid", _hybrid, "m^2/s^2", "Sec 4.4", parameters=("skyhook_weight",),
-        stiff=_hybrid_coefficient),
-)}
+LAWS: dict[str, Law] = {
+    law.name: law
+    for law in (
+        Law("sh_2", _skyhook, "m^2/s^2", "Eq 2.34"),
+        Law(
+            "sh_l",
+            _skyhook,
+            "m^2/s^2",
+            "Eq 2.35",
+            parameters=("linear_weight",),
+            stiff=_sh_l_coefficient,
+        ),
+        Law(
+            "add",
+            lambda m: m.travel_vel * m.body_acc,
+            "m^2/s^3",
+            "Eq 2.36",
+            needs_acceleration=True,
+        ),
+        Law(
+            "sh_add_1",
+            _sh_add_1,
+            "m^2/s^2",
+            "Eq 2.37",
+            needs_acceleration=True,
+            parameters=("crossover_frequency",),
+        ),
+        Law(
+            "sh_add_2",
+            _selector,
+            "m^2/s^4",
+            "Eq 2.39",
+            stiff_below=True,
+            needs_acceleration=True,
+            parameters=("crossover_frequency",),
+        ),
+        Law("groundhook", lambda m: -(m.travel_vel * m.wheel_vel), "m^2/s^2", "Sec 4.4"),
+        Law(
+            "hybrid",
+            _hybrid,
+            "m^2/s^2",
+            "Sec 4.4",
+            parameters=("skyhook_weight",),
+            stiff=_hybrid_coefficient,
+        ),
+    )
+}
 
 
 def _motion(travel_vel, body_vel, wheel_vel, body_acc, **parameters) -> Motion:
-    values = {name: np.asarray(parameters.get(name, p.default), dtype=float)
-              for name, p in PARAMETERS.items()}
-    return Motion(np.asarray(travel_vel), np.asarray(body_vel), np.asarray(wheel_vel),
-                  None if body_acc is None else np.asarray(body_acc), values)
+    values = {
+        name: np.asarray(parameters.get(name, p.default), dtype=float)
+        for name, p in PARAMETERS.items()
+    }
+    return Motion(
+        np.asarray(travel_vel),
+        np.asarray(body_vel),
+        np.asarray(wheel_vel),
+        None if body_acc is None else np.asarray(body_acc),
+        values,
+    )
 
 
-def law_condition(law: str, travel_vel: np.ndarray, body_vel: np.ndarray,
-                  wheel_vel: np.ndarray, body_acc: np.ndarray | None = None,
-                  **parameters) -> np.ndarray:
+def law_condition(
+    law: str,
+    travel_vel: np.ndarray,
+    body_vel: np.ndarray,
+    wheel_vel: np.ndarray,
+    body_acc: np.ndarray | None = None,
+    **parameters,
+) -> np.ndarray:
     """Operational condition ``X`` of ``law`` (table of the module docstring), in
     ``LAWS[law].unit``.
 
@@ -209,16 +284,17 @@ def law_condition(law: str, travel_vel: np.ndarray, body_vel: np.ndarray,
     """
     if law not in LAWS:
         raise ValueError(f"unknown control law {law!r}; known: {', '.join(LAWS)}")
-    return LAWS[law].condition(_motion(travel_vel, body_vel, wheel_vel, body_acc,
-                                       **parameters))
+    return LAWS[law].condition(_motion(travel_vel, body_vel, wheel_vel, body_acc, **parameters))
 
 
-def stiff_coefficient(law: str, c_min, c_max, travel_vel, body_vel, condition,
-                      **parameters) -> np.ndarray:
+def stiff_coefficient(
+    law: str, c_min, c_max, travel_vel, body_vel, condition, **parameters
+) -> np.ndarray:
     """Coefficient [N s/m] of ``law`` in its stiff state: ``C_max`` for the on-off laws, the
     clipped SH-L (Eq 2.35) or hybrid coefficient for the continuous ones."""
     stiff = LAWS[law].stiff
     if stiff is None:
         return c_max
-    return stiff(c_min, c_max, _motion(travel_vel, body_vel, np.zeros(1), None, **parameters),
-                 condition)
+    return stiff(
+        c_min, c_max, _motion(travel_vel, body_vel, np.zeros(1), None, **parameters), condition
+    )

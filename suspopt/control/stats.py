@@ -16,8 +16,13 @@ import numpy as np
 
 from .laws import LAWS
 
-__all__ = ["fit_student_t", "distribution_quantile", "threshold_for_share", "StudentTSummary",
-           "t_quantile"]
+__all__ = [
+    "fit_student_t",
+    "distribution_quantile",
+    "threshold_for_share",
+    "StudentTSummary",
+    "t_quantile",
+]
 
 #: Student-t fit: cap on the log-likelihood evaluations, and the size of the last Newton step
 #: (μ in units of s, log s and log ν) at which it stops: the error left is about its square.
@@ -34,11 +39,11 @@ def _robust_location_scale(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     transposed copy, along its contiguous axis (np.median along axis 0 is several times
     slower)."""
     shape, flat = x.shape[1:], x.reshape(x.shape[0], -1)
-    columns = np.array(flat.T, order="C")            # a copy, partitioned in place
+    columns = np.array(flat.T, order="C")  # a copy, partitioned in place
     k = (x.shape[0] - 1) // 2
     columns.partition(k, axis=1)
     middle = columns[:, k].copy()
-    columns -= middle[:, None]                       # the same values, in another order
+    columns -= middle[:, None]  # the same values, in another order
     np.abs(columns, out=columns)
     columns.partition(k, axis=1)
     scale = 1.4826 * columns[:, k]
@@ -58,7 +63,7 @@ def _t_derivatives(x: np.ndarray, weights: np.ndarray | None, total, loc, scale,
     With ``d = (x - μ)/s`` and the E-step weight ``w = (ν + 1)/(ν + d²)`` everything follows
     from five sums, ``Σw, Σw², Σwd, Σw²d`` and ``L = Σ log(1 + d²/ν)``, because
     ``w d² = ν + 1 - ν w``."""
-    from scipy.special import digamma, gammaln     # (loaded by the fits that use them)
+    from scipy.special import digamma, gammaln  # (loaded by the fits that use them)
 
     def wsum(a: np.ndarray) -> np.ndarray:
         return np.sum(a, axis=0) if weights is None else np.einsum("ij,ij->j", weights, a)
@@ -66,9 +71,9 @@ def _t_derivatives(x: np.ndarray, weights: np.ndarray | None, total, loc, scale,
     r = x - loc
     s2 = scale * scale
     den = r * r
-    den += df * s2                                   # s² (ν + d²)
+    den += df * s2  # s² (ν + d²)
     w = np.divide((df + 1.0) * s2, den)
-    wr = w * r                                       # w d s
+    wr = w * r  # w d s
     s_w, s_wd = wsum(w), wsum(wr) / scale
     wr *= w
     s_wwd = wsum(wr) / scale
@@ -76,25 +81,35 @@ def _t_derivatives(x: np.ndarray, weights: np.ndarray | None, total, loc, scale,
     s_ww = wsum(w)
     log_terms = wsum(np.log(den, out=den)) - total * np.log(df * s2)
     nu, nu1 = df, df + 1.0
-    s_wd2 = total * nu1 - nu * s_w                   # Σ w d²
-    s_w2d2 = nu1 * s_w - nu * s_ww                   # Σ w² d²
-    s_w2d3 = nu1 * s_wd - nu * s_wwd                 # Σ w² d³
+    s_wd2 = total * nu1 - nu * s_w  # Σ w d²
+    s_w2d2 = nu1 * s_w - nu * s_ww  # Σ w² d²
+    s_w2d3 = nu1 * s_wd - nu * s_wwd  # Σ w² d³
     s_w2d4 = total * nu1 * nu1 - 2.0 * nu * nu1 * s_w + nu * nu * s_ww
     half, half1 = 0.5 * nu, 0.5 * nu1
-    loglik = total * (gammaln(half1) - gammaln(half) - 0.5 * np.log(nu) - np.log(scale)) \
+    loglik = (
+        total * (gammaln(half1) - gammaln(half) - 0.5 * np.log(nu) - np.log(scale))
         - half1 * log_terms
-    d_nu = total * 0.5 * (digamma(half1) - digamma(half) - 1.0 / nu) - 0.5 * log_terms \
+    )
+    d_nu = (
+        total * 0.5 * (digamma(half1) - digamma(half) - 1.0 / nu)
+        - 0.5 * log_terms
         + 0.5 * s_wd2 / nu
-    trigamma = 0.25 * _trigamma_step(half)                            # ∂²/∂ν² of log Γ terms
-    d2_nu = total * (trigamma + 0.5 / (nu * nu)) \
-        + 0.5 * (2.0 * s_wd2 - s_w2d2) / (nu * nu1) - 0.5 * s_wd2 / (nu * nu)
+    )
+    trigamma = 0.25 * _trigamma_step(half)  # ∂²/∂ν² of log Γ terms
+    d2_nu = (
+        total * (trigamma + 0.5 / (nu * nu))
+        + 0.5 * (2.0 * s_wd2 - s_w2d2) / (nu * nu1)
+        - 0.5 * s_wd2 / (nu * nu)
+    )
     grad = (s_wd, s_wd2 - total, nu * d_nu)
-    hess = (2.0 * s_w2d2 / nu1 - s_w,                # μ μ
-            2.0 * s_w2d3 / nu1 - 2.0 * s_wd,         # log s, μ
-            nu * (s_wd - s_wwd) / nu1,               # log ν, μ
-            2.0 * s_w2d4 / nu1 - 2.0 * s_wd2,        # log s, log s
-            nu * (s_wd2 - s_w2d2) / nu1,             # log ν, log s
-            nu * nu * d2_nu + nu * d_nu)             # log ν, log ν
+    hess = (
+        2.0 * s_w2d2 / nu1 - s_w,  # μ μ
+        2.0 * s_w2d3 / nu1 - 2.0 * s_wd,  # log s, μ
+        nu * (s_wd - s_wwd) / nu1,  # log ν, μ
+        2.0 * s_w2d4 / nu1 - 2.0 * s_wd2,  # log s, log s
+        nu * (s_wd2 - s_w2d2) / nu1,  # log ν, log s
+        nu * nu * d2_nu + nu * d_nu,
+    )  # log ν, log ν
     return loglik, grad, hess, trigamma
 
 
@@ -109,7 +124,7 @@ def _trigamma_step(a: np.ndarray) -> np.ndarray:
     relative error below 1e-11 for ``a >= 0.15`` (ν >= 0.3; tests/test_control.py). Several
     times faster than scipy's Hurwitz zeta for the t fit's hundreds to thousands of columns;
     it enters only the Hessian, so it changes no fit's maximum."""
-    x = np.add.outer((0.5, 0.0), a)                  # rows: a + 1/2, a
+    x = np.add.outer((0.5, 0.0), a)  # rows: a + 1/2, a
     total = np.zeros_like(x)
     for _ in range(6):
         total += 1.0 / (x * x)
@@ -140,8 +155,9 @@ def _solve_symmetric(a: tuple, b: tuple) -> tuple[np.ndarray, np.ndarray]:
     return p, (a11 > 0) & (d2 > 0) & (d3 > 0)
 
 
-def _ascent_step(grad: np.ndarray, hess: tuple, trigamma, total, df
-                 ) -> tuple[np.ndarray, np.ndarray]:
+def _ascent_step(
+    grad: np.ndarray, hess: tuple, trigamma, total, df
+) -> tuple[np.ndarray, np.ndarray]:
     """Step in ``(μ/s, log s, log ν)``: Newton's where the Hessian is negative definite, else
     Fisher scoring's (the t's expected information, positive definite), so always uphill;
     shortened to at most 1 in every coordinate. ``ν`` at a bound of ``_NU_RANGE`` with the
@@ -150,18 +166,26 @@ def _ascent_step(grad: np.ndarray, hess: tuple, trigamma, total, df
     free = ~out
     grad = (grad[0], grad[1], np.where(out, 0.0, grad[2]))
     h11, h21, h31, h22, h32, h33 = hess
-    newton, concave = _solve_symmetric((-h11, -h21, -h31 * free, -h22, -h32 * free,
-                                        np.where(out, 1.0, -h33)), grad)
+    newton, concave = _solve_symmetric(
+        (-h11, -h21, -h31 * free, -h22, -h32 * free, np.where(out, 1.0, -h33)), grad
+    )
     if concave.all():
         step = newton
     else:
         nu, nu1, nu3 = df, df + 1.0, df + 3.0
-        info_nu = -trigamma - (nu + 5.0) / (2.0 * nu * nu1 * nu3)     # per sample, in ν
+        info_nu = -trigamma - (nu + 5.0) / (2.0 * nu * nu1 * nu3)  # per sample, in ν
         zero = np.zeros_like(nu)
         fisher, _ = _solve_symmetric(
-            (total * nu1 / nu3, zero, zero, total * 2.0 * nu / nu3,
-             -total * free * 2.0 * nu / (nu1 * nu3),
-             np.where(out, 1.0, total * nu * nu * info_nu)), grad)
+            (
+                total * nu1 / nu3,
+                zero,
+                zero,
+                total * 2.0 * nu / nu3,
+                -total * free * 2.0 * nu / (nu1 * nu3),
+                np.where(out, 1.0, total * nu * nu * info_nu),
+            ),
+            grad,
+        )
         step = np.where(concave, newton, fisher)
     step /= np.maximum(1.0, _largest(step))
     return step, concave
@@ -174,12 +198,22 @@ def _largest(step: np.ndarray) -> np.ndarray:
 
 def _moved(loc, scale, df, step):
     """Parameters after ``step`` (see :func:`_ascent_step`)."""
-    return (loc + step[0] * scale, scale * np.exp(step[1]),
-            np.clip(df * np.exp(step[2]), *_NU_RANGE))
+    return (
+        loc + step[0] * scale,
+        scale * np.exp(step[1]),
+        np.clip(df * np.exp(step[2]), *_NU_RANGE),
+    )
 
 
-def _fit_t(x: np.ndarray, weights: np.ndarray | None, loc, scale, df, active,
-           tolerance: float = _T_TOLERANCE):
+def _fit_t(
+    x: np.ndarray,
+    weights: np.ndarray | None,
+    loc,
+    scale,
+    df,
+    active,
+    tolerance: float = _T_TOLERANCE,
+):
     """Maximum-likelihood ``(μ, s, ν)`` of a location-scale t over ``x`` (samples along axis 0,
     with multiplicities ``weights`` or None), from ``(loc, scale, df)``, for the columns
     ``active`` (the others are returned as given). Newton's method with a backtracking line
@@ -188,15 +222,14 @@ def _fit_t(x: np.ndarray, weights: np.ndarray | None, loc, scale, df, active,
     loc, scale, df = (np.array(a, dtype=float) for a in (loc, scale, df))
     x = x.reshape(x.shape[0], -1)
     weights = None if weights is None else weights.reshape(x.shape)
-    work = np.flatnonzero(active)                # the columns still iterating
+    work = np.flatnonzero(active)  # the columns still iterating
     if work.size == 0:
         return loc, scale, df
     if work.size < x.shape[1]:
         x, weights = x[:, work], None if weights is None else weights[:, work]
-    total = np.full(x.shape[1], float(x.shape[0])) if weights is None else \
-        np.sum(weights, axis=0)
+    total = np.full(x.shape[1], float(x.shape[0])) if weights is None else np.sum(weights, axis=0)
     params = tuple(a.reshape(-1)[work] for a in (loc, scale, df))
-    loglik = step = None                         # at params, and the step from there
+    loglik = step = None  # at params, and the step from there
 
     def finish(which: np.ndarray, values: tuple) -> None:
         for whole, value in zip((loc, scale, df), values):
@@ -206,7 +239,7 @@ def _fit_t(x: np.ndarray, weights: np.ndarray | None, loc, scale, df, active,
         for _ in range(_T_MAX_EVALUATIONS):
             trial = params if step is None else _moved(*params, step)
             new_loglik, grad, hess, trigamma = _t_derivatives(x, weights, total, *trial)
-            better = None                        # the trial point is accepted if not lower
+            better = None  # the trial point is accepted if not lower
             if step is not None:
                 better = new_loglik >= loglik - 1e-12 * np.abs(loglik)
                 if better.all():
@@ -216,7 +249,7 @@ def _fit_t(x: np.ndarray, weights: np.ndarray | None, loc, scale, df, active,
                     new_loglik = np.where(better, new_loglik, loglik)
             params, loglik = trial, new_loglik
             new_step, newton = _ascent_step(grad, hess, trigamma, total, params[2])
-            if better is not None:               # rejected: a quarter of the last step
+            if better is not None:  # rejected: a quarter of the last step
                 new_step = np.where(better, new_step, 0.25 * step)
                 newton &= better
             step = new_step
@@ -236,9 +269,11 @@ def _fit_t(x: np.ndarray, weights: np.ndarray | None, loc, scale, df, active,
     return loc, scale, df
 
 
-def fit_student_t(samples: np.ndarray, axis: int = 0,
-                  start: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def fit_student_t(
+    samples: np.ndarray,
+    axis: int = 0,
+    start: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Maximum-likelihood location ``μ``, scale ``s`` and degrees of freedom ``ν`` of a
     location-scale Student-t fitted along ``axis``, vectorised over the other axes.
 
@@ -273,8 +308,11 @@ def fit_student_t(samples: np.ndarray, axis: int = 0,
         df = np.where(cold, 5.0, df)
     df = np.clip(df, *_NU_RANGE)
     loc, scale, df = _fit_t(x, None, loc, np.where(flat, 1.0, scale), df, ~flat)
-    return (np.where(finite, loc, np.nan), np.where(finite, np.where(flat, 0.0, scale), np.nan),
-            np.where(finite, df, np.nan))
+    return (
+        np.where(finite, loc, np.nan),
+        np.where(finite, np.where(flat, 0.0, scale), np.nan),
+        np.where(finite, df, np.nan),
+    )
 
 
 def t_quantile(fit: tuple[np.ndarray, np.ndarray, np.ndarray], level) -> np.ndarray:
@@ -296,8 +334,9 @@ def _empirical_quantile(x: np.ndarray, level: np.ndarray) -> np.ndarray:
     return a + (b - a) * (position - lo)
 
 
-def distribution_quantile(samples: np.ndarray, level: np.ndarray | float,
-                          distribution: str, axis: int = 0) -> np.ndarray:
+def distribution_quantile(
+    samples: np.ndarray, level: np.ndarray | float, distribution: str, axis: int = 0
+) -> np.ndarray:
     """Quantile at ``level`` (0-1, broadcast over the non-fitted axes) of the distribution
     fitted to ``samples`` along ``axis``: ``student_t`` (:func:`fit_student_t`, then
     ``μ + s t_ν⁻¹(level)``), ``normal`` (``μ + σ Φ⁻¹(level)`` with the sample mean and standard
@@ -314,12 +353,16 @@ def distribution_quantile(samples: np.ndarray, level: np.ndarray | float,
         return np.mean(x, axis=0) + np.std(x, axis=0) * ndtri(level)
     if distribution == "student_t":
         return t_quantile(fit_student_t(x, axis=0), level)
-    raise ValueError(f"unknown distribution {distribution!r}; use student_t, normal or "
-                     "empirical")
+    raise ValueError(f"unknown distribution {distribution!r}; use student_t, normal or empirical")
 
 
-def threshold_for_share(condition: np.ndarray, c_max_share: np.ndarray | float, law: str,
-                        distribution: str = "student_t", axis: int = -1) -> np.ndarray:
+def threshold_for_share(
+    condition: np.ndarray,
+    c_max_share: np.ndarray | float,
+    law: str,
+    distribution: str = "student_t",
+    axis: int = -1,
+) -> np.ndarray:
     """Threshold ``T`` that leaves the share ``c_max_share`` of the samples at ``C_max``
     (Eq 4.5-4.7 as mended: the quantile of the distribution fitted to ``condition``; slip:
     docs/thesis-slips.md#eq-47).
@@ -386,18 +429,19 @@ class StudentTSummary:
     """
 
     def __init__(self, columns: int):
-        self._moments = np.zeros((3, _SUMMARY_BINS, columns))    # count, Σ o, Σ o² per bin
-        self._centre = np.zeros(columns)                         # m0
-        self._spread = np.ones(columns)                          # s0
+        self._moments = np.zeros((3, _SUMMARY_BINS, columns))  # count, Σ o, Σ o² per bin
+        self._centre = np.zeros(columns)  # m0
+        self._spread = np.ones(columns)  # s0
         self._binned = np.zeros(columns, dtype=bool)
-        self._built_rows = np.zeros(columns, dtype=np.intp)      # rows when (m0, s0) were set
-        self._low = np.full(columns, np.inf)                     # range of the samples
+        self._built_rows = np.zeros(columns, dtype=np.intp)  # rows when (m0, s0) were set
+        self._low = np.full(columns, np.inf)  # range of the samples
         self._high = np.full(columns, -np.inf)
-        self._rows = 0                                           # history rows summarised
+        self._rows = 0  # history rows summarised
         self._fit = tuple(np.full(columns, np.nan) for _ in range(3))
 
-    def fit(self, history: np.ndarray, columns: np.ndarray | slice = slice(None)
-            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def fit(
+        self, history: np.ndarray, columns: np.ndarray | slice = slice(None)
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(μ, s, ν)`` of ``columns`` (indices or a slice) from all rows of ``history``
         ``(n, columns)``; the summary first takes in the rows it has not seen (of every
         column)."""
@@ -414,15 +458,21 @@ class StudentTSummary:
             self._rebin(history, new, centre, 0.5 * spread)
         fitted = index[varied]
         collapsed = fitted[self._fit[2][fitted] <= _NU_RANGE[0]]
-        if collapsed.size:                       # on an atom last time: start afresh
+        if collapsed.size:  # on an atom last time: start afresh
             middle, lower, upper = self._quantiles(collapsed, (0.5, 0.25, 0.75))
             for stored, start in zip(self._fit, (middle, (upper - lower) / 1.349, 5.0)):
                 stored[collapsed] = start
         self._refit(fitted)
         loc, scale, df = (a[fitted] for a in self._fit)
-        stale = ((scale < self._spread[fitted]) | (scale > 16.0 * self._spread[fitted])
-                 | (np.abs(loc - self._centre[fitted]) > 0.5 * scale)) \
-            & (history.shape[0] >= 2 * self._built_rows[fitted]) & (df > _NU_RANGE[0])
+        stale = (
+            (
+                (scale < self._spread[fitted])
+                | (scale > 16.0 * self._spread[fitted])
+                | (np.abs(loc - self._centre[fitted]) > 0.5 * scale)
+            )
+            & (history.shape[0] >= 2 * self._built_rows[fitted])
+            & (df > _NU_RANGE[0])
+        )
         if stale.any():
             moved = fitted[stale]
             self._rebin(history, moved, loc[stale], 0.5 * scale[stale])
@@ -442,7 +492,7 @@ class StudentTSummary:
     def _take_in(self, history: np.ndarray) -> None:
         """Extend the range of every column and the bins of the binned ones by the rows of
         ``history`` after ``self._rows``."""
-        block = history[self._rows:]
+        block = history[self._rows :]
         if block.shape[0] == 0:
             return
         self._low = np.minimum(self._low, np.min(block, axis=0))
@@ -450,14 +500,16 @@ class StudentTSummary:
         binned = np.flatnonzero(self._binned)
         if binned.size:
             which = self._select(binned)
-            finite = bool(np.isfinite(self._low[which]).all()
-                          and np.isfinite(self._high[which]).all())
+            finite = bool(
+                np.isfinite(self._low[which]).all() and np.isfinite(self._high[which]).all()
+            )
             if isinstance(which, slice):
                 self._bin(block, self._centre, self._spread, finite, self._moments)
             else:
                 moments = np.zeros((3, _SUMMARY_BINS, binned.size))
-                self._bin(block[:, which], self._centre[which], self._spread[which], finite,
-                          moments)
+                self._bin(
+                    block[:, which], self._centre[which], self._spread[which], finite, moments
+                )
                 self._moments[:, :, which] += moments
         self._rows = history.shape[0]
 
@@ -467,14 +519,15 @@ class StudentTSummary:
         which = self._select(columns)
         self._centre[which], self._spread[which] = centre, spread
         moments = np.zeros((3, _SUMMARY_BINS, columns.size))
-        self._bin(history[:self._rows, which], centre, spread, True, moments)
+        self._bin(history[: self._rows, which], centre, spread, True, moments)
         self._moments[:, :, which] = moments
         self._binned[which] = True
         self._built_rows[which] = self._rows
 
     @staticmethod
-    def _bin(block: np.ndarray, centre: np.ndarray, spread: np.ndarray, finite: bool,
-             moments: np.ndarray) -> None:
+    def _bin(
+        block: np.ndarray, centre: np.ndarray, spread: np.ndarray, finite: bool, moments: np.ndarray
+    ) -> None:
         """Add the count and first two moments of the offset ``o`` from the bin's centre (in
         bin widths) per bin and column of the samples ``block`` ``(n, columns)`` to
         ``moments`` (3, bins, columns), C-contiguous; ``finite`` says every sample is finite
@@ -486,11 +539,11 @@ class StudentTSummary:
             position[~np.isfinite(position)] = 0.0
         np.arcsinh(position, out=position)
         position += _SUMMARY_RANGE
-        position *= bins / (2.0 * _SUMMARY_RANGE)            # in bin widths from -U
-        key = position.astype(np.intp)                        # = floor where it matters:
-        np.clip(key, 0, bins - 1, out=key)                    # below 0 is the first bin
+        position *= bins / (2.0 * _SUMMARY_RANGE)  # in bin widths from -U
+        key = position.astype(np.intp)  # = floor where it matters:
+        np.clip(key, 0, bins - 1, out=key)  # below 0 is the first bin
         position -= key
-        position -= 0.5                                       # offset from the bin's centre
+        position -= 0.5  # offset from the bin's centre
         key *= columns
         key += np.arange(columns)
         key, offset = key.ravel(), position.ravel()
@@ -526,12 +579,12 @@ class StudentTSummary:
         count, first, second = count[span], first[span], second[span]
         with np.errstate(divide="ignore", invalid="ignore"):
             mean = np.where(count > 0, first / count, 0.0)
-            sd = np.sqrt(np.maximum(np.where(count > 0, second / count, 0.0) - mean * mean,
-                                    0.0))
+            sd = np.sqrt(np.maximum(np.where(count > 0, second / count, 0.0) - mean * mean, 0.0))
         width = 2.0 * _SUMMARY_RANGE / _SUMMARY_BINS
         middle = (np.arange(_SUMMARY_BINS)[span] + 0.5) * width - _SUMMARY_RANGE
-        u = np.concatenate([middle[:, None] + width * (mean - sd),
-                            middle[:, None] + width * (mean + sd)])
+        u = np.concatenate(
+            [middle[:, None] + width * (mean - sd), middle[:, None] + width * (mean + sd)]
+        )
         which = self._select(columns)
         values = self._centre[which] + self._spread[which] * np.sinh(u)
         return values, np.concatenate([count, count]) * 0.5
@@ -543,7 +596,6 @@ class StudentTSummary:
         values, weights = self._points(columns)
         which = self._select(columns)
         start = tuple(a[which] for a in self._fit)
-        fit = _fit_t(values, weights, *start, np.ones(columns.size, dtype=bool),
-                     _SUMMARY_TOLERANCE)
+        fit = _fit_t(values, weights, *start, np.ones(columns.size, dtype=bool), _SUMMARY_TOLERANCE)
         for stored, new in zip(self._fit, fit):
             stored[which] = new

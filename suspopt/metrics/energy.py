@@ -15,8 +15,9 @@ __all__ = [
 ]
 
 
-def mean_dissipated_power(damper_force: np.ndarray, travel_velocity: np.ndarray,
-                          t: np.ndarray) -> np.ndarray:
+def mean_dissipated_power(
+    damper_force: np.ndarray, travel_velocity: np.ndarray, t: np.ndarray
+) -> np.ndarray:
     """DE: mean power dissipated by a damper in W (thesis Eq 2.92, first form).
 
     ``(1/t_f) ∫ F_C · ṠT dt`` with the trapezoidal rule over the time samples ``t`` (s, ``(T,)``)
@@ -30,8 +31,9 @@ def mean_dissipated_power(damper_force: np.ndarray, travel_velocity: np.ndarray,
     return trapezoid(power, t, axis=-1) / (t[-1] - t[0])
 
 
-def mean_dissipated_power_from_damping(damping: np.ndarray | float, travel_velocity: np.ndarray,
-                                       t: np.ndarray) -> np.ndarray:
+def mean_dissipated_power_from_damping(
+    damping: np.ndarray | float, travel_velocity: np.ndarray, t: np.ndarray
+) -> np.ndarray:
     """DE from the damping coefficient, ``(1/t_f) ∫ C·ṠT² dt`` in W (thesis Eq 2.92, 2nd form).
 
     ``damping`` in N·s/m is either the instantaneous coefficient with the shape of
@@ -59,8 +61,9 @@ def damper_switches(state: np.ndarray, tol: float = 0.0) -> np.ndarray:
     return np.count_nonzero(steps > tol, axis=-1)
 
 
-def share_at_max_damping(damping: np.ndarray, c_max: np.ndarray | float,
-                         tol: float = 0.0) -> np.ndarray:
+def share_at_max_damping(
+    damping: np.ndarray, c_max: np.ndarray | float, tol: float = 0.0
+) -> np.ndarray:
     """Fraction (0-1) of the samples at which the damper is at ``C_max`` (thesis Sec 4.2.3).
 
     The thesis's "percentage of the sample operating with C_max" (``1 - N%``) that the CDF

@@ -99,10 +99,12 @@ COMFORT_REACTIONS: tuple[tuple[float, float, str], ...] = (
 """ISO 2631-1 Annex C.2.3 comfort reactions: (lower, upper, wording), a_w in m/s²."""
 
 _ZONE_EDGES = np.unique([edge for band in COMFORT_REACTIONS for edge in band[:2]])[1:-1]
-_ZONE_LABELS = np.array([
-    " / ".join(label for lower, upper, label in COMFORT_REACTIONS if lower <= start < upper)
-    for start in np.concatenate(([0.0], _ZONE_EDGES))
-])
+_ZONE_LABELS = np.array(
+    [
+        " / ".join(label for lower, upper, label in COMFORT_REACTIONS if lower <= start < upper)
+        for start in np.concatenate(([0.0], _ZONE_EDGES))
+    ]
+)
 
 
 def _parameters(weighting: str | None) -> WeightingParameters | None:
@@ -115,7 +117,8 @@ def _parameters(weighting: str | None) -> WeightingParameters | None:
     hint = f" Did you mean {', '.join(close)}?" if close else ""
     raise ValueError(
         f"unknown ISO 2631-1 weighting {weighting!r}; choose one of "
-        f"{', '.join(WEIGHTINGS)} or 'none'.{hint}")
+        f"{', '.join(WEIGHTINGS)} or 'none'.{hint}"
+    )
 
 
 def _second_order(s: np.ndarray, f: float, q: float) -> np.ndarray:
@@ -160,13 +163,19 @@ def weighting_response(f: np.ndarray | float, weighting: str | None) -> np.ndarr
 
 def _slowest_decay_rate(params: WeightingParameters) -> float:
     """Smallest |Re(pole)| (1/s) over the denominators of the Annex A product."""
+
     def rate(f: float, q: float) -> float:
         if math.isinf(f):
             return math.inf
         w = 2.0 * math.pi * f
         return w * (1.0 / (2.0 * q) - math.sqrt(max(0.0, 1.0 / (4.0 * q * q) - 1.0)))
-    return min(rate(params.f1, _Q_BAND), rate(params.f2, _Q_BAND),
-               rate(params.f4, params.q4), rate(params.f6, params.q6))
+
+    return min(
+        rate(params.f1, _Q_BAND),
+        rate(params.f2, _Q_BAND),
+        rate(params.f4, params.q4),
+        rate(params.f6, params.q6),
+    )
 
 
 def _check(a: np.ndarray, fs: float) -> tuple[np.ndarray, float]:
@@ -174,7 +183,9 @@ def _check(a: np.ndarray, fs: float) -> tuple[np.ndarray, float]:
     if a.ndim == 0 or a.shape[-1] == 0:
         raise ValueError("acceleration must have a non-empty time axis (last axis)")
     if not fs >= MIN_SAMPLE_RATE:
-        raise ValueError(f"sampling rate fs = {fs} Hz is below the supported {MIN_SAMPLE_RATE:g} Hz")
+        raise ValueError(
+            f"sampling rate fs = {fs} Hz is below the supported {MIN_SAMPLE_RATE:g} Hz"
+        )
     return a, float(fs)
 
 
@@ -267,8 +278,9 @@ def crest_factor(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
         return np.max(np.abs(aw), axis=-1) / _rms(aw)
 
 
-def ratio_tests(a: np.ndarray, fs: float, weighting: str | None,
-                tau: float = 1.0) -> dict[str, np.ndarray | float]:
+def ratio_tests(
+    a: np.ndarray, fs: float, weighting: str | None, tau: float = 1.0
+) -> dict[str, np.ndarray | float]:
     """Whether the basic r.m.s. evaluation suffices (thesis Eq 2.84-2.85, ISO 2631-1 6.3.3).
 
     Returns ``mtvv_ratio = MTVV/a_w`` and ``vdv_ratio = VDV/(a_w T^¼)`` (dimensionless, ``T``
@@ -288,8 +300,9 @@ def ratio_tests(a: np.ndarray, fs: float, weighting: str | None,
         "vdv_ratio": vdv_ratio,
         "mtvv_limit": MTVV_RATIO_LIMIT,
         "vdv_limit": VDV_RATIO_LIMIT,
-        "basic_method_sufficient": ((mtvv_ratio <= MTVV_RATIO_LIMIT)
-                                    & (vdv_ratio <= VDV_RATIO_LIMIT)),
+        "basic_method_sufficient": (
+            (mtvv_ratio <= MTVV_RATIO_LIMIT) & (vdv_ratio <= VDV_RATIO_LIMIT)
+        ),
     }
 
 

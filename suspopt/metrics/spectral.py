@@ -34,8 +34,9 @@ def psd(x: np.ndarray, fs: float, nperseg: int | None = None) -> tuple[np.ndarra
     return signal.welch(x, fs, nperseg=_segment(x.shape[-1], nperseg), axis=-1)
 
 
-def transfer_function(x: np.ndarray, y: np.ndarray, fs: float,
-                      nperseg: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+def transfer_function(
+    x: np.ndarray, y: np.ndarray, fs: float, nperseg: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """H1 estimate ``H(f) = P_xy / P_xx`` from input ``x`` to output ``y`` (complex).
 
     Unit: unit of ``y`` per unit of ``x``. H1 is unbiased by noise on the output.
@@ -50,18 +51,21 @@ def transfer_function(x: np.ndarray, y: np.ndarray, fs: float,
     return f, p_xy / p_xx
 
 
-def coherence(x: np.ndarray, y: np.ndarray, fs: float,
-              nperseg: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+def coherence(
+    x: np.ndarray, y: np.ndarray, fs: float, nperseg: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Magnitude-squared coherence ``|P_xy|²/(P_xx P_yy)`` between ``x`` and ``y`` (0-1)."""
     x = np.asarray(x, dtype=float)
     from scipy import signal
 
-    return signal.coherence(x, np.asarray(y, dtype=float), fs,
-                            nperseg=_segment(x.shape[-1], nperseg), axis=-1)
+    return signal.coherence(
+        x, np.asarray(y, dtype=float), fs, nperseg=_segment(x.shape[-1], nperseg), axis=-1
+    )
 
 
-def transmissibility(input_acc: np.ndarray, output_acc: np.ndarray, fs: float,
-                     nperseg: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+def transmissibility(
+    input_acc: np.ndarray, output_acc: np.ndarray, fs: float, nperseg: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Acceleration transmissibility ``TR = |z̈_i / z̈_input|`` (thesis Eq 2.86), dimensionless.
 
     Both accelerations in m/s²; estimated as ``|H1|`` (:func:`transfer_function`). Eq 2.86 writes

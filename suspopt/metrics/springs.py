@@ -7,8 +7,9 @@ import numpy as np
 __all__ = ["nonlinear_spring_usage"]
 
 
-def nonlinear_spring_usage(travel: np.ndarray, k_linear: np.ndarray | float,
-                           k_nonlinear: np.ndarray | float) -> np.ndarray:
+def nonlinear_spring_usage(
+    travel: np.ndarray, k_linear: np.ndarray | float, k_nonlinear: np.ndarray | float
+) -> np.ndarray:
     """``Ratio = max_t k_nl x³ / (k_l x + k_nl x³)``, dimensionless (thesis Eq 5.3).
 
     The share of the spring force ``k_l x + k_nl x³`` (Eq 2.31) carried by the cubic term, at its

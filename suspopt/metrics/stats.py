@@ -141,8 +141,9 @@ def dynamic_tyre_load_ratio(tyre_force: np.ndarray, static_load: np.ndarray | fl
     return std(tyre_force) / np.asarray(static_load, dtype=float)
 
 
-def peak_dynamic_tyre_load_ratio(tyre_force: np.ndarray, static_load: np.ndarray | float,
-                                 includes_static: bool = False) -> np.ndarray:
+def peak_dynamic_tyre_load_ratio(
+    tyre_force: np.ndarray, static_load: np.ndarray | float, includes_static: bool = False
+) -> np.ndarray:
     """Largest dynamic tyre force magnitude over the static wheel load, dimensionless.
 
     ``tyre_force`` in N is the dynamic force about static equilibrium (Eq 2.28) unless

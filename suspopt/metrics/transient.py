@@ -66,9 +66,13 @@ def _settling_time(t: np.ndarray, deviation: np.ndarray, half_width: np.ndarray)
     return np.where(outside.any(axis=-1), time, t[0])
 
 
-def transient_metrics(t: np.ndarray, y: np.ndarray, band: float = 0.02,
-                      start: float | None = None,
-                      final_fraction: float = 0.1) -> dict[str, np.ndarray]:
+def transient_metrics(
+    t: np.ndarray,
+    y: np.ndarray,
+    band: float = 0.02,
+    start: float | None = None,
+    final_fraction: float = 0.1,
+) -> dict[str, np.ndarray]:
     """Rise time, peak, peak time, overshoot, steady state and settling time (Sec 2.4.1).
 
     ``t`` in s, ``(T,)``; ``y`` ``(T,)`` or ``(P, T)`` in the response's unit; ``band`` the
@@ -104,8 +108,9 @@ def transient_metrics(t: np.ndarray, y: np.ndarray, band: float = 0.02,
     peak = _take(y, peak_at)
     with np.errstate(invalid="ignore", divide="ignore"):
         overshoot = np.where(returns, np.nan, 100.0 * direction * (peak - steady) / np.abs(change))
-    rise_time = (_first_crossing(t, signed, 0.9 * reference)
-                 - _first_crossing(t, signed, 0.1 * reference))
+    rise_time = _first_crossing(t, signed, 0.9 * reference) - _first_crossing(
+        t, signed, 0.1 * reference
+    )
     peak_time = t[peak_at]
     settling_time = _settling_time(t, y - steady[..., None], band * reference)
     settling_time = np.where(settling_time < t[-final], settling_time, np.nan)

@@ -37,16 +37,29 @@ from dataclasses import dataclass
 
 import numpy as np
 from pymoo.core.problem import Problem as _PymooProblem
-from pymoo.termination.default import (DefaultMultiObjectiveTermination,
-                                       DefaultSingleObjectiveTermination)
-from scipy.optimize import Bounds, minimize as _scipy_minimize
+from pymoo.termination.default import (
+    DefaultMultiObjectiveTermination,
+    DefaultSingleObjectiveTermination,
+)
+from scipy.optimize import Bounds
+from scipy.optimize import minimize as _scipy_minimize
 
 from .problem import PENALTY
 
-__all__ = ["Solutions", "Optimiser", "PymooOptimiser", "Gradient", "Hybrid", "WeightedSum",
-           "balanced_weights", "pymoo_algorithm", "termination", "minimize"]
+__all__ = [
+    "Solutions",
+    "Optimiser",
+    "PymooOptimiser",
+    "Gradient",
+    "Hybrid",
+    "WeightedSum",
+    "balanced_weights",
+    "pymoo_algorithm",
+    "termination",
+    "minimize",
+]
 
-_SLSQP_ITERATION_LIMIT = 9      # scipy's status when maxiter stops SLSQP
+_SLSQP_ITERATION_LIMIT = 9  # scipy's status when maxiter stops SLSQP
 
 
 @dataclass
@@ -166,11 +179,16 @@ class Gradient(Optimiser):
     the pickled cache an exact checkpoint.
     """
 
-    def __init__(self, max_iterations: int | None = None, max_evaluations: int | None = None,
-                 tolerance: float = 1e-6, step: float = 1e-4,
-                 constraint_scale: np.ndarray | None = None,
-                 box: tuple[np.ndarray, np.ndarray] | None = None,
-                 start: np.ndarray | None = None):
+    def __init__(
+        self,
+        max_iterations: int | None = None,
+        max_evaluations: int | None = None,
+        tolerance: float = 1e-6,
+        step: float = 1e-4,
+        constraint_scale: np.ndarray | None = None,
+        box: tuple[np.ndarray, np.ndarray] | None = None,
+        start: np.ndarray | None = None,
+    ):
         if not 0 < step < 0.5:
             raise ValueError(f"step must be in (0, 0.5) of each variable's range, got {step}")
         self.max_iterations, self.max_evaluations = max_iterations, max_evaluations
@@ -183,16 +201,24 @@ class Gradient(Optimiser):
 
     def setup(self, problem, rng):
         if problem.n_obj != 1:
-            raise ValueError(f"SLSQP minimises one objective, the problem has {problem.n_obj}: "
-                             f"combine them with a weighted sum")
+            raise ValueError(
+                f"SLSQP minimises one objective, the problem has {problem.n_obj}: "
+                f"combine them with a weighted sum"
+            )
         self.problem = problem
         lo, hi = self.box if self.box is not None else (problem.xl, problem.xu)
         self._lo, self._span = np.asarray(lo, float), np.asarray(hi, float) - lo
         n = problem.n_var
-        self._u0 = np.full(n, 0.5) if self.start is None else \
-            np.clip((np.asarray(self.start, float) - self._lo) / self._span, 0.0, 1.0)
-        self._g_scale = np.ones(problem.n_ieq_constr) if self.constraint_scale is None \
+        self._u0 = (
+            np.full(n, 0.5)
+            if self.start is None
+            else np.clip((np.asarray(self.start, float) - self._lo) / self._span, 0.0, 1.0)
+        )
+        self._g_scale = (
+            np.ones(problem.n_ieq_constr)
+            if self.constraint_scale is None
             else np.asarray(self.constraint_scale, float)
+        )
         self._cache: dict[bytes, _Point] = {}
         self._evaluations, self.n_gen, self._status = 0, 0, None
         self._u = self._u0
@@ -208,22 +234,34 @@ class Gradient(Optimiser):
             G = np.asarray(G, float).reshape(len(U), -1)
             self._evaluations += len(U)
             self._last = Solutions(X, F, G)
-            self._cache[key] = _Point(f=F[0, 0], g=G[0], df=(F[1:, 0] - F[0, 0]) / h,
-                                      dg=((G[1:] - G[0]) / h[:, None]).T)
+            self._cache[key] = _Point(
+                f=F[0, 0], g=G[0], df=(F[1:, 0] - F[0, 0]) / h, dg=((G[1:] - G[0]) / h[:, None]).T
+            )
         return self._cache[key]
 
     def next(self) -> None:
         self.n_gen += 1
         scale = self._f_scale
-        constraints = [] if not self.problem.n_ieq_constr else [{
-            "type": "ineq",
-            "fun": lambda u: -self._point(u).g / self._g_scale,
-            "jac": lambda u: -self._point(u).dg / self._g_scale[:, None]}]
+        constraints = (
+            []
+            if not self.problem.n_ieq_constr
+            else [
+                {
+                    "type": "ineq",
+                    "fun": lambda u: -self._point(u).g / self._g_scale,
+                    "jac": lambda u: -self._point(u).dg / self._g_scale[:, None],
+                }
+            ]
+        )
         result = _scipy_minimize(
-            lambda u: self._point(u).f / scale, self._u0,
-            jac=lambda u: self._point(u).df / scale, method="SLSQP",
+            lambda u: self._point(u).f / scale,
+            self._u0,
+            jac=lambda u: self._point(u).df / scale,
+            method="SLSQP",
             bounds=Bounds(np.zeros_like(self._u0), np.ones_like(self._u0)),
-            constraints=constraints, options={"maxiter": self.n_gen, "ftol": self.tolerance})
+            constraints=constraints,
+            options={"maxiter": self.n_gen, "ftol": self.tolerance},
+        )
         self._u, self._status = result.x, result.status
 
     def has_next(self) -> bool:
@@ -253,8 +291,14 @@ class Hybrid(Optimiser):
     ``max_iterations``/``max_evaluations`` leave after the GA.
     """
 
-    def __init__(self, ga: PymooOptimiser, gradient: Gradient, shrink: float = 0.2,
-                 max_iterations: int | None = None, max_evaluations: int | None = None):
+    def __init__(
+        self,
+        ga: PymooOptimiser,
+        gradient: Gradient,
+        shrink: float = 0.2,
+        max_iterations: int | None = None,
+        max_evaluations: int | None = None,
+    ):
         if not 0 < shrink <= 1:
             raise ValueError(f"shrink must be in (0, 1], got {shrink}")
         self.ga, self.gradient, self.shrink = ga, gradient, shrink
@@ -319,8 +363,13 @@ class WeightedSum(_PymooProblem):
         if (weights < 0).any() or not weights.any():
             raise ValueError("weights must be >= 0 and not all 0")
         self.problem, self.weights = problem, weights
-        super().__init__(n_var=problem.n_var, n_obj=1, n_ieq_constr=problem.n_ieq_constr,
-                         xl=problem.xl, xu=problem.xu)
+        super().__init__(
+            n_var=problem.n_var,
+            n_obj=1,
+            n_ieq_constr=problem.n_ieq_constr,
+            xl=problem.xl,
+            xu=problem.xu,
+        )
 
     def _evaluate(self, X, out, *args, **kwargs):
         F, G = self.problem.evaluate(X, return_values_of=["F", "G"])
@@ -328,8 +377,13 @@ class WeightedSum(_PymooProblem):
         out["G"] = G
 
 
-def balanced_weights(problem: _PymooProblem, samples: int, rng: np.random.Generator,
-                     dominant: int | None = None, factor: float = 10.0) -> np.ndarray:
+def balanced_weights(
+    problem: _PymooProblem,
+    samples: int,
+    rng: np.random.Generator,
+    dominant: int | None = None,
+    factor: float = 10.0,
+) -> np.ndarray:
     """Weights that put the objectives on one scale (Sec 5.2.1, Cases 4-5).
 
     ``w_i = 1 / median |f_i|`` over ``samples`` designs drawn uniformly in the bounds from
@@ -342,26 +396,45 @@ def balanced_weights(problem: _PymooProblem, samples: int, rng: np.random.Genera
     F = F[(np.isfinite(F) & (F < PENALTY)).all(axis=1)]
     median = np.median(np.abs(F), axis=0) if len(F) else np.zeros(problem.n_obj)
     if not (median > 0).all():
-        raise ValueError(f"cannot balance the weights: {len(F)} of {samples} random designs "
-                         f"gave finite objectives and some objective's median is 0")
+        raise ValueError(
+            f"cannot balance the weights: {len(F)} of {samples} random designs "
+            f"gave finite objectives and some objective's median is 0"
+        )
     weights = 1.0 / median
     if dominant is not None:
         weights[dominant] *= factor
     return weights
 
 
-def termination(n_obj: int, generations: int | None, max_evaluations: int | None,
-                tolerance: float, stall_generations: int):
+def termination(
+    n_obj: int,
+    generations: int | None,
+    max_evaluations: int | None,
+    tolerance: float,
+    stall_generations: int,
+):
     """pymoo's default termination: budget, or no progress over ``stall_generations``."""
     cls = DefaultSingleObjectiveTermination if n_obj == 1 else DefaultMultiObjectiveTermination
-    return cls(ftol=tolerance, period=stall_generations,
-               n_max_gen=generations or float("inf"),
-               n_max_evals=max_evaluations or float("inf"))
+    return cls(
+        ftol=tolerance,
+        period=stall_generations,
+        n_max_gen=generations or float("inf"),
+        n_max_evals=max_evaluations or float("inf"),
+    )
 
 
 #: Constructor arguments suspopt sets itself.
-_RESERVED = ("termination", "seed", "callback", "display", "verbose", "evaluator", "output",
-             "save_history", "pop_size")
+_RESERVED = (
+    "termination",
+    "seed",
+    "callback",
+    "display",
+    "verbose",
+    "evaluator",
+    "output",
+    "save_history",
+    "pop_size",
+)
 
 
 def _flag(value) -> bool:
@@ -369,31 +442,39 @@ def _flag(value) -> bool:
 
 
 def _real(low: float, high: float):
-    return lambda value: (isinstance(value, (int, float)) and not isinstance(value, bool)
-                          and low <= value <= high)
+    return lambda value: (
+        isinstance(value, (int, float)) and not isinstance(value, bool) and low <= value <= high
+    )
 
 
 def _choice(*values):
     return lambda value: isinstance(value, str) and value in values
 
 
-_DE_VARIANTS = tuple(f"DE/{selection}/{n}/{crossover}" for selection in
-                     ("rand", "best", "target-to-best") for n in (1, 2)
-                     for crossover in ("bin", "exp"))
+_DE_VARIANTS = tuple(
+    f"DE/{selection}/{n}/{crossover}"
+    for selection in ("rand", "best", "target-to-best")
+    for n in (1, 2)
+    for crossover in ("bin", "exp")
+)
 #: The options a config may pass to a pymoo constructor: plain data (a config cannot hold a
 #: pymoo object, and nothing read from a file runs as code), each with its check and what it
 #: takes.
 DATA_OPTIONS: dict[str, tuple] = {
     "eliminate_duplicates": (_flag, "true or false"),
     "return_least_infeasible": (_flag, "true or false"),
-    "n_offsprings": (lambda v: isinstance(v, int) and not isinstance(v, bool)
-                     and 1 <= v <= 1_000_000, "a whole number from 1 to 1000000"),
+    "n_offsprings": (
+        lambda v: isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 1_000_000,
+        "a whole number from 1 to 1000000",
+    ),
     "CR": (_real(0.0, 1.0), "a number in [0, 1]"),
     "F": (_real(1e-6, 2.0), "a number in (0, 2]"),
     "gamma": (_real(0.0, 1.0), "a number in [0, 1]"),
     "variant": (_choice(*_DE_VARIANTS), "one of " + ", ".join(_DE_VARIANTS)),
-    "de_repair": (_choice("bounce-back", "midway", "rand-init", "to-bounds"),
-                  "bounce-back, midway, rand-init or to-bounds"),
+    "de_repair": (
+        _choice("bounce-back", "midway", "rand-init", "to-bounds"),
+        "bounce-back, midway, rand-init or to-bounds",
+    ),
 }
 
 
@@ -412,13 +493,17 @@ def pymoo_algorithm(target: str, options: dict, population: int | None, n_obj: i
             raise ValueError(f"option {key!r} is set by suspopt (from the optimiser section)")
         if key not in allowed:
             close = difflib.get_close_matches(key, sorted(allowed), n=3)
-            raise ValueError(f"{name} has no option {key!r}" + (
-                f"; did you mean {', '.join(close)}?" if close else ""))
+            raise ValueError(
+                f"{name} has no option {key!r}"
+                + (f"; did you mean {', '.join(close)}?" if close else "")
+            )
         if key not in DATA_OPTIONS:
             usable = sorted(k for k in DATA_OPTIONS if k in allowed)
-            raise ValueError(f"{name}'s option {key!r} takes a pymoo object, which a config "
-                             f"cannot give; the options it takes from a config are "
-                             f"{', '.join(usable) or 'none'}")
+            raise ValueError(
+                f"{name}'s option {key!r} takes a pymoo object, which a config "
+                f"cannot give; the options it takes from a config are "
+                f"{', '.join(usable) or 'none'}"
+            )
         check, takes = DATA_OPTIONS[key]
         if not check(value):
             raise ValueError(f"option {key!r} takes {takes}, got {value!r:.40}")
@@ -437,18 +522,21 @@ def _init_parameters(cls) -> set[str]:
         if "__init__" not in vars(klass):
             continue
         params = inspect.signature(klass.__init__).parameters.values()
-        allowed |= {p.name for p in params
-                    if p.name != "self" and p.kind not in (p.VAR_KEYWORD, p.VAR_POSITIONAL)}
+        allowed |= {
+            p.name
+            for p in params
+            if p.name != "self" and p.kind not in (p.VAR_KEYWORD, p.VAR_POSITIONAL)
+        }
         if not any(p.kind is p.VAR_KEYWORD for p in params):
             break
-    if any(k.__name__ == "DE" for k in cls.__mro__):    # DE (GDE3) hands **kwargs to Variant
+    if any(k.__name__ == "DE" for k in cls.__mro__):  # DE (GDE3) hands **kwargs to Variant
         from pymoo.algorithms.soo.nonconvex.de import Variant
+
         allowed |= set(inspect.signature(Variant.__init__).parameters) - {"self", "kwargs"}
     return allowed
 
 
-def minimize(problem: _PymooProblem, optimiser: Optimiser, seed: int,
-             callback=None) -> Solutions:
+def minimize(problem: _PymooProblem, optimiser: Optimiser, seed: int, callback=None) -> Solutions:
     """Run ``optimiser`` on ``problem`` with ``np.random.default_rng(seed)``; call
     ``callback(optimiser)`` after every generation; return the optimum."""
     optimiser.setup(problem, np.random.default_rng(seed))

@@ -54,8 +54,8 @@ class _Term:
     spec: Objective
     names: tuple[str, ...]
     units: tuple[str, ...]
-    keys: tuple[str, ...] = ()      # seat.geometry: the seat_constraints keys, in order
-    signals: tuple[str, ...] = ()   # the signals a metric reads
+    keys: tuple[str, ...] = ()  # seat.geometry: the seat_constraints keys, in order
+    signals: tuple[str, ...] = ()  # the signals a metric reads
 
 
 class Problem(_PymooProblem):
@@ -68,8 +68,13 @@ class Problem(_PymooProblem):
     constraint's bound magnitude (1 where the bound is 0), for algorithms that scale ``G``.
     """
 
-    def __init__(self, cfg: Config, objectives: Sequence[_Term], constraints: Sequence[_Term],
-                 supplementary: Sequence[_Term] = ()):
+    def __init__(
+        self,
+        cfg: Config,
+        objectives: Sequence[_Term],
+        constraints: Sequence[_Term],
+        supplementary: Sequence[_Term] = (),
+    ):
         self.cfg = cfg
         self.variables: list[DesignVariable] = list(cfg.design_variables)
         self._objectives, self._constraints = list(objectives), list(constraints)
@@ -98,32 +103,41 @@ class Problem(_PymooProblem):
         self.constraint_names.append(_FAILED)
         self.constraint_units.append("1")
         self.constraint_scale = np.array(scale + [1.0])
-        lower[self._log], upper[self._log] = np.log10(lower[self._log]), \
-            np.log10(upper[self._log])
-        super().__init__(n_var=len(self.variables), n_obj=len(self.obj_names),
-                         n_ieq_constr=len(self.constraint_names), xl=lower, xu=upper)
+        lower[self._log], upper[self._log] = np.log10(lower[self._log]), np.log10(upper[self._log])
+        super().__init__(
+            n_var=len(self.variables),
+            n_obj=len(self.obj_names),
+            n_ieq_constr=len(self.constraint_names),
+            xl=lower,
+            xu=upper,
+        )
 
     @classmethod
-    def from_config(cls, cfg: Config) -> "Problem":
+    def from_config(cls, cfg: Config) -> Problem:
         """Build the problem of ``cfg``; raise ConfigError (with the YAML line) for a bad path,
         a bound the model rejects, an unknown signal or an objective with several values."""
         if not cfg.design_variables:
-            raise cfg.error(("design_variables",), "required key is missing: list the config "
-                            "fields to optimise, with their bounds")
+            raise cfg.error(
+                ("design_variables",),
+                "required key is missing: list the config fields to optimise, with their bounds",
+            )
         if cfg.objectives is None:
-            raise cfg.error(("objectives",), "required key is missing: give the main "
-                            "objectives")
+            raise cfg.error(("objectives",), "required key is missing: give the main objectives")
         _check_paths(cfg)
         available, unit_of, corners = _signals_at_bounds(cfg)
 
         def compile_all(specs, loc, objective):
-            return [_compile(cfg, spec, loc + (i,), available, unit_of, corners, objective)
-                    for i, spec in enumerate(specs)]
+            return [
+                _compile(cfg, spec, loc + (i,), available, unit_of, corners, objective)
+                for i, spec in enumerate(specs)
+            ]
 
-        return cls(cfg, compile_all(cfg.objectives.main, ("objectives", "main"), True),
-                   compile_all(cfg.constraints, ("constraints",), False),
-                   compile_all(cfg.objectives.supplementary, ("objectives", "supplementary"),
-                               True))
+        return cls(
+            cfg,
+            compile_all(cfg.objectives.main, ("objectives", "main"), True),
+            compile_all(cfg.constraints, ("constraints",), False),
+            compile_all(cfg.objectives.supplementary, ("objectives", "supplementary"), True),
+        )
 
     @property
     def search_units(self) -> list[str]:
@@ -164,8 +178,7 @@ class Problem(_PymooProblem):
             from ..simulate import prepare, run_memory
 
             _, model, _, attachments = prepare(self._sim_cfg)
-            signals = len({n for t in self._all_terms() if t.spec.metric
-                           for n in t.signals})
+            signals = len({n for t in self._all_terms() if t.spec.metric for n in t.signals})
             _, per_design = run_memory(self._sim_cfg, model, attachments, 1, signals)
             cap = memory.explicit_limit()
             budget = BATCH_BYTES if cap is None else min(BATCH_BYTES, cap // 2)
@@ -174,38 +187,45 @@ class Problem(_PymooProblem):
 
     def _evaluate(self, X, out, *args, **kwargs):
         width = self.batch_width() if self._simulates else max(len(X), 1)
-        parts = [self._evaluate_batch(X[i:i + width], "S" in out)
-                 for i in range(0, len(X), width)]
+        parts = [
+            self._evaluate_batch(X[i : i + width], "S" in out) for i in range(0, len(X), width)
+        ]
         for j, key in enumerate(("F", "G", "S")):
             if key in out or key != "S":
-                out[key] = np.concatenate([p[j] for p in parts]) if parts else \
-                    np.empty((0, (self.n_obj, self.n_ieq_constr,
-                                  len(self.supplementary_names))[j]))
+                out[key] = (
+                    np.concatenate([p[j] for p in parts])
+                    if parts
+                    else np.empty(
+                        (0, (self.n_obj, self.n_ieq_constr, len(self.supplementary_names))[j])
+                    )
+                )
 
     def _evaluate_batch(self, X, supplementary: bool):
         """F, G (and S, or None) of one batch of designs, in one simulation."""
         params = self.params(X)
-        with np.errstate(all="ignore"):      # failed designs are flagged, not warned about
+        with np.errstate(all="ignore"):  # failed designs are flagged, not warned about
             result = simulate(self._sim_cfg, params) if self._simulates else None
         return self.values(result, params, len(X), supplementary)
 
-    def values(self, result, params: dict[str, np.ndarray], P: int,
-               supplementary: bool = False):
+    def values(self, result, params: dict[str, np.ndarray], P: int, supplementary: bool = False):
         """``(F, G, S)`` of P designs from their simulation ``result`` (None when no term
         needs one) and ``params`` (dotted path -> (P,) physical values): the objectives, the
         constraints with ``simulation_failed`` last, and the supplementary objectives (None
         unless asked), failed designs penalised (module docstring)."""
-        with np.errstate(all="ignore"):      # failed designs are flagged below, not warned about
+        with np.errstate(all="ignore"):  # failed designs are flagged below, not warned about
             F = _stack(self._objectives, self.cfg, result, params, P)
             G = self._constraint_values(result, params, P)
             failed = ~(np.isfinite(F).all(axis=1) & np.isfinite(G).all(axis=1))
             if result is not None:
                 failed |= result.diverged
-            S = _stack(self._supplementary, self.cfg, result, params, P) \
-                if supplementary else None
-            return (np.where(failed[:, None], PENALTY, F),
-                    np.column_stack([np.where(np.isfinite(G), G, PENALTY),
-                                     np.where(failed, PENALTY, -1.0)]), S)
+            S = _stack(self._supplementary, self.cfg, result, params, P) if supplementary else None
+            return (
+                np.where(failed[:, None], PENALTY, F),
+                np.column_stack(
+                    [np.where(np.isfinite(G), G, PENALTY), np.where(failed, PENALTY, -1.0)]
+                ),
+                S,
+            )
 
     def _constraint_values(self, result, params, P: int) -> np.ndarray:
         """``g = min - value`` and ``g = value - max`` of every constraint column, (P, k)."""
@@ -240,6 +260,7 @@ def _values(term: _Term, cfg: Config, result, params) -> np.ndarray:
 
 # --- construction checks ----------------------------------------------------------------------
 
+
 def _check_paths(cfg: Config) -> None:
     """Every design variable is a numeric config field that the simulator reads per design."""
     numeric = numeric_paths(cfg)
@@ -248,9 +269,15 @@ def _check_paths(cfg: Config) -> None:
         loc = ("design_variables", i, "path")
         if var.path not in numeric:
             close = difflib.get_close_matches(var.path, list(numeric), n=3, cutoff=0.5)
-            raise cfg.error(loc, f"{var.path!r} is not a numeric field of this config" + (
-                f"; did you mean {', '.join(close)}?" if close else
-                " (derived quantities such as a seat's K_v stay derived)"))
+            raise cfg.error(
+                loc,
+                f"{var.path!r} is not a numeric field of this config"
+                + (
+                    f"; did you mean {', '.join(close)}?"
+                    if close
+                    else " (derived quantities such as a seat's K_v stay derived)"
+                ),
+            )
         why = one_per_run(var.path)
         if why is not None:
             raise cfg.error(loc, f"{var.path} cannot vary between designs: {why}")
@@ -284,13 +311,22 @@ def _at_variable(cfg: Config, message: str) -> ConfigError:
     message = message.removeprefix("params: ")
     for i, var in sorted(enumerate(cfg.design_variables), key=lambda iv: -len(iv[1].path)):
         if var.path in message:
-            return cfg.error(("design_variables", i), f"with every variable at its lower "
-                             f"(design 0) or upper (design 1) bound: {message}")
+            return cfg.error(
+                ("design_variables", i),
+                f"with every variable at its lower (design 0) or upper (design 1) bound: {message}",
+            )
     return cfg.error(("design_variables",), message)
 
 
-def _compile(cfg: Config, spec: Objective, loc: tuple, available: list[str], unit_of,
-             corners: tuple[str, ...], objective: bool) -> _Term:
+def _compile(
+    cfg: Config,
+    spec: Objective,
+    loc: tuple,
+    available: list[str],
+    unit_of,
+    corners: tuple[str, ...],
+    objective: bool,
+) -> _Term:
     """Check one spec against the model and name its value columns."""
     if spec.quantity is not None:
         if cfg.seat is None:
@@ -302,10 +338,16 @@ def _compile(cfg: Config, spec: Objective, loc: tuple, available: list[str], uni
         for j, key in enumerate(keys):
             if key not in known:
                 close = difflib.get_close_matches(key, known, n=3)
-                raise cfg.error(loc + ("conditions", j), f"{cfg.seat.kind} has no condition "
-                                f"{key!r}; it has {', '.join(close or known)}")
-        return _Term(spec, tuple(f"{spec.label}.{k}" for k in keys),
-                     tuple(CONSTRAINT_UNITS[k] for k in keys), keys)
+                raise cfg.error(
+                    loc + ("conditions", j),
+                    f"{cfg.seat.kind} has no condition {key!r}; it has {', '.join(close or known)}",
+                )
+        return _Term(
+            spec,
+            tuple(f"{spec.label}.{k}" for k in keys),
+            tuple(CONSTRAINT_UNITS[k] for k in keys),
+            keys,
+        )
     try:
         signals = spec_signals(spec, available, corners)
     except ValueError as exc:
@@ -315,11 +357,18 @@ def _compile(cfg: Config, spec: Objective, loc: tuple, available: list[str], uni
         return _Term(spec, (spec.label,), (unit,), signals=tuple(signals))
     if objective:
         corner_list = ", ".join(s.rsplit(".", 1)[1] for s in signals)
-        raise cfg.error(loc + ("reduce",), f"{spec.label} gives one value per corner "
-                        f"({corner_list}); an objective is one number per design: add "
-                        f"reduce: mean (or max, min, sum)")
-    return _Term(spec, tuple(f"{spec.label}.{s.rsplit('.', 1)[1]}" for s in signals),
-                 (unit,) * len(signals), signals=tuple(signals))
+        raise cfg.error(
+            loc + ("reduce",),
+            f"{spec.label} gives one value per corner "
+            f"({corner_list}); an objective is one number per design: add "
+            f"reduce: mean (or max, min, sum)",
+        )
+    return _Term(
+        spec,
+        tuple(f"{spec.label}.{s.rsplit('.', 1)[1]}" for s in signals),
+        (unit,) * len(signals),
+        signals=tuple(signals),
+    )
 
 
 _UNIT = re.compile(r"\[([^\],]+)\]")

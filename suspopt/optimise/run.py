@@ -51,10 +51,20 @@ from pymoo.core.problem import Problem as _PymooProblem
 from pymoo.indicators.hv import HV
 
 from ..config import Config, ConfigError
-from ..config.optimise import ALGORITHMS, Hybrid as HybridSettings
+from ..config.optimise import ALGORITHMS
+from ..config.optimise import Hybrid as HybridSettings
 from ..io import atomic_h5, write_dataset
-from .algorithms import (Gradient, Hybrid, Optimiser, PymooOptimiser, Solutions, WeightedSum,
-                         balanced_weights, pymoo_algorithm, termination)
+from .algorithms import (
+    Gradient,
+    Hybrid,
+    Optimiser,
+    PymooOptimiser,
+    Solutions,
+    WeightedSum,
+    balanced_weights,
+    pymoo_algorithm,
+    termination,
+)
 from .problem import PENALTY, Problem
 
 __all__ = ["optimise", "build_optimiser", "Progress", "OptimisationResult"]
@@ -70,12 +80,12 @@ class Progress:
     max_generations: int | None
     evaluations: int
     max_evaluations: int | None
-    best: np.ndarray                 # (m,) lowest feasible objective values, NaN if none
-    hypervolume: float               # NaN for one objective
-    feasible: float                  # share of the generation's designs that are feasible
-    elapsed: float                   # [s], including time before a resume
-    time_left: float | None          # [s], from the budget; None without one
-    phase: str                       # the algorithm running now
+    best: np.ndarray  # (m,) lowest feasible objective values, NaN if none
+    hypervolume: float  # NaN for one objective
+    feasible: float  # share of the generation's designs that are feasible
+    elapsed: float  # [s], including time before a resume
+    time_left: float | None  # [s], from the budget; None without one
+    phase: str  # the algorithm running now
 
 
 @dataclass
@@ -107,10 +117,16 @@ class _Recorder(_PymooProblem):
     checkpoint); on a resume the stored batches answer, in order, for as long as they last,
     each checked to be the batch the optimiser asks for."""
 
-    def __init__(self, problem: Problem, stored: list[tuple] | None = None,
-                 source: Path | None = None):
-        super().__init__(n_var=problem.n_var, n_obj=problem.n_obj,
-                         n_ieq_constr=problem.n_ieq_constr, xl=problem.xl, xu=problem.xu)
+    def __init__(
+        self, problem: Problem, stored: list[tuple] | None = None, source: Path | None = None
+    ):
+        super().__init__(
+            n_var=problem.n_var,
+            n_obj=problem.n_obj,
+            n_ieq_constr=problem.n_ieq_constr,
+            xl=problem.xl,
+            xu=problem.xu,
+        )
         self.problem, self.source = problem, source
         self.batches: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         self._stored = deque(stored or [])
@@ -124,10 +140,12 @@ class _Recorder(_PymooProblem):
         if self._stored:
             stored_X, F, G = self._stored.popleft()
             if stored_X.shape != X.shape or not np.array_equal(stored_X, X):
-                raise ConfigError(f"--resume: {self.source}: /checkpoint/X: batch "
-                                  f"{len(self.batches)} holds other designs than the run asks "
-                                  f"for (the file was written by another version of suspopt "
-                                  f"or pymoo, or was changed); run without --resume")
+                raise ConfigError(
+                    f"--resume: {self.source}: /checkpoint/X: batch "
+                    f"{len(self.batches)} holds other designs than the run asks "
+                    f"for (the file was written by another version of suspopt "
+                    f"or pymoo, or was changed); run without --resume"
+                )
         else:
             F, G = self.problem.evaluate(X, return_values_of=["F", "G"])
         self.batches.append((X, np.asarray(F, float), np.asarray(G, float)))
@@ -141,30 +159,36 @@ class _Run:
     optimiser: Optimiser
     recorder: _Recorder
     weights: np.ndarray | None
-    history: dict[str, list] = field(default_factory=lambda: {
-        k: [] for k in ("generation", "best", "hypervolume", "evaluations", "time",
-                        "feasible")})
+    history: dict[str, list] = field(
+        default_factory=lambda: {
+            k: [] for k in ("generation", "best", "hypervolume", "evaluations", "time", "feasible")
+        }
+    )
     elapsed: float = 0.0
     normalisation: tuple[np.ndarray, np.ndarray] | None = None
-    archive: np.ndarray | None = None        # non-dominated feasible F found so far
-    archived: int = 0                        # the recorder's batches in the archive
-    weighted_optimum: tuple[bytes, np.ndarray, np.ndarray] | None = None   # X key, F, G
+    archive: np.ndarray | None = None  # non-dominated feasible F found so far
+    archived: int = 0  # the recorder's batches in the archive
+    weighted_optimum: tuple[bytes, np.ndarray, np.ndarray] | None = None  # X key, F, G
 
 
 @dataclass
 class _Snapshot:
     """The run after a completed generation, ready to write."""
 
-    batches: int                    # the recorder's batches so far
-    optimum: Solutions              # X physical, F main objectives
+    batches: int  # the recorder's batches so far
+    optimum: Solutions  # X physical, F main objectives
     history: dict[str, np.ndarray]
     generation: int
     evaluations: int
 
 
-def optimise(cfg: Config, output: str | Path, resume: bool = False,
-             callback: Callable[[Progress], None] | None = None,
-             command: str | None = None) -> OptimisationResult:
+def optimise(
+    cfg: Config,
+    output: str | Path,
+    resume: bool = False,
+    callback: Callable[[Progress], None] | None = None,
+    command: str | None = None,
+) -> OptimisationResult:
     """Optimise ``cfg`` and write ``output`` (HDF5, layout in the module docstring).
 
     ``resume`` continues from the checkpoint in ``output``, which must have been written for
@@ -174,8 +198,11 @@ def optimise(cfg: Config, output: str | Path, resume: bool = False,
     output = Path(output)
     problem = Problem.from_config(cfg)
     optimiser = build_optimiser(cfg, problem)
-    run = _resume(output, cfg, problem, optimiser) if resume else \
-        _start(cfg, _Recorder(problem), optimiser)
+    run = (
+        _resume(output, cfg, problem, optimiser)
+        if resume
+        else _start(cfg, _Recorder(problem), optimiser)
+    )
     snapshot = None
     status = "finished"
     try:
@@ -192,10 +219,10 @@ def optimise(cfg: Config, output: str | Path, resume: bool = False,
         if snapshot is None:
             raise
         status = "interrupted"
-    if snapshot is None:                 # resumed a finished run, or nothing to do
+    if snapshot is None:  # resumed a finished run, or nothing to do
         snapshot = _snapshot(run, problem)
     if status == "finished" and (snapshot.optimum.F >= PENALTY).all():
-        status = "failed"                # every design of the optimum failed to simulate
+        status = "failed"  # every design of the optimum failed to simulate
     return _write(output, cfg, problem, snapshot, run, status, command)
 
 
@@ -204,33 +231,52 @@ def build_optimiser(cfg: Config, problem: Problem) -> Optimiser:
     combination that cannot work (e.g. GA on three objectives without a weighted sum)."""
     opt = cfg.optimiser
     if opt is None:
-        raise cfg.error(("optimiser",), "required key is missing: give at least algorithm, "
-                        "seed and a budget")
+        raise cfg.error(
+            ("optimiser",), "required key is missing: give at least algorithm, seed and a budget"
+        )
     _check_objectives(cfg, problem)
     if opt.algorithm == "gradient":
         return _gradient(cfg, problem, opt.generations, opt.max_evaluations)
     n_obj = 1 if opt.weighted_sum else problem.n_obj
     try:
-        algorithm = pymoo_algorithm(ALGORITHMS[opt.algorithm].target, opt.options, opt.population,
-                                    n_obj)
+        algorithm = pymoo_algorithm(
+            ALGORITHMS[opt.algorithm].target, opt.options, opt.population, n_obj
+        )
     except ValueError as exc:
         raise cfg.error(("optimiser", "options"), str(exc)) from None
     if opt.algorithm == "hybrid":
         settings = opt.hybrid or HybridSettings()
         ga_generations = min(settings.ga_generations, opt.generations or float("inf"))
-        ga = PymooOptimiser(algorithm, termination(1, ga_generations, opt.max_evaluations,
-                                                   opt.tolerance, opt.stall_generations))
-        return Hybrid(ga, _gradient(cfg, problem, None, None), settings.shrink,
-                      opt.generations, opt.max_evaluations)
-    return PymooOptimiser(algorithm, termination(n_obj, opt.generations, opt.max_evaluations,
-                                                 opt.tolerance, opt.stall_generations))
+        ga = PymooOptimiser(
+            algorithm,
+            termination(
+                1, ga_generations, opt.max_evaluations, opt.tolerance, opt.stall_generations
+            ),
+        )
+        return Hybrid(
+            ga,
+            _gradient(cfg, problem, None, None),
+            settings.shrink,
+            opt.generations,
+            opt.max_evaluations,
+        )
+    return PymooOptimiser(
+        algorithm,
+        termination(
+            n_obj, opt.generations, opt.max_evaluations, opt.tolerance, opt.stall_generations
+        ),
+    )
 
 
 def _gradient(cfg: Config, problem: Problem, iterations, evaluations) -> Gradient:
     opt = cfg.optimiser
-    return Gradient(max_iterations=iterations, max_evaluations=evaluations,
-                    tolerance=opt.tolerance, step=opt.gradient.step,
-                    constraint_scale=problem.constraint_scale)
+    return Gradient(
+        max_iterations=iterations,
+        max_evaluations=evaluations,
+        tolerance=opt.tolerance,
+        step=opt.gradient.step,
+        constraint_scale=problem.constraint_scale,
+    )
 
 
 def _check_objectives(cfg: Config, problem: Problem) -> None:
@@ -239,22 +285,36 @@ def _check_objectives(cfg: Config, problem: Problem) -> None:
     single = ALGORITHMS[opt.algorithm].single_objective
     if opt.weighted_sum is None:
         if single and problem.n_obj > 1:
-            raise cfg.error(("optimiser", "algorithm"), f"{opt.algorithm} minimises one "
-                            f"objective and objectives.main has {problem.n_obj}: add "
-                            f"optimiser.weighted_sum (Eq 5.7) or use nsga2")
+            raise cfg.error(
+                ("optimiser", "algorithm"),
+                f"{opt.algorithm} minimises one "
+                f"objective and objectives.main has {problem.n_obj}: add "
+                f"optimiser.weighted_sum (Eq 5.7) or use nsga2",
+            )
         return
     if not single:
-        raise cfg.error(("optimiser", "weighted_sum"), f"a weighted sum leaves one objective; "
-                        f"{opt.algorithm} is for several: use ga, gradient or hybrid")
+        raise cfg.error(
+            ("optimiser", "weighted_sum"),
+            f"a weighted sum leaves one objective; "
+            f"{opt.algorithm} is for several: use ga, gradient or hybrid",
+        )
     weights, balance = opt.weighted_sum.weights, opt.weighted_sum.balance
     if weights is not None and len(weights) != problem.n_obj:
-        raise cfg.error(("optimiser", "weighted_sum", "weights"), f"{len(weights)} weights for "
-                        f"{problem.n_obj} main objectives ({', '.join(problem.obj_names)})")
-    if balance is not None and balance.dominant is not None and \
-            balance.dominant not in problem.obj_names:
-        raise cfg.error(("optimiser", "weighted_sum", "balance", "dominant"),
-                        f"{balance.dominant!r} is not a main objective; they are "
-                        f"{', '.join(problem.obj_names)}")
+        raise cfg.error(
+            ("optimiser", "weighted_sum", "weights"),
+            f"{len(weights)} weights for "
+            f"{problem.n_obj} main objectives ({', '.join(problem.obj_names)})",
+        )
+    if (
+        balance is not None
+        and balance.dominant is not None
+        and balance.dominant not in problem.obj_names
+    ):
+        raise cfg.error(
+            ("optimiser", "weighted_sum", "balance", "dominant"),
+            f"{balance.dominant!r} is not a main objective; they are "
+            f"{', '.join(problem.obj_names)}",
+        )
 
 
 def _start(cfg: Config, recorder: _Recorder, optimiser: Optimiser) -> _Run:
@@ -268,11 +328,15 @@ def _start(cfg: Config, recorder: _Recorder, optimiser: Optimiser) -> _Run:
         if ws.weights is not None:
             weights = np.array(ws.weights, dtype=float)
         else:
-            dominant = None if ws.balance.dominant is None else \
-                recorder.problem.obj_names.index(ws.balance.dominant)
+            dominant = (
+                None
+                if ws.balance.dominant is None
+                else recorder.problem.obj_names.index(ws.balance.dominant)
+            )
             try:
-                weights = balanced_weights(recorder, ws.balance.samples, rng, dominant,
-                                           ws.balance.factor)
+                weights = balanced_weights(
+                    recorder, ws.balance.samples, rng, dominant, ws.balance.factor
+                )
             except ValueError as exc:
                 raise cfg.error(("optimiser", "weighted_sum", "balance"), str(exc)) from None
         working = WeightedSum(recorder, weights)
@@ -292,8 +356,11 @@ def _record(run: _Run, cfg: Config) -> Progress:
             ideal, nadir = feasible_f.min(axis=0), feasible_f.max(axis=0)
             run.normalisation = (ideal, np.where(nadir > ideal, nadir, ideal + 1.0))
         ideal, nadir = run.normalisation
-        hv = float(HV(ref_point=np.full(len(ideal), _HV_REFERENCE))(
-            (run.archive - ideal) / (nadir - ideal)))
+        hv = float(
+            HV(ref_point=np.full(len(ideal), _HV_REFERENCE))(
+                (run.archive - ideal) / (nadir - ideal)
+            )
+        )
     h = run.history
     h["generation"].append(optimiser.n_gen)
     h["best"].append(best)
@@ -301,10 +368,18 @@ def _record(run: _Run, cfg: Config) -> Progress:
     h["evaluations"].append(optimiser.n_eval)
     h["time"].append(run.elapsed)
     h["feasible"].append(float(population.feasible.mean()) if len(population.X) else 0.0)
-    return Progress(generation=optimiser.n_gen, max_generations=opt.generations,
-                    evaluations=optimiser.n_eval, max_evaluations=opt.max_evaluations,
-                    best=best, hypervolume=hv, feasible=h["feasible"][-1],
-                    elapsed=run.elapsed, time_left=_time_left(run, opt), phase=optimiser.phase)
+    return Progress(
+        generation=optimiser.n_gen,
+        max_generations=opt.generations,
+        evaluations=optimiser.n_eval,
+        max_evaluations=opt.max_evaluations,
+        best=best,
+        hypervolume=hv,
+        feasible=h["feasible"][-1],
+        elapsed=run.elapsed,
+        time_left=_time_left(run, opt),
+        phase=optimiser.phase,
+    )
 
 
 def _archive(run: _Run) -> np.ndarray:
@@ -313,11 +388,16 @@ def _archive(run: _Run) -> np.ndarray:
     reports, so that it never falls (an algorithm's own front can lose a design)."""
     from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-    batches = run.recorder.batches[run.archived:]
+    batches = run.recorder.batches[run.archived :]
     run.archived = len(run.recorder.batches)
     found = [F[(G <= 0).all(axis=1)] for _, F, G in batches]
-    pool = np.vstack([run.archive] + found) if run.archive is not None else \
-        np.vstack(found) if found else np.empty((0, 0))
+    pool = (
+        np.vstack([run.archive] + found)
+        if run.archive is not None
+        else np.vstack(found)
+        if found
+        else np.empty((0, 0))
+    )
     if len(pool) > 1:
         pool = pool[NonDominatedSorting().do(pool, only_non_dominated_front=True)]
     run.archive = pool
@@ -330,8 +410,7 @@ def _time_left(run: _Run, opt) -> float | None:
     if opt.generations is not None and optimiser.n_gen:
         left.append(run.elapsed / optimiser.n_gen * max(opt.generations - optimiser.n_gen, 0))
     if opt.max_evaluations is not None and optimiser.n_eval:
-        left.append(run.elapsed / optimiser.n_eval
-                    * max(opt.max_evaluations - optimiser.n_eval, 0))
+        left.append(run.elapsed / optimiser.n_eval * max(opt.max_evaluations - optimiser.n_eval, 0))
     return min(left) if left else None
 
 
@@ -346,10 +425,13 @@ def _snapshot(run: _Run, problem: Problem) -> _Snapshot:
         if run.weighted_optimum is None or run.weighted_optimum[0] != key:
             run.weighted_optimum = (key, *problem.evaluate(X, return_values_of=["F", "G"]))
         F, G = run.weighted_optimum[1:]
-    return _Snapshot(batches=len(run.recorder.batches),
-                     optimum=Solutions(problem.to_physical(X), F, G),
-                     history={k: np.array(v, dtype=float) for k, v in run.history.items()},
-                     generation=run.optimiser.n_gen, evaluations=run.optimiser.n_eval)
+    return _Snapshot(
+        batches=len(run.recorder.batches),
+        optimum=Solutions(problem.to_physical(X), F, G),
+        history={k: np.array(v, dtype=float) for k, v in run.history.items()},
+        generation=run.optimiser.n_gen,
+        evaluations=run.optimiser.n_eval,
+    )
 
 
 def _read_checkpoint(output: Path, cfg: Config, problem: Problem):
@@ -362,32 +444,42 @@ def _read_checkpoint(output: Path, cfg: Config, problem: Problem):
         raise ConfigError(f"{where}: does not exist (run without --resume to start)")
     with H5Reader(output, where) as h5:
         if h5.text_attr("config") != cfg.text:
-            raise ConfigError(f"{where}: was written for another config (its YAML text "
-                              f"differs); use the same config or run without --resume")
+            raise ConfigError(
+                f"{where}: was written for another config (its YAML text "
+                f"differs); use the same config or run without --resume"
+            )
         if "checkpoint/state" in h5.file:
-            raise ConfigError(f"{where}: /checkpoint/state: an old checkpoint (a pickle), "
-                              f"which suspopt no longer loads: a file must never run code; "
-                              f"run without --resume")
+            raise ConfigError(
+                f"{where}: /checkpoint/state: an old checkpoint (a pickle), "
+                f"which suspopt no longer loads: a file must never run code; "
+                f"run without --resume"
+            )
         group = h5.group("checkpoint")
         if group.attrs.get("format") != CHECKPOINT_FORMAT:
-            raise ConfigError(f"{where}: /checkpoint: not a suspopt checkpoint of format "
-                              f"{CHECKPOINT_FORMAT}")
-        generations = h5.int_attr("checkpoint", "generations", 0, 10 ** 7)
+            raise ConfigError(
+                f"{where}: /checkpoint: not a suspopt checkpoint of format {CHECKPOINT_FORMAT}"
+            )
+        generations = h5.int_attr("checkpoint", "generations", 0, 10**7)
         sizes = h5.array("checkpoint/batches", ndim=1, integer=True)
         X = h5.array("checkpoint/X", ndim=2, columns=problem.n_var)
         F = h5.array("checkpoint/F", ndim=2, columns=problem.n_obj)
         G = h5.array("checkpoint/G", ndim=2, columns=problem.n_ieq_constr)
-        history = {key: h5.array(f"history/{key}", ndim=2 if key == "best" else 1)
-                   for key in ("generation", "best", "hypervolume", "evaluations", "time",
-                               "feasible")}
+        history = {
+            key: h5.array(f"history/{key}", ndim=2 if key == "best" else 1)
+            for key in ("generation", "best", "hypervolume", "evaluations", "time", "feasible")
+        }
     if (sizes < 1).any() or sizes.sum() != len(X) or not len(X) == len(F) == len(G):
-        raise ConfigError(f"{where}: /checkpoint: batches of {int(sizes.sum())} designs, "
-                          f"X, F, G of {len(X)}, {len(F)}, {len(G)}")
+        raise ConfigError(
+            f"{where}: /checkpoint: batches of {int(sizes.sum())} designs, "
+            f"X, F, G of {len(X)}, {len(F)}, {len(G)}"
+        )
     if not np.isfinite(X).all():
         raise ConfigError(f"{where}: /checkpoint/X: values must be finite")
     if len(history["time"]) != generations:
-        raise ConfigError(f"{where}: /history/time: {len(history['time'])} generations, the "
-                          f"checkpoint {generations}")
+        raise ConfigError(
+            f"{where}: /history/time: {len(history['time'])} generations, the "
+            f"checkpoint {generations}"
+        )
     edges = np.concatenate([[0], np.cumsum(sizes)])
     batches = [(X[a:b], F[a:b], G[a:b]) for a, b in zip(edges[:-1], edges[1:])]
     return batches, generations, history
@@ -404,61 +496,129 @@ def _resume(output: Path, cfg: Config, problem: Problem, optimiser: Optimiser) -
         run.elapsed = float(stored["time"][generation])
         _record(run, cfg)
     rebuilt = {k: np.array(v, dtype=float) for k, v in run.history.items()}
-    same = all(np.array_equal(rebuilt[k].reshape(stored[k].shape), stored[k], equal_nan=True)
-               if rebuilt[k].size == stored[k].size else False for k in stored)
+    same = all(
+        np.array_equal(rebuilt[k].reshape(stored[k].shape), stored[k], equal_nan=True)
+        if rebuilt[k].size == stored[k].size
+        else False
+        for k in stored
+    )
     if run.recorder.replaying or not same:
-        raise ConfigError(f"--resume: {output}: /history: replaying the checkpoint does not "
-                          f"give the stored run (the file was written by another version "
-                          f"of suspopt or pymoo, or was changed); run without --resume")
+        raise ConfigError(
+            f"--resume: {output}: /history: replaying the checkpoint does not "
+            f"give the stored run (the file was written by another version "
+            f"of suspopt or pymoo, or was changed); run without --resume"
+        )
     return run
 
 
-def _write(output: Path, cfg: Config, problem: Problem, snap: _Snapshot, run: _Run,
-           status: str, command: str | None) -> OptimisationResult:
+def _write(
+    output: Path,
+    cfg: Config,
+    problem: Problem,
+    snap: _Snapshot,
+    run: _Run,
+    status: str,
+    command: str | None,
+) -> OptimisationResult:
     weights, run_batches = run.weights, run.recorder.batches
     opt = cfg.optimiser
     best_names = problem.obj_names if weights is None else ["weighted_sum"]
     best_units = problem.obj_units if weights is None else ["1"]
     with atomic_h5(output, cfg, command) as h5:
-        h5.attrs.update(status=status, algorithm=opt.algorithm, optimiser_seed=opt.seed,
-                        generations=snap.generation, evaluations=snap.evaluations)
+        h5.attrs.update(
+            status=status,
+            algorithm=opt.algorithm,
+            optimiser_seed=opt.seed,
+            generations=snap.generation,
+            evaluations=snap.evaluations,
+        )
         pareto = h5.create_group("pareto")
         if weights is not None:
             pareto.attrs["weights"] = weights
         o = snap.optimum
-        write_dataset(pareto, "X", o.X, problem.var_units, dims=("design", "variable"),
-                      names=problem.var_names)
-        write_dataset(pareto, "F", o.F, problem.obj_units, dims=("design", "objective"),
-                      names=problem.obj_names)
-        write_dataset(pareto, "G", o.G, problem.constraint_units,
-                      dims=("design", "constraint"), names=problem.constraint_names)
+        write_dataset(
+            pareto,
+            "X",
+            o.X,
+            problem.var_units,
+            dims=("design", "variable"),
+            names=problem.var_names,
+        )
+        write_dataset(
+            pareto,
+            "F",
+            o.F,
+            problem.obj_units,
+            dims=("design", "objective"),
+            names=problem.obj_names,
+        )
+        write_dataset(
+            pareto,
+            "G",
+            o.G,
+            problem.constraint_units,
+            dims=("design", "constraint"),
+            names=problem.constraint_names,
+        )
         hist = h5.create_group("history")
-        units = {"generation": "1", "hypervolume": "1", "evaluations": "1", "time": "s",
-                 "feasible": "1"}
+        units = {
+            "generation": "1",
+            "hypervolume": "1",
+            "evaluations": "1",
+            "time": "s",
+            "feasible": "1",
+        }
         write_dataset(hist, "generation", snap.history["generation"], "1", dims=("generation",))
         for key, values in snap.history.items():
             if key == "best":
-                write_dataset(hist, key, values.reshape(len(values), -1), best_units,
-                              dims=("generation", "objective"), names=best_names)
+                write_dataset(
+                    hist,
+                    key,
+                    values.reshape(len(values), -1),
+                    best_units,
+                    dims=("generation", "objective"),
+                    names=best_names,
+                )
             elif key != "generation":
                 write_dataset(hist, key, values, units[key], dims=("generation",))
-        batches = run_batches[:snap.batches]
+        batches = run_batches[: snap.batches]
         checkpoint = h5.create_group("checkpoint")
         checkpoint.attrs.update(format=CHECKPOINT_FORMAT, generations=snap.generation)
-        for j, (key, columns, units, dim, names) in enumerate((
+        for j, (key, columns, units, dim, names) in enumerate(
+            (
                 ("X", problem.n_var, problem.search_units, "variable", problem.var_names),
                 ("F", problem.n_obj, problem.obj_units, "objective", problem.obj_names),
-                ("G", problem.n_ieq_constr, problem.constraint_units, "constraint",
-                 problem.constraint_names))):
-            data = np.concatenate([b[j] for b in batches]) if batches else \
-                np.empty((0, columns))
-            write_dataset(checkpoint, key, data, units, dims=("evaluation", dim),
-                          coords={dim: names})
-        write_dataset(checkpoint, "batches", np.array([len(b[0]) for b in batches],
-                                                      dtype=np.int64), "1", dims=("batch",))
-    return OptimisationResult(X=o.X, F=o.F, G=o.G, var_names=problem.var_names,
-                              var_units=problem.var_units, obj_names=problem.obj_names,
-                              obj_units=problem.obj_units,
-                              constraint_names=problem.constraint_names,
-                              history=snap.history, status=status, path=output,
-                              weights=weights)
+                (
+                    "G",
+                    problem.n_ieq_constr,
+                    problem.constraint_units,
+                    "constraint",
+                    problem.constraint_names,
+                ),
+            )
+        ):
+            data = np.concatenate([b[j] for b in batches]) if batches else np.empty((0, columns))
+            write_dataset(
+                checkpoint, key, data, units, dims=("evaluation", dim), coords={dim: names}
+            )
+        write_dataset(
+            checkpoint,
+            "batches",
+            np.array([len(b[0]) for b in batches], dtype=np.int64),
+            "1",
+            dims=("batch",),
+        )
+    return OptimisationResult(
+        X=o.X,
+        F=o.F,
+        G=o.G,
+        var_names=problem.var_names,
+        var_units=problem.var_units,
+        obj_names=problem.obj_names,
+        obj_units=problem.obj_units,
+        constraint_names=problem.constraint_names,
+        history=snap.history,
+        status=status,
+        path=output,
+        weights=weights,
+    )

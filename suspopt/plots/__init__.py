@@ -35,9 +35,70 @@ Figures of the thesis they correspond to:
 
 from __future__ import annotations
 
-from .style import (FORMATS, MAX_DESIGNS, PSD_SEGMENT, check_path, new_figure, save, curve_styles, mark_indices)
-from .panels import (draw_time_responses, draw_spectra, draw_front, draw_design_variable, draw_comfort_levels, draw_weighted_rms, draw_history)
-from .figures import (model_comparison, model_figure, pareto_fronts, sensitivity, transmissibilities, plot_kesort)
-from .runs import (simulation_figure, plot_simulation, default_signals, optimisation_figure, plot_optimisation, chosen_designs, design_labels)
+from .figures import (
+    model_comparison,
+    model_figure,
+    pareto_fronts,
+    plot_kesort,
+    sensitivity,
+    transmissibilities,
+)
+from .panels import (
+    draw_comfort_levels,
+    draw_design_variable,
+    draw_front,
+    draw_history,
+    draw_spectra,
+    draw_time_responses,
+    draw_weighted_rms,
+)
+from .runs import (
+    chosen_designs,
+    default_signals,
+    design_labels,
+    optimisation_figure,
+    plot_optimisation,
+    plot_simulation,
+    simulation_figure,
+)
+from .style import (
+    FORMATS,
+    MAX_DESIGNS,
+    PSD_SEGMENT,
+    check_path,
+    curve_styles,
+    mark_indices,
+    new_figure,
+    save,
+)
 
-__all__ = ['FORMATS', 'MAX_DESIGNS', 'PSD_SEGMENT', 'check_path', 'new_figure', 'save', 'curve_styles', 'mark_indices', 'draw_time_responses', 'draw_spectra', 'draw_front', 'draw_design_variable', 'draw_comfort_levels', 'draw_weighted_rms', 'draw_history', 'model_comparison', 'model_figure', 'pareto_fronts', 'sensitivity', 'transmissibilities', 'plot_kesort', 'simulation_figure', 'plot_simulation', 'default_signals', 'optimisation_figure', 'plot_optimisation', 'chosen_designs', 'design_labels']
+__all__ = [
+    "FORMATS",
+    "MAX_DESIGNS",
+    "PSD_SEGMENT",
+    "check_path",
+    "new_figure",
+    "save",
+    "curve_styles",
+    "mark_indices",
+    "draw_time_responses",
+    "draw_spectra",
+    "draw_front",
+    "draw_design_variable",
+    "draw_comfort_levels",
+    "draw_weighted_rms",
+    "draw_history",
+    "model_comparison",
+    "model_figure",
+    "pareto_fronts",
+    "sensitivity",
+    "transmissibilities",
+    "plot_kesort",
+    "simulation_figure",
+    "plot_simulation",
+    "default_signals",
+    "optimisation_figure",
+    "plot_optimisation",
+    "chosen_designs",
+    "design_labels",
+]

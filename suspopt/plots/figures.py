@@ -4,24 +4,28 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-import numpy as np
-from .style import (check_path, new_figure, save, axis_label, figure_legend, figure_title)
-from .panels import (draw_time_responses, draw_spectra, draw_front, draw_design_variable)
 
+import numpy as np
+
+from .panels import draw_design_variable, draw_front, draw_spectra, draw_time_responses
+from .style import axis_label, check_path, figure_legend, figure_title, new_figure, save
 
 # --- figures -------------------------------------------------------------------------------
 
-def model_figure(title: str,
-                 time_series: Mapping[str, Sequence[tuple[str, np.ndarray, np.ndarray]]],
-                 spectra: Mapping[str, Sequence[tuple[str, np.ndarray, np.ndarray]]],
-                 units: Mapping[str, str]):
+
+def model_figure(
+    title: str,
+    time_series: Mapping[str, Sequence[tuple[str, np.ndarray, np.ndarray]]],
+    spectra: Mapping[str, Sequence[tuple[str, np.ndarray, np.ndarray]]],
+    units: Mapping[str, str],
+):
     """The figure of :func:`model_comparison`, unsaved: every series lists the models in
     the same order, so each model has one :func:`curve_styles` style in every panel; the one
     legend is below the panels."""
     fig, axes = new_figure(len(time_series) + len(spectra))
     for ax, (name, series) in zip(axes, time_series.items()):
         draw_time_responses(ax, series, name, units[name], legend=False)
-    for ax, (name, series) in zip(axes[len(time_series):], spectra.items()):
+    for ax, (name, series) in zip(axes[len(time_series) :], spectra.items()):
         draw_spectra(ax, series, "PSD", units[f"PSD of {name}"], legend=False)
         ax.set_title(f"PSD of {name}", fontsize=9)
     if axes:
@@ -30,10 +34,13 @@ def model_figure(title: str,
     return fig
 
 
-def model_comparison(path: str | Path, title: str,
-                     time_series: Mapping[str, Sequence[tuple[str, np.ndarray, np.ndarray]]],
-                     spectra: Mapping[str, Sequence[tuple[str, np.ndarray, np.ndarray]]],
-                     units: Mapping[str, str]) -> Path:
+def model_comparison(
+    path: str | Path,
+    title: str,
+    time_series: Mapping[str, Sequence[tuple[str, np.ndarray, np.ndarray]]],
+    spectra: Mapping[str, Sequence[tuple[str, np.ndarray, np.ndarray]]],
+    units: Mapping[str, str],
+) -> Path:
     """Several models side by side: one panel per signal of ``time_series`` (name -> series
     of ``(model, t, y)``) and one per spectrum of ``spectra`` (name -> ``(model, f, PSD)``);
     ``units`` maps each name to its unit. Models whose curves coincide stay distinguishable
@@ -42,11 +49,15 @@ def model_comparison(path: str | Path, title: str,
     return save(model_figure(title, time_series, spectra, units), path)
 
 
-def pareto_fronts(path: str | Path, title: str, objectives: Sequence[tuple[str, str]],
-                  fronts: Sequence[tuple[str, np.ndarray]],
-                  variables: Sequence[tuple[str, str, np.ndarray]] = (),
-                  marks: Mapping[str, int] | None = None,
-                  comfort: Sequence[bool] | None = None) -> Path:
+def pareto_fronts(
+    path: str | Path,
+    title: str,
+    objectives: Sequence[tuple[str, str]],
+    fronts: Sequence[tuple[str, np.ndarray]],
+    variables: Sequence[tuple[str, str, np.ndarray]] = (),
+    marks: Mapping[str, int] | None = None,
+    comfort: Sequence[bool] | None = None,
+) -> Path:
     """Fronts ``(label, F (N, m))`` over ``objectives`` ``(name, unit)`` - the first the
     optimised front, the rest pseudo-fronts of the same designs - as the first objective
     against each other one (Figs. 7.5, 8.22-8.24); then each design variable
@@ -62,22 +73,35 @@ def pareto_fronts(path: str | Path, title: str, objectives: Sequence[tuple[str, 
     for ax, (i, j) in zip(axes, pairs):
         F0 = fronts[0][1]
         points = {name: (F0[k, i], F0[k, j]) for name, k in (marks or {}).items()}
-        draw_front(ax, [(label, F[:, i], F[:, j]) for label, F in fronts], x_label,
-                   axis_label(*objectives[j]), points, bool(comfort and comfort[0]))
+        draw_front(
+            ax,
+            [(label, F[:, i], F[:, j]) for label, F in fronts],
+            x_label,
+            axis_label(*objectives[j]),
+            points,
+            bool(comfort and comfort[0]),
+        )
     F0 = fronts[0][1]
-    for ax, (name, unit, values) in zip(axes[len(pairs):], variables):
+    for ax, (name, unit, values) in zip(axes[len(pairs) :], variables):
         draw_design_variable(ax, F0[:, 0], values, x_label, axis_label(name, unit))
     fig.suptitle(title)
     return save(fig, path)
 
 
-def sensitivity(path: str | Path, title: str, x: np.ndarray, x_label: str,
-                panels: Sequence[Mapping[str, np.ndarray]], y_label: str,
-                marker: float | None = None, marker_label: str = "") -> Path:
+def sensitivity(
+    path: str | Path,
+    title: str,
+    x: np.ndarray,
+    x_label: str,
+    panels: Sequence[Mapping[str, np.ndarray]],
+    y_label: str,
+    marker: float | None = None,
+    marker_label: str = "",
+) -> Path:
     """Sensitivity curves: one panel per mapping of ``panels`` (curve name -> (X,) values
     over ``x``), a zero line, and a dashed vertical ``marker`` (e.g. the base law's share)."""
     fig, axes = new_figure(len(panels), columns=1, panel_size=(7.0, 3.0))
-    for k, (ax, curves) in enumerate(zip(axes, panels)):
+    for ax, curves in zip(axes, panels):
         for name, values in curves.items():
             ax.plot(x, values, "o-", label=name)
         ax.axhline(0, color="0.6", lw=0.8)
@@ -91,10 +115,13 @@ def sensitivity(path: str | Path, title: str, x: np.ndarray, x_label: str,
     return save(fig, path)
 
 
-def transmissibilities(path: str | Path, title: str,
-                       lines: Sequence[tuple[str, np.ndarray, np.ndarray]],
-                       points: Sequence[tuple[str, np.ndarray, np.ndarray]] = (),
-                       f_range: tuple[float, float] = (0.1, 30.0)) -> Path:
+def transmissibilities(
+    path: str | Path,
+    title: str,
+    lines: Sequence[tuple[str, np.ndarray, np.ndarray]],
+    points: Sequence[tuple[str, np.ndarray, np.ndarray]] = (),
+    f_range: tuple[float, float] = (0.1, 30.0),
+) -> Path:
     """Transmissibility magnitudes [-] on a log frequency axis: ``lines`` ``(label, f, T)``
     (e.g. linearised) as lines, ``points`` (e.g. simulated, H1, where coherent) as dots in
     the colours of the lines of the same position."""
@@ -134,26 +161,55 @@ def plot_kesort(selection, path: str | Path) -> Path:
         rows = s.case == label
         style = dict(marker=markers[c % len(markers)], label=label, s=28)
         if two:
-            points = front.scatter(F[rows, 0], F[rows, 1], c=levels[rows], cmap="viridis",
-                                   vmin=lo, vmax=hi if hi > lo else lo + 1, **style)
+            points = front.scatter(
+                F[rows, 0],
+                F[rows, 1],
+                c=levels[rows],
+                cmap="viridis",
+                vmin=lo,
+                vmax=hi if hi > lo else lo + 1,
+                **style,
+            )
         level_ax.scatter(F[rows, 0], levels[rows], **style)
     chosen = s.sort.chosen
     for ax, y in ((front, F[:, 1] if two else None), (level_ax, levels)):
         if ax is None:
             continue
-        ax.scatter(F[chosen, 0], y[chosen], marker="*", s=260, facecolor="none",
-                   edgecolor="red", linewidth=1.5, label="optimum (all)", zorder=3)
+        ax.scatter(
+            F[chosen, 0],
+            y[chosen],
+            marker="*",
+            s=260,
+            facecolor="none",
+            edgecolor="red",
+            linewidth=1.5,
+            label="optimum (all)",
+            zorder=3,
+        )
         for j, cs in enumerate(s.case_sorts.values()):
-            ax.scatter(F[cs.chosen, 0], y[cs.chosen], marker="s", s=110, facecolor="none",
-                       edgecolor="black", linewidth=1.0, zorder=3,
-                       label="optimum of each case" if j == 0 else None)
+            ax.scatter(
+                F[cs.chosen, 0],
+                y[cs.chosen],
+                marker="s",
+                s=110,
+                facecolor="none",
+                edgecolor="black",
+                linewidth=1.0,
+                zorder=3,
+                label="optimum of each case" if j == 0 else None,
+            )
     if two:
         at: dict[int, list[str]] = {}
         for key, i in s.picks.items():
             at.setdefault(i, []).append(key)
         for i, keys in at.items():
-            front.annotate(", ".join(keys), (F[i, 0], F[i, 1]), textcoords="offset points",
-                           xytext=(6, 6), fontsize=8)
+            front.annotate(
+                ", ".join(keys),
+                (F[i, 0], F[i, 1]),
+                textcoords="offset points",
+                xytext=(6, 6),
+                fontsize=8,
+            )
         front.set_xlabel(f"{names[0]} [{units[0]}]")
         front.set_ylabel(f"{names[1]} [{units[1]}]")
         fig.colorbar(points, ax=front, label="k-ε level (Eq 6.10, 6.12)")

@@ -4,16 +4,23 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-import numpy as np
-from ..metrics import COMFORT_REACTIONS
-from .style import (COMFORT_WEIGHTING, LABEL_GAP, axis_label, curve_styles, draw_curves)
 
+import numpy as np
+
+from ..metrics import COMFORT_REACTIONS
+from .style import COMFORT_WEIGHTING, LABEL_GAP, axis_label, curve_styles, draw_curves
 
 # --- panels --------------------------------------------------------------------------------
 
-def draw_time_responses(ax, series: Sequence[tuple[str, np.ndarray, np.ndarray]],
-                        name: str, unit: str, styles: Sequence[dict] | None = None,
-                        legend: bool = True) -> None:
+
+def draw_time_responses(
+    ax,
+    series: Sequence[tuple[str, np.ndarray, np.ndarray]],
+    name: str,
+    unit: str,
+    styles: Sequence[dict] | None = None,
+    legend: bool = True,
+) -> None:
     """Time histories ``(label, t [s], y)`` of one signal, one line per label, in ``styles``
     (default :func:`curve_styles`); ``legend`` False leaves it to the figure."""
     draw_curves(ax, series, styles, log=False)
@@ -24,13 +31,25 @@ def draw_time_responses(ax, series: Sequence[tuple[str, np.ndarray, np.ndarray]]
         ax.legend(fontsize=8)
 
 
-def draw_spectra(ax, series: Sequence[tuple[str, np.ndarray, np.ndarray]], name: str,
-                 unit: str, f_range: tuple[float, float] = (0.1, 30.0),
-                 styles: Sequence[dict] | None = None, legend: bool = True) -> None:
+def draw_spectra(
+    ax,
+    series: Sequence[tuple[str, np.ndarray, np.ndarray]],
+    name: str,
+    unit: str,
+    f_range: tuple[float, float] = (0.1, 30.0),
+    styles: Sequence[dict] | None = None,
+    legend: bool = True,
+) -> None:
     """Spectra ``(label, f [Hz], value)`` on log-log axes, within ``f_range``, in ``styles``
     (default :func:`curve_styles`); ``legend`` False leaves it to the figure."""
-    band = [(label, f[(f >= f_range[0]) & (f <= f_range[1])],
-             value[(f >= f_range[0]) & (f <= f_range[1])]) for label, f, value in series]
+    band = [
+        (
+            label,
+            f[(f >= f_range[0]) & (f <= f_range[1])],
+            value[(f >= f_range[0]) & (f <= f_range[1])],
+        )
+        for label, f, value in series
+    ]
     # zeros (a signal at rest) have no logarithm: masked, not drawn
     band = [(label, f, np.where(v > 0, v, np.nan)) for label, f, v in band]
     draw_curves(ax, band, styles, log=True)
@@ -65,27 +84,29 @@ def draw_comfort_levels(ax, axis: str = "x", outside: bool = False) -> None:
 
     vertical = axis == "x"
     low, high = ax.get_xlim() if vertical else ax.get_ylim()
-    edges = [(lower, label) for lower, _upper, label in COMFORT_REACTIONS[1:]
-             if low < lower < high]
+    edges = [(lower, label) for lower, _upper, label in COMFORT_REACTIONS[1:] if low < lower < high]
     line = ax.axvline if vertical else ax.axhline
     for lower, _label in edges:
         line(lower, color="0.5", ls=":", lw=0.8, zorder=1)
     to_axes = ax.transAxes.inverted()
-    fraction = [to_axes.transform(ax.transData.transform(
-        (lower, 1.0) if vertical else (1.0, lower)))[0 if vertical else 1]
-        for lower, _label in edges]
+    fraction = [
+        to_axes.transform(ax.transData.transform((lower, 1.0) if vertical else (1.0, lower)))[
+            0 if vertical else 1
+        ]
+        for lower, _label in edges
+    ]
     # a label needs LABEL_GAP line heights (1.2 font sizes) along the axis; the axes' size
     # is taken before the constrained layout shrinks it a little
     box = ax.get_position()
-    length = (box.width * ax.figure.get_figwidth() if vertical else
-              box.height * ax.figure.get_figheight())
+    length = (
+        box.width * ax.figure.get_figwidth() if vertical else box.height * ax.figure.get_figheight()
+    )
     gap = LABEL_GAP * 1.2 * (7 if outside else 6) / 72.0 / max(length, 1e-3)
     edges = [edge for edge, keep in zip(edges, _spaced(fraction, gap)) if keep]
     if outside:
         second = ax.secondary_xaxis("top") if vertical else ax.secondary_yaxis("right")
         target = second.xaxis if vertical else second.yaxis
-        target.set_ticks([lower for lower, _label in edges],
-                         [label for _lower, label in edges])
+        target.set_ticks([lower for lower, _label in edges], [label for _lower, label in edges])
         target.set_minor_locator(NullLocator())
         second.tick_params(labelsize=7, colors="0.35", length=2)
         if vertical:
@@ -93,14 +114,27 @@ def draw_comfort_levels(ax, axis: str = "x", outside: bool = False) -> None:
         return
     for lower, label in edges:
         x, y = (lower, 1.0) if vertical else (1.0, lower)
-        ax.annotate(label, (x, y), xycoords=("data", "axes fraction") if vertical else
-                    ("axes fraction", "data"), fontsize=6, color="0.4",
-                    rotation=90 if vertical else 0, ha="right", va="top")
+        ax.annotate(
+            label,
+            (x, y),
+            xycoords=("data", "axes fraction") if vertical else ("axes fraction", "data"),
+            fontsize=6,
+            color="0.4",
+            rotation=90 if vertical else 0,
+            ha="right",
+            va="top",
+        )
 
 
-def draw_front(ax, fronts: Sequence[tuple[str, np.ndarray, np.ndarray]], x_label: str,
-               y_label: str, marks: Mapping[str, tuple[float, float]] | None = None,
-               comfort: bool = False, legend: bool = True) -> None:
+def draw_front(
+    ax,
+    fronts: Sequence[tuple[str, np.ndarray, np.ndarray]],
+    x_label: str,
+    y_label: str,
+    marks: Mapping[str, tuple[float, float]] | None = None,
+    comfort: bool = False,
+    legend: bool = True,
+) -> None:
     """Fronts ``(label, x (N,), y (N,))`` as points, the first one (the optimised front)
     filled, the others (pseudo-fronts) hollow; ``marks`` (name -> (x, y)) as labelled stars;
     ``comfort`` draws the ISO 2631-1 levels on the x axis; ``legend`` False leaves the
@@ -124,8 +158,9 @@ def draw_front(ax, fronts: Sequence[tuple[str, np.ndarray, np.ndarray]], x_label
         ax.legend(fontsize=8)
 
 
-def draw_design_variable(ax, objective: np.ndarray, values: np.ndarray, x_label: str,
-                         y_label: str) -> None:
+def draw_design_variable(
+    ax, objective: np.ndarray, values: np.ndarray, x_label: str, y_label: str
+) -> None:
     """One design variable along the front against an objective (Figs. 8.11-8.20)."""
     order = np.argsort(objective, kind="stable")
     ax.plot(objective[order], values[order], "o-", ms=3, lw=0.8)
@@ -134,9 +169,14 @@ def draw_design_variable(ax, objective: np.ndarray, values: np.ndarray, x_label:
     ax.grid(alpha=0.3)
 
 
-def draw_weighted_rms(ax, names: Sequence[str], values: np.ndarray,
-                      labels: Sequence[str], styles: Sequence[dict] | None = None,
-                      weighting: str = COMFORT_WEIGHTING) -> None:
+def draw_weighted_rms(
+    ax,
+    names: Sequence[str],
+    values: np.ndarray,
+    labels: Sequence[str],
+    styles: Sequence[dict] | None = None,
+    weighting: str = COMFORT_WEIGHTING,
+) -> None:
     """ISO 2631-1 weighted r.m.s. ``values (S, P)`` [m/s^2] of ``S`` accelerations ``names``
     for ``P`` designs ``labels``: one point per design beside the others at each signal, in
     the designs' colours and markers (``styles``), on a log axis that spans at least the
@@ -150,13 +190,27 @@ def draw_weighted_rms(ax, names: Sequence[str], values: np.ndarray,
     width = 0.6 / P
     for j, (label, style) in enumerate(zip(labels, styles)):
         x = np.arange(S) + (j - (P - 1) / 2) * width
-        ax.plot(x, values[:, j], ls="none", marker=style.get("marker", "o"), ms=6,
-                color=style["color"], mec=style.get("mec", style["color"]), label=label)
+        ax.plot(
+            x,
+            values[:, j],
+            ls="none",
+            marker=style.get("marker", "o"),
+            ms=6,
+            color=style["color"],
+            mec=style.get("mec", style["color"]),
+            label=label,
+        )
         if P <= 3:
             for xi, v in zip(x, values[:, j]):
                 if np.isfinite(v):
-                    ax.annotate(f"{v:.3g}", (xi, v), textcoords="offset points",
-                                xytext=(6, 0), va="center", fontsize=7)
+                    ax.annotate(
+                        f"{v:.3g}",
+                        (xi, v),
+                        textcoords="offset points",
+                        xytext=(6, 0),
+                        va="center",
+                        fontsize=7,
+                    )
     finite = values[np.isfinite(values) & (values > 0)]
     low = min(0.2, 0.7 * finite.min()) if finite.size else 0.2
     high = max(1.0, 1.4 * finite.max()) if finite.size else 1.0
@@ -172,8 +226,9 @@ def draw_weighted_rms(ax, names: Sequence[str], values: np.ndarray,
     draw_comfort_levels(ax, "y", outside=True)
 
 
-def draw_history(ax, generation: np.ndarray, values: np.ndarray, name: str,
-                 unit: str, title: str | None = None) -> None:
+def draw_history(
+    ax, generation: np.ndarray, values: np.ndarray, name: str, unit: str, title: str | None = None
+) -> None:
     """``values`` per ``generation`` (NaN where there is none yet, e.g. no feasible design)
     as a line with points over every generation; the panel's title is ``title``, by default
     the last finite value."""
@@ -185,11 +240,11 @@ def draw_history(ax, generation: np.ndarray, values: np.ndarray, name: str,
     ok = np.flatnonzero(np.isfinite(values))
     if title is None and ok.size:
         k = ok[-1]
-        title = f"generation {generation[k]:g}: {values[k]:.4g}" + \
-            ("" if unit in ("", "1") else f" {unit}")
+        title = f"generation {generation[k]:g}: {values[k]:.4g}" + (
+            "" if unit in ("", "1") else f" {unit}"
+        )
     if not ok.size:
-        ax.text(0.5, 0.5, "none yet", transform=ax.transAxes, ha="center", va="center",
-                color="0.4")
+        ax.text(0.5, 0.5, "none yet", transform=ax.transAxes, ha="center", va="center", color="0.4")
     if title:
         ax.set_title(title, fontsize=9)
     if generation.size:

@@ -5,12 +5,29 @@ from __future__ import annotations
 import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-import numpy as np
-from .style import (SAME_STYLE, MAX_DESIGNS, PSD_SEGMENT, COMFORT_WEIGHTING, FAILED_VALUE, check_path, figure_class, new_figure, save, axis_label, curve_styles, figure_legend, legend_entries, figure_title)
-from .panels import (draw_time_responses, draw_spectra, draw_front, draw_weighted_rms, draw_history)
 
+import numpy as np
+
+from .panels import draw_front, draw_history, draw_spectra, draw_time_responses, draw_weighted_rms
+from .style import (
+    COMFORT_WEIGHTING,
+    FAILED_VALUE,
+    MAX_DESIGNS,
+    PSD_SEGMENT,
+    SAME_STYLE,
+    axis_label,
+    check_path,
+    curve_styles,
+    figure_class,
+    figure_legend,
+    figure_title,
+    legend_entries,
+    new_figure,
+    save,
+)
 
 # --- simulate and optimise -----------------------------------------------------------------
+
 
 def _comfort_signals(names: Sequence[str], units: Mapping[str, str]) -> list[str]:
     """The translational accelerations of ``names`` a person feels (the body, the seat, the
@@ -18,8 +35,13 @@ def _comfort_signals(names: Sequence[str], units: Mapping[str, str]) -> list[str
     return [n for n in names if units[n] == "m/s^2" and not n.startswith("wheel.")]
 
 
-def simulation_figure(time: np.ndarray, signals: Mapping[str, np.ndarray],
-                      units: Mapping[str, str], labels: Sequence[str], title: str = ""):
+def simulation_figure(
+    time: np.ndarray,
+    signals: Mapping[str, np.ndarray],
+    units: Mapping[str, str],
+    labels: Sequence[str],
+    title: str = "",
+):
     """The figure of :func:`plot_simulation` from arrays, unsaved: ``signals`` (name ->
     ``(P, T)`` over ``time (T,)`` [s]) with their ``units``, one design per row, ``labels``
     ``(P,)``. One row per signal: its time history (left) and its one-sided Welch PSD
@@ -44,43 +66,73 @@ def simulation_figure(time: np.ndarray, signals: Mapping[str, np.ndarray],
     comfort = _comfort_signals(names, units)
     rows = len(names) + bool(comfort)
     Figure = figure_class()
-    fig = Figure(figsize=(9.6, 2.5 * len(names) + (2.9 if comfort else 0.0) + 0.6),
-                 layout="constrained")
-    grid = fig.add_gridspec(rows, 2, height_ratios=[1.0] * len(names) +
-                            ([1.15] if comfort else []))
+    fig = Figure(
+        figsize=(9.6, 2.5 * len(names) + (2.9 if comfort else 0.0) + 0.6), layout="constrained"
+    )
+    grid = fig.add_gridspec(rows, 2, height_ratios=[1.0] * len(names) + ([1.15] if comfort else []))
     segment = min(time.size, round(PSD_SEGMENT * fs))
     for r, name in enumerate(names):
         values = np.asarray(signals[name], dtype=float).reshape(P, -1)
         # a signal the designs do not change (the body under a one-way seat) is one curve
         same = P > 1 and all(np.array_equal(v, values[0], equal_nan=True) for v in values)
-        drawn, row_labels, row_styles = (values[:1], ["every design"], [SAME_STYLE]) if same \
-            else (values, labels, styles)
+        drawn, row_labels, row_styles = (
+            (values[:1], ["every design"], [SAME_STYLE]) if same else (values, labels, styles)
+        )
         ax = fig.add_subplot(grid[r, 0])
-        draw_time_responses(ax, [(label, time, y) for label, y in zip(row_labels, drawn)],
-                            name, units[name], row_styles, legend=False)
+        draw_time_responses(
+            ax,
+            [(label, time, y) for label, y in zip(row_labels, drawn)],
+            name,
+            units[name],
+            row_styles,
+            legend=False,
+        )
         if same:
             ax.set_title(f"the same for all {P} designs", fontsize=9)
         with np.errstate(invalid="ignore"):
             f, spectrum = psd(drawn, fs, segment)
         ax = fig.add_subplot(grid[r, 1])
-        draw_spectra(ax, [(label, f, s) for label, s in zip(row_labels, spectrum)], "PSD",
-                     METRICS["var"].unit(units[name]) + "/Hz", styles=row_styles,
-                     legend=False)
+        draw_spectra(
+            ax,
+            [(label, f, s) for label, s in zip(row_labels, spectrum)],
+            "PSD",
+            METRICS["var"].unit(units[name]) + "/Hz",
+            styles=row_styles,
+            legend=False,
+        )
         ax.set_title(f"PSD of {name}", fontsize=9)
     if comfort:
         ax = fig.add_subplot(grid[rows - 1, :])
         if fs >= MIN_SAMPLE_RATE:
             with np.errstate(invalid="ignore"):
-                rms = np.array([weighted_rms(np.asarray(signals[n], dtype=float).reshape(P, -1),
-                                             fs, COMFORT_WEIGHTING) for n in comfort])
+                rms = np.array(
+                    [
+                        weighted_rms(
+                            np.asarray(signals[n], dtype=float).reshape(P, -1),
+                            fs,
+                            COMFORT_WEIGHTING,
+                        )
+                        for n in comfort
+                    ]
+                )
             draw_weighted_rms(ax, comfort, rms, labels, styles)
-            ax.set_title(f"ISO 2631-1 {COMFORT_WEIGHTING}-weighted r.m.s. and comfort "
-                         f"reactions (Annex C.2.3)", fontsize=9)
+            ax.set_title(
+                f"ISO 2631-1 {COMFORT_WEIGHTING}-weighted r.m.s. and comfort "
+                f"reactions (Annex C.2.3)",
+                fontsize=9,
+            )
         else:
             ax.set_axis_off()
-            ax.text(0.5, 0.5, f"no ISO 2631-1 weighted r.m.s.: the signals are sampled at "
-                    f"{fs:g} Hz, the weighting needs {MIN_SAMPLE_RATE:g} Hz or more "
-                    f"(simulation.output_dt)", ha="center", va="center", fontsize=9)
+            ax.text(
+                0.5,
+                0.5,
+                f"no ISO 2631-1 weighted r.m.s.: the signals are sampled at "
+                f"{fs:g} Hz, the weighting needs {MIN_SAMPLE_RATE:g} Hz or more "
+                f"(simulation.output_dt)",
+                ha="center",
+                va="center",
+                fontsize=9,
+            )
     if P > 1:
         figure_legend(fig, legend_entries(styles, labels))
     figure_title(fig, title)
@@ -98,18 +150,23 @@ def _short_names(paths: Sequence[str]) -> list[str]:
     return list(paths)
 
 
-def design_labels(designs: Mapping[str, np.ndarray], chosen: Sequence[int], P: int,
-                   diverged_at: np.ndarray) -> list[str]:
+def design_labels(
+    designs: Mapping[str, np.ndarray], chosen: Sequence[int], P: int, diverged_at: np.ndarray
+) -> list[str]:
     """``#i`` and the parameters that vary over the P designs (three at most), and where a
     design diverged."""
-    varying = [k for k, v in designs.items()
-               if np.size(v) == P and P > 1 and np.ptp(np.asarray(v, dtype=float)) > 0]
+    varying = [
+        k
+        for k, v in designs.items()
+        if np.size(v) == P and P > 1 and np.ptp(np.asarray(v, dtype=float)) > 0
+    ]
     short = _short_names(varying)
     labels = []
     for i in chosen:
         label = "design" if P == 1 else f"#{i}"
-        values = [f"{s}={float(np.asarray(designs[k])[i]):.4g}"
-                  for s, k in zip(short[:3], varying[:3])]
+        values = [
+            f"{s}={float(np.asarray(designs[k])[i]):.4g}" for s, k in zip(short[:3], varying[:3])
+        ]
         if values:
             label += " " + ", ".join(values) + (", ..." if len(varying) > 3 else "")
         if np.isfinite(diverged_at[i]):
@@ -136,25 +193,32 @@ def chosen_designs(P: int, designs: Sequence[int] | None) -> tuple[list[int], st
         if P <= MAX_DESIGNS:
             return list(range(P)), ""
         chosen = sorted({int(round(x)) for x in np.linspace(0, P - 1, MAX_DESIGNS)})
-        return chosen, (f"{len(chosen)} of {P} designs drawn (evenly spaced by index; at "
-                        f"most {MAX_DESIGNS} on one figure)")
+        return chosen, (
+            f"{len(chosen)} of {P} designs drawn (evenly spaced by index; at "
+            f"most {MAX_DESIGNS} on one figure)"
+        )
     chosen = [int(i) for i in designs]
     if not chosen:
         raise ValueError("designs: choose at least one design")
     if len(chosen) > MAX_DESIGNS:
-        raise ValueError(f"designs: {len(chosen)} designs; at most {MAX_DESIGNS} fit on one "
-                         f"figure")
+        raise ValueError(f"designs: {len(chosen)} designs; at most {MAX_DESIGNS} fit on one figure")
     if len(set(chosen)) != len(chosen):
         raise ValueError("designs: a design is chosen twice")
     bad = [i for i in chosen if not 0 <= i < P]
     if bad:
-        raise ValueError(f"designs: {', '.join(map(str, bad))} out of range: the result has "
-                         f"{P} design{'s' if P > 1 else ''} (0 to {P - 1})")
+        raise ValueError(
+            f"designs: {', '.join(map(str, bad))} out of range: the result has "
+            f"{P} design{'s' if P > 1 else ''} (0 to {P - 1})"
+        )
     return chosen, "" if len(chosen) == P else f"{len(chosen)} of {P} designs drawn"
 
 
-def plot_simulation(result, path: str | Path, signals: Sequence[str] | None = None,
-                    designs: Sequence[int] | None = None) -> Path:
+def plot_simulation(
+    result,
+    path: str | Path,
+    signals: Sequence[str] | None = None,
+    designs: Sequence[int] | None = None,
+) -> Path:
     """Draw a :class:`suspopt.simulate.Result` (:func:`simulation_figure`) to ``path`` (.png
     or .svg): ``signals`` (default :func:`default_signals`) of the ``designs`` (indices;
     default every design, or :data:`MAX_DESIGNS` of them evenly spaced by index when there
@@ -167,24 +231,34 @@ def plot_simulation(result, path: str | Path, signals: Sequence[str] | None = No
     for name in names:
         if name not in result.signals:
             close = difflib.get_close_matches(name, list(result.signals), n=3)
-            raise ValueError(f"unknown signal {name!r}" +
-                             (f"; did you mean {', '.join(close)}?" if close else ""))
+            raise ValueError(
+                f"unknown signal {name!r}"
+                + (f"; did you mean {', '.join(close)}?" if close else "")
+            )
     P = result.P
     chosen, note = chosen_designs(P, designs)
     labels = design_labels(result.designs, chosen, P, np.asarray(result.diverged_at))
     cfg = result.config
     source = cfg.source.name if getattr(cfg, "source", None) else "simulation"
-    title = f"{source}: road {cfg.road.kind}, {P} design{'s' if P > 1 else ''}" + \
-        (f"; {note}" if note else "")
+    title = f"{source}: road {cfg.road.kind}, {P} design{'s' if P > 1 else ''}" + (
+        f"; {note}" if note else ""
+    )
     data = {name: np.asarray(result.signals[name])[chosen] for name in names}
-    fig = simulation_figure(result.time, data, {n: result.signal_unit(n) for n in names},
-                            labels, title)
+    fig = simulation_figure(
+        result.time, data, {n: result.signal_unit(n) for n in names}, labels, title
+    )
     return save(fig, path)
 
 
-def optimisation_figure(F: np.ndarray, G: np.ndarray, names: Sequence[str],
-                        units: Sequence[str], history: Mapping[str, np.ndarray],
-                        title: str = "", weights: np.ndarray | None = None):
+def optimisation_figure(
+    F: np.ndarray,
+    G: np.ndarray,
+    names: Sequence[str],
+    units: Sequence[str],
+    history: Mapping[str, np.ndarray],
+    title: str = "",
+    weights: np.ndarray | None = None,
+):
     """The figure of :func:`plot_optimisation` from arrays, unsaved: the optimum ``F (N,
     m)`` with constraints ``G (N, k)`` (G <= 0 feasible) over objectives ``names`` and
     ``units``, and the ``history`` of ``/history`` (generation, best, hypervolume,
@@ -211,10 +285,13 @@ def optimisation_figure(F: np.ndarray, G: np.ndarray, names: Sequence[str],
         summary = None
         if (~failed).any():
             k = int(np.flatnonzero(~failed)[0])
-            values = ", ".join(f"{n} = {F[k, j]:.4g}" + ("" if u in ("", "1") else f" {u}")
-                               for j, (n, u) in enumerate(zip(names, units)))
-            summary = "\n".join(textwrap.wrap(
-                f"best design{'' if feasible[k] else ' (infeasible)'}: {values}", 60))
+            values = ", ".join(
+                f"{n} = {F[k, j]:.4g}" + ("" if u in ("", "1") else f" {u}")
+                for j, (n, u) in enumerate(zip(names, units))
+            )
+            summary = "\n".join(
+                textwrap.wrap(f"best design{'' if feasible[k] else ' (infeasible)'}: {values}", 60)
+            )
         draw_history(axes[0], generation, best, f"best {name}", unit, summary)
     else:
         pairs = [(i, j) for i in range(m) for j in range(i + 1, m)]
@@ -224,18 +301,23 @@ def optimisation_figure(F: np.ndarray, G: np.ndarray, names: Sequence[str],
             fronts = [("feasible", F[feasible, i], F[feasible, j])]
             if other.any():
                 fronts.append(("infeasible (a constraint G > 0)", F[other, i], F[other, j]))
-            draw_front(ax, fronts, axis_label(names[i], units[i]),
-                       axis_label(names[j], units[j]), legend=False)
+            draw_front(
+                ax,
+                fronts,
+                axis_label(names[i], units[i]),
+                axis_label(names[j], units[j]),
+                legend=False,
+            )
             ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
-        draw_history(axes[len(pairs)], generation, history["hypervolume"],
-                     "hypervolume (normalised)", "1")
+        draw_history(
+            axes[len(pairs)], generation, history["hypervolume"], "hypervolume (normalised)", "1"
+        )
         figure_legend(fig, axes[0])
     ax = axes[-1]
     draw_history(ax, generation, share, "feasible share", "1")
     ax.set_ylim(-0.05, 1.05)
     if failed.any():
-        title += f" ({int(failed.sum())} failed design{'s' if failed.sum() > 1 else ''} " \
-                 f"not drawn)"
+        title += f" ({int(failed.sum())} failed design{'s' if failed.sum() > 1 else ''} not drawn)"
     figure_title(fig, title)
     return fig
 
@@ -248,10 +330,16 @@ def plot_optimisation(result, path: str | Path) -> Path:
     generations = len(np.atleast_1d(history["generation"]))
     evaluations = int(history["evaluations"][-1]) if generations else 0
     N, m = np.atleast_2d(result.F).shape
-    what = "best design" if (m == 1 or result.weights is not None) else \
-        f"{N} design{'s' if N > 1 else ''} on the front"
-    title = (f"{Path(result.path).name} ({result.status}): {what}, {generations} "
-             f"generation{'s' if generations != 1 else ''}, {evaluations} evaluations")
-    fig = optimisation_figure(result.F, result.G, result.obj_names, result.obj_units,
-                              history, title, result.weights)
+    what = (
+        "best design"
+        if (m == 1 or result.weights is not None)
+        else f"{N} design{'s' if N > 1 else ''} on the front"
+    )
+    title = (
+        f"{Path(result.path).name} ({result.status}): {what}, {generations} "
+        f"generation{'s' if generations != 1 else ''}, {evaluations} evaluations"
+    )
+    fig = optimisation_figure(
+        result.F, result.G, result.obj_names, result.obj_units, history, title, result.weights
+    )
     return save(fig, path)

@@ -6,15 +6,20 @@ import math
 import textwrap
 from collections.abc import Sequence
 from pathlib import Path
+
 import numpy as np
-
-
 
 #: Figure formats, by file suffix.
 FORMATS = {".png": "png", ".svg": "svg"}
 #: Line styles cycled with the colours (solid first, then dashes of distinct rhythms).
-_LINES = ("-", (0, (6, 2)), (0, (2, 1.5)), (0, (7, 2, 1.5, 2)), (0, (1, 1)),
-          (0, (4, 1.5, 1, 1.5, 1, 1.5)))
+_LINES = (
+    "-",
+    (0, (6, 2)),
+    (0, (2, 1.5)),
+    (0, (7, 2, 1.5, 2)),
+    (0, (1, 1)),
+    (0, (4, 1.5, 1, 1.5, 1, 1.5)),
+)
 #: Marker shapes cycled with the colours.
 _MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*", "<", ">")
 #: Markers per curve, spread evenly along the x axis.
@@ -40,8 +45,7 @@ def check_path(path: str | Path) -> Path:
     before computing, so that a bad name fails before anything is written."""
     path = Path(path)
     if path.suffix.lower() not in FORMATS:
-        raise ValueError(f"--plot {path}: the figure's suffix must be one of "
-                         f"{', '.join(FORMATS)}")
+        raise ValueError(f"--plot {path}: the figure's suffix must be one of {', '.join(FORMATS)}")
     return path
 
 
@@ -98,13 +102,22 @@ def curve_styles(n: int) -> list[dict]:
     if n <= 1:
         return [dict(color="C0", ls="-", lw=1.2)]
     step = min(0.7, 2.4 / (n - 1))
-    return [dict(color=f"C{i % 10}", ls=_LINES[i % len(_LINES)],
-                 lw=_THINNEST + step * (n - 1 - i), marker=_MARKERS[i % len(_MARKERS)],
-                 ms=4.5, mec=f"C{i % 10}") for i in range(n)]
+    return [
+        dict(
+            color=f"C{i % 10}",
+            ls=_LINES[i % len(_LINES)],
+            lw=_THINNEST + step * (n - 1 - i),
+            marker=_MARKERS[i % len(_MARKERS)],
+            ms=4.5,
+            mec=f"C{i % 10}",
+        )
+        for i in range(n)
+    ]
 
 
-def mark_indices(x: np.ndarray, i: int, n: int, count: int = MARKS_PER_CURVE,
-                 log: bool = False) -> np.ndarray:
+def mark_indices(
+    x: np.ndarray, i: int, n: int, count: int = MARKS_PER_CURVE, log: bool = False
+) -> np.ndarray:
     """Sample indices at which curve ``i`` of ``n`` over the ascending ``x`` gets its
     markers: ``count`` points evenly spaced along x (in log10 x if ``log``), shifted by
     ``(i + 1/2)/n`` of a spacing, so that the markers of coinciding curves interleave. A
@@ -125,8 +138,12 @@ def mark_indices(x: np.ndarray, i: int, n: int, count: int = MARKS_PER_CURVE,
     return where[nearest[keep]]
 
 
-def draw_curves(ax, series: Sequence[tuple[str, np.ndarray, np.ndarray]],
-                 styles: Sequence[dict] | None, log: bool) -> None:
+def draw_curves(
+    ax,
+    series: Sequence[tuple[str, np.ndarray, np.ndarray]],
+    styles: Sequence[dict] | None,
+    log: bool,
+) -> None:
     """``(label, x, y)`` curves in ``styles`` (default :func:`curve_styles`), markers at
     :func:`mark_indices`."""
     styles = list(styles) if styles is not None else curve_styles(len(series))
@@ -149,8 +166,7 @@ def figure_legend(fig, entries, fontsize: float = 8) -> None:
     """One legend for the figure, with the entries of an axes, or ``entries`` ``(handles,
     labels)``: in the grid's first unused cell when there is one, else below all panels;
     outside the panels either way, so it never hides data."""
-    handles, labels = entries if isinstance(entries, tuple) else \
-        entries.get_legend_handles_labels()
+    handles, labels = entries if isinstance(entries, tuple) else entries.get_legend_handles_labels()
     if not handles:
         return
     spare = [a for a in fig.axes if not a.get_visible()]
@@ -158,11 +174,23 @@ def figure_legend(fig, entries, fontsize: float = 8) -> None:
         cell = spare[0]
         cell.set_visible(True)
         cell.set_axis_off()
-        cell.legend(handles, labels, loc="center", fontsize=fontsize, frameon=False,
-                    ncols=1 if len(labels) <= 12 else 2)
+        cell.legend(
+            handles,
+            labels,
+            loc="center",
+            fontsize=fontsize,
+            frameon=False,
+            ncols=1 if len(labels) <= 12 else 2,
+        )
         return
-    fig.legend(handles, labels, loc="outside lower center", fontsize=fontsize,
-               ncols=_legend_columns(fig, labels, fontsize), frameon=False)
+    fig.legend(
+        handles,
+        labels,
+        loc="outside lower center",
+        fontsize=fontsize,
+        ncols=_legend_columns(fig, labels, fontsize),
+        frameon=False,
+    )
 
 
 def legend_entries(styles: Sequence[dict], labels: Sequence[str]) -> tuple[list, list]:

@@ -14,11 +14,20 @@ from .model import PASSENGER_PARTS, build_seat, linearise
 
 #: Unit of each constraint value of :func:`seat_constraints`.
 CONSTRAINT_UNITS = {
-    "stability": "N/m", "gamma2_above_one": "-", "gamma2_within_gamma1": "-",
-    "stiffness_ratio_limit": "-", "static_deflection_exists": "-",
-    "roller_radius_positive": "m", "cam_offset_positive": "m", "cam_offset_within_radius": "m",
-    "precompression_positive": "m", "roller_within_cam": "m", "cam_offset_ratio": "m",
-    "c_I_upper": "-", "c_I_lower": "-", "hinge_within_bar": "m",
+    "stability": "N/m",
+    "gamma2_above_one": "-",
+    "gamma2_within_gamma1": "-",
+    "stiffness_ratio_limit": "-",
+    "static_deflection_exists": "-",
+    "roller_radius_positive": "m",
+    "cam_offset_positive": "m",
+    "cam_offset_within_radius": "m",
+    "precompression_positive": "m",
+    "roller_within_cam": "m",
+    "cam_offset_ratio": "m",
+    "c_I_upper": "-",
+    "c_I_lower": "-",
+    "hinge_within_bar": "m",
 }
 
 
@@ -27,8 +36,9 @@ def seat_static_deflection(cfg: Config, params: Mapping[str, Any] | None = None)
     return build_seat(cfg, ParamView(cfg, params)).static_deflection
 
 
-def seat_constraints(cfg: Config, params: Mapping[str, Any] | None = None,
-                     mu: float = 0.8) -> dict[str, np.ndarray]:
+def seat_constraints(
+    cfg: Config, params: Mapping[str, Any] | None = None, mu: float = 0.8
+) -> dict[str, np.ndarray]:
     """Geometric and static feasibility of every design as constraint values, ``g <= 0``
     feasible, (P,) each (units in :data:`CONSTRAINT_UNITS`). Never raises for an infeasible
     design: an undefined geometry gives NaN or a positive value.
@@ -66,18 +76,29 @@ def seat_constraints(cfg: Config, params: Mapping[str, Any] | None = None,
     if seat.kind == "nss2":
         l_o = get("spring_free_length")
         g1, g2 = get("bar_length") / l_o, get("wall_distance") / l_o
-        out.update(gamma2_above_one=1.0 - g2, gamma2_within_gamma1=g2 - g1,
-                   stiffness_ratio_limit=get("stiffness_ratio") - g1 / (2.0 * (1.0 + g1 - g2)),
-                   static_deflection_exists=g2 - 1.0 - g1)
+        out.update(
+            gamma2_above_one=1.0 - g2,
+            gamma2_within_gamma1=g2 - g1,
+            stiffness_ratio_limit=get("stiffness_ratio") - g1 / (2.0 * (1.0 + g1 - g2)),
+            static_deflection_exists=g2 - 1.0 - g1,
+        )
     elif seat.kind == "nss3":
         R, r, d = get("cam_radius"), get("roller_radius"), get("cam_offset")
-        out.update(roller_radius_positive=-r, cam_offset_positive=-d,
-                   cam_offset_within_radius=d - R, precompression_positive=-get("precompression"),
-                   roller_within_cam=r - R, cam_offset_ratio=d - mu * R)
+        out.update(
+            roller_radius_positive=-r,
+            cam_offset_positive=-d,
+            cam_offset_within_radius=d - R,
+            precompression_positive=-get("precompression"),
+            roller_within_cam=r - R,
+            cam_offset_ratio=d - mu * R,
+        )
     elif seat.kind == "nss4":
         c_i = seat.isolator["c_I"]
-        out.update(c_I_upper=c_i - 0.1, c_I_lower=-0.1 - c_i,
-                   hinge_within_bar=np.abs(get("hinge_offset")) - get("bar_length"))
+        out.update(
+            c_I_upper=c_i - 0.1,
+            c_I_lower=-0.1 - c_i,
+            hinge_within_bar=np.abs(get("hinge_offset")) - get("bar_length"),
+        )
     return out
 
 
@@ -105,8 +126,10 @@ def passenger_mass_change(cfg: Config, load_mass) -> dict[str, np.ndarray]:
         params = {"seat.mass": load_mass}
     else:
         scale = (load_mass - seat.mass) / (old - seat.mass)
-        params = {f"seat.passenger.{part}.mass": getattr(seat.passenger, part).mass * scale
-                  for part in PASSENGER_PARTS}
+        params = {
+            f"seat.passenger.{part}.mass": getattr(seat.passenger, part).mass * scale
+            for part in PASSENGER_PARTS
+        }
     if seat.kind in ("nss1", "nss2", "nss3"):
         params["seat.stiffness_ratio"] = seat.stiffness_ratio * old / load_mass
     return params

@@ -14,6 +14,7 @@ from ..network import widen
 # --------------------------------------------------------------------------------------------
 # Statics (Sec 8.2.2)
 
+
 def vertical_stiffness(load_mass, static_deflection, gravity):
     """``K_v = m g / X_ST`` [N/m]: the vertical spring that carries the load at the static
     deflection (Hooke's law at equilibrium, Sec 2.2.2-2.2.4, 8.2.2)."""
@@ -30,14 +31,14 @@ def nss1_static_deflection(wall_distance, gamma):
     (Eq 2.42 at the unloaded position, Sec 8.2.2): the inclined springs are free there. NaN
     unless ``0 < γ < 1``."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        return wall_distance * np.sqrt(1.0 / gamma ** 2 - 1.0)
+        return wall_distance * np.sqrt(1.0 / gamma**2 - 1.0)
 
 
 def nss2_static_deflection(wall_distance, spring_free_length, bar_length):
     """NSS2 static deflection ``X_ST = sqrt(b² - (a_o - L_o)²)`` [m] (Sec 2.2.3, 8.2.2);
     NaN where ``b <= |a_o - L_o|`` (no such geometry)."""
     with np.errstate(invalid="ignore"):
-        return np.sqrt(bar_length ** 2 - (wall_distance - spring_free_length) ** 2)
+        return np.sqrt(bar_length**2 - (wall_distance - spring_free_length) ** 2)
 
 
 def nss3_static_deflection(cam_radius, roller_radius, cam_offset):
@@ -62,6 +63,7 @@ def nss4_static_deflection(load_mass, inner_mass, support_stiffness, preload, gr
 
 # --------------------------------------------------------------------------------------------
 # Mechanism forces (exact geometry) and their Taylor series
+
 
 def _link_law(stiffness, offset, length) -> Callable[[np.ndarray], np.ndarray]:
     """``w -> 2 k (1 + c / sqrt(ℓ² - w²)) w``: two symmetric horizontal springs acting through
@@ -89,9 +91,9 @@ def _link_series(rest, stiffness, offset, length):
     """
     L2 = length * length
     D = L2 - rest * rest
-    k1 = 2.0 * stiffness * (1.0 + offset * L2 * D ** -1.5)
-    k2 = 3.0 * stiffness * offset * L2 * rest * D ** -2.5
-    k3 = stiffness * offset * L2 * (L2 + 4.0 * rest * rest) * D ** -3.5
+    k1 = 2.0 * stiffness * (1.0 + offset * L2 * D**-1.5)
+    k2 = 3.0 * stiffness * offset * L2 * rest * D**-2.5
+    k3 = stiffness * offset * L2 * (L2 + 4.0 * rest * rest) * D**-3.5
     return k1, k2, k3
 
 
@@ -112,7 +114,7 @@ def nss1_taylor(horizontal_stiffness, wall_distance, spring_free_length):
     ``k1 = 2 K_h (1 - γ)/γ``, ``k2 = 0``, ``k3 = -K_h / (L_o² γ³)``, ``γ = a_o/L_o`` — Eq 2.45
     with ``K_h = α K_v``."""
     k1 = 2.0 * horizontal_stiffness * (spring_free_length / wall_distance - 1.0)
-    k3 = -horizontal_stiffness * spring_free_length / wall_distance ** 3
+    k3 = -horizontal_stiffness * spring_free_length / wall_distance**3
     return k1, np.zeros_like(k1), k3
 
 
@@ -141,8 +143,7 @@ def _nss2_law(horizontal_stiffness, wall_distance, spring_free_length, bar_lengt
 def nss2_taylor(horizontal_stiffness, wall_distance, spring_free_length, bar_length):
     """Series of :func:`nss2_force` about ``u = 0``: ``k1 = 2 K_h (1 + γ1 - γ2)/γ1``, ``k2 = 0``,
     ``k3 = K_h (1 - γ2) / (L_o² γ1³)`` — Eq 2.52 with ``K_h = α K_v``."""
-    return _link_series(0.0, horizontal_stiffness, spring_free_length - wall_distance,
-                        bar_length)
+    return _link_series(0.0, horizontal_stiffness, spring_free_length - wall_distance, bar_length)
 
 
 def nss3_force(u, horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression):
@@ -155,21 +156,27 @@ def nss3_force(u, horizontal_stiffness, cam_radius, roller_radius, cam_offset, p
     distance less ``d + r``, and the contact normal gives the vertical share
     ``u / sqrt((R + r)² - u²)``.
     """
-    return _nss3_law(horizontal_stiffness, cam_radius, roller_radius, cam_offset,
-                     precompression)(u)
+    return _nss3_law(horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression)(u)
 
 
 def _nss3_law(horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression):
     """:func:`nss3_force` as a function of the travel (constants folded)."""
-    return _link_law(horizontal_stiffness, precompression - cam_offset - roller_radius,
-                     cam_radius + roller_radius)
+    return _link_law(
+        horizontal_stiffness,
+        precompression - cam_offset - roller_radius,
+        cam_radius + roller_radius,
+    )
 
 
 def nss3_taylor(horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression):
     """Series of :func:`nss3_force` about ``u = 0`` (the thesis prints none):
     ``k1 = 2 K_h (R + u_2 - d)/(R + r)``, ``k2 = 0``, ``k3 = K_h (u_2 - d - r)/(R + r)³``."""
-    return _link_series(0.0, horizontal_stiffness, precompression - cam_offset - roller_radius,
-                        cam_radius + roller_radius)
+    return _link_series(
+        0.0,
+        horizontal_stiffness,
+        precompression - cam_offset - roller_radius,
+        cam_radius + roller_radius,
+    )
 
 
 def nss3_contact_limit(cam_radius, roller_radius, cam_offset, precompression):
@@ -177,7 +184,7 @@ def nss3_contact_limit(cam_radius, roller_radius, cam_offset, precompression):
     their compression ``u_2 + sqrt((R + r)² - u²) - d - r`` stays positive (Sec 8.2.2: the
     precompression keeps the contact at the extreme positions); at most ``R + r``."""
     gap = np.maximum(cam_offset + roller_radius - precompression, 0.0)
-    return np.sqrt((cam_radius + roller_radius) ** 2 - gap ** 2)
+    return np.sqrt((cam_radius + roller_radius) ** 2 - gap**2)
 
 
 def nss4_force(u, horizontal_stiffness, wall_distance, spring_free_length, bar_length):
@@ -195,18 +202,19 @@ def nss4_force(u, horizontal_stiffness, wall_distance, spring_free_length, bar_l
 _nss4_law = _nss2_law
 
 
-def nss4_taylor(hinge_offset, horizontal_stiffness, wall_distance, spring_free_length,
-                bar_length):
+def nss4_taylor(hinge_offset, horizontal_stiffness, wall_distance, spring_free_length, bar_length):
     """Series of :func:`nss4_force` about the rest position ``u = u_0`` (the thesis prints
     none): ``f_ND(u_0 + δ) = k1 δ + k2 δ² + k3 δ³``; ``k2 ≠ 0`` since ``u_0 ≠ 0``."""
-    return _link_series(hinge_offset, horizontal_stiffness, spring_free_length - wall_distance,
-                        bar_length)
+    return _link_series(
+        hinge_offset, horizontal_stiffness, spring_free_length - wall_distance, bar_length
+    )
 
 
 # --------------------------------------------------------------------------------------------
 # The mechanism as an element
 
 _COMPLEX_STEP = 1.0e-20
+
 
 @dataclass
 class Mechanism:
@@ -261,8 +269,10 @@ class Mechanism:
         """``dF/dδ`` at rest, (P,) [N/m] (a positive slope is a negative stiffness), by
         complex-step differentiation: ``Im F(i h) / h`` is exact to rounding for these
         analytic forces, the same for the exact and the Taylor form."""
-        return np.atleast_2d(self.force(np.full((1, 1), 1j * _COMPLEX_STEP))).imag[:, 0] \
+        return (
+            np.atleast_2d(self.force(np.full((1, 1), 1j * _COMPLEX_STEP))).imag[:, 0]
             / _COMPLEX_STEP
+        )
 
     def coordinate(self, delta: np.ndarray) -> np.ndarray:
         """The mechanism coordinate ``w`` for the travel ``delta`` from rest [m]."""

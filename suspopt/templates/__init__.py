@@ -23,10 +23,9 @@ TEMPLATES: dict[str, str] = {
     "full": "full car of Table 3.1 on class B with independent left and right tracks",
     "seat": "Ch. 8 quarter car with a passive seat and the Table 2.3 passenger, class A",
     "semi_active": "Ch. 4 quarter car, SH-2 dampers, adaptive CDF threshold (control "
-                   "section), class C",
+    "section), class C",
     "optimise": "GA on the Ch. 5 half car (Case 1: comfort under Eq 5.2-5.3), small budget",
-    "kesort": "NSGA-II front of Ch. 6 Part B with supplementary objectives, for suspopt "
-              "kesort",
+    "kesort": "NSGA-II front of Ch. 6 Part B with supplementary objectives, for suspopt kesort",
 }
 
 
