@@ -12,6 +12,34 @@ preallocated buffers, with no Python loop over designs. Its parts are separate: 
 that meets a bump's edge is split there, the step bump's Dirac in the road's rate entering as
 an exact impulse, so every edge is seen at its instant.
 
+Road edges (``edges``; the bumps' jumps in z or its rate, Eq 2.101-2.104) are seen at their
+instants. A step whose interior holds edges is split at them into RK4 sub-steps; each
+sub-step's last stage takes the road's left limit at its end and the next one's first stage
+the right limit, so a step ending on an edge uses the left limit in its last stage and one
+starting on it (the grid) the right limit. Where the inputs jump by ``Δu`` their rate
+holds a Dirac ``Δu δ(t - t_e)``, integrated exactly: an impulse ``c D_u Δu`` [N s] of the
+viscous elements that see the road (the tyre damping c_T, Eq 2.29), so the velocities
+jump by ``M^-1 (-D_qᵀ) (c D_u Δu)`` at the edge (the elastic forces stay bounded and give
+no impulse). A tyre that may lift off cannot pull: its force is capped at the static load,
+so its impulse at an edge where it would pull (the road dropping away) is not applied; one
+that pushes is. A split step still makes one output sample, its controller sample (at the
+step's start) and one actuator-lag update; the sample's accelerations are the first stage
+of the step, as for any step. Only the few split steps allocate and call the road again;
+the others pay one dictionary look-up.
+
+The parts: :class:`_RK4` (the steps), :class:`_Recorder` (the samples),
+:class:`_ControllerHold` (the controller's samples, hold and lag) and
+:class:`_Divergence` (the check). A sample at ``t_k`` holds the state, the accelerations
+``f(y_k)`` - the first stage of step k, so they cost nothing more - and the controller's
+coefficients and records in force over step k (from ``t_k`` on); the last sample, where
+no step begins, asks the controller once more and evaluates the accelerations.
+
+A single design is integrated as two identical columns: BLAS multiplies one column by a
+matrix-vector kernel whose rounding differs from the matrix-matrix kernel's. Beyond that,
+OpenBLAS chooses its kernels by the shapes, batch width included, and some choices round
+some rows differently (by an ulp): a design re-simulated in a batch of another width agrees
+with its first run to rounding, while the same batch repeats bit for bit.
+
 A design whose state becomes non-finite or exceeds :data:`DIVERGENCE_LIMIT` gets its time in
 ``Trajectory.diverged_at`` and NaN samples from then on, so a diverged design can never pass
 for a valid one.
@@ -96,24 +124,6 @@ class _VehicleState:
         return self._acceleration()
 
 
-class _VehicleState:
-    """The vehicle's motion at the current step, as the controller reads it: one row per
-    vehicle DOF, one column per design."""
-
-    __slots__ = ("_velocity", "_acceleration")
-
-    def __init__(self, velocity: np.ndarray, acceleration: Callable[[], np.ndarray]):
-        self._velocity, self._acceleration = velocity, acceleration
-
-    def velocity(self) -> np.ndarray:
-        """(n_vehicle, P) [m/s, rad/s] (a view of the integrator's state)."""
-        return self._velocity
-
-    def acceleration(self) -> np.ndarray:
-        """(n_vehicle, P) [m/s^2, rad/s^2]."""
-        return self._acceleration()
-
-
 class Held:
     """A controller quantity held between changes: the distinct values ``(S, P, N)`` and, for
     each output sample, which of them held ``(T,)``. Expanded to ``(N, P, T)`` on demand, so a
@@ -169,20 +179,6 @@ class HeldRecords(Mapping):
 
 
 @dataclass
-class _Trajectory:
-    """What one integration produced: states (2n, P, T), accelerations (n, P, T), the damping
-    coefficients (held between changes, or (N, P, T) when a lagged actuator changes them
-    every step) and controller records (or None / empty without a controller) and the
-    divergence times (P,)."""
-
-    states: np.ndarray
-    accelerations: np.ndarray
-    damping: Held | np.ndarray | None
-    records: Mapping[str, Held]
-    diverged_at: np.ndarray
-
-
-@dataclass
 class Trajectory:
     """What one integration produced: states (2n, P, T), accelerations (n, P, T), the damping
     coefficients (held between changes, or (N, P, T) when a lagged actuator changes them
@@ -202,13 +198,7 @@ def _stacked(arrays: list[np.ndarray]) -> np.ndarray:
     return np.concatenate(arrays).reshape((len(arrays),) + arrays[0].shape)
 
 
-def _stacked(arrays: list[np.ndarray]) -> np.ndarray:
-    """``np.stack(arrays)`` of equal-shaped arrays (of at least one dimension) by one
-    concatenation: for thousands of small arrays np.stack takes about three times as long."""
-    return np.concatenate(arrays).reshape((len(arrays),) + arrays[0].shape)
-
-
-class _Edges(NamedTuple):
+class Edges(NamedTuple):
     """The road's edges (:func:`suspopt.road.road_edges`) as :func:`integrate` takes them."""
 
     times: np.ndarray  #: (E,) ascending [s]
@@ -218,9 +208,6 @@ class _Edges(NamedTuple):
     inputs: Callable[[np.ndarray, bool], np.ndarray]
     #: (R,) element rows that cannot pull (a tyre that may lift off), or None
     no_pull: np.ndarray | None
-
-
-Edges = _Edges
 
 
 class _Recorder:
@@ -529,35 +516,8 @@ def integrate(
 ) -> Trajectory:
     """Classical RK4 over ``n_steps``; ``offsets`` (2 n_steps + 1, 2R, 1, 1) are the inputs'
     part of the deformations on the half-step grid ``t = j dt/2`` (their right limits at a
-    road edge). Samples are kept every ``every``-th step.
-
-    Road edges (``edges``; the bumps' jumps in z or its rate, Eq 2.101-2.104) are seen at their
-    instants. A step whose interior holds edges is split at them into RK4 sub-steps; each
-    sub-step's last stage takes the road's left limit at its end and the next one's first stage
-    the right limit, so a step ending on an edge uses the left limit in its last stage and one
-    starting on it (the grid) the right limit. Where the inputs jump by ``Δu`` their rate
-    holds a Dirac ``Δu δ(t - t_e)``, integrated exactly: an impulse ``c D_u Δu`` [N s] of the
-    viscous elements that see the road (the tyre damping c_T, Eq 2.29), so the velocities
-    jump by ``M^-1 (-D_qᵀ) (c D_u Δu)`` at the edge (the elastic forces stay bounded and give
-    no impulse). A tyre that may lift off cannot pull: its force is capped at the static load,
-    so its impulse at an edge where it would pull (the road dropping away) is not applied; one
-    that pushes is. A split step still makes one output sample, its controller sample (at the
-    step's start) and one actuator-lag update; the sample's accelerations are the first stage
-    of the step, as for any step. Only the few split steps allocate and call the road again;
-    the others pay one dictionary look-up.
-
-    The parts: :class:`_RK4` (the steps), :class:`_Recorder` (the samples),
-    :class:`_ControllerHold` (the controller's samples, hold and lag) and
-    :class:`_Divergence` (the check). A sample at ``t_k`` holds the state, the accelerations
-    ``f(y_k)`` - the first stage of step k, so they cost nothing more - and the controller's
-    coefficients and records in force over step k (from ``t_k`` on); the last sample, where
-    no step begins, asks the controller once more and evaluates the accelerations.
-
-    A single design is integrated as two identical columns: BLAS multiplies one column by a
-    matrix-vector kernel whose rounding differs from the matrix-matrix kernel's. Beyond that,
-    OpenBLAS chooses its kernels by the shapes, batch width included, and some choices round
-    some rows differently (by an ulp): a design re-simulated in a batch of another width agrees
-    with its first run to rounding, while the same batch repeats bit for bit.
+    road edge). Samples are kept every ``every``-th step. Road edges, the samples, the
+    controller's hold and the batch width: see the module docstring.
     """
     n, P = asm.n, asm.P
     width = max(P, 2)

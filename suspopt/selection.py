@@ -326,20 +326,8 @@ def load_design_sets(
     return sets
 
 
-def select(
-    sets: Sequence[DesignSet],
-    eps=None,
-    *,
-    P=None,
-    normalise: str = "max",
-    feasible_only: bool = True,
-    P_range=(0.01, 1.0),
-    P_step: float = 0.01,
-) -> Selection:
-    """Pool ``sets`` and sort them by k-ε optimality (see the module docstring); ``eps``,
-    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`suspopt.kesort.kesort`.
-    ConfigError when the sets have different objectives or no design is left to sort."""
-    sets = list(sets)
+def _common_objectives(sets: list[DesignSet]) -> tuple[list[str], list[str]]:
+    """The objectives' names and units that every set shares; ConfigError where they differ."""
     names, units = sets[0].names, sets[0].units
     for s in sets[1:]:
         if sorted(s.names) != sorted(names):
@@ -354,12 +342,12 @@ def select(
                     f"{s.source} ({s.label}): objective {name} is in {unit}, in "
                     f"{units[names.index(name)]} for {sets[0].source}"
                 )
-    var_names, var_units = [], []
-    for s in sets:
-        for n, u in zip(s.var_names, s.var_units):
-            if n not in var_names:
-                var_names.append(n)
-                var_units.append(u)
+    return names, units
+
+
+def _kept(sets: list[DesignSet], feasible_only: bool) -> tuple[list[np.ndarray], list[str]]:
+    """Which designs of each set are sorted (not failed, feasible if asked) and the notes
+    saying what was left out."""
     notes = [note for s in sets for note in s.notes]
     keep = [~s.failed & (s.feasible if feasible_only else True) for s in sets]
     for s, k in zip(sets, keep):
@@ -369,6 +357,31 @@ def select(
             if dropped > dropped_failed:
                 why += (", " if why else "") + f"{dropped - dropped_failed} infeasible"
             notes.append(f"{s.source} ({s.label}): left out {dropped} of {len(k)} designs ({why})")
+    return keep, notes
+
+
+def select(
+    sets: Sequence[DesignSet],
+    eps=None,
+    *,
+    P=None,
+    normalise: str = "max",
+    feasible_only: bool = True,
+    P_range=(0.01, 1.0),
+    P_step: float = 0.01,
+) -> Selection:
+    """Pool ``sets`` and sort them by k-ε optimality (see the module docstring); ``eps``,
+    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`suspopt.kesort.kesort`.
+    ConfigError when the sets have different objectives or no design is left to sort."""
+    sets = list(sets)
+    names, units = _common_objectives(sets)
+    var_names, var_units = [], []
+    for s in sets:
+        for n, u in zip(s.var_names, s.var_units):
+            if n not in var_names:
+                var_names.append(n)
+                var_units.append(u)
+    keep, notes = _kept(sets, feasible_only)
     cases = list(dict.fromkeys(s.label for s in sets))
     for label in cases:
         if not any(k.any() for s, k in zip(sets, keep) if s.label == label):

@@ -135,16 +135,9 @@ def _corner_geometry(pv: ParamView, body_dofs: tuple[str, ...], corners: tuple[s
     return x, y
 
 
-def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
-    """Assemble the batched model of ``cfg.vehicle`` for the designs in ``pv``."""
-    pv = pv or ParamView(cfg)
-    veh = cfg.vehicle
-    P = pv.P
-    corners = PRESET_CORNERS[veh.preset]
-    body_dofs = PRESET_BODY_DOFS[veh.preset]
-    nb, N = len(body_dofs), len(corners)
-    n = nb + N
-    x, y = _corner_geometry(pv, body_dofs, corners)
+def _corner_parameters(pv: ParamView, veh, corners: tuple[str, ...]):
+    """Per-corner parameters (P, N): unsprung mass [kg], tyre stiffness [N/m] and damping
+    [N s/m], spring linear [N/m] and cubic [N/m^3] coefficients, damper coefficient [N s/m]."""
 
     def corner_param(key: str, positive: bool = False) -> np.ndarray:
         get = pv.require_positive if positive else pv.get
@@ -165,6 +158,38 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     for name, arr in (("tyre.damping", ct), ("damper.c (c_min if semi-active)", c)):
         if np.any(arr < 0):
             raise ConfigError(f"params: vehicle.corners.*.{name}: must be >= 0")
+    return mu, kt, ct, kl, knl, c
+
+
+def _wheelbase_offsets(cfg: Config, pv: ParamView, corners: tuple[str, ...]) -> np.ndarray:
+    """Distance of each corner behind the front axle (N,) [m], the road's wheelbase delay; zero
+    without it."""
+    veh = cfg.vehicle
+    rear = np.array([cn[0] == "R" for cn in corners])
+    wheelbase = (veh.body.a_front or 0.0) + (veh.body.a_rear or 0.0)
+    offsets = np.where(rear, wheelbase, 0.0) if cfg.road.wheelbase_delay else np.zeros(len(corners))
+    if pv.varies("vehicle.body.a_front") or pv.varies("vehicle.body.a_rear"):
+        if any(cn[0] == "R" for cn in corners):
+            raise ConfigError(
+                "params: vehicle.body.a_front/a_rear cannot be design parameters "
+                "of a model with a rear axle: the road's wheelbase delay is one "
+                "per run"
+            )
+    return offsets
+
+
+def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
+    """Assemble the batched model of ``cfg.vehicle`` for the designs in ``pv``."""
+    pv = pv or ParamView(cfg)
+    veh = cfg.vehicle
+    P = pv.P
+    corners = PRESET_CORNERS[veh.preset]
+    body_dofs = PRESET_BODY_DOFS[veh.preset]
+    nb, N = len(body_dofs), len(corners)
+    n = nb + N
+    x, y = _corner_geometry(pv, body_dofs, corners)
+
+    mu, kt, ct, kl, knl, c = _corner_parameters(pv, veh, corners)
 
     mass = np.empty((P, n))
     for j, dof in enumerate(body_dofs):
@@ -198,16 +223,7 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     if veh.tyre_lift_off:
         tyre = network.group("tyre")
         tyre.extra, tyre.extra_uses_force = tyre_lift_off(static), True
-    rear = np.array([cn[0] == "R" for cn in corners])
-    wheelbase = (veh.body.a_front or 0.0) + (veh.body.a_rear or 0.0)
-    offsets = np.where(rear, wheelbase, 0.0) if cfg.road.wheelbase_delay else np.zeros(N)
-    if pv.varies("vehicle.body.a_front") or pv.varies("vehicle.body.a_rear"):
-        if any(cn[0] == "R" for cn in corners):
-            raise ConfigError(
-                "params: vehicle.body.a_front/a_rear cannot be design parameters "
-                "of a model with a rear axle: the road's wheelbase delay is one "
-                "per run"
-            )
+    offsets = _wheelbase_offsets(cfg, pv, corners)
     sides = tuple("right" if cn[1] == "1" else "left" for cn in corners)
     e = (slice(None), None, slice(None))
     return VehicleModel(

@@ -104,6 +104,30 @@ def _check(cfg) -> None:
         )
 
 
+def _write(
+    output: Path, cfg, active: list[str], laws: list[str], tables: dict, threshold, unit: str
+) -> None:
+    """``/cdf_sensitivity``: the shares asked for and achieved, the final thresholds (in the
+    laws' condition unit) and the metrics of the base law, with the CDF threshold and their
+    reduction [%] (layout: README, "HDF5 files")."""
+    with atomic_h5(output, cfg) as h5:
+        grp = h5.create_group("cdf_sensitivity")
+        grp.attrs["laws"] = ",".join(laws)
+        grp.attrs["distribution"] = cfg.control.threshold.distribution
+        grp.attrs["corners"] = ",".join(active)
+        share = ("c_max_share",)
+        write_dataset(grp, "c_max_share", SHARES, "1", dims=share)
+        write_dataset(grp, "achieved_share", tables["cdf"]["share"], "1", dims=share)
+        write_dataset(grp, "base_share", tables["base"]["share"], "1")
+        dims = ("c_max_share", "corner")
+        write_dataset(grp, "final_threshold", threshold, unit, dims=dims, coords={"corner": active})
+        for key, values in tables.items():
+            group = grp.create_group(key)
+            for name, m_unit in METRIC_UNITS.items():
+                units = "%" if key == "reduction" else m_unit
+                write_dataset(group, name, values[name], units, dims=() if key == "base" else share)
+
+
 def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
     """Sweep the C_max share 20-70 % against the base law (module docstring)."""
     if plot is not None:
@@ -130,42 +154,12 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
     )
 
     if output is not None:
-        with atomic_h5(output, cfg) as h5:
-            grp = h5.create_group("cdf_sensitivity")
-            grp.attrs["laws"] = ",".join(laws)
-            grp.attrs["distribution"] = spec.distribution
-            grp.attrs["corners"] = ",".join(active)
-
-            share = ("c_max_share",)
-            write_dataset(grp, "c_max_share", SHARES, "1", dims=share)
-            write_dataset(grp, "achieved_share", values["share"][1:], "1", dims=share)
-            write_dataset(grp, "base_share", values["share"][0], "1")
-            write_dataset(
-                grp,
-                "final_threshold",
-                threshold,
-                unit,
-                dims=("c_max_share", "corner"),
-                coords={"corner": active},
-            )
-            for key, group in (
-                ("base", grp.create_group("base")),
-                ("cdf", grp.create_group("cdf")),
-                ("reduction", grp.create_group("reduction")),
-            ):
-                for name, m_unit in METRIC_UNITS.items():
-                    data = {
-                        "base": base[name],
-                        "cdf": values[name][1:],
-                        "reduction": reduction[name],
-                    }[key]
-                    write_dataset(
-                        group,
-                        name,
-                        data,
-                        "%" if key == "reduction" else m_unit,
-                        dims=() if key == "base" else share,
-                    )
+        tables = {
+            "base": base,
+            "cdf": {k: v[1:] for k, v in values.items()},
+            "reduction": reduction,
+        }
+        _write(output, cfg, active, laws, tables, threshold, unit)
     if plot is not None:
         plots.sensitivity(
             plot,

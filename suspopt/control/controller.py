@@ -27,7 +27,8 @@ from ..config.control import Control
 from ..params import ParamView
 from ..vehicle import VehicleModel
 from .laws import LAWS, PARAMETERS, Motion
-from .stats import StudentTSummary, distribution_quantile, t_quantile
+from .stats import distribution_quantile, t_quantile
+from .summary import StudentTSummary
 
 __all__ = ["SemiActiveController", "build_controller"]
 
@@ -275,16 +276,8 @@ class SemiActiveController:
         return records
 
 
-def build_controller(
-    cfg: Config, pv: ParamView, model: VehicleModel
-) -> SemiActiveController | None:
-    """The controller of ``cfg``'s semi-active dampers for the designs of ``pv``; None when
-    every damper is passive. Law parameters, lag and threshold settings may vary per design
-    (dotted paths in ``pv``); the sample time is one per run."""
-    dampers = [cfg.vehicle.corners[c].damper for c in model.corners]
-    if all(d.kind == "passive" for d in dampers):
-        return None
-    control = cfg.control or Control()
+def _sample_ratio(cfg: Config, pv: ParamView, control: Control) -> float:
+    """Integration steps per controller sample ``ΔT / dt``: a whole number, one per run."""
     sim = cfg.simulation
     ratio = control.sample_time / sim.dt
     if ratio < 1 - 1e-9 or abs(ratio - round(ratio)) > 1e-6:
@@ -299,6 +292,51 @@ def build_controller(
             "params: control.sample_time cannot vary between designs: the "
             "controller samples once per run"
         )
+
+    return ratio
+
+
+def _threshold(cfg: Config, pv: ParamView, control: Control, laws: list, n_corners: int):
+    """The fixed CDF threshold ``(P, 1, N)`` (zero when there is none or it adapts) and the
+    adaptive threshold's settings by keyword (empty unless ``mode: adaptive``)."""
+    threshold = np.zeros((pv.P, 1, n_corners))
+    settings = {}
+    spec = control.threshold
+    if spec is not None and spec.mode == "fixed":
+        units = {LAWS[law].unit for law in laws if law is not None}
+        if len(units) > 1:
+            raise cfg.error(
+                ("control", "threshold", "value"),
+                "one fixed threshold cannot serve "
+                f"conditions of different units ({', '.join(sorted(units))}); "
+                "give the corners laws of one unit or use mode adaptive",
+            )
+        threshold = threshold + pv.get("control.threshold.value")[:, None, None]
+    elif spec is not None:
+        base = "control.threshold."
+        settings = dict(
+            c_max_share=_per_design(pv, base + "c_max_share", 0.0, None, True),
+            learn_time=_per_design(pv, base + "learn_time", 0.0, low_open=True),
+            refit_factor=_per_design(pv, base + "refit_factor", 0.0, low_open=True),
+            distribution=spec.distribution,
+        )
+        if np.any(settings["c_max_share"] >= 1):
+            raise ConfigError(f"params: {base}c_max_share: must be in (0, 1)")
+    return threshold, settings
+
+
+def build_controller(
+    cfg: Config, pv: ParamView, model: VehicleModel
+) -> SemiActiveController | None:
+    """The controller of ``cfg``'s semi-active dampers for the designs of ``pv``; None when
+    every damper is passive. Law parameters, lag and threshold settings may vary per design
+    (dotted paths in ``pv``); the sample time is one per run."""
+    dampers = [cfg.vehicle.corners[c].damper for c in model.corners]
+    if all(d.kind == "passive" for d in dampers):
+        return None
+    control = cfg.control or Control()
+    sim = cfg.simulation
+    ratio = _sample_ratio(cfg, pv, control)
 
     def setting(
         path: str, default: float, low: float, high: float | None = None, low_open: bool = False
@@ -344,29 +382,7 @@ def build_controller(
         return np.stack(values, axis=1)[:, None, :]
 
     lag = setting("control.actuator_lag", 0.0, 0.0)[:, None, None]
-    threshold = np.zeros((pv.P, 1, len(model.corners)))
-    settings = {}
-    spec = control.threshold
-    if spec is not None and spec.mode == "fixed":
-        units = {LAWS[law].unit for law in laws if law is not None}
-        if len(units) > 1:
-            raise cfg.error(
-                ("control", "threshold", "value"),
-                "one fixed threshold cannot serve "
-                f"conditions of different units ({', '.join(sorted(units))}); "
-                "give the corners laws of one unit or use mode adaptive",
-            )
-        threshold = threshold + pv.get("control.threshold.value")[:, None, None]
-    elif spec is not None:
-        base = "control.threshold."
-        settings = dict(
-            c_max_share=_per_design(pv, base + "c_max_share", 0.0, None, True),
-            learn_time=_per_design(pv, base + "learn_time", 0.0, low_open=True),
-            refit_factor=_per_design(pv, base + "refit_factor", 0.0, low_open=True),
-            distribution=spec.distribution,
-        )
-        if np.any(settings["c_max_share"] >= 1):
-            raise ConfigError(f"params: {base}c_max_share: must be in (0, 1)")
+    threshold, settings = _threshold(cfg, pv, control, laws, len(model.corners))
     return SemiActiveController(
         model,
         laws,

@@ -53,7 +53,7 @@ from pymoo.indicators.hv import HV
 from ..config import Config, ConfigError
 from ..config.optimise import ALGORITHMS
 from ..config.optimise import Hybrid as HybridSettings
-from ..io import atomic_h5, write_dataset
+from ..io import atomic_h5
 from .algorithms import (
     Gradient,
     Hybrid,
@@ -65,6 +65,7 @@ from .algorithms import (
     pymoo_algorithm,
     termination,
 )
+from .output import read_checkpoint, write_checkpoint, write_history, write_pareto
 from .problem import PENALTY, Problem
 
 __all__ = ["optimise", "build_optimiser", "Progress", "OptimisationResult"]
@@ -106,10 +107,6 @@ class OptimisationResult:
     status: str
     path: Path
     weights: np.ndarray | None = None
-
-
-#: ``/checkpoint`` attribute ``format`` of the data-only checkpoint.
-CHECKPOINT_FORMAT = "replay-1"
 
 
 class _Recorder(_PymooProblem):
@@ -434,60 +431,9 @@ def _snapshot(run: _Run, problem: Problem) -> _Snapshot:
     )
 
 
-def _read_checkpoint(output: Path, cfg: Config, problem: Problem):
-    """The stored batches ``[(X, F, G), ...]``, generations and history of ``output``;
-    ConfigError naming the file and the dataset for anything missing or malformed."""
-    from ..h5read import H5Reader
-
-    where = f"--resume: {output}"
-    if not output.exists():
-        raise ConfigError(f"{where}: does not exist (run without --resume to start)")
-    with H5Reader(output, where) as h5:
-        if h5.text_attr("config") != cfg.text:
-            raise ConfigError(
-                f"{where}: was written for another config (its YAML text "
-                f"differs); use the same config or run without --resume"
-            )
-        if "checkpoint/state" in h5.file:
-            raise ConfigError(
-                f"{where}: /checkpoint/state: an old checkpoint (a pickle), "
-                f"which suspopt no longer loads: a file must never run code; "
-                f"run without --resume"
-            )
-        group = h5.group("checkpoint")
-        if group.attrs.get("format") != CHECKPOINT_FORMAT:
-            raise ConfigError(
-                f"{where}: /checkpoint: not a suspopt checkpoint of format {CHECKPOINT_FORMAT}"
-            )
-        generations = h5.int_attr("checkpoint", "generations", 0, 10**7)
-        sizes = h5.array("checkpoint/batches", ndim=1, integer=True)
-        X = h5.array("checkpoint/X", ndim=2, columns=problem.n_var)
-        F = h5.array("checkpoint/F", ndim=2, columns=problem.n_obj)
-        G = h5.array("checkpoint/G", ndim=2, columns=problem.n_ieq_constr)
-        history = {
-            key: h5.array(f"history/{key}", ndim=2 if key == "best" else 1)
-            for key in ("generation", "best", "hypervolume", "evaluations", "time", "feasible")
-        }
-    if (sizes < 1).any() or sizes.sum() != len(X) or not len(X) == len(F) == len(G):
-        raise ConfigError(
-            f"{where}: /checkpoint: batches of {int(sizes.sum())} designs, "
-            f"X, F, G of {len(X)}, {len(F)}, {len(G)}"
-        )
-    if not np.isfinite(X).all():
-        raise ConfigError(f"{where}: /checkpoint/X: values must be finite")
-    if len(history["time"]) != generations:
-        raise ConfigError(
-            f"{where}: /history/time: {len(history['time'])} generations, the "
-            f"checkpoint {generations}"
-        )
-    edges = np.concatenate([[0], np.cumsum(sizes)])
-    batches = [(X[a:b], F[a:b], G[a:b]) for a, b in zip(edges[:-1], edges[1:])]
-    return batches, generations, history
-
-
 def _resume(output: Path, cfg: Config, problem: Problem, optimiser: Optimiser) -> _Run:
     """The run checkpointed in ``output`` (module docstring), rebuilt by replaying it."""
-    batches, generations, stored = _read_checkpoint(output, cfg, problem)
+    batches, generations, stored = read_checkpoint(output, cfg, problem)
     run = _start(cfg, _Recorder(problem, batches, output), optimiser)
     for generation in range(generations):
         if not run.optimiser.has_next():
@@ -532,82 +478,10 @@ def _write(
             generations=snap.generation,
             evaluations=snap.evaluations,
         )
-        pareto = h5.create_group("pareto")
-        if weights is not None:
-            pareto.attrs["weights"] = weights
-        o = snap.optimum
-        write_dataset(
-            pareto,
-            "X",
-            o.X,
-            problem.var_units,
-            dims=("design", "variable"),
-            names=problem.var_names,
-        )
-        write_dataset(
-            pareto,
-            "F",
-            o.F,
-            problem.obj_units,
-            dims=("design", "objective"),
-            names=problem.obj_names,
-        )
-        write_dataset(
-            pareto,
-            "G",
-            o.G,
-            problem.constraint_units,
-            dims=("design", "constraint"),
-            names=problem.constraint_names,
-        )
-        hist = h5.create_group("history")
-        units = {
-            "generation": "1",
-            "hypervolume": "1",
-            "evaluations": "1",
-            "time": "s",
-            "feasible": "1",
-        }
-        write_dataset(hist, "generation", snap.history["generation"], "1", dims=("generation",))
-        for key, values in snap.history.items():
-            if key == "best":
-                write_dataset(
-                    hist,
-                    key,
-                    values.reshape(len(values), -1),
-                    best_units,
-                    dims=("generation", "objective"),
-                    names=best_names,
-                )
-            elif key != "generation":
-                write_dataset(hist, key, values, units[key], dims=("generation",))
-        batches = run_batches[: snap.batches]
-        checkpoint = h5.create_group("checkpoint")
-        checkpoint.attrs.update(format=CHECKPOINT_FORMAT, generations=snap.generation)
-        for j, (key, columns, units, dim, names) in enumerate(
-            (
-                ("X", problem.n_var, problem.search_units, "variable", problem.var_names),
-                ("F", problem.n_obj, problem.obj_units, "objective", problem.obj_names),
-                (
-                    "G",
-                    problem.n_ieq_constr,
-                    problem.constraint_units,
-                    "constraint",
-                    problem.constraint_names,
-                ),
-            )
-        ):
-            data = np.concatenate([b[j] for b in batches]) if batches else np.empty((0, columns))
-            write_dataset(
-                checkpoint, key, data, units, dims=("evaluation", dim), coords={dim: names}
-            )
-        write_dataset(
-            checkpoint,
-            "batches",
-            np.array([len(b[0]) for b in batches], dtype=np.int64),
-            "1",
-            dims=("batch",),
-        )
+        write_pareto(h5, problem, snap.optimum, weights)
+        write_history(h5, snap.history, best_names, best_units)
+        write_checkpoint(h5, problem, run_batches[: snap.batches], snap.generation)
+    o = snap.optimum
     return OptimisationResult(
         X=o.X,
         F=o.F,

@@ -140,6 +140,16 @@ def transmissibilities(
     return save(fig, path)
 
 
+def _mark_optima(ax, x: np.ndarray, y: np.ndarray, s) -> None:
+    """The pool's k-ε optimum (a red star) and each case's own (open squares) at ``(x, y)``."""
+    optimum = dict(marker="*", s=260, facecolor="none", edgecolor="red", linewidth=1.5)
+    ax.scatter(x[s.sort.chosen], y[s.sort.chosen], label="optimum (all)", zorder=3, **optimum)
+    own = dict(marker="s", s=110, facecolor="none", edgecolor="black", linewidth=1.0)
+    for j, cs in enumerate(s.case_sorts.values()):
+        label = "optimum of each case" if j == 0 else None
+        ax.scatter(x[cs.chosen], y[cs.chosen], zorder=3, label=label, **own)
+
+
 def plot_kesort(selection, path: str | Path) -> Path:
     """The k-ε levels over the front (Fig. 6.7, 7.5, 7.6) of a
     :class:`suspopt.selection.Selection`.
@@ -171,33 +181,9 @@ def plot_kesort(selection, path: str | Path) -> Path:
                 **style,
             )
         level_ax.scatter(F[rows, 0], levels[rows], **style)
-    chosen = s.sort.chosen
     for ax, y in ((front, F[:, 1] if two else None), (level_ax, levels)):
-        if ax is None:
-            continue
-        ax.scatter(
-            F[chosen, 0],
-            y[chosen],
-            marker="*",
-            s=260,
-            facecolor="none",
-            edgecolor="red",
-            linewidth=1.5,
-            label="optimum (all)",
-            zorder=3,
-        )
-        for j, cs in enumerate(s.case_sorts.values()):
-            ax.scatter(
-                F[cs.chosen, 0],
-                y[cs.chosen],
-                marker="s",
-                s=110,
-                facecolor="none",
-                edgecolor="black",
-                linewidth=1.0,
-                zorder=3,
-                label="optimum of each case" if j == 0 else None,
-            )
+        if ax is not None:
+            _mark_optima(ax, F[:, 0], y, s)
     if two:
         at: dict[int, list[str]] = {}
         for key, i in s.picks.items():

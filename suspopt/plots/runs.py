@@ -35,6 +35,82 @@ def _comfort_signals(names: Sequence[str], units: Mapping[str, str]) -> list[str
     return [n for n in names if units[n] == "m/s^2" and not n.startswith("wheel.")]
 
 
+def _signal_row(fig, left, right, time, name: str, values, unit: str, labels, styles) -> None:
+    """One signal's time history (``left`` grid cell) and Welch PSD (``right``), ``values``
+    ``(P, T)`` [unit] over ``time (T,)`` [s]."""
+    from ..metrics import psd
+    from ..specs import METRICS
+
+    P = len(values)
+    fs = 1.0 / float(time[1] - time[0])
+    segment = min(time.size, round(PSD_SEGMENT * fs))
+    # a signal the designs do not change (the body under a one-way seat) is one curve
+    same = P > 1 and all(np.array_equal(v, values[0], equal_nan=True) for v in values)
+    drawn, row_labels, row_styles = (
+        (values[:1], ["every design"], [SAME_STYLE]) if same else (values, labels, styles)
+    )
+    ax = fig.add_subplot(left)
+    draw_time_responses(
+        ax,
+        [(label, time, y) for label, y in zip(row_labels, drawn)],
+        name,
+        unit,
+        row_styles,
+        legend=False,
+    )
+    if same:
+        ax.set_title(f"the same for all {P} designs", fontsize=9)
+    with np.errstate(invalid="ignore"):
+        f, spectrum = psd(drawn, fs, segment)
+    ax = fig.add_subplot(right)
+    draw_spectra(
+        ax,
+        [(label, f, s) for label, s in zip(row_labels, spectrum)],
+        "PSD",
+        METRICS["var"].unit(unit) + "/Hz",
+        styles=row_styles,
+        legend=False,
+    )
+    ax.set_title(f"PSD of {name}", fontsize=9)
+
+
+def _comfort_panel(ax, signals, comfort: list[str], fs: float, labels, styles) -> None:
+    """The ISO 2631-1 weighted r.m.s. of the ``comfort`` signals against the comfort
+    reactions, or a note when the sampling rate ``fs`` [Hz] is too low for the weighting."""
+    from ..metrics.iso2631 import MIN_SAMPLE_RATE, weighted_rms
+
+    P = len(labels)
+    if fs >= MIN_SAMPLE_RATE:
+        with np.errstate(invalid="ignore"):
+            rms = np.array(
+                [
+                    weighted_rms(
+                        np.asarray(signals[n], dtype=float).reshape(P, -1),
+                        fs,
+                        COMFORT_WEIGHTING,
+                    )
+                    for n in comfort
+                ]
+            )
+        draw_weighted_rms(ax, comfort, rms, labels, styles)
+        ax.set_title(
+            f"ISO 2631-1 {COMFORT_WEIGHTING}-weighted r.m.s. and comfort reactions (Annex C.2.3)",
+            fontsize=9,
+        )
+    else:
+        ax.set_axis_off()
+        ax.text(
+            0.5,
+            0.5,
+            f"no ISO 2631-1 weighted r.m.s.: the signals are sampled at "
+            f"{fs:g} Hz, the weighting needs {MIN_SAMPLE_RATE:g} Hz or more "
+            f"(simulation.output_dt)",
+            ha="center",
+            va="center",
+            fontsize=9,
+        )
+
+
 def simulation_figure(
     time: np.ndarray,
     signals: Mapping[str, np.ndarray],
@@ -50,10 +126,6 @@ def simulation_figure(
     is at least 100 Hz, their ISO 2631-1 :data:`COMFORT_WEIGHTING`-weighted r.m.s. against
     the comfort reactions (:func:`draw_weighted_rms`). Each design keeps one
     :func:`curve_styles` style throughout; the legend (several designs) is below."""
-    from ..metrics import psd
-    from ..metrics.iso2631 import MIN_SAMPLE_RATE, weighted_rms
-    from ..specs import METRICS
-
     time = np.asarray(time, dtype=float)
     if time.size < 2:
         raise ValueError("a simulation figure needs at least two samples")
@@ -70,69 +142,11 @@ def simulation_figure(
         figsize=(9.6, 2.5 * len(names) + (2.9 if comfort else 0.0) + 0.6), layout="constrained"
     )
     grid = fig.add_gridspec(rows, 2, height_ratios=[1.0] * len(names) + ([1.15] if comfort else []))
-    segment = min(time.size, round(PSD_SEGMENT * fs))
     for r, name in enumerate(names):
         values = np.asarray(signals[name], dtype=float).reshape(P, -1)
-        # a signal the designs do not change (the body under a one-way seat) is one curve
-        same = P > 1 and all(np.array_equal(v, values[0], equal_nan=True) for v in values)
-        drawn, row_labels, row_styles = (
-            (values[:1], ["every design"], [SAME_STYLE]) if same else (values, labels, styles)
-        )
-        ax = fig.add_subplot(grid[r, 0])
-        draw_time_responses(
-            ax,
-            [(label, time, y) for label, y in zip(row_labels, drawn)],
-            name,
-            units[name],
-            row_styles,
-            legend=False,
-        )
-        if same:
-            ax.set_title(f"the same for all {P} designs", fontsize=9)
-        with np.errstate(invalid="ignore"):
-            f, spectrum = psd(drawn, fs, segment)
-        ax = fig.add_subplot(grid[r, 1])
-        draw_spectra(
-            ax,
-            [(label, f, s) for label, s in zip(row_labels, spectrum)],
-            "PSD",
-            METRICS["var"].unit(units[name]) + "/Hz",
-            styles=row_styles,
-            legend=False,
-        )
-        ax.set_title(f"PSD of {name}", fontsize=9)
+        _signal_row(fig, grid[r, 0], grid[r, 1], time, name, values, units[name], labels, styles)
     if comfort:
-        ax = fig.add_subplot(grid[rows - 1, :])
-        if fs >= MIN_SAMPLE_RATE:
-            with np.errstate(invalid="ignore"):
-                rms = np.array(
-                    [
-                        weighted_rms(
-                            np.asarray(signals[n], dtype=float).reshape(P, -1),
-                            fs,
-                            COMFORT_WEIGHTING,
-                        )
-                        for n in comfort
-                    ]
-                )
-            draw_weighted_rms(ax, comfort, rms, labels, styles)
-            ax.set_title(
-                f"ISO 2631-1 {COMFORT_WEIGHTING}-weighted r.m.s. and comfort "
-                f"reactions (Annex C.2.3)",
-                fontsize=9,
-            )
-        else:
-            ax.set_axis_off()
-            ax.text(
-                0.5,
-                0.5,
-                f"no ISO 2631-1 weighted r.m.s.: the signals are sampled at "
-                f"{fs:g} Hz, the weighting needs {MIN_SAMPLE_RATE:g} Hz or more "
-                f"(simulation.output_dt)",
-                ha="center",
-                va="center",
-                fontsize=9,
-            )
+        _comfort_panel(fig.add_subplot(grid[rows - 1, :]), signals, comfort, fs, labels, styles)
     if P > 1:
         figure_legend(fig, legend_entries(styles, labels))
     figure_title(fig, title)

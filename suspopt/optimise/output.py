@@ -1,0 +1,126 @@
+"""The groups of an optimisation's HDF5 output (layout: README, "HDF5 files"): the optimum
+``/pareto``, the ``/history`` per generation and the data-only ``/checkpoint`` that a
+``--resume`` replays."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..config import Config, ConfigError
+from ..io import write_dataset
+from .problem import Problem
+
+#: Format of the ``/checkpoint`` group: every evaluated design and its objectives, in batches.
+CHECKPOINT_FORMAT = "replay-1"
+
+
+def _tables(problem: Problem, x_units):
+    """(name, columns, units, dimension, names) of the design, objective and constraint tables."""
+    return (
+        ("X", problem.n_var, x_units, "variable", problem.var_names),
+        ("F", problem.n_obj, problem.obj_units, "objective", problem.obj_names),
+        (
+            "G",
+            problem.n_ieq_constr,
+            problem.constraint_units,
+            "constraint",
+            problem.constraint_names,
+        ),
+    )
+
+
+def write_pareto(h5, problem: Problem, optimum, weights) -> None:
+    """``/pareto/X, F, G`` of the optimum designs (physical variables, SI units)."""
+    pareto = h5.create_group("pareto")
+    if weights is not None:
+        pareto.attrs["weights"] = weights
+    values = {"X": optimum.X, "F": optimum.F, "G": optimum.G}
+    for key, _, units, dim, names in _tables(problem, problem.var_units):
+        write_dataset(pareto, key, values[key], units, dims=("design", dim), names=names)
+
+
+def write_history(h5, history: dict, best_names, best_units) -> None:
+    """``/history``: per generation the best objectives (or weighted sum), the hypervolume,
+    the evaluations, the time [s] and the feasible share."""
+    hist = h5.create_group("history")
+    units = {
+        "generation": "1",
+        "hypervolume": "1",
+        "evaluations": "1",
+        "time": "s",
+        "feasible": "1",
+    }
+    write_dataset(hist, "generation", history["generation"], "1", dims=("generation",))
+    for key, values in history.items():
+        if key == "best":
+            best = values.reshape(len(values), -1)
+            dims = ("generation", "objective")
+            write_dataset(hist, key, best, best_units, dims=dims, names=best_names)
+        elif key != "generation":
+            write_dataset(hist, key, values, units[key], dims=("generation",))
+
+
+def write_checkpoint(h5, problem: Problem, batches: list, generations: int) -> None:
+    """``/checkpoint``: every evaluated design (search variables) with its objectives and
+    constraints, and the sizes of the evaluation batches, from which ``--resume`` replays
+    the run (data only: nothing in it is code)."""
+    checkpoint = h5.create_group("checkpoint")
+    checkpoint.attrs.update(format=CHECKPOINT_FORMAT, generations=generations)
+    for j, (key, columns, units, dim, names) in enumerate(_tables(problem, problem.search_units)):
+        data = np.concatenate([b[j] for b in batches]) if batches else np.empty((0, columns))
+        write_dataset(checkpoint, key, data, units, dims=("evaluation", dim), coords={dim: names})
+    sizes = np.array([len(b[0]) for b in batches], dtype=np.int64)
+    write_dataset(checkpoint, "batches", sizes, "1", dims=("batch",))
+
+
+def read_checkpoint(output: Path, cfg: Config, problem: Problem):
+    """The stored batches ``[(X, F, G), ...]``, generations and history of ``output``;
+    ConfigError naming the file and the dataset for anything missing or malformed."""
+    from ..h5read import H5Reader
+
+    where = f"--resume: {output}"
+    if not output.exists():
+        raise ConfigError(f"{where}: does not exist (run without --resume to start)")
+    with H5Reader(output, where) as h5:
+        if h5.text_attr("config") != cfg.text:
+            raise ConfigError(
+                f"{where}: was written for another config (its YAML text "
+                f"differs); use the same config or run without --resume"
+            )
+        if "checkpoint/state" in h5.file:
+            raise ConfigError(
+                f"{where}: /checkpoint/state: an old checkpoint (a pickle), "
+                f"which suspopt no longer loads: a file must never run code; "
+                f"run without --resume"
+            )
+        group = h5.group("checkpoint")
+        if group.attrs.get("format") != CHECKPOINT_FORMAT:
+            raise ConfigError(
+                f"{where}: /checkpoint: not a suspopt checkpoint of format {CHECKPOINT_FORMAT}"
+            )
+        generations = h5.int_attr("checkpoint", "generations", 0, 10**7)
+        sizes = h5.array("checkpoint/batches", ndim=1, integer=True)
+        X = h5.array("checkpoint/X", ndim=2, columns=problem.n_var)
+        F = h5.array("checkpoint/F", ndim=2, columns=problem.n_obj)
+        G = h5.array("checkpoint/G", ndim=2, columns=problem.n_ieq_constr)
+        history = {
+            key: h5.array(f"history/{key}", ndim=2 if key == "best" else 1)
+            for key in ("generation", "best", "hypervolume", "evaluations", "time", "feasible")
+        }
+    if (sizes < 1).any() or sizes.sum() != len(X) or not len(X) == len(F) == len(G):
+        raise ConfigError(
+            f"{where}: /checkpoint: batches of {int(sizes.sum())} designs, "
+            f"X, F, G of {len(X)}, {len(F)}, {len(G)}"
+        )
+    if not np.isfinite(X).all():
+        raise ConfigError(f"{where}: /checkpoint/X: values must be finite")
+    if len(history["time"]) != generations:
+        raise ConfigError(
+            f"{where}: /history/time: {len(history['time'])} generations, the "
+            f"checkpoint {generations}"
+        )
+    edges = np.concatenate([[0], np.cumsum(sizes)])
+    batches = [(X[a:b], F[a:b], G[a:b]) for a, b in zip(edges[:-1], edges[1:])]
+    return batches, generations, history
