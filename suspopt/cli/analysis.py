@@ -8,17 +8,8 @@ from pathlib import Path
 import typer
 
 from ..errors import ConfigError
-from .base import (
-    FORCE_HELP,
-    MEMORY_HELP,
-    app,
-    claim_output,
-    fail,
-    new_table,
-    out,
-    set_memory_limit,
-    show_table,
-)
+from . import base
+from .base import app, out
 
 _ANALYSE_OPTIONS = {
     "reference": "--reference",
@@ -70,8 +61,8 @@ def analyse(
         "--mass-change",
         help="masses: change of the load on the seat, in kg; repeatable (default -20 and +20)",
     ),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+    force: bool = typer.Option(False, "--force", help=base.FORCE_HELP),
+    max_memory: str | None = typer.Option(None, "--max-memory", help=base.MEMORY_HELP),
 ) -> None:
     """Run an analysis of configs or of a Pareto file and print its table: models, roads,
     masses, controllers, transmissibility or cdf-sensitivity (see KIND below)."""
@@ -80,13 +71,13 @@ def analyse(
 
     kinds = analysis_kinds()
     if kind not in kinds:
-        fail(f"analyse: unknown kind {kind!r}; available: {', '.join(sorted(kinds))}")
+        base.fail(f"analyse: unknown kind {kind!r}; available: {', '.join(sorted(kinds))}")
     spec = kinds[kind]
     if len(sources) > 1 and not spec.many:
-        fail(f"analyse {kind} takes one SOURCE, got {len(sources)}")
+        base.fail(f"analyse {kind} takes one SOURCE, got {len(sources)}")
     for source in sources:
         if not source.exists():
-            fail(f"{source}: no such file")
+            base.fail(f"{source}: no such file")
     given = {
         "reference": reference,
         "road": road or None,
@@ -96,26 +87,26 @@ def analyse(
     options = {key: value for key, value in given.items() if value is not None}
     wrong = [_ANALYSE_OPTIONS[key] for key in options if key not in spec.options]
     if wrong:
-        fail(f"analyse {kind} does not take {', '.join(wrong)}")
-    set_memory_limit(max_memory)
+        base.fail(f"analyse {kind} does not take {', '.join(wrong)}")
+    base.set_memory_limit(max_memory)
     with ExitStack() as stack:
         try:
             if plot is not None:
                 check_path(plot)
         except ValueError as exc:
-            fail(str(exc))
-        claim_output(stack, output, force)
-        claim_output(stack, plot, force, "--plot")
+            base.fail(str(exc))
+        base.claim_output(stack, output, force)
+        base.claim_output(stack, plot, force, "--plot")
         try:
             report = spec.run(sources if spec.many else sources[0], output, plot, **options)
         except (ConfigError, FileNotFoundError, ValueError) as exc:
-            fail(str(exc))
-    table = new_table(report.title)
+            base.fail(str(exc))
+    table = base.new_table(report.title)
     for col in report.columns:
         table.add_column(col)
     for row in report.rows:
         table.add_row(*row)
-    show_table(table, keys=2 if report.columns[:2] == ["metric", "unit"] else 1)
+    base.show_table(table, keys=2 if report.columns[:2] == ["metric", "unit"] else 1)
     for note in report.notes:
         out.print(note)
     for path in (output, plot):

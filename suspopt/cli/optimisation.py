@@ -9,21 +9,8 @@ import typer
 from rich.table import Table
 
 from ..errors import ConfigError
-from .base import (
-    EXIT_ALL_FAILED,
-    FORCE_HELP,
-    MEMORY_HELP,
-    app,
-    claim_output,
-    command_line,
-    err,
-    fail,
-    new_table,
-    out,
-    read_config,
-    set_memory_limit,
-    show_table,
-)
+from . import base
+from .base import app, err, out
 
 
 def _progress_line(p) -> str:
@@ -54,7 +41,7 @@ def _optimum_table(result, rows: int = 12) -> Table:
     feasible = ["yes" if ok else "no" for ok in (result.G <= 0).all(axis=1)]
     suffix = "" if result.status == "finished" else " (interrupted)"
     if N == 1:
-        table = new_table("best design" + suffix)
+        table = base.new_table("best design" + suffix)
         for col in ("quantity", "unit", "value"):
             table.add_column(col, justify="right" if col == "value" else "left")
         for name, unit, value in zip(names, units, values[0]):
@@ -62,7 +49,7 @@ def _optimum_table(result, rows: int = 12) -> Table:
         table.add_row("feasible", "", feasible[0])
         return table
     pick = np.unique(np.linspace(0, N - 1, min(rows, N)).round().astype(int))
-    table = new_table(f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
+    table = base.new_table(f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
     table.add_column("#", justify="right")
     for name, unit in zip(names, units):
         table.add_column(f"{name} [{unit}]", justify="right")
@@ -90,8 +77,8 @@ def optimise(
         "(or the best value) and the history per "
         "generation (.png or .svg)",
     ),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+    force: bool = typer.Option(False, "--force", help=base.FORCE_HELP),
+    max_memory: str | None = typer.Option(None, "--max-memory", help=base.MEMORY_HELP),
 ) -> None:
     """Optimise the config's design variables; write the optimum or Pareto set to HDF5.
 
@@ -100,16 +87,16 @@ def optimise(
     it never falls."""
     with ExitStack() as stack:
         output = output if output is not None else Path(config.stem + ".h5")
-        set_memory_limit(max_memory)
+        base.set_memory_limit(max_memory)
         if plot is not None:
             from ..plots import check_path
 
             try:
                 check_path(plot)
             except ValueError as exc:
-                fail(str(exc))
-        claim_output(stack, output, force)
-        claim_output(stack, plot, force, "--plot")
+                base.fail(str(exc))
+        base.claim_output(stack, output, force)
+        base.claim_output(stack, plot, force, "--plot")
         _optimise(config, output, resume, plot)
 
 
@@ -119,11 +106,11 @@ def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> No
     from ..checks import check_config
     from ..optimise import optimise as run
 
-    cfg = read_config(config)
+    cfg = base.read_config(config)
     try:
         check_config(cfg)
     except ConfigError as exc:
-        fail(str(exc))
+        base.fail(str(exc))
     total = cfg.optimiser.generations if cfg.optimiser is not None else None
     bar = Progress(
         TextColumn("{task.description}"),
@@ -140,13 +127,13 @@ def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> No
 
     try:
         with bar:
-            result = run(cfg, output, resume=resume, callback=report, command=command_line())
+            result = run(cfg, output, resume=resume, callback=report, command=base.command_line())
     except ConfigError as exc:
-        fail(str(exc))
+        base.fail(str(exc))
     except KeyboardInterrupt:
         err.print("the first generation had not completed: nothing written")
         raise typer.Exit(code=130) from None
-    show_table(_optimum_table(result))
+    base.show_table(_optimum_table(result))
     if result.weights is not None:
         out.print(
             "weighted sum (Eq 5.7): "
@@ -166,7 +153,7 @@ def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> No
         try:
             plot_optimisation(result, plot)
         except ValueError as exc:
-            fail(str(exc))
+            base.fail(str(exc))
         out.print(f"wrote {plot}")
     if result.status == "failed":
         err.print(
@@ -174,4 +161,4 @@ def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> No
             f"NaN); {output} holds them with the penalty values and status 'failed'",
             soft_wrap=True,
         )
-        raise typer.Exit(code=EXIT_ALL_FAILED)
+        raise typer.Exit(code=base.EXIT_ALL_FAILED)

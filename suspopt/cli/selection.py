@@ -9,25 +9,15 @@ import typer
 from rich.table import Table
 
 from ..errors import ConfigError
-from .base import (
-    FORCE_HELP,
-    MEMORY_HELP,
-    app,
-    claim_output,
-    command_line,
-    fail,
-    new_table,
-    out,
-    set_memory_limit,
-    show_table,
-)
+from . import base
+from .base import app, out
 
 
 def _floats(option: str, text: str) -> list[float]:
     try:
         values = [float(v) for v in text.split(",")]
     except ValueError:
-        fail(f"{option} {text}: expected numbers separated by commas")
+        base.fail(f"{option} {text}: expected numbers separated by commas")
     return values
 
 
@@ -39,7 +29,9 @@ def _kesort_tables(sel) -> list[Table]:
     columns = [(f"{label} optimum", cs.chosen) for label, cs in sel.case_sorts.items()]
     columns.append(("optimum among all" if sel.case_sorts else "k-ε optimum", sel.chosen))
     columns += [(f"tie {n}", int(i)) for n, i in enumerate(sel.sort.ties[1:], start=2)]
-    table = new_table("k-ε optimum" + (" of each case and among all" if sel.case_sorts else ""))
+    table = base.new_table(
+        "k-ε optimum" + (" of each case and among all" if sel.case_sorts else "")
+    )
     table.add_column("quantity")
     table.add_column("unit")
     rows = [i for _, i in columns]
@@ -66,7 +58,7 @@ def _kesort_tables(sel) -> list[Table]:
             name, unit, *("-" if np.isnan(sel.X[i, j]) else f"{sel.X[i, j]:.5g}" for i in rows)
         )
     table.add_row("feasible", "", *("yes" if sel.feasible[i] else "no" for i in rows))
-    picks = new_table("Pareto picks among all (Fig. 8.21: edges and knee)")
+    picks = base.new_table("Pareto picks among all (Fig. 8.21: edges and knee)")
     for col in ("pick", "design #", "case", "k-ε level"):
         picks.add_column(col, justify="left" if col in ("pick", "case") else "right")
     for name, unit in zip(sel.names, sel.units):
@@ -133,15 +125,15 @@ def kesort(
     plot: Path | None = typer.Option(
         None, "--plot", help="figure of the k-ε levels over the front (.png or .svg)"
     ),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+    force: bool = typer.Option(False, "--force", help=base.FORCE_HELP),
+    max_memory: str | None = typer.Option(None, "--max-memory", help=base.MEMORY_HELP),
 ) -> None:
     """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12); supplementary
     objectives are re-simulated in one batch."""
-    set_memory_limit(max_memory)
+    base.set_memory_limit(max_memory)
     with ExitStack() as stack:
-        claim_output(stack, output, force)
-        claim_output(stack, plot, force, "--plot")
+        base.claim_output(stack, output, force)
+        base.claim_output(stack, plot, force, "--plot")
         _kesort(
             pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot
         )
@@ -157,33 +149,33 @@ def _kesort(
 
     if plot is not None:
         if plot.suffix.lower() not in (".png", ".svg"):
-            fail(f"--plot {plot}: give a .png or .svg file")
+            base.fail(f"--plot {plot}: give a .png or .svg file")
         if importlib.util.find_spec("matplotlib") is None:
-            fail("--plot needs matplotlib: pip install 'suspopt[plot]'")
+            base.fail("--plot needs matplotlib: pip install 'suspopt[plot]'")
     if P is not None and P != "auto":
         P = _floats("--P", P)[0]
     P_lo_hi = _floats("--P-range", P_range)
     if len(P_lo_hi) != 2:
-        fail(f"--P-range {P_range}: expected LOW,HIGH")
+        base.fail(f"--P-range {P_range}: expected LOW,HIGH")
     eps_values = None if eps is None else _floats("--eps", eps)
     options = dict(P=P, normalise=normalise, P_range=tuple(P_lo_hi), P_step=P_step)
     try:
         check_options(eps_values, **options)
     except ValueError as exc:
-        fail(f"kesort options: {exc}")
+        base.fail(f"kesort options: {exc}")
     try:
         sets = load_design_sets(pareto, config, label)
         selection = select(sets, eps_values, feasible_only=not keep_infeasible, **options)
     except ConfigError as exc:
-        fail(str(exc))
+        base.fail(str(exc))
     if output is not None:
-        write_selection(output, selection, command=command_line())
+        write_selection(output, selection, command=base.command_line())
     if plot is not None:
         from ..plots import plot_kesort
 
         plot_kesort(selection, plot)
     for table, keys in zip(_kesort_tables(selection), (2, 3)):
-        show_table(table, keys=keys)
+        base.show_table(table, keys=keys)
     for label_, cs in selection.case_sorts.items():
         out.print(_threshold_line(cs.sort, label_))
     out.print(

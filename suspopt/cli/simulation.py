@@ -10,22 +10,8 @@ import typer
 from rich.table import Table
 
 from ..errors import ConfigError
-from .base import (
-    FORCE_HELP,
-    MEMORY_HELP,
-    VERBOSE,
-    app,
-    claim_output,
-    command_line,
-    err,
-    fail,
-    new_table,
-    out,
-    read_config,
-    set_memory_limit,
-    show_table,
-    verbose_info,
-)
+from . import base
+from .base import app, err, out
 
 
 def _summary_table(result) -> Table:
@@ -33,7 +19,7 @@ def _summary_table(result) -> Table:
     import numpy as np
 
     P = min(result.P, 5)
-    table = new_table(
+    table = base.new_table(
         f"{result.model.preset} - key results"
         + (f" (first {P} of {result.P} designs)" if result.P > P else "")
     )
@@ -66,7 +52,7 @@ def _summary_table(result) -> Table:
 def _metrics_table(result) -> Table:
     """The config's metrics (``metrics:`` section), one row each."""
     P = min(result.P, 5)
-    table = new_table("metrics")
+    table = base.new_table("metrics")
     table.add_column("metric")
     table.add_column("unit")
     for p in range(P):
@@ -125,18 +111,18 @@ def simulate(
         "over time, their PSD and the ISO 2631 "
         "comfort levels (.png or .svg)",
     ),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
-    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+    force: bool = typer.Option(False, "--force", help=base.FORCE_HELP),
+    max_memory: str | None = typer.Option(None, "--max-memory", help=base.MEMORY_HELP),
 ) -> None:
     """Simulate a config (or designs picked from a result file) and write signals to HDF5."""
-    set_memory_limit(max_memory)
+    base.set_memory_limit(max_memory)
     with ExitStack() as stack:
-        claim_output(stack, output, force)
-        claim_output(stack, plot, force, "--plot")
+        base.claim_output(stack, output, force)
+        base.claim_output(stack, plot, force, "--plot")
         try:
             _simulate(source, output, pick, set_, sweep_, zipped, plot)
         except (ConfigError, ValueError) as exc:
-            fail(str(exc))
+            base.fail(str(exc))
 
 
 def _inputs(source: Path, pick, sets, sweeps, zipped):
@@ -147,20 +133,22 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
         from ..picks import read_picks, split_picks
 
         if not pick:
-            fail(
+            base.fail(
                 f"{source} is a result file: name the designs to simulate with --pick "
                 f"(knee, best_<objective>, chosen or a row number)"
             )
         if sweeps:
-            fail("--sweep takes a config; with --pick the designs are the picked ones")
+            base.fail("--sweep takes a config; with --pick the designs are the picked ones")
         picked = read_picks(source, split_picks(pick))
         cfg = apply_sets(picked.config, sets)
         params = picked.params()
     else:
         picked = None
         if pick:
-            fail(f"--pick takes a result file (optimise, kesort, analyse); {source} is a config")
-        cfg = apply_sets(read_config(source), sets)
+            base.fail(
+                f"--pick takes a result file (optimise, kesort, analyse); {source} is a config"
+            )
+        cfg = apply_sets(base.read_config(source), sets)
         params = sweep(cfg, sweeps, zipped) or None
     return cfg, params, picked
 
@@ -218,34 +206,34 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
         else signal_names(model, getattr(controller, "units", {}), attachments)
     )
     check_memory(cfg, model, attachments, pv.P, signals=len(written) + len(cfg.metrics))
-    if VERBOSE[0]:
+    if base.VERBOSE[0]:
         from ..memory import describe
         from ..simulate import run_memory
 
         shared, per_design = run_memory(
             cfg, model, attachments, pv.P, len(written) + len(cfg.metrics)
         )
-        verbose_info(
+        base.verbose_info(
             f"{cfg.source}: checked; {pv.P} design{'s' if pv.P > 1 else ''}, "
             f"{cfg.simulation.n_steps} steps of {cfg.simulation.dt:g} s, about "
             f"{describe(shared + pv.P * per_design)} of memory"
         )
     started = time.perf_counter()
     result = run(cfg, params)
-    verbose_info(f"simulated in {time.perf_counter() - started:.3g} s")
+    base.verbose_info(f"simulated in {time.perf_counter() - started:.3g} s")
     if result.diverged.any():
         err.print(
             f"warning: design(s) {np.flatnonzero(result.diverged).tolist()} diverged "
             f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
             f"try a smaller simulation.dt"
         )
-    show_table(_summary_table(result), keys=2)
+    base.show_table(_summary_table(result), keys=2)
     if result.metrics:
-        show_table(_metrics_table(result), keys=2)
+        base.show_table(_metrics_table(result), keys=2)
     extra = None
     if picked is not None:
         objectives = _pick_objectives(picked, cfg, result)
-        show_table(_picks_table(picked, *objectives), keys=3)
+        base.show_table(_picks_table(picked, *objectives), keys=3)
         extra = _picks_writer(picked, objectives)
     if output is not None:
         started = time.perf_counter()
@@ -254,10 +242,10 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
             result,
             signals=None if cfg.output.signals == "all" else cfg.output.signals,
             float32=cfg.output.float32,
-            command=command_line(),
+            command=base.command_line(),
             extra=extra,
         )
-        verbose_info(f"wrote {len(written)} signals in {time.perf_counter() - started:.3g} s")
+        base.verbose_info(f"wrote {len(written)} signals in {time.perf_counter() - started:.3g} s")
         out.print(f"wrote {output}")
     if plot is not None:
         from ..plots import plot_simulation
@@ -286,7 +274,7 @@ def _picks_table(picked, F, names, units) -> Table:
     """Each pick's objectives as the file stored them and as simulated now."""
     import numpy as np
 
-    table = new_table(f"{picked.source.name}: the picked designs' objectives")
+    table = base.new_table(f"{picked.source.name}: the picked designs' objectives")
     for col in ("pick", "row", "objective", "stored", "simulated", "change"):
         table.add_column(col, justify="left" if col in ("pick", "objective") else "right")
     for i, name in enumerate(picked.names):

@@ -12,118 +12,42 @@ signals without looping over the ``P`` designs. One topic per module:
 - :mod:`.springs`: non-linear spring usage ratio (Eq 5.3)
 """
 
-import importlib
+from .._lazy import lazy_names
 
 #: Public name -> the module that defines it; imported when first used (PEP 562), so that
 #: a run that computes no metric never loads scipy.
+# fmt: off
 _MODULES = {
     "iso2631": (
-        "WEIGHTINGS",
-        "MTVV_RATIO_LIMIT",
-        "VDV_RATIO_LIMIT",
-        "COMFORT_REACTIONS",
-        "weighting_response",
-        "weight",
-        "weighted_rms",
-        "running_rms",
-        "mtvv",
-        "vdv",
-        "crest_factor",
-        "ratio_tests",
-        "comfort_reaction",
+        "WEIGHTINGS", "MTVV_RATIO_LIMIT", "VDV_RATIO_LIMIT", "COMFORT_REACTIONS",
+        "weighting_response", "weight", "weighted_rms", "running_rms", "mtvv", "vdv",
+        "crest_factor", "ratio_tests", "comfort_reaction"
     ),
     "stats": (
-        "STATISTICS",
-        "var",
-        "std",
-        "rms",
-        "maximum",
-        "minimum",
-        "max_abs",
-        "mean",
-        "peak_to_peak",
-        "suspension_travel_variance",
-        "suspension_travel_max",
-        "suspension_travel_max_abs",
-        "tyre_deflection_variance",
-        "tyre_deflection_max",
-        "tyre_deflection_max_abs",
-        "pitch_variance",
-        "dynamic_tyre_load_ratio",
-        "peak_dynamic_tyre_load_ratio",
-        "peak_tyre_force",
+        "STATISTICS", "var", "std", "rms", "maximum", "minimum", "max_abs", "mean",
+        "peak_to_peak", "suspension_travel_variance", "suspension_travel_max",
+        "suspension_travel_max_abs", "tyre_deflection_variance", "tyre_deflection_max",
+        "tyre_deflection_max_abs", "pitch_variance", "dynamic_tyre_load_ratio",
+        "peak_dynamic_tyre_load_ratio", "peak_tyre_force"
     ),
     "energy": (
-        "mean_dissipated_power",
-        "mean_dissipated_power_from_damping",
-        "damper_switches",
-        "share_at_max_damping",
+        "mean_dissipated_power", "mean_dissipated_power_from_damping", "damper_switches",
+        "share_at_max_damping"
     ),
-    "transient": ("transient_metrics",),
-    "spectral": ("psd", "transfer_function", "coherence", "transmissibility"),
-    "springs": ("nonlinear_spring_usage",),
+    "transient": (
+        "transient_metrics",
+    ),
+    "spectral": (
+        "psd", "transfer_function", "coherence", "transmissibility"
+    ),
+    "springs": (
+        "nonlinear_spring_usage",
+    ),
 }
+# fmt: on
 _HOME = {name: module for module, names in _MODULES.items() for name in names}
 
-__all__ = [
-    # iso2631
-    "WEIGHTINGS",
-    "MTVV_RATIO_LIMIT",
-    "VDV_RATIO_LIMIT",
-    "COMFORT_REACTIONS",
-    "weighting_response",
-    "weight",
-    "weighted_rms",
-    "running_rms",
-    "mtvv",
-    "vdv",
-    "crest_factor",
-    "ratio_tests",
-    "comfort_reaction",
-    # stats
-    "STATISTICS",
-    "var",
-    "std",
-    "rms",
-    "maximum",
-    "minimum",
-    "max_abs",
-    "mean",
-    "peak_to_peak",
-    "suspension_travel_variance",
-    "suspension_travel_max",
-    "suspension_travel_max_abs",
-    "tyre_deflection_variance",
-    "tyre_deflection_max",
-    "tyre_deflection_max_abs",
-    "pitch_variance",
-    "dynamic_tyre_load_ratio",
-    "peak_dynamic_tyre_load_ratio",
-    "peak_tyre_force",
-    # energy
-    "mean_dissipated_power",
-    "mean_dissipated_power_from_damping",
-    "damper_switches",
-    "share_at_max_damping",
-    # transient
-    "transient_metrics",
-    # spectral
-    "psd",
-    "transfer_function",
-    "coherence",
-    "transmissibility",
-    # springs
-    "nonlinear_spring_usage",
-]
+__all__ = list(_HOME)
 
 
-def __getattr__(name: str):
-    if name in _HOME:
-        value = getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(__all__)
+__getattr__, __dir__ = lazy_names(__name__, globals(), _HOME, __all__)

@@ -75,7 +75,7 @@ def _link_law(stiffness, offset, length) -> Callable[[np.ndarray], np.ndarray]:
     return lambda w, out=None: np.multiply(a + b / np.sqrt(square - w * w), w, out=out)
 
 
-def _carrella_law(stiffness, wall_distance, spring_free_length):
+def carrella_law(stiffness, wall_distance, spring_free_length):
     """``u -> 2 K_h (L_o / sqrt(u² + a_o²) - 1) u`` (:func:`nss1_force`), constants folded."""
     a, b = -2.0 * stiffness, 2.0 * stiffness * spring_free_length
     square = wall_distance * wall_distance
@@ -106,7 +106,7 @@ def nss1_force(u, horizontal_stiffness, wall_distance, spring_free_length):
     its force ``u / sqrt(u² + a_o²)``. Zero at ``u = 0`` (springs horizontal) and at
     ``u = X_ST`` (springs free).
     """
-    return _carrella_law(horizontal_stiffness, wall_distance, spring_free_length)(u)
+    return carrella_law(horizontal_stiffness, wall_distance, spring_free_length)(u)
 
 
 def nss1_taylor(horizontal_stiffness, wall_distance, spring_free_length):
@@ -132,10 +132,10 @@ def nss2_force(u, horizontal_stiffness, wall_distance, spring_free_length, bar_l
     fraction by ``L_o`` gives ``f_N = 2 K_h (1 + (1 - γ2) / sqrt(γ1² - (u/L_o)²)) u`` — the
     printed ``sqrt(γ1² - x²)`` lacks the ``1/L_o`` on ``x``.
     """
-    return _nss2_law(horizontal_stiffness, wall_distance, spring_free_length, bar_length)(u)
+    return nss2_law(horizontal_stiffness, wall_distance, spring_free_length, bar_length)(u)
 
 
-def _nss2_law(horizontal_stiffness, wall_distance, spring_free_length, bar_length):
+def nss2_law(horizontal_stiffness, wall_distance, spring_free_length, bar_length):
     """:func:`nss2_force` as a function of the travel (constants folded)."""
     return _link_law(horizontal_stiffness, spring_free_length - wall_distance, bar_length)
 
@@ -156,10 +156,10 @@ def nss3_force(u, horizontal_stiffness, cam_radius, roller_radius, cam_offset, p
     distance less ``d + r``, and the contact normal gives the vertical share
     ``u / sqrt((R + r)² - u²)``.
     """
-    return _nss3_law(horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression)(u)
+    return nss3_law(horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression)(u)
 
 
-def _nss3_law(horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression):
+def nss3_law(horizontal_stiffness, cam_radius, roller_radius, cam_offset, precompression):
     """:func:`nss3_force` as a function of the travel (constants folded)."""
     return _link_law(
         horizontal_stiffness,
@@ -195,11 +195,11 @@ def nss4_force(u, horizontal_stiffness, wall_distance, spring_free_length, bar_l
     on ``m_d`` is ``-f_N``; its positive slope ``2 K_h (1 + c_I)`` at ``u = 0`` is the negative
     stiffness ``K_N = -2 K_h`` of Sec 2.2.5 for ``c_I = 0``. The same geometry as NSS2.
     """
-    return _nss4_law(horizontal_stiffness, wall_distance, spring_free_length, bar_length)(u)
+    return nss4_law(horizontal_stiffness, wall_distance, spring_free_length, bar_length)(u)
 
 
 #: :func:`nss4_force` as a function of the travel: the geometry of NSS2.
-_nss4_law = _nss2_law
+nss4_law = nss2_law
 
 
 def nss4_taylor(hinge_offset, horizontal_stiffness, wall_distance, spring_free_length, bar_length):

@@ -12,25 +12,8 @@ import numpy as np
 from ..config import Config, ConfigError
 from ..network import Elements, LinearModel, Network, parameter_rows, shared_rows, widen
 from ..params import ParamView
-from .mechanisms import (
-    Mechanism,
-    _carrella_law,
-    _nss2_law,
-    _nss3_law,
-    _nss4_law,
-    nss1_static_deflection,
-    nss1_taylor,
-    nss2_static_deflection,
-    nss2_taylor,
-    nss3_contact_limit,
-    nss3_static_deflection,
-    nss3_taylor,
-    nss4_force,
-    nss4_static_deflection,
-    nss4_taylor,
-    ps_static_deflection,
-    vertical_stiffness,
-)
+from . import mechanisms
+from .mechanisms import Mechanism
 
 #: Body parts of the passenger, bottom to top (Fig. 2.14, Table 2.3).
 PASSENGER_PARTS = ("pelvis", "abdomen", "diaphragm", "thorax", "torso", "back", "head")
@@ -151,7 +134,10 @@ def _passive(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form:
     return (
         [(0, 1, k_v, get("damping"))],
         None,
-        {"static_deflection": ps_static_deflection(load, k_v, g), "vertical_stiffness": k_v},
+        {
+            "static_deflection": mechanisms.ps_static_deflection(load, k_v, g),
+            "mechanisms.vertical_stiffness": k_v,
+        },
     )
 
 
@@ -175,11 +161,11 @@ def _negative_stiffness(kind: str):
         if kind == "nss1":
             a_o, gamma = get("wall_distance"), get("gamma")
             geometry, limit = (a_o, a_o / gamma), None
-            x_st = nss1_static_deflection(a_o, gamma)
+            x_st = mechanisms.nss1_static_deflection(a_o, gamma)
         elif kind == "nss2":
             a_o, l_o, b = get("wall_distance"), get("spring_free_length"), get("bar_length")
             geometry, limit = (a_o, l_o, b), b
-            x_st = nss2_static_deflection(a_o, l_o, b)
+            x_st = mechanisms.nss2_static_deflection(a_o, l_o, b)
         else:
             geometry = (
                 get("cam_radius"),
@@ -187,9 +173,9 @@ def _negative_stiffness(kind: str):
                 get("cam_offset"),
                 get("precompression"),
             )
-            limit = nss3_contact_limit(*geometry)
-            x_st = nss3_static_deflection(*geometry[:3])
-        k_v = vertical_stiffness(load, x_st, g)
+            limit = mechanisms.nss3_contact_limit(*geometry)
+            x_st = mechanisms.nss3_static_deflection(*geometry[:3])
+        k_v = mechanisms.vertical_stiffness(load, x_st, g)
         k_h = get("stiffness_ratio") * k_v
         params = tuple(p[:, None] for p in (k_h,) + geometry)
         law, series = _FORMS[kind]
@@ -203,7 +189,11 @@ def _negative_stiffness(kind: str):
         return (
             [(0, 1, k_v, get("damping"))],
             mech,
-            {"static_deflection": x_st, "vertical_stiffness": k_v, "horizontal_stiffness": k_h},
+            {
+                "static_deflection": x_st,
+                "mechanisms.vertical_stiffness": k_v,
+                "horizontal_stiffness": k_h,
+            },
         )
 
     return build
@@ -216,20 +206,22 @@ def _kdamper(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form:
     a_o, l_o, b = get("wall_distance"), get("spring_free_length"), get("bar_length")
     u_0 = get("hinge_offset")
     params = tuple(p[:, None] for p in (k_h, a_o, l_o, b))
-    preload = nss4_force(u_0, k_h, a_o, l_o, b)
+    preload = mechanisms.nss4_force(u_0, k_h, a_o, l_o, b)
     mech = Mechanism(
         node=1,
-        law=_scaled(_nss4_law, params),
+        law=_scaled(mechanisms.nss4_law, params),
         rest=u_0[:, None],
-        series=nss4_taylor(u_0[:, None], *params) if form == "taylor" else None,
+        series=mechanisms.nss4_taylor(u_0[:, None], *params) if form == "taylor" else None,
         limit=b[:, None],
     )
     return (
         [(0, 1, k_s, 0.0), (1, 2, k_v, get("damping"))],
         mech,
         {
-            "static_deflection": nss4_static_deflection(load, get("inner_mass"), k_s, preload, g),
-            "vertical_stiffness": k_v,
+            "static_deflection": mechanisms.nss4_static_deflection(
+                load, get("inner_mass"), k_s, preload, g
+            ),
+            "mechanisms.vertical_stiffness": k_v,
             "horizontal_stiffness": k_h,
             "support_stiffness": k_s,
             "mechanism_preload": preload,
@@ -241,9 +233,9 @@ def _kdamper(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form:
 #: Exact force law (the parameters of the ``*_force`` function after the travel, giving the
 #: function of the travel) and Taylor coefficients of NSS1-NSS3.
 _FORMS = {
-    "nss1": (_carrella_law, nss1_taylor),
-    "nss2": (_nss2_law, nss2_taylor),
-    "nss3": (_nss3_law, nss3_taylor),
+    "nss1": (mechanisms.carrella_law, mechanisms.nss1_taylor),
+    "nss2": (mechanisms.nss2_law, mechanisms.nss2_taylor),
+    "nss3": (mechanisms.nss3_law, mechanisms.nss3_taylor),
 }
 #: Isolator builders: (get, load [kg], g, form) -> (links, mechanism, quantities). Links are
 #: (node_a, node_b, stiffness, damping) over the nodes 0 floor, 1 seat, 2 inner mass.
