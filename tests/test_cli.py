@@ -12,6 +12,8 @@ import numpy as np
 import pytest
 from conftest import CONFIGS
 
+pytestmark = pytest.mark.cli
+
 GOOD = (CONFIGS / "quickstart.yaml").read_text()
 
 
@@ -108,6 +110,7 @@ def test_simulate_writes_the_design_md_layout(tmp_path):
         assert h5["modal/frequency"].attrs["units"] == "Hz"
 
 
+@pytest.mark.slow
 def test_every_bundled_config_validates():
     # in-process (typer's runner): a subprocess per config costs seconds of imports each,
     # and the command's own process behaviour is covered by test_validate_and_schema

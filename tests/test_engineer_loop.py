@@ -14,6 +14,8 @@ from conftest import CONFIGS, optimised_front
 import suspopt
 from suspopt._entry import main
 
+pytestmark = pytest.mark.cli
+
 
 def cli(capsys, *args) -> tuple[int, str, str]:
     code = main([str(a) for a in args])

@@ -20,6 +20,8 @@ from __future__ import annotations
 import fuzz_harness as fh
 import pytest
 
+pytestmark = pytest.mark.slow
+
 DEFAULT_CASES = 500
 CASES = fh.config_cases(fh.case_count(DEFAULT_CASES))
 

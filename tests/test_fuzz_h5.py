@@ -20,6 +20,8 @@ import os
 import fuzz_harness as fh
 import pytest
 
+pytestmark = pytest.mark.slow
+
 VARIANTS = fh.h5_variants() + fh.h5_random_variants(
     int(os.environ.get("SUSPOPT_FUZZ_H5_CASES", "48"))
 )

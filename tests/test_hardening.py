@@ -631,6 +631,8 @@ def test_usage_errors_are_one_line(capsys):
     assert "No such command 'simulat'" in one_error(capsys, "simulat")
 
 
+@pytest.mark.cli
+@pytest.mark.slow
 @pytest.mark.parametrize("delay", [0.0, 1.5])
 def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
     """Interrupted during the start-up imports (as soon as numpy is being loaded, which

@@ -105,6 +105,7 @@ def sweep():
     )
 
 
+@pytest.mark.slow
 def test_the_simulation_figure_has_time_psd_and_comfort_panels_for_every_design(sweep, tmp_path):
     signals = plots.default_signals(sweep)
     assert signals == [
@@ -153,6 +154,7 @@ def test_the_simulation_figure_has_time_psd_and_comfort_panels_for_every_design(
     assert overlapping_texts(fig) == []
 
 
+@pytest.mark.slow
 def test_plot_simulation_writes_png_and_svg(sweep, tmp_path):
     png = plots.plot_simulation(sweep, tmp_path / "sim.png", signals=["body.heave_acc"])
     svg = plots.plot_simulation(sweep, tmp_path / "sim.svg", designs=[0, 2])

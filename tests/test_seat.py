@@ -531,6 +531,7 @@ def test_ch8_configs_cover_every_isolator_road_and_passenger(load):
                 assert {k: getattr(cfg.seat, k) for k in SEATS[kind]} == SEATS[kind]
 
 
+@pytest.mark.slow
 def test_analyse_transmissibility_linear_and_simulated_agree(tmp_path):
     """A linear seat (PS + passenger): the H1 estimate from a random-road simulation matches
     the linearised STHT and seat transmissibility where the coherence is high."""

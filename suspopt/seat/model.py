@@ -136,7 +136,7 @@ def _passive(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form:
         None,
         {
             "static_deflection": mechanisms.ps_static_deflection(load, k_v, g),
-            "mechanisms.vertical_stiffness": k_v,
+            "vertical_stiffness": k_v,
         },
     )
 
@@ -191,7 +191,7 @@ def _negative_stiffness(kind: str):
             mech,
             {
                 "static_deflection": x_st,
-                "mechanisms.vertical_stiffness": k_v,
+                "vertical_stiffness": k_v,
                 "horizontal_stiffness": k_h,
             },
         )
@@ -221,7 +221,7 @@ def _kdamper(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form:
             "static_deflection": mechanisms.nss4_static_deflection(
                 load, get("inner_mass"), k_s, preload, g
             ),
-            "mechanisms.vertical_stiffness": k_v,
+            "vertical_stiffness": k_v,
             "horizontal_stiffness": k_h,
             "support_stiffness": k_s,
             "mechanism_preload": preload,
