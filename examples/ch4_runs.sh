@@ -17,7 +17,9 @@ for path in "$here"/configs/ch4/*.yaml; do
         -o "$out/$name.h5" > /dev/null
 done
 echo "== the other threshold fits"
-for path in $(python "$here/examples/ch4_tables.py" --fits "$out"); do
+# a separate assignment, so that a failing check stops the script (set -e)
+fits="$(python "$here/examples/ch4_tables.py" --fits "$out")"
+for path in $fits; do
     echo "   $(basename "$path" .yaml)"
     suspopt simulate "$path" -o "${path%.yaml}.h5" > /dev/null
 done
