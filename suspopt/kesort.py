@@ -71,12 +71,30 @@ _CHUNK_BYTES = 64 * 2**20
 class KEpsilonSort:
     """Result of :func:`kesort` for ``N`` solutions and ``m`` objectives.
 
-    ``k_eps (N,)``: k-ε levels (Eq 6.10 with Eq 6.12); ``k (N,)``: k-optimality levels (Eq 6.10
-    with Eq 6.11), integers from -1 to m - 1, computed when first read (one more pass over
-    the pairs); ``chosen``: index of the solution of the highest k-ε level (the first of
-    ``ties``); ``ties``: indices of every solution within ``tie_tol`` of that level; ``epsilon (m,)``: the thresholds in the objectives' units; ``P``: the factor
-    of Eq 6.19/7.13 (None for an absolute ``eps``); ``P_auto``: whether ``P`` was searched;
-    ``normalisation``; ``NF (N, m)``: the normalised objectives; ``names``.
+    ``k (N,)``: the k-optimality levels (Eq 6.10 with Eq 6.11), integers from -1 to m - 1,
+    computed when first read (one more pass over the pairs); ``unique``: whether one solution
+    alone holds the highest k-ε level.
+
+    Attributes
+    ----------
+    k_eps : ndarray
+        k-ε levels ``(N,)`` [-] (Eq 6.10 with Eq 6.12).
+    chosen : int
+        Index of the solution of the highest k-ε level (the first of ``ties``).
+    ties : ndarray
+        Indices of every solution within ``tie_tol`` of that level.
+    epsilon : ndarray
+        The thresholds ``(m,)`` in the objectives' units.
+    P : float or None
+        The factor [-] of Eq 6.19/7.13 (None for an absolute ``eps``).
+    P_auto : bool
+        Whether ``P`` was searched.
+    normalisation : str
+        ``max`` or ``minmax``.
+    NF : ndarray
+        The normalised objectives ``(N, m)`` [-].
+    names : tuple of str
+        The objectives' names.
     """
 
     k_eps: np.ndarray
@@ -249,6 +267,33 @@ def kesort(
     ... <= P_range[1]`` that leaves one solution alone at the top level; if none does, the
     largest ``P`` is kept and ``unique`` is False. ``normalise``: ``max`` (Eq 7.12) or
     ``minmax`` (see the module docstring). Returns a :class:`KEpsilonSort`.
+
+    Parameters
+    ----------
+    F : array_like
+        Objective values ``(N, m)`` of the solutions, each in its own unit (minimised).
+    eps : float or array_like, optional
+        Absolute thresholds ``ε`` in the units of ``F``, one value or ``(m,)``.
+    P : float or "auto", optional
+        Threshold as a share [-] of each objective's largest normalised value.
+    normalise : {"max", "minmax"}
+        Normalisation of ``F`` before the thresholds.
+    names : sequence of str, optional
+        The objectives' names (default ``f1``, ``f2``, ...).
+    P_range : (float, float)
+        The range [-] searched for ``P = "auto"``.
+    P_step : float
+        Step [-] of that search.
+    tie_tol : float
+        Relative tolerance [-] below which two k-ε levels count as a tie.
+    chunk_bytes : int
+        Memory [bytes] one block of the pairwise comparison may take (larger sets are
+        compared in blocks).
+
+    Returns
+    -------
+    KEpsilonSort
+        The k-ε level of each solution and the chosen one.
     """
     check_options(eps, P, normalise, P_range, P_step)
     F = _objectives(F)
@@ -311,6 +356,18 @@ def pareto_picks(F, names: Sequence[str] | None = None) -> dict[str, int]:
     designs far off the front (a pooled or re-simulated set) from moving it. It is always
     non-dominated (a solution that dominates another is nearer the utopia point), and on a
     convex two-objective front it lands in the middle, where Fig. 8.21 puts "Mid".
+
+    Parameters
+    ----------
+    F : array_like
+        Objective values ``(N, m)`` (minimised), each in its own unit.
+    names : sequence of str, optional
+        The objectives' names (default ``f1``, ``f2``, ...).
+
+    Returns
+    -------
+    dict of str to int
+        Row of ``F`` for ``best_<name>`` of each objective and for ``knee``.
     """
     F = _objectives(F)
     names = _names(names, F.shape[1])

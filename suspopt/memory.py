@@ -38,7 +38,13 @@ _KEEP = 2**31 - 1
 def reuse_memory() -> bool:
     """Make glibc's allocator keep freed memory for reuse (``mallopt``: no ``mmap`` for large
     blocks, no trimming of the heap). Returns True when it took effect, False (changing
-    nothing) where the C library is not glibc."""
+    nothing) where the C library is not glibc.
+
+    Returns
+    -------
+    bool
+        Whether the setting took effect.
+    """
     name = ctypes.util.find_library("c")
     if name is None:
         return False

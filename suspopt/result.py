@@ -165,13 +165,45 @@ class SignalMap(Mapping):
 class Result:
     """Output of :func:`simulate`.
 
-    ``time (T,)`` [s]; ``signals[name] (P, T)`` (lazy); ``metrics[name] (P,)``;
-    ``diverged (P,)`` and ``diverged_at (P,)`` [s, NaN when fine]; ``designs`` the (P,) arrays of
-    the design parameters by dotted path; ``states (2n, P, T)`` the raw [q, q'] samples, DOF
-    by DOF (vehicle, then attachments), and ``accelerations (n, P, T)`` their q''. A sample
-    at ``t`` holds what is in force from ``t`` on: a semi-active damper's coefficient (and so
-    its force and the accelerations) is the one set at ``t`` when ``t`` is a sample instant
-    of its controller.
+    A sample at ``t`` holds what is in force from ``t`` on: a semi-active damper's coefficient
+    (and so its force and the accelerations) is the one set at ``t`` when ``t`` is a sample
+    instant of its controller. Signals by name are :attr:`signals` (computed on first use),
+    their units :meth:`signal_unit`.
+
+    Attributes
+    ----------
+    config : Config
+        The simulated study.
+    model : VehicleModel
+        The batched vehicle model (SI units: kg, N/m, N s/m).
+    time : ndarray
+        Sample times ``(T,)`` [s].
+    states : ndarray
+        The raw ``[q, q']`` samples ``(2n, P, T)``, DOF by DOF (vehicle, then attachments)
+        [m, rad, m/s, rad/s].
+    accelerations : ndarray
+        Their ``q''`` ``(n, P, T)`` [m/s^2, rad/s^2].
+    road : ndarray
+        Road height under each wheel ``(N, 1, T)`` [m].
+    road_vel : ndarray
+        Its rate ``(N, 1, T)`` [m/s].
+    diverged_at : ndarray
+        Time a design diverged ``(P,)`` [s], NaN when it did not.
+    designs : dict of str to ndarray
+        The design parameters ``(P,)`` by dotted path, in the field's SI unit.
+    attachments : tuple of Attachment
+        The body attachments (a seat and its passenger).
+    held_damping : Held or ndarray or None
+        The semi-active dampers' coefficients [N s/m] (held between samples), or None.
+    controller_records : mapping of str to Held
+        What the controller decided at each sample, by record name (units in
+        ``controller_units``).
+    controller_units : dict of str to str
+        SI unit of each controller record.
+    metrics : dict of str to ndarray
+        The config's metrics ``(P,)`` by name, units in ``metric_units``.
+    metric_units : dict of str to str
+        SI unit of each metric.
     """
 
     config: Config

@@ -78,6 +78,20 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:
     ``params`` maps dotted config paths (e.g. ``"vehicle.corners.F1.damper.c"``) to arrays of
     shape (P,). Returns a :class:`Result` whose signals are (P, T) and whose ``metrics`` hold
     the config's ``metrics:`` specs as (P,) arrays.
+
+    Parameters
+    ----------
+    cfg : Config
+        The study (vehicle, seat, road, control, simulation, metrics).
+    params : mapping of str to array_like, optional
+        Design parameters by dotted config path, each ``(P,)`` in the field's SI unit (the
+        unit the schema gives that key: N/m, N s/m, kg, m, ...); all of one length P.
+
+    Returns
+    -------
+    Result
+        Signals ``(P, T)`` with their SI units (``Result.signal_unit``), the metrics ``(P,)``
+        and the time ``(T,)`` [s].
     """
     pv, model, controller, attachments = prepare(cfg, params)
     check_memory(cfg, model, attachments, pv.P, signals=len(cfg.metrics))

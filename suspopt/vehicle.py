@@ -179,7 +179,21 @@ def _wheelbase_offsets(cfg: Config, pv: ParamView, corners: tuple[str, ...]) -> 
 
 
 def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
-    """Assemble the batched model of ``cfg.vehicle`` for the designs in ``pv``."""
+    """Assemble the batched model of ``cfg.vehicle`` for the designs in ``pv``.
+
+    Parameters
+    ----------
+    cfg : Config
+        The study; its ``vehicle`` section and, for the wheelbase delay, its road.
+    pv : ParamView, optional
+        The designs' parameters by dotted path (SI units); default the config's one design.
+
+    Returns
+    -------
+    VehicleModel
+        The batched model: masses [kg, kg m^2], stiffness [N/m, N m/rad] and damping
+        [N s/m] matrices, the element network and the static tyre loads [N].
+    """
     pv = pv or ParamView(cfg)
     veh = cfg.vehicle
     P = pv.P
@@ -425,6 +439,17 @@ def modal_analysis(model: VehicleModel) -> ModalResult:
     by the DOFs that carry its kinetic energy (:class:`ModalResult`): on a full car the wheel
     hop modes are collective (a pair of wheels in or against phase), so no single wheel names
     them.
+
+    Parameters
+    ----------
+    model : VehicleModel
+        The assembled model (:func:`build_vehicle`).
+
+    Returns
+    -------
+    ModalResult
+        Natural frequencies ``(P, n)`` [Hz], mode shapes ``(P, n, n)`` (largest entry 1, in
+        m or rad), kinetic-energy shares ``(P, n, n)`` [-] and a label per mode.
     """
     frequency, shape = model.linear.modes()
     m = model.linear.mass
@@ -456,6 +481,22 @@ def frequency_response(
     terms ``B_k, B_c`` (the tyres' ``k_T, c_T`` on the wheels) from the network's linear
     model. Body accelerations are ``-ω² Q``. Duffing and lift-off are not in the linear
     model.
+
+    Parameters
+    ----------
+    model : VehicleModel
+        The assembled model (:func:`build_vehicle`).
+    f : array_like
+        Frequencies ``(F,)`` [Hz].
+    speed : float, optional
+        Forward speed [m/s] for the wheelbase delay of the rear wheels; none without it.
+    corners : tuple of str, optional
+        The corners whose wheels see the road (default all, e.g. ``("F1", "R1")``).
+
+    Returns
+    -------
+    ndarray
+        Complex DOF amplitudes ``(P, F, n)`` per metre of road height [m/m, rad/m].
     """
     f = np.atleast_1d(np.asarray(f, dtype=float))
     omega = 2 * np.pi * f

@@ -48,10 +48,12 @@ SCHEMA_ID = "urn:suspopt:schema:config"
 class Config(Section):
     """A whole suspopt study."""
 
-    vehicle: Vehicle
-    road: RoadConfig
-    simulation: Simulation
-    output: Output = Field(default_factory=Output)
+    vehicle: Vehicle = Field(description="the vehicle: preset, body, corners, anti-roll bars")
+    road: RoadConfig = Field(description="the road under the wheels: a bump, ISO 8608 or a file")
+    simulation: Simulation = Field(description="time step, duration and output sampling [s]")
+    output: Output = Field(
+        default_factory=Output, description="which signals simulate writes, and their precision"
+    )
     metrics: list[MetricSpec] = Field(
         default_factory=list, description="metrics computed and stored by simulate"
     )
@@ -284,7 +286,23 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
 
 def load_config(path: str | Path) -> Config:
     """Read and validate a YAML config file (a regular UTF-8 file of at most
-    :data:`~suspopt.config.yamlio.MAX_CONFIG_BYTES`)."""
+    :data:`~suspopt.config.yamlio.MAX_CONFIG_BYTES`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The YAML file; relative paths inside it (a road CSV) are read from its folder.
+
+    Returns
+    -------
+    Config
+        The validated config, quantities in SI units (m, kg, s, N, rad).
+
+    Raises
+    ------
+    ConfigError
+        For anything wrong with the file, naming the file, the key and its line.
+    """
     path = Path(path)
     try:
         text = read_text(path)
@@ -329,7 +347,13 @@ def config_schema() -> dict:
     dict: the corners' keys that ``vehicle.corner_defaults`` may give are optional
     (:func:`~suspopt.config.vehicle.corner_defaults_schema`). The schema checks keys, types
     and ranges; rules between keys (``c_max >= c_min``, a preset's body fields, RK4
-    stability, ...) are the loader's and ``suspopt validate``'s."""
+    stability, ...) are the loader's and ``suspopt validate``'s.
+
+    Returns
+    -------
+    dict
+        The schema as JSON-compatible data (the same as ``suspopt schema`` prints).
+    """
     schema = Config.model_json_schema()
     corner_defaults_schema(schema["$defs"])
     return {"$schema": SCHEMA_DIALECT, "$id": SCHEMA_ID, **schema}

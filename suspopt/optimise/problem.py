@@ -66,6 +66,17 @@ class Problem(_PymooProblem):
     ``supplementary_names``/``supplementary_units`` (``S``, computed when asked for with
     ``evaluate(X, return_values_of=["S"])``). ``constraint_scale (n_ieq_constr,)`` is each
     constraint's bound magnitude (1 where the bound is 0), for algorithms that scale ``G``.
+
+    Parameters
+    ----------
+    cfg : Config
+        The study, with its ``design_variables`` (bounds in the fields' SI units).
+    objectives : sequence of _Term
+        The objectives, each a metric spec with its sense (minimised or maximised).
+    constraints : sequence of _Term
+        The constraints ``g <= 0``, each a metric spec with its bound (in the metric's unit).
+    supplementary : sequence of _Term
+        Further metrics computed only when asked for (``S``).
     """
 
     def __init__(
