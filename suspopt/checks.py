@@ -48,6 +48,18 @@ def _whole(ratio: float) -> bool:
     return abs(ratio - round(ratio)) <= _WHOLE * max(1.0, ratio)
 
 
+def _resolved(cfg: Config, span: float, steps: int, what: str, tail: str = "") -> None:
+    """ConfigError on ``simulation.dt`` unless ``span`` [s] (``what``, formatted with it) spans
+    at least ``steps`` steps."""
+    dt = cfg.simulation.dt
+    if span < steps * dt * (1 - _WHOLE):
+        raise cfg.error(
+            ("simulation", "dt"),
+            f"{dt:g} s steps over {what.format(span)} must span at least {steps} steps; "
+            f"use dt <= {span / steps:.3g} s{tail}",
+        )
+
+
 def check_steps(cfg: Config) -> None:
     """The time grid, the road's features against ``dt`` and the metrics' sample rate (module
     docstring)."""
@@ -70,24 +82,12 @@ def check_steps(cfg: Config) -> None:
                 f"the run ends (simulation.duration = {sim.duration:g} s)",
             )
         crossing = road.length / road.speed
-        if crossing < MIN_STEPS_PER_BUMP * sim.dt * (1 - _WHOLE):
-            raise cfg.error(
-                ("simulation", "dt"),
-                f"{sim.dt:g} s steps over the bump: a wheel "
-                f"crosses it in {crossing:.4g} s (road.length/road.speed), which "
-                f"must span at least {MIN_STEPS_PER_BUMP} steps; use dt <= "
-                f"{crossing / MIN_STEPS_PER_BUMP:.3g} s",
-            )
+        what = "the bump: a wheel crosses it in {:.4g} s (road.length/road.speed), which"
+        _resolved(cfg, crossing, MIN_STEPS_PER_BUMP, what)
     if isinstance(road, Iso8608Road):
         period = 1.0 / (road.n_max * road.speed)
-        if period < MIN_STEPS_PER_WAVE * sim.dt * (1 - _WHOLE):
-            raise cfg.error(
-                ("simulation", "dt"),
-                f"{sim.dt:g} s steps over the road's "
-                f"shortest wave: 1/(n_max V) = {period:.4g} s must span at least "
-                f"{MIN_STEPS_PER_WAVE} steps; use dt <= "
-                f"{period / MIN_STEPS_PER_WAVE:.3g} s or a lower road.n_max",
-            )
+        what = "the road's shortest wave: 1/(n_max V) = {:.4g} s"
+        _resolved(cfg, period, MIN_STEPS_PER_WAVE, what, " or a lower road.n_max")
     rate = sim.output_rate
     specs = [(("metrics", i), spec) for i, spec in enumerate(cfg.metrics)]
     if cfg.objectives is not None:

@@ -282,22 +282,12 @@ def write_transmissibility(
             grp = h5.create_group("designs")
             write_attrs(grp, picks=[", ".join(p) for p in designs.picks])
             write_dataset(grp, "row", designs.rows, "1", dims=("design",))
-            write_dataset(
-                grp,
-                "X",
-                designs.X,
-                list(designs.var_units),
-                dims=("design", "variable"),
-                names=designs.var_names,
-            )
-            write_dataset(
-                grp,
-                "F",
-                designs.F,
-                list(designs.obj_units),
-                dims=("design", "objective"),
-                names=designs.obj_names,
-            )
+            for key, values, units, dim, names in (
+                ("X", designs.X, designs.var_units, "variable", designs.var_names),
+                ("F", designs.F, designs.obj_units, "objective", designs.obj_names),
+            ):
+                dims = ("design", dim)
+                write_dataset(grp, key, values, list(units), dims=dims, names=names)
     return Path(path)
 
 

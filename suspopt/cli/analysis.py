@@ -61,8 +61,8 @@ def analyse(
         "--mass-change",
         help="masses: change of the load on the seat, in kg; repeatable (default -20 and +20)",
     ),
-    force: bool = typer.Option(False, "--force", help=base.FORCE_HELP),
-    max_memory: str | None = typer.Option(None, "--max-memory", help=base.MEMORY_HELP),
+    force: bool = base.force_option(),
+    max_memory: str | None = base.max_memory_option(),
 ) -> None:
     """Run an analysis of configs or of a Pareto file and print its table: models, roads,
     masses, controllers, transmissibility or cdf-sensitivity (see KIND below)."""

@@ -34,6 +34,21 @@ MEMORY_HELP = (
 )
 
 
+def force_option():
+    """``--force``: replace an existing output that suspopt did not write."""
+    return typer.Option(False, "--force", help=FORCE_HELP)
+
+
+def plot_option(what: str):
+    """``--plot FIG``: a figure of ``what``, PNG or SVG by the suffix."""
+    return typer.Option(None, "--plot", help=f"figure of {what} (.png or .svg)")
+
+
+def max_memory_option():
+    """``--max-memory SIZE``: the most memory a run may take."""
+    return typer.Option(None, "--max-memory", help=MEMORY_HELP)
+
+
 #: ``-v``: what each step did and how long it took, on stderr.
 VERBOSE = [False]
 

@@ -11,11 +11,11 @@ import typer
 
 from ..errors import ConfigError
 from .base import (
-    FORCE_HELP,
-    MEMORY_HELP,
     app,
     claim_output,
     fail,
+    force_option,
+    max_memory_option,
     out,
     read_config,
     set_memory_limit,
@@ -26,7 +26,7 @@ from .base import (
 @app.command()
 def validate(
     config: Path = typer.Argument(..., help="YAML config file"),
-    max_memory: str | None = typer.Option(None, "--max-memory", help=MEMORY_HELP),
+    max_memory: str | None = max_memory_option(),
 ) -> None:
     """Check a config and report its first problem with its line (what any command would
     reject about it)."""
@@ -74,7 +74,7 @@ def _template_kinds(incomplete: str) -> list[str]:
 def init(
     kind: str = typer.Argument(..., help=_template_help(), autocompletion=_template_kinds),
     output: Path = typer.Option(..., "-o", "--output", help="the new config (YAML)"),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = force_option(),
 ) -> None:
     """Write a commented starter config of one kind of study, ready to validate and run."""
     from ..io import atomic_file
@@ -109,7 +109,7 @@ def export(
     csv: Path | None = typer.Option(
         None, "--csv", help="folder for the file's tables as CSV, units in the headers"
     ),
-    force: bool = typer.Option(False, "--force", help=FORCE_HELP),
+    force: bool = force_option(),
 ) -> None:
     """Write a picked design as a standalone config (-o design.yaml), or a result file's
     tables as CSV (--csv DIR)."""

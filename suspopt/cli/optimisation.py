@@ -70,15 +70,11 @@ def optimise(
         "the current folder), rewritten every generation",
     ),
     resume: bool = typer.Option(False, "--resume", help="continue from the checkpoint in OUT.h5"),
-    plot: Path | None = typer.Option(
-        None,
-        "--plot",
-        help="figure of the front "
-        "(or the best value) and the history per "
-        "generation (.png or .svg)",
+    plot: Path | None = base.plot_option(
+        "the front (or the best value) and the history per generation"
     ),
-    force: bool = typer.Option(False, "--force", help=base.FORCE_HELP),
-    max_memory: str | None = typer.Option(None, "--max-memory", help=base.MEMORY_HELP),
+    force: bool = base.force_option(),
+    max_memory: str | None = base.max_memory_option(),
 ) -> None:
     """Optimise the config's design variables; write the optimum or Pareto set to HDF5.
 

@@ -125,8 +125,8 @@ def kesort(
     plot: Path | None = typer.Option(
         None, "--plot", help="figure of the k-ε levels over the front (.png or .svg)"
     ),
-    force: bool = typer.Option(False, "--force", help=base.FORCE_HELP),
-    max_memory: str | None = typer.Option(None, "--max-memory", help=base.MEMORY_HELP),
+    force: bool = base.force_option(),
+    max_memory: str | None = base.max_memory_option(),
 ) -> None:
     """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12); supplementary
     objectives are re-simulated in one batch."""

@@ -104,15 +104,11 @@ def simulate(
     zipped: bool = typer.Option(
         False, "--zip", help="pair the --sweep values instead of taking every combination"
     ),
-    plot: Path | None = typer.Option(
-        None,
-        "--plot",
-        help="figure of the signals "
-        "over time, their PSD and the ISO 2631 "
-        "comfort levels (.png or .svg)",
+    plot: Path | None = base.plot_option(
+        "the signals over time, their PSD and the ISO 2631 comfort levels"
     ),
-    force: bool = typer.Option(False, "--force", help=base.FORCE_HELP),
-    max_memory: str | None = typer.Option(None, "--max-memory", help=base.MEMORY_HELP),
+    force: bool = base.force_option(),
+    max_memory: str | None = base.max_memory_option(),
 ) -> None:
     """Simulate a config (or designs picked from a result file) and write signals to HDF5."""
     base.set_memory_limit(max_memory)
