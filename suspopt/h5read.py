@@ -61,27 +61,24 @@ class H5Reader:
         except (OSError, ValueError, KeyError, RuntimeError):
             raise ConfigError(f"{self.where}: /{name}: damaged, cannot be read") from None
 
-    def group(self, name: str):
-        """The group ``/name``."""
+    def _kind(self, name: str, kind: str):
+        """``/name`` if it is a ``kind`` (``Group`` or ``Dataset``), else ConfigError."""
         import h5py
 
         node = self._node(name)
-        if not isinstance(node, h5py.Group):
+        if not isinstance(node, getattr(h5py, kind)):
             raise ConfigError(
                 f"{self.where}: /{name}: missing (is this a suspopt file of the right kind?)"
             )
         return node
+
+    def group(self, name: str):
+        """The group ``/name``."""
+        return self._kind(name, "Group")
 
     def dataset(self, name: str):
         """The dataset ``/name``."""
-        import h5py
-
-        node = self._node(name)
-        if not isinstance(node, h5py.Dataset):
-            raise ConfigError(
-                f"{self.where}: /{name}: missing (is this a suspopt file of the right kind?)"
-            )
-        return node
+        return self._kind(name, "Dataset")
 
     def array(
         self, name: str, ndim: int, columns: int | None = None, integer: bool = False

@@ -51,6 +51,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -490,14 +491,8 @@ def run_roads(
     source: Path, output: Path | None = None, plot: Path | None = None, road: Sequence[str] = ()
 ) -> Report:
     """``suspopt analyse roads PARETO.h5 --road B --road C`` (Sec 8.4.2, Table 8.12)."""
-    return _run(
-        "roads",
-        source,
-        output,
-        plot,
-        lambda p: road_variants(p, road),
-        "on other roads (Sec 8.4.2)",
-    )
+    variants = partial(road_variants, roads=road)
+    return _run("roads", source, output, plot, variants, "on other roads (Sec 8.4.2)")
 
 
 def run_masses(
@@ -508,28 +503,16 @@ def run_masses(
 ) -> Report:
     """``suspopt analyse masses PARETO.h5 [--mass-change -20 --mass-change 20]`` (Sec 8.4.3,
     Table 8.13)."""
-    return _run(
-        "masses",
-        source,
-        output,
-        plot,
-        lambda p: mass_variants(p, mass_change),
-        "with other passengers (Sec 8.4.3)",
-    )
+    variants = partial(mass_variants, changes=mass_change)
+    return _run("masses", source, output, plot, variants, "with other passengers (Sec 8.4.3)")
 
 
 def run_controllers(
     source: Path, output: Path | None = None, plot: Path | None = None, with_: Sequence[Path] = ()
 ) -> Report:
     """``suspopt analyse controllers PARETO.h5 --with OTHER.yaml`` (Sec 7.3, Fig. 7.4b)."""
-    return _run(
-        "controllers",
-        source,
-        output,
-        plot,
-        lambda p: controller_variants(p, with_),
-        "with other controllers (Fig. 7.4b)",
-    )
+    variants = partial(controller_variants, sources=with_)
+    return _run("controllers", source, output, plot, variants, "with other controllers (Fig. 7.4b)")
 
 
 KINDS["roads"] = Kind(run_roads, options=("road",))

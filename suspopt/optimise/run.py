@@ -54,17 +54,7 @@ from ..config import Config, ConfigError
 from ..config.optimise import ALGORITHMS
 from ..config.optimise import Hybrid as HybridSettings
 from ..io import atomic_h5
-from .algorithms import (
-    Gradient,
-    Hybrid,
-    Optimiser,
-    PymooOptimiser,
-    Solutions,
-    WeightedSum,
-    balanced_weights,
-    pymoo_algorithm,
-    termination,
-)
+from . import algorithms
 from .output import read_checkpoint, write_checkpoint, write_history, write_pareto
 from .problem import PENALTY, Problem
 
@@ -153,7 +143,7 @@ class _Recorder(_PymooProblem):
 class _Run:
     """A run: the optimiser, the recorder it evaluates through, and what is reported."""
 
-    optimiser: Optimiser
+    optimiser: algorithms.Optimiser
     recorder: _Recorder
     weights: np.ndarray | None
     history: dict[str, list] = field(
@@ -173,7 +163,7 @@ class _Snapshot:
     """The run after a completed generation, ready to write."""
 
     batches: int  # the recorder's batches so far
-    optimum: Solutions  # X physical, F main objectives
+    optimum: algorithms.Solutions  # X physical, F main objectives
     history: dict[str, np.ndarray]
     generation: int
     evaluations: int
@@ -223,7 +213,7 @@ def optimise(
     return _write(output, cfg, problem, snapshot, run, status, command)
 
 
-def build_optimiser(cfg: Config, problem: Problem) -> Optimiser:
+def build_optimiser(cfg: Config, problem: Problem) -> algorithms.Optimiser:
     """The optimiser of ``cfg.optimiser`` for ``problem`` (not yet set up); ConfigError for a
     combination that cannot work (e.g. GA on three objectives without a weighted sum)."""
     opt = cfg.optimiser
@@ -236,7 +226,7 @@ def build_optimiser(cfg: Config, problem: Problem) -> Optimiser:
         return _gradient(cfg, problem, opt.generations, opt.max_evaluations)
     n_obj = 1 if opt.weighted_sum else problem.n_obj
     try:
-        algorithm = pymoo_algorithm(
+        algorithm = algorithms.pymoo_algorithm(
             ALGORITHMS[opt.algorithm].target, opt.options, opt.population, n_obj
         )
     except ValueError as exc:
@@ -244,30 +234,30 @@ def build_optimiser(cfg: Config, problem: Problem) -> Optimiser:
     if opt.algorithm == "hybrid":
         settings = opt.hybrid or HybridSettings()
         ga_generations = min(settings.ga_generations, opt.generations or float("inf"))
-        ga = PymooOptimiser(
+        ga = algorithms.PymooOptimiser(
             algorithm,
-            termination(
+            algorithms.termination(
                 1, ga_generations, opt.max_evaluations, opt.tolerance, opt.stall_generations
             ),
         )
-        return Hybrid(
+        return algorithms.Hybrid(
             ga,
             _gradient(cfg, problem, None, None),
             settings.shrink,
             opt.generations,
             opt.max_evaluations,
         )
-    return PymooOptimiser(
+    return algorithms.PymooOptimiser(
         algorithm,
-        termination(
+        algorithms.termination(
             n_obj, opt.generations, opt.max_evaluations, opt.tolerance, opt.stall_generations
         ),
     )
 
 
-def _gradient(cfg: Config, problem: Problem, iterations, evaluations) -> Gradient:
+def _gradient(cfg: Config, problem: Problem, iterations, evaluations) -> algorithms.Gradient:
     opt = cfg.optimiser
-    return Gradient(
+    return algorithms.Gradient(
         max_iterations=iterations,
         max_evaluations=evaluations,
         tolerance=opt.tolerance,
@@ -314,7 +304,7 @@ def _check_objectives(cfg: Config, problem: Problem) -> None:
         )
 
 
-def _start(cfg: Config, recorder: _Recorder, optimiser: Optimiser) -> _Run:
+def _start(cfg: Config, recorder: _Recorder, optimiser: algorithms.Optimiser) -> _Run:
     """A run from the start: the Generator of the seed balances the weights (if asked), then
     drives the optimiser; every evaluation goes through ``recorder``."""
     opt = cfg.optimiser
@@ -331,12 +321,12 @@ def _start(cfg: Config, recorder: _Recorder, optimiser: Optimiser) -> _Run:
                 else recorder.problem.obj_names.index(ws.balance.dominant)
             )
             try:
-                weights = balanced_weights(
+                weights = algorithms.balanced_weights(
                     recorder, ws.balance.samples, rng, dominant, ws.balance.factor
                 )
             except ValueError as exc:
                 raise cfg.error(("optimiser", "weighted_sum", "balance"), str(exc)) from None
-        working = WeightedSum(recorder, weights)
+        working = algorithms.WeightedSum(recorder, weights)
     optimiser.setup(working, rng)
     return _Run(optimiser=optimiser, recorder=recorder, weights=weights)
 
@@ -424,14 +414,14 @@ def _snapshot(run: _Run, problem: Problem) -> _Snapshot:
         F, G = run.weighted_optimum[1:]
     return _Snapshot(
         batches=len(run.recorder.batches),
-        optimum=Solutions(problem.to_physical(X), F, G),
+        optimum=algorithms.Solutions(problem.to_physical(X), F, G),
         history={k: np.array(v, dtype=float) for k, v in run.history.items()},
         generation=run.optimiser.n_gen,
         evaluations=run.optimiser.n_eval,
     )
 
 
-def _resume(output: Path, cfg: Config, problem: Problem, optimiser: Optimiser) -> _Run:
+def _resume(output: Path, cfg: Config, problem: Problem, optimiser: algorithms.Optimiser) -> _Run:
     """The run checkpointed in ``output`` (module docstring), rebuilt by replaying it."""
     batches, generations, stored = read_checkpoint(output, cfg, problem)
     run = _start(cfg, _Recorder(problem, batches, output), optimiser)
