@@ -3,34 +3,15 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
-from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, run, write
 
 pytestmark = pytest.mark.cli
 
 GOOD = (CONFIGS / "quickstart.yaml").read_text()
-
-
-def run(*args, cwd=None):
-    return subprocess.run(
-        [sys.executable, "-m", "suspopt", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        timeout=120,
-    )
-
-
-def write(tmp_path: Path, text: str, name="case.yaml") -> Path:
-    path = tmp_path / name
-    path.write_text(text)
-    return path
 
 
 BAD_INPUTS = {

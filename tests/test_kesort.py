@@ -5,7 +5,7 @@ from __future__ import annotations
 import h5py
 import numpy as np
 import pytest
-from test_optimise import TINY
+from conftest import TINY
 from typer.testing import CliRunner
 
 import suspopt

@@ -9,6 +9,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from conftest import TINY
 from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.algorithms.soo.nonconvex.ga import GA
 from pymoo.core.problem import Problem as PymooProblem
@@ -221,39 +222,6 @@ def test_every_registered_pymoo_algorithm_is_seeded_and_resumes_by_replay(name, 
 
 
 # --- the YAML problem on a tiny Chapter 5 half car -----------------------------------------------
-
-TINY = """\
-vehicle:
-  preset: half_pitch
-  body: {mass: 2210, pitch_inertia: 1142, a_front: 1.61, a_rear: 1.67}
-  corners:
-    F1:
-      unsprung_mass: 50
-      tyre: {stiffness: 4.0e5}
-      spring: {linear: 5.0e4, cubic: 1.0e7}
-      damper: {c: 3000}
-    R1:
-      unsprung_mass: 100
-      tyre: {stiffness: 8.0e5}
-      spring: {linear: 6.0e4, cubic: 1.0e7}
-      damper: {c: 3500}
-road: {kind: bump_half_sine, height: 0.05, length: 1.0, speed: 11.111, start: 0.1}
-simulation: {duration: 0.5, dt: 1.0e-3}
-design_variables:
-  - {name: k_F1, path: vehicle.corners.F1.spring.linear, lower: 3.2e4, upper: 1.5e5}
-  - {name: c_F1, path: vehicle.corners.F1.damper.c, lower: 2.0e3, upper: 1.0e4}
-  - {name: knl_F1, path: vehicle.corners.F1.spring.cubic, lower: 5.0e5, upper: 3.0e7, scale: log}
-objectives:
-  main:
-    - {name: f1, metric: var, signal: body.heave_acc}
-    - {name: f3, metric: var, signal: tyre_deflection, reduce: mean}
-  supplementary:
-    - {name: f2, metric: var, signal: travel, reduce: mean}
-constraints:
-  - {name: RC, metric: rms_weighted, signal: body.heave_acc, weighting: Wk, max: 1.4}
-  - {name: ratio, metric: spring_usage, min: 0.1, max: 0.3}
-optimiser: {algorithm: nsga2, population: 8, generations: 4, seed: 1}
-"""
 
 
 def tiny(text: str = TINY, **replace) -> suspopt.Config:

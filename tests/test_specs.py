@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import CONFIGS
-from test_cli import run, write
+from conftest import CONFIGS, run, write
 
 import suspopt
 from suspopt.metrics import iso2631, stats
