@@ -178,6 +178,25 @@ def _wheelbase_offsets(cfg: Config, pv: ParamView, corners: tuple[str, ...]) -> 
     return offsets
 
 
+def _mass_and_travel_map(pv: ParamView, body_dofs: tuple[str, ...], mu, x, y):
+    """The diagonal of M ``(P, n)`` [kg, kg m^2] (body DOFs, then the wheels' unsprung masses
+    ``mu (P, N)``) and the travel map ``J (P, N, n)``, ``ST_i = z_s + y_i φ - x_i θ - z_ui``
+    (``x, y`` the corners' positions [m])."""
+    P, nb, N = pv.P, len(body_dofs), mu.shape[1]
+    n = nb + N
+    mass = np.empty((P, n))
+    for j, dof in enumerate(body_dofs):
+        mass[:, j] = pv.require_positive("vehicle.body." + DOF_FIELDS[dof][0])
+    mass[:, nb:] = mu
+
+    # travel map J: ST_i = z_s + y_i φ - x_i θ - z_ui
+    J = np.zeros((P, N, n))
+    for j, dof in enumerate(body_dofs):
+        J[:, :, j] = {"heave": 1.0, "roll": y, "pitch": -x}[dof]
+    J[:, np.arange(N), nb + np.arange(N)] = -1.0
+    return mass, J
+
+
 def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     """Assemble the batched model of ``cfg.vehicle`` for the designs in ``pv``.
 
@@ -200,21 +219,11 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     corners = PRESET_CORNERS[veh.preset]
     body_dofs = PRESET_BODY_DOFS[veh.preset]
     nb, N = len(body_dofs), len(corners)
-    n = nb + N
     x, y = _corner_geometry(pv, body_dofs, corners)
 
     mu, kt, ct, kl, knl, c = _corner_parameters(pv, veh, corners)
 
-    mass = np.empty((P, n))
-    for j, dof in enumerate(body_dofs):
-        mass[:, j] = pv.require_positive("vehicle.body." + DOF_FIELDS[dof][0])
-    mass[:, nb:] = mu
-
-    # travel map J: ST_i = z_s + y_i φ - x_i θ - z_ui
-    J = np.zeros((P, N, n))
-    for j, dof in enumerate(body_dofs):
-        J[:, :, j] = {"heave": 1.0, "roll": y, "pitch": -x}[dof]
-    J[:, np.arange(N), nb + np.arange(N)] = -1.0
+    mass, J = _mass_and_travel_map(pv, body_dofs, mu, x, y)
 
     bar_map, bar_k = _anti_roll_bars(pv, corners, body_dofs)
     dof_names = tuple(f"body.{d}" for d in body_dofs) + tuple(f"wheel.{cn}" for cn in corners)
