@@ -37,12 +37,12 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import mdtables as md  # noqa: E402
+import mdtables as md
 
-from suspopt.analyse.cdf import semi_active_metrics  # noqa: E402
-from suspopt.config.loader import load_config_text  # noqa: E402
-from suspopt.control import threshold_for_share  # noqa: E402
-from suspopt.io import read_simulation_signals  # noqa: E402
+from suspopt.analyse.cdf import semi_active_metrics
+from suspopt.config.loader import load_config_text
+from suspopt.control import threshold_for_share
+from suspopt.io import read_simulation_signals
 
 ROADS = {
     "bump": "Road bump",

@@ -15,10 +15,10 @@ import pytest
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 sys.path.insert(0, str(EXAMPLES))
 
-import mdtables as md  # noqa: E402
+import mdtables as md
 
 pytest.importorskip("matplotlib")
-import report  # noqa: E402
+import report
 
 THESIS = md.thesis_values()
 
