@@ -105,6 +105,21 @@ def ch3_rows(spec: dict, comp: Models) -> list[list[str]]:
 def chapter3(out: Path, doc: Doc) -> list[str]:
     d = out / "ch3"
     doc("# Chapter 3: comparison of vehicle models", "")
+    _what_was_run(doc)
+    _tables(d, doc)
+    _figures(d, doc)
+    doc("## Why they differ (measured)", "")
+    _step_size(d, doc)
+    seed_rows = _road_realisation(d, doc)
+    _road_length(d, doc)
+    disagree = _part2a(d, doc)
+    disagree += _part1b(d, doc)
+    acc_outside = [r[0] for r in seed_rows if r[1].startswith("Max") and r[7] == "no"]
+    return [ch3_headline(out, acc_outside, disagree)]
+
+
+def _what_was_run(doc: Doc) -> None:
+    """What was run, and the tables' columns."""
     doc("## What was run", "")
     doc.para(
         "Every config of `configs/ch3` (Table 3.1's car; Part 1a passive, Part 1b SH-2,",
@@ -128,6 +143,10 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
         "ours and the thesis's, both by Sec 3.2.1's formula (X - X_ref)/X_ref, computed",
         "from the printed values (the thesis's % columns print the opposite sign).",
     )
+
+
+def _tables(d: Path, doc: Doc) -> None:
+    """Tables 3.3-3.21: ours beside the thesis's, each model against the part's reference."""
     doc("## Tables 3.3-3.21", "")
     for number, spec in THESIS["ch3"]["tables"].items():
         part, road = CH3_FILES[number]
@@ -149,6 +168,10 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
         )
         if spec.get("notes"):
             doc.para(f"*Note:* {spec['notes']}")
+
+
+def _figures(d: Path, doc: Doc) -> None:
+    """The models' figures (Figs. 3.2-3.19)."""
     doc("## Figures", "")
     for name, caption in [
         (
@@ -170,34 +193,27 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
         "`part2a_models_class_b.png`, `part2b_models_{bump,class_b}.png`).",
     )
 
-    # measurements behind the differences
+
+def _seeds(d: Path) -> dict[str, list[dict[str, float]]]:
+    """The class B metrics of QC and FC for road seeds 1-5 (seed 1: the config's own)."""
     checks = d / "checks"
+    return {
+        m: [read_metrics(d / f"part1a_{m}_class_b.h5")]
+        + [read_metrics(checks / f"part1a_{m}_class_b_seed_{s}.h5") for s in range(2, 6)]
+        for m in ("qc", "fc")
+    }
+
+
+def _step_size(d: Path, doc: Doc) -> None:
+    """QC's peak z̈_s with dt halved, and on the thesis's output grid."""
     base = read_metrics(d / "part1a_qc_bump.h5")
-    half = read_metrics(checks / "part1a_qc_bump_dt_half.h5")
+    half = read_metrics(d / "checks" / "part1a_qc_bump_dt_half.h5")
     dt_change = float(relative_change(half["peak.body.heave_acc"], base["peak.body.heave_acc"]))
     comp = read_models(d / "part1a_models_bump.h5", "part1a", "bump")
     qc_acc = comp.value["peak.body.heave_acc"][0]
     qc_acc_thesis = ch3_printed("3.3")["peak.body.heave_acc"]["qc"]
     qc_diff = md.difference(qc_acc, qc_acc_thesis)
     coarse, after_step = coarse_peak(d / "part1a_qc_bump.h5", "body.heave_acc")
-    roll = ch3_printed("3.14")["steady_state.body.roll"]
-    left_vtd = ch3_printed("3.17")["VTD.F2"]
-    seeds = {
-        m: [read_metrics(d / f"part1a_{m}_class_b.h5")]  # seed 1: the config's own
-        + [read_metrics(checks / f"part1a_{m}_class_b_seed_{s}.h5") for s in range(2, 6)]
-        for m in ("qc", "fc")
-    }
-    double = read_metrics(checks / "part1a_qc_class_b_double_length.h5")
-    comp2 = read_models(d / "part2a_models_bump.h5", "part2a", "bump")
-    p1b = read_models(d / "part1b_models_bump.h5", "part1b", "bump")
-    part1b_gap = hc_gap(p1b.value, p1b.keys)
-    t1b = {r["quantity"]: r for n in ("3.8", "3.9") for r in THESIS["ch3"]["tables"][n]["rows"]}
-    part1b_thesis_gap = hc_gap(
-        {q: np.array([r.get(k, math.nan) for k in p1b.keys], dtype=float) for q, r in t1b.items()},
-        p1b.keys,
-    )
-    comp3 = read_models(d / "part2a_models_class_b.h5", "part2a", "class_b")
-    doc("## Why they differ (measured)", "")
     doc.para(
         f"- **Step size.** Halving dt to 0.5 ms moves QC's peak z̈_s by {md.pct(dt_change)}",
         f"({md.num(base['peak.body.heave_acc'], 4)} ->",
@@ -210,6 +226,11 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
         grid_sentence(md.difference(coarse, qc_acc_thesis), qc_diff) + ";",
         "the thesis's solver and grid are not stated.",
     )
+
+
+def _road_realisation(d: Path, doc: Doc) -> list[list[str]]:
+    """The class B metrics over road seeds 1-5 against the thesis's; the table's rows."""
+    seeds = _seeds(d)
     seed_rows = []
     printed = ch3_printed("3.6") | ch3_printed("3.7")
     for m in ("qc", "fc"):
@@ -262,6 +283,14 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
         "distribution) is not stated.",
         seed_sentence("The maxima (max |z̈_s|, MST, MTD)", *group(("Max", "MST", "MTD"))) + ".",
     )
+    return seed_rows
+
+
+def _road_length(d: Path, doc: Doc) -> None:
+    """QC on 60 s and on 120 s of the same class B road."""
+    seeds = _seeds(d)
+    printed = ch3_printed("3.6") | ch3_printed("3.7")
+    double = read_metrics(d / "checks" / "part1a_qc_class_b_double_length.h5")
     length_rows = []
     for q in ("RC", "max_body_acc", "VST.F1", "MST.F1"):
         unit = printed[q]["unit"]
@@ -280,6 +309,13 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
     )
     doc.table(["quantity", "unit", "60 s", "120 s", "change"], length_rows)
 
+
+def _part2a(d: Path, doc: Doc) -> list[str]:
+    """Part 2a's anti-roll bar and the flat side's tyre; what we disagree with."""
+    roll = ch3_printed("3.14")["steady_state.body.roll"]
+    left_vtd = ch3_printed("3.17")["VTD.F2"]
+    comp2 = read_models(d / "part2a_models_bump.h5", "part2a", "bump")
+    comp3 = read_models(d / "part2a_models_class_b.h5", "part2a", "class_b")
     cfg2, _ = ch4_tables.stored_config(d / "part2a_fc_arb_bump.h5")
     rolled = cfg2.road.height / (cfg2.vehicle.body.b_right + cfg2.vehicle.body.b_left)
     i2 = {k: n for n, k in enumerate(comp2.keys)}
@@ -326,6 +362,19 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
         ),
     ]
     doc.para(*s2a)
+    return disagree
+
+
+def _part1b(d: Path, doc: Doc) -> list[str]:
+    """Part 1b's half cars against QC and FC on the bump; what we disagree with."""
+    disagree = []
+    p1b = read_models(d / "part1b_models_bump.h5", "part1b", "bump")
+    part1b_gap = hc_gap(p1b.value, p1b.keys)
+    t1b = {r["quantity"]: r for n in ("3.8", "3.9") for r in THESIS["ch3"]["tables"][n]["rows"]}
+    part1b_thesis_gap = hc_gap(
+        {q: np.array([r.get(k, math.nan) for k in p1b.keys], dtype=float) for q, r in t1b.items()},
+        p1b.keys,
+    )
     s1b = [
         "- **Part 1b.** On the bump (transient metrics) our HC1 and HC2 differ from QC and",
         f"FC by at most {md.pct(part1b_gap, False)}, the thesis's by up to",
@@ -345,8 +394,7 @@ def chapter3(out: Path, doc: Doc) -> list[str]:
             " QC and FC on this road."
         )
     doc.para(*s1b)
-    acc_outside = [r[0] for r in seed_rows if r[1].startswith("Max") and r[7] == "no"]
-    return [ch3_headline(out, acc_outside, disagree)]
+    return disagree
 
 
 def coarse_peak(path: Path, signal: str) -> tuple[float, float]:
