@@ -11,8 +11,11 @@ declare 10^12 rows it never wrote); text attributes must be UTF-8 and at most
 
 from __future__ import annotations
 
+import math
 import os
+import signal
 import stat
+import time
 from pathlib import Path
 
 import numpy as np
@@ -20,11 +23,83 @@ import numpy as np
 from .config import ConfigError
 from .config.yamlio import MAX_CONFIG_BYTES
 
-__all__ = ["H5Reader", "MAX_DATASET_BYTES"]
+__all__ = ["H5Reader", "MAX_DATASET_BYTES", "MAX_ATTRIBUTE_BYTES"]
 
 #: Largest dataset read from an input file [bytes]. A Pareto set of a million designs with a
 #: hundred columns is 800 MB.
 MAX_DATASET_BYTES = 1 << 30
+#: Longest a forked probe may take to walk a file's metadata [s] (:func:`_probe`).
+PROBE_SECONDS = 10.0
+#: Largest attribute read from an input file [bytes]: a damaged attribute may declare a shape
+#: of 10^15 elements, which h5py would allocate before reading.
+MAX_ATTRIBUTE_BYTES = 4 * MAX_CONFIG_BYTES
+
+
+def _walk(path: Path) -> None:
+    """Read every attribute and every text dataset of ``path`` (within the size limits)."""
+    import h5py
+
+    def visit(obj) -> None:
+        for key in obj.attrs:
+            declared = h5py.h5a.open(obj.id, key.encode())
+            if math.prod(declared.shape) * max(declared.dtype.itemsize, 1) <= MAX_ATTRIBUTE_BYTES:
+                obj.attrs[key]
+        if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "OSU":
+            if obj.size * max(obj.dtype.itemsize, 16) <= MAX_DATASET_BYTES:
+                obj[()]
+
+    with h5py.File(path, "r") as f:
+        visit(f)
+        f.visititems(lambda name, obj: visit(obj))
+
+
+def _probe(path: Path, where: str) -> None:
+    """Walk the file's metadata in a forked child first: a damaged file can send the HDF5
+    library into an endless loop or a crash, in C, where no Python timer reaches (a
+    corrupted global heap behind a text attribute does). The child's own errors are left to
+    the reader's checks; a child that does not finish in :data:`PROBE_SECONDS` or dies by a
+    signal makes the file bad input. Where there is no ``fork`` the probe is skipped."""
+    if not hasattr(os, "fork"):
+        return
+    pid = os.fork()
+    if pid == 0:  # the child: walk, and leave without running any of the parent's exit code
+        try:
+            import faulthandler
+
+            faulthandler.disable()  # its crash is the parent's to report, in one line
+            os.dup2(os.open(os.devnull, os.O_WRONLY), 2)
+            _walk(path)
+        except BaseException:
+            pass
+        os._exit(0)
+    deadline = time.monotonic() + PROBE_SECONDS
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            if os.WIFSIGNALED(status):
+                raise ConfigError(
+                    f"{where}: damaged: reading its metadata crashed the HDF5 library"
+                )
+            return
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            raise ConfigError(
+                f"{where}: damaged: reading its metadata did not finish in {PROBE_SECONDS:g} s"
+            )
+        time.sleep(0.002)
+
+
+def _from_h5py(kind, tb) -> bool:
+    """Whether an exception of ``kind`` with traceback ``tb`` is h5py's (or the HDF5
+    library's) failure to read, raised in h5py's own code."""
+    if kind is None or issubclass(kind, ConfigError):
+        return False
+    if not issubclass(kind, (OSError, RuntimeError, KeyError, ValueError, TypeError)):
+        return False
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    return tb is not None and "h5py" in Path(tb.tb_frame.f_code.co_filename).parts
 
 
 class H5Reader:
@@ -44,6 +119,7 @@ class H5Reader:
             raise ConfigError(f"{self.where}: cannot read it ({exc.strerror})") from None
         if not stat.S_ISREG(mode):
             raise ConfigError(f"{self.where}: not a regular file")
+        _probe(self.path, self.where)
         try:
             self.file = h5py.File(self.path, "r")
         except (OSError, ValueError):
@@ -52,8 +128,16 @@ class H5Reader:
     def __enter__(self) -> H5Reader:
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.file.close()
+    def __exit__(self, kind, exc, tb) -> None:
+        try:
+            self.file.close()
+        except (OSError, RuntimeError, ValueError):
+            pass
+        if _from_h5py(kind, tb):
+            # a damaged file fails inside h5py wherever it is walked (keys, membership,
+            # attributes): bad input, one line, whatever the reader was doing
+            text = " ".join(str(exc).split()).strip("'\"")
+            raise ConfigError(f"{self.where}: damaged, cannot be read ({text})") from None
 
     def _node(self, name: str):
         try:
@@ -137,26 +221,41 @@ class H5Reader:
                 f"{self.where}: attributes of /{node}: damaged, cannot be read"
             ) from None
 
+    def attribute(self, obj, key: str, label: str):
+        """The attribute ``key`` of the group or dataset ``obj``, None when it has none;
+        ConfigError (``label`` naming it) when it is damaged or declares more than
+        :data:`MAX_ATTRIBUTE_BYTES`, checked before anything is allocated."""
+        import h5py
+
+        try:
+            if obj is None or key not in obj.attrs:
+                return None
+            declared = h5py.h5a.open(obj.id, key.encode())
+            size = math.prod(declared.shape) * max(declared.dtype.itemsize, 1)
+            if size > MAX_ATTRIBUTE_BYTES:
+                raise ConfigError(
+                    f"{self.where}: {label}: declares {size} bytes, more than the "
+                    f"{MAX_ATTRIBUTE_BYTES} an attribute may take"
+                )
+            return obj.attrs[key]
+        except (OSError, ValueError, TypeError, RuntimeError, KeyError) as exc:
+            if isinstance(exc, ConfigError):
+                raise
+            raise ConfigError(f"{self.where}: {label}: damaged, cannot be read") from None
+
     def text_attr(self, key: str, node: str = "") -> str:
         """The text attribute ``key`` of ``/node`` (the root by default)."""
         obj = self.file if not node else self._node(node)
         label = f"attribute {key!r}" + (f" of /{node}" if node else "")
         if not self.has_attr(key, node):
             raise ConfigError(f"{self.where}: {label}: missing")
-        try:
-            value = obj.attrs[key]
-        except (OSError, ValueError, TypeError, RuntimeError, KeyError):
-            raise ConfigError(f"{self.where}: {label}: damaged, cannot be read") from None
-        return self.text(value, label)
+        return self.text(self.attribute(obj, key, label), label)
 
     def int_attr(self, node: str, key: str, low: int, high: int) -> int:
         """The whole-number attribute ``key`` of ``/node``, in ``[low, high]``."""
         obj = self._node(node)
         label = f"/{node}: attribute {key!r}"
-        try:
-            value = obj.attrs[key] if obj is not None and key in obj.attrs else None
-        except (OSError, ValueError, TypeError, RuntimeError, KeyError):
-            value = None
+        value = self.attribute(obj, key, label)
         if isinstance(value, np.ndarray) and value.ndim == 0:
             value = value[()]
         if (
@@ -174,10 +273,7 @@ class H5Reader:
         one entry per column."""
         ds = self.dataset(name)
         label = f"/{name}: attribute {key!r}"
-        try:
-            raw = ds.attrs[key] if key in ds.attrs else None
-        except (OSError, ValueError, TypeError, RuntimeError, KeyError):
-            raise ConfigError(f"{self.where}: {label}: damaged, cannot be read") from None
+        raw = self.attribute(ds, key, label)
         if raw is None:
             raise ConfigError(f"{self.where}: {label}: missing")
         entries = [self.text(v, label) for v in np.atleast_1d(raw)]

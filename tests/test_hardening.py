@@ -699,3 +699,42 @@ def test_mode_labels_say_what_a_mode_is(load):
     assert all(
         sum(f"wheel.{c}" in label for c in ("F1", "F2", "R1", "R2")) >= 2 for label in wheel_modes
     ), wheel_modes
+
+
+# --- a file that hangs or crashes the HDF5 library ----------------------------------------------
+
+
+@pytest.mark.parametrize("failure", ["hang", "crash"])
+def test_a_file_that_hangs_or_crashes_hdf5_is_bad_input(tmp_path, monkeypatch, failure):
+    import os
+    import signal
+    import time
+
+    from suspopt import h5read
+
+    path = tmp_path / "front.h5"
+    with h5py.File(path, "w") as h5:
+        h5.attrs["x"] = 1
+
+    def walk(_path):  # stands for a damaged global heap: an endless loop, or a crash, in C
+        if failure == "hang":
+            time.sleep(60)
+        os.kill(os.getpid(), signal.SIGSEGV)
+
+    monkeypatch.setattr(h5read, "_walk", walk)
+    monkeypatch.setattr(h5read, "PROBE_SECONDS", 0.5)
+    started = time.monotonic()
+    with pytest.raises(suspopt.ConfigError, match="damaged: reading its metadata"):
+        h5read.H5Reader(path)
+    assert time.monotonic() - started < 5
+
+
+def test_an_intact_file_passes_the_probe(tmp_path):
+    from suspopt import h5read
+
+    path = tmp_path / "front.h5"
+    with h5py.File(path, "w") as h5:
+        h5.attrs["config"] = "vehicle: {}"
+        h5.create_dataset("names", data=["a", "b"])
+    with h5read.H5Reader(path) as h5:
+        assert h5.text_attr("config") == "vehicle: {}"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import corner, make_config
+from conftest import CONFIGS, corner, make_config
 
 import suspopt
 from suspopt.vehicle import build_vehicle, modal_analysis
@@ -127,3 +127,26 @@ def test_frequency_response_peaks_at_body_mode(load):
     H = suspopt.frequency_response(model, f)[0, :, 0]
     assert f[np.argmax(np.abs(H))] == pytest.approx(0.93, abs=0.05)
     assert abs(H[0]) == pytest.approx(1.0, rel=0.05)  # body follows the road at low frequency
+
+
+@pytest.mark.parametrize(
+    "name, field",
+    [
+        ("ch3/part1a_hc1_bump.yaml", "roll_inertia"),
+        ("ch3/part1a_hc1_bump.yaml", "b_left"),
+        ("ch3/part1a_hc2_bump.yaml", "pitch_inertia"),
+        ("ch3/part1a_hc2_bump.yaml", "a_rear"),
+        ("ch3/part1a_fc_bump.yaml", "pitch_inertia"),
+        ("ch3/part1a_fc_bump.yaml", "roll_inertia"),
+    ],
+)
+def test_a_preset_without_a_body_field_it_needs_is_bad_input(name, field):
+    import re
+
+    from suspopt.config.loader import load_config_text
+
+    text = (CONFIGS / name).read_text()
+    cut = re.sub(rf"{field}: [-0-9.e+]+,? ?", "", text, count=1)
+    assert cut != text
+    with pytest.raises(suspopt.ConfigError, match=f"body.{field}"):
+        load_config_text(cut)

@@ -67,8 +67,9 @@ class Preset:
 
     @property
     def required_body(self) -> tuple[str, ...]:
-        """The body fields this preset needs besides the mass."""
-        return tuple(f for dof in self.body_dofs for f in DOF_FIELDS[dof][1:])
+        """The body fields this preset needs besides the mass: each DOF's inertia and lever
+        arms."""
+        return tuple(f for dof in self.body_dofs for f in DOF_FIELDS[dof] if f != "mass")
 
 
 #: What each body DOF needs of the body: its inertia (or the mass) and the corners' lever arms.

@@ -96,7 +96,7 @@ def read_checkpoint(output: Path, cfg: Config, problem: Problem):
                 f"run without --resume"
             )
         group = h5.group("checkpoint")
-        if group.attrs.get("format") != CHECKPOINT_FORMAT:
+        if h5.attribute(group, "format", "/checkpoint: attribute 'format'") != CHECKPOINT_FORMAT:
             raise ConfigError(
                 f"{where}: /checkpoint: not a suspopt checkpoint of format {CHECKPOINT_FORMAT}"
             )
