@@ -28,8 +28,11 @@ __all__ = ["H5Reader", "MAX_DATASET_BYTES", "MAX_ATTRIBUTE_BYTES"]
 #: Largest dataset read from an input file [bytes]. A Pareto set of a million designs with a
 #: hundred columns is 800 MB.
 MAX_DATASET_BYTES = 1 << 30
-#: Longest a forked probe may take to walk a file's metadata [s] (:func:`_probe`).
-PROBE_SECONDS = 10.0
+#: Longest a forked probe may take to walk a file's metadata (:func:`_probe`): this many
+#: seconds, and one more per :data:`PROBE_BYTES_PER_SECOND` of file. A sound file's walk takes
+#: milliseconds (a 1000-design front: about 5 ms).
+PROBE_SECONDS = 1.0
+PROBE_BYTES_PER_SECOND = 50e6
 #: Largest attribute read from an input file [bytes]: a damaged attribute may declare a shape
 #: of 10^15 elements, which h5py would allocate before reading.
 MAX_ATTRIBUTE_BYTES = 4 * MAX_CONFIG_BYTES
@@ -57,7 +60,7 @@ def _probe(path: Path, where: str) -> None:
     """Walk the file's metadata in a forked child first: a damaged file can send the HDF5
     library into an endless loop or a crash, in C, where no Python timer reaches (a
     corrupted global heap behind a text attribute does). The child's own errors are left to
-    the reader's checks; a child that does not finish in :data:`PROBE_SECONDS` or dies by a
+    the reader's checks; a child that does not finish in time (:data:`PROBE_SECONDS`) or dies by a
     signal makes the file bad input. Where there is no ``fork`` the probe is skipped."""
     if not hasattr(os, "fork"):
         return
@@ -72,7 +75,8 @@ def _probe(path: Path, where: str) -> None:
         except BaseException:
             pass
         os._exit(0)
-    deadline = time.monotonic() + PROBE_SECONDS
+    budget = PROBE_SECONDS + path.stat().st_size / PROBE_BYTES_PER_SECOND
+    deadline = time.monotonic() + budget
     while True:
         done, status = os.waitpid(pid, os.WNOHANG)
         if done:
@@ -85,7 +89,7 @@ def _probe(path: Path, where: str) -> None:
             os.kill(pid, signal.SIGKILL)
             os.waitpid(pid, 0)
             raise ConfigError(
-                f"{where}: damaged: reading its metadata did not finish in {PROBE_SECONDS:g} s"
+                f"{where}: damaged: reading its metadata did not finish in {budget:.3g} s"
             )
         time.sleep(0.002)
 
