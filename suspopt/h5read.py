@@ -33,6 +33,8 @@ MAX_DATASET_BYTES = 1 << 30
 #: milliseconds (a 1000-design front: about 5 ms).
 PROBE_SECONDS = 1.0
 PROBE_BYTES_PER_SECOND = 50e6
+#: Files this process has probed: (device, inode, size, modification time).
+_PROBED: set[tuple[int, int, int, int]] = set()
 #: Largest attribute read from an input file [bytes]: a damaged attribute may declare a shape
 #: of 10^15 elements, which h5py would allocate before reading.
 MAX_ATTRIBUTE_BYTES = 4 * MAX_CONFIG_BYTES
@@ -64,9 +66,17 @@ def _probe(path: Path, where: str) -> None:
     signal makes the file bad input. Where there is no ``fork`` the probe is skipped."""
     if not hasattr(os, "fork"):
         return
+    info = path.stat()
+    key = (info.st_dev, info.st_ino, info.st_size, info.st_mtime_ns)
+    if key in _PROBED:  # this file, unchanged, walked already by this process
+        return
+    budget = PROBE_SECONDS + info.st_size / PROBE_BYTES_PER_SECOND
     pid = os.fork()
     if pid == 0:  # the child: walk, and leave without running any of the parent's exit code
         try:
+            # the kernel ends the child even in a loop in C, and even if the parent is gone
+            signal.signal(signal.SIGALRM, signal.SIG_DFL)
+            signal.alarm(int(budget) + 2)
             import faulthandler
 
             faulthandler.disable()  # its crash is the parent's to report, in one line
@@ -75,7 +85,6 @@ def _probe(path: Path, where: str) -> None:
         except BaseException:
             pass
         os._exit(0)
-    budget = PROBE_SECONDS + path.stat().st_size / PROBE_BYTES_PER_SECOND
     deadline = time.monotonic() + budget
     while True:
         done, status = os.waitpid(pid, os.WNOHANG)
@@ -84,6 +93,7 @@ def _probe(path: Path, where: str) -> None:
                 raise ConfigError(
                     f"{where}: damaged: reading its metadata crashed the HDF5 library"
                 )
+            _PROBED.add(key)
             return
         if time.monotonic() > deadline:
             os.kill(pid, signal.SIGKILL)
@@ -91,7 +101,7 @@ def _probe(path: Path, where: str) -> None:
             raise ConfigError(
                 f"{where}: damaged: reading its metadata did not finish in {budget:.3g} s"
             )
-        time.sleep(0.002)
+        time.sleep(0.0005)
 
 
 def _from_h5py(kind, tb) -> bool:
