@@ -43,6 +43,7 @@ def datasets(h5):
     return found
 
 
+@pytest.mark.slow
 def test_models_on_the_bump_compare_transient_metrics_with_the_reference(tmp_path):
     qc, hc2 = short(tmp_path, "part1a_qc_bump", 6.0), short(tmp_path, "part1a_hc2_bump", 6.0)
     out, fig = tmp_path / "models.h5", tmp_path / "models.svg"

@@ -465,6 +465,7 @@ def test_adaptive_threshold_reaches_the_requested_share(law, distribution, share
     assert np.allclose(np.sort(res.time[refits])[1:], 5.0 * np.arange(1, 9))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("law", ["sh_2", "sh_add_2"])
 def test_adaptive_student_t_threshold_follows_the_exact_fit(law):
     """The controller's bounded Student-t refit on 40 s of class C road, three designs, one

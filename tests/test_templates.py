@@ -68,6 +68,7 @@ def test_template_says_what_every_value_is_and_where_it_comes_from(name):
     assert max(len(line) for line in lines) <= 99, name
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_template_validates_runs_and_is_physically_sensible(name, tmp_path):
     cfg = load_config_text(template_text(name))
