@@ -93,6 +93,9 @@ def git(*args: str) -> str:
         return "unknown"
 
 
+CHAPTER_BUILDERS = {3: chapter3, 4: chapter4, 5: chapter5, 6: chapter6, 7: chapter7, 8: chapter8}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", type=Path, help="the output folder of reproduce_thesis.sh")
@@ -107,10 +110,29 @@ def main() -> None:
     args.report.mkdir(parents=True, exist_ok=True)
     if (args.report / "figures").is_dir():
         shutil.rmtree(args.report / "figures")
-    chapters = {3: chapter3, 4: chapter4, 5: chapter5, 6: chapter6, 7: chapter7, 8: chapter8}
+    headlines, missing = _chapters(args)
+    doc = Doc(args.report)
+    steps = _header(args, doc)
+    _budgets(args, doc, steps)
+    doc("## Headlines", "")
+    for number in CHAPTER_BUILDERS:
+        doc(*[f"- {h}" for h in headlines[number]])
+    doc("")
+    doc("## Chapters", "")
+    for number, title in CHAPTERS.items():
+        doc(f"- [Chapter {number}: {title}](ch{number}.md)")
+    doc("")
+    (args.report / "README.md").write_text(doc.text())
+    print(f"wrote {args.report / 'README.md'} and ch3.md ... ch8.md")
+    for number, why in missing.items():
+        print(f"not built: chapter {number}: {why}", file=sys.stderr)
+
+
+def _chapters(args) -> tuple[dict, dict]:
+    """Write ch3.md ... ch8.md; each chapter's headlines, and why a chapter was not built."""
     headlines = {}
     missing = {}
-    for number, build in chapters.items():
+    for number, build in CHAPTER_BUILDERS.items():
         doc = Doc(args.report)
         try:
             headlines[number] = build(args.out, doc)
@@ -125,6 +147,11 @@ def main() -> None:
                 f"Run `examples/reproduce_thesis.sh` (or this chapter's script) to make them.",
             )
         (args.report / f"ch{number}.md").write_text(doc.text())
+    return headlines, missing
+
+
+def _header(args, doc: Doc) -> dict:
+    """The report's header: version, commit, machine, wall time; the steps' wall times."""
     steps = read_steps(args.out)
     wall = args.wall if args.wall is not None else sum(steps.values())
     tsv = args.out / "run.tsv"
@@ -134,7 +161,6 @@ def main() -> None:
         else "unknown"
     )
     dirty = git("status", "--porcelain", "--untracked-files=no")
-    doc = Doc(args.report)
     doc(
         "# suspopt: reproduction report of the thesis",
         "",
@@ -160,6 +186,11 @@ def main() -> None:
             ["outputs", f"`{args.out}`"],
         ],
     )
+    return steps
+
+
+def _budgets(args, doc: Doc, steps: dict) -> None:
+    """The mode and every step's budget and wall time."""
     doc("## Budgets and wall times", "")
     mode = (args.out / "mode").read_text().split() if (args.out / "mode").is_file() else []
     if mode[:1] == ["quick"]:
@@ -192,18 +223,6 @@ def main() -> None:
         "Each chapter's file gives the generations, evaluations and wall time of every",
         "optimisation next to its tables.",
     )
-    doc("## Headlines", "")
-    for number in chapters:
-        doc(*[f"- {h}" for h in headlines[number]])
-    doc("")
-    doc("## Chapters", "")
-    for number, title in CHAPTERS.items():
-        doc(f"- [Chapter {number}: {title}](ch{number}.md)")
-    doc("")
-    (args.report / "README.md").write_text(doc.text())
-    print(f"wrote {args.report / 'README.md'} and ch3.md ... ch8.md")
-    for number, why in missing.items():
-        print(f"not built: chapter {number}: {why}", file=sys.stderr)
 
 
 if __name__ == "__main__":
