@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
-from conftest import TINY
+from conftest import TINY, run
 from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.algorithms.soo.nonconvex.ga import GA
 from pymoo.core.problem import Problem as PymooProblem
@@ -368,21 +366,11 @@ def test_resume_equals_an_uninterrupted_run(tmp_path, variant):
         optimise(tiny(**{"seed: 1}": "seed: 2}"}), tmp_path / "part.h5", resume=True)
 
 
-def run_cli(*args, cwd=None):
-    return subprocess.run(
-        [sys.executable, "-m", "suspopt", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        timeout=120,
-    )
-
-
 def test_cli_optimise_writes_the_design_md_layout(tmp_path):
     config = tmp_path / "case.yaml"
     config.write_text(TINY.replace("generations: 4", "generations: 2"))
     out = tmp_path / "front.h5"
-    proc = run_cli("optimise", config, "-o", out)
+    proc = run("optimise", config, "-o", out)
     assert proc.returncode == 0, proc.stderr
     assert "Pareto set" in proc.stdout or "best design" in proc.stdout
     assert "NSGA2 gen 2/2" in proc.stderr
