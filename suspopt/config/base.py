@@ -28,47 +28,55 @@ __all__ = [
     "Ratio",
     "Seed",
     "Finite",
+    "bounds",
 ]
 
 
-def quantity(low: float | None, high: float, *, closed: bool = True) -> Any:
-    """A finite float in ``[low, high]`` (``(low, high]`` with ``closed=False``): the range is
-    checked on load and stated in the JSON schema."""
+def bounds(low: float | None, high: float, *, closed: bool = True) -> Any:
+    """The field constraint of a finite float in ``[low, high]`` (``(low, high]`` with
+    ``closed=False``), for ``Annotated[float, bounds(...)]``: the range is checked on load and
+    stated in the JSON schema."""
     bound = {} if low is None else {"ge" if closed else "gt": low}
-    return Annotated[float, Field(le=high, allow_inf_nan=False, **bound)]
+    return Field(le=high, allow_inf_nan=False, **bound)
+
+
+def quantity(low: float | None, high: float, *, closed: bool = True) -> Any:
+    """``Annotated[float, bounds(low, high)]`` built at run time (for models made by
+    ``create_model``; in a class body write the ``Annotated`` form, which type checkers read)."""
+    return Annotated[float, bounds(low, high, closed=closed)]
 
 
 # Physically plausible ranges of the config's quantities, SI. They are wide (a bicycle's seat
 # to a mining truck) and exist so that a value no suspension has (0 kg, 1e308 N/m, inf) is bad
 # input with its key and line, never an overflow or a singular matrix deep in a run.
 #: [kg] from a gram (a passenger's diaphragm is 0.46 kg) to 1000 t
-Mass = quantity(1e-3, 1e6)
+Mass = Annotated[float, bounds(1e-3, 1e6)]
 #: [kg m^2]
-Inertia = quantity(1e-3, 1e8)
+Inertia = Annotated[float, bounds(1e-3, 1e8)]
 #: [N/m], > 0
-Stiffness = quantity(1e-3, 1e10)
+Stiffness = Annotated[float, bounds(1e-3, 1e10)]
 #: [N m/rad] (anti-roll bars), 0 for none
-TorsionalStiffness = quantity(0.0, 1e10)
+TorsionalStiffness = Annotated[float, bounds(0.0, 1e10)]
 #: [N/m^3] (Duffing term, Eq 2.31; the thesis's k_nl reach 3e7)
-CubicStiffness = quantity(-1e14, 1e14)
+CubicStiffness = Annotated[float, bounds(-1e14, 1e14)]
 #: [N s/m]
-Damping = quantity(0.0, 1e8)
+Damping = Annotated[float, bounds(0.0, 1e8)]
 #: [m] body geometry: centre of gravity to an axle or a wheel track
-VehicleLength = quantity(1e-3, 100.0)
+VehicleLength = Annotated[float, bounds(1e-3, 100.0)]
 #: [m] seat mechanism geometry
-SeatLength = quantity(1e-4, 10.0)
+SeatLength = Annotated[float, bounds(1e-4, 10.0)]
 #: [m] bump height, negative for a pothole
-RoadHeight = quantity(-10.0, 10.0)
+RoadHeight = Annotated[float, bounds(-10.0, 10.0)]
 #: [m] bump length on the road
-RoadLength = quantity(1e-3, 1e5, closed=False)
+RoadLength = Annotated[float, bounds(1e-3, 1e5, closed=False)]
 #: [m/s] vehicle speed, up to 720 km/h
-Speed = quantity(1e-3, 200.0)
+Speed = Annotated[float, bounds(1e-3, 200.0)]
 #: [s] times within a run
-Duration = quantity(0.0, 1e5, closed=False)
+Duration = Annotated[float, bounds(0.0, 1e5, closed=False)]
 #: [s] integration and output steps
-Step = quantity(1e-7, 1.0)
+Step = Annotated[float, bounds(1e-7, 1.0)]
 #: [-] a dimensionless factor
-Ratio = quantity(0.0, 1e3)
+Ratio = Annotated[float, bounds(0.0, 1e3)]
 #: [-] any finite number
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 #: a random seed (numpy SeedSequence entropy, stored in HDF5 as int64)

@@ -9,11 +9,11 @@ It is ignored when every damper is passive.
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
-from .base import Duration, Section, quantity
+from .base import Duration, Section, bounds
 
 __all__ = ["Threshold", "Control", "DEFAULT_SAMPLE_TIME"]
 
@@ -39,7 +39,7 @@ class Threshold(Section):
     mode: Literal["fixed", "adaptive"] = Field(
         description="fixed: T = value; adaptive: T re-fitted from the condition history"
     )
-    value: quantity(-1e12, 1e12) | None = Field(
+    value: Annotated[float, bounds(-1e12, 1e12)] | None = Field(
         None,
         description="fixed threshold T in the unit of the laws' condition (m^2/s^2 for SH-2, "
         "SH-L, SH-ADD-1, groundhook, hybrid; m^2/s^3 for ADD; m^2/s^4 for SH-ADD-2); mode "
@@ -58,7 +58,7 @@ class Threshold(Section):
         description="T_learn: the base law runs until t >= learn_time, then the first fit "
         "is made [s] (Fig. 4.4; the thesis says 'a few seconds')",
     )
-    refit_factor: quantity(1e-3, 1e3) = Field(
+    refit_factor: Annotated[float, bounds(1e-3, 1e3)] = Field(
         1.0,
         description="kappa: the threshold is re-fitted every refit_factor * learn_time "
         "seconds (Fig. 4.4) [-]",
@@ -101,12 +101,12 @@ class Control(Section):
     updated exactly once per integration step.
     """
 
-    sample_time: quantity(1e-7, 10.0) = Field(
+    sample_time: Annotated[float, bounds(1e-7, 10.0)] = Field(
         DEFAULT_SAMPLE_TIME,
         description="controller sample time ΔT [s], a whole multiple of "
         "simulation.dt (Sec 4.2: 4 ms)",
     )
-    actuator_lag: quantity(0.0, 10.0) = Field(
+    actuator_lag: Annotated[float, bounds(0.0, 10.0)] = Field(
         0.0,
         description="time constant τ of the damper's first-order response to a new "
         "command [s]; 0 switches instantly",

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, field_validator
 
 from ..specs import METRICS
-from .base import Duration, Section, check_known, quantity
+from .base import Duration, Section, bounds, check_known
 
 __all__ = ["MetricSpec"]
 
@@ -32,7 +32,7 @@ class MetricSpec(Section):
         "crest_factor (none: unweighted)",
     )
     tau: Duration = Field(1.0, description="running r.m.s. integration time for mtvv [s]")
-    band: quantity(0.0, 1.0, closed=False) = Field(
+    band: Annotated[float, bounds(0.0, 1.0, closed=False)] = Field(
         0.02, description="settling band for transient metrics [-]"
     )
 

@@ -24,7 +24,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from .base import Section, Seed, check_known, quantity
+from .base import Section, Seed, bounds, check_known
 from .metrics import MetricSpec
 
 __all__ = [
@@ -43,7 +43,7 @@ __all__ = [
 ]
 
 #: a bound or limit in a field's or a metric's SI unit
-_Finite = quantity(-1e15, 1e15)
+_Finite = Annotated[float, bounds(-1e15, 1e15)]
 
 
 def _count(high: int) -> Any:
@@ -166,7 +166,7 @@ class Constraint(Objective):
 
     min: _Finite | None = Field(None, description="lowest allowed value (g = min - value)")
     max: _Finite | None = Field(None, description="highest allowed value (g = value - max)")
-    mu: quantity(0.0, 1.0, closed=False) | None = Field(
+    mu: Annotated[float, bounds(0.0, 1.0, closed=False)] | None = Field(
         None,
         description="μ of the NSS3 condition d < μ R (Table 8.9 #4; quantity "
         "seat.geometry only; default 0.8, Sec 8.3.4)",
@@ -227,7 +227,7 @@ class Balance(Section):
     dominant: str | None = Field(
         None, description="name of the objective that dominates (Case 5: f1)"
     )
-    factor: quantity(0.0, 1e6, closed=False) = Field(
+    factor: Annotated[float, bounds(0.0, 1e6, closed=False)] = Field(
         10.0, description="how much the dominant term outweighs the others [-] (Case 5: 10)"
     )
 
@@ -235,7 +235,7 @@ class Balance(Section):
 class WeightedSum(Section):
     """Pseudo multi-objective optimisation, Eq 5.7: minimise ``sum_i w_i f_i``."""
 
-    weights: list[quantity(0.0, 1e12)] | None = Field(
+    weights: list[Annotated[float, bounds(0.0, 1e12)]] | None = Field(
         None, description="one weight per main objective, in the order of objectives.main"
     )
     balance: Balance | None = Field(
@@ -297,7 +297,7 @@ class Optimiser(Section):
         "generations plus SLSQP iterations)",
     )
     max_evaluations: _count(10**10) | None = Field(None, description="most designs simulated")
-    tolerance: quantity(0.0, 1.0, closed=False) = Field(
+    tolerance: Annotated[float, bounds(0.0, 1.0, closed=False)] = Field(
         1.0e-6,
         description="stop when the best objective improves less than this over "
         "stall_generations (GA; Ch. 5: 1e-6), or SLSQP's ftol on the objective scaled by its "

@@ -27,7 +27,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from .base import RoadHeight, RoadLength, Section, Seed, Speed, quantity
+from .base import RoadHeight, RoadLength, Section, Seed, Speed, bounds
 
 __all__ = [
     "Tracks",
@@ -44,9 +44,9 @@ __all__ = [
 Tracks = Literal["identical", "independent", "right_only", "left_only"]
 
 #: [s] when the front wheels reach a bump
-_Start = quantity(0.0, 1e5)
+_Start = Annotated[float, bounds(0.0, 1e5)]
 #: [cycles/m] spatial frequencies, down to a 10 km wavelength and up to a 1 cm one
-_SpatialFrequency = quantity(1e-4, 100.0)
+_SpatialFrequency = Annotated[float, bounds(1e-4, 100.0)]
 _TRACKS_DESCRIPTION = (
     "what the two sides see: 'identical' (left = right), 'independent' (left is an independent "
     "realisation; iso8608 only), 'right_only' / 'left_only' (the other side is flat)"
@@ -130,7 +130,7 @@ class Iso8608Road(_Road):
         description="ISO 8608 class; sets G_d(n0) to the class's geometric mean "
         "(A 16, B 64, C 256, D 1024, E 4096 x 1e-6 m^3)",
     )
-    level: quantity(1e-12, 1.0) | None = Field(
+    level: Annotated[float, bounds(1e-12, 1.0)] | None = Field(
         None,
         description="displacement PSD level G_d(n0) at n0 = 0.1 cycles/m [m^3]; "
         "overrides road_class",
@@ -141,7 +141,7 @@ class Iso8608Road(_Road):
         "1/sqrt(2 pi) times smaller); G_d(n_i) dn and Phi(Omega_i) dOmega stand for the PSD's "
         "integral over harmonic i's cell"
     )
-    waviness: quantity(0.1, 10.0) = Field(
+    waviness: Annotated[float, bounds(0.1, 10.0)] = Field(
         2.0, description="waviness w, the PSD slope exponent (Eq 2.93) [-]"
     )
     n_min: _SpatialFrequency = Field(
@@ -197,7 +197,9 @@ class FileRoad(_DeterministicRoad):
         description="CSV file with columns distance [m], height [m] and an "
         "optional header line; relative to the config file's directory",
     )
-    scale: quantity(-1e3, 1e3) = Field(1.0, description="factor applied to the heights [-]")
+    scale: Annotated[float, bounds(-1e3, 1e3)] = Field(
+        1.0, description="factor applied to the heights [-]"
+    )
 
     @field_validator("path")
     @classmethod

@@ -31,7 +31,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
-from .base import Damping, Mass, Ratio, SeatLength, Section, Stiffness, quantity
+from .base import Damping, Mass, Ratio, SeatLength, Section, Stiffness, bounds
 
 __all__ = [
     "Position",
@@ -48,7 +48,7 @@ __all__ = [
 ]
 
 #: [m] a point of the body relative to its centre of gravity
-_BodyPoint = quantity(-100.0, 100.0)
+_BodyPoint = Annotated[float, bounds(-100.0, 100.0)]
 
 
 class Position(Section):
@@ -243,7 +243,7 @@ class YanSeat(_NegativeStiffnessSeat):
     stiffness_ratio: Ratio = Field(description="α = K_h/K_v [-] (Table 8.8: 0-5)")
     cam_radius: SeatLength = Field(description="R, cam radius [m] (Table 8.8: 0.01-0.25)")
     roller_radius: SeatLength = Field(description="r, roller radius [m] (Table 8.8: 0.01-0.25)")
-    cam_offset: quantity(0.0, 10.0) = Field(
+    cam_offset: Annotated[float, bounds(0.0, 10.0)] = Field(
         description="d, distance from the cam centre [m] (Table 8.8: 0-0.25)"
     )
     precompression: SeatLength = Field(
@@ -278,7 +278,7 @@ class KDamperSeat(_NegativeStiffnessSeat):
     inner_stiffness: Stiffness = Field(
         description="K_v, seat to inner mass [N/m] (Table 8.10: 2e3-7e4)"
     )
-    horizontal_stiffness: quantity(0.0, 1e10) = Field(
+    horizontal_stiffness: Annotated[float, bounds(0.0, 1e10)] = Field(
         description="K_h, each horizontal spring [N/m] (Table 8.10: 2e3-7e4)"
     )
     spring_free_length: SeatLength = Field(
@@ -286,7 +286,7 @@ class KDamperSeat(_NegativeStiffnessSeat):
     )
     wall_distance: SeatLength = Field(description="a_o [m] (Table 8.10: 0.1-0.3)")
     bar_length: SeatLength = Field(description="b, bar length [m] (Table 8.10: 0.1-0.3)")
-    hinge_offset: quantity(-10.0, 10.0) = Field(
+    hinge_offset: Annotated[float, bounds(-10.0, 10.0)] = Field(
         0.001,
         description="u_0, the hinge's height above the horizontal at rest [m] (Sec 2.2.5: 1 mm)",
     )

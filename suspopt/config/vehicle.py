@@ -27,6 +27,7 @@ from .base import (
     Stiffness,
     TorsionalStiffness,
     VehicleLength,
+    bounds,
     quantity,
 )
 
@@ -287,7 +288,9 @@ class Vehicle(Section):
         description="tyres cannot pull (no tensile force); the "
         "thesis assumes permanent contact, so off by default",
     )
-    gravity: quantity(0.1, 100.0) = Field(9.81, description="gravitational acceleration [m/s^2]")
+    gravity: Annotated[float, bounds(0.1, 100.0)] = Field(
+        9.81, description="gravitational acceleration [m/s^2]"
+    )
 
     @model_validator(mode="before")
     @classmethod
