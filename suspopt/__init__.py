@@ -48,8 +48,9 @@ class _Package(types.ModuleType):
         def get(self):
             return getattr(importlib.import_module(f"suspopt.{name}"), name)
 
-        def keep(self, module):  # the import system's setattr: the function stays
-            pass
+        def keep(self, module):
+            """The import system sets the submodule as an attribute: ignored, the function
+            stays."""
 
         return property(get, keep)
 

@@ -11,6 +11,7 @@ declare 10^12 rows it never wrote); text attributes must be UTF-8 and at most
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import signal
@@ -40,14 +41,22 @@ _PROBED: set[tuple[int, int, int, int]] = set()
 MAX_ATTRIBUTE_BYTES = 4 * MAX_CONFIG_BYTES
 
 
+def _declared_bytes(obj, key: str) -> int:
+    """Bytes the attribute ``key`` of ``obj`` declares (its shape times its item size), read
+    from its header without allocating it."""
+    import h5py
+
+    declared = h5py.h5a.open(obj.id, key.encode())
+    return math.prod(declared.shape) * max(declared.dtype.itemsize, 1)
+
+
 def _walk(path: Path) -> None:
     """Read every attribute and every text dataset of ``path`` (within the size limits)."""
     import h5py
 
     def visit(obj) -> None:
         for key in obj.attrs:
-            declared = h5py.h5a.open(obj.id, key.encode())
-            if math.prod(declared.shape) * max(declared.dtype.itemsize, 1) <= MAX_ATTRIBUTE_BYTES:
+            if _declared_bytes(obj, key) <= MAX_ATTRIBUTE_BYTES:
                 obj.attrs[key]
         if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "OSU":
             if obj.size * max(obj.dtype.itemsize, 16) <= MAX_DATASET_BYTES:
@@ -73,7 +82,8 @@ def _probe(path: Path, where: str) -> None:
     budget = PROBE_SECONDS + info.st_size / PROBE_BYTES_PER_SECOND
     pid = os.fork()
     if pid == 0:  # the child: walk, and leave without running any of the parent's exit code
-        try:
+        # errors it meets are the reader's to report, by its own checks
+        with contextlib.suppress(BaseException):
             # the kernel ends the child even in a loop in C, and even if the parent is gone
             signal.signal(signal.SIGALRM, signal.SIG_DFL)
             signal.alarm(int(budget) + 2)
@@ -82,8 +92,6 @@ def _probe(path: Path, where: str) -> None:
             faulthandler.disable()  # its crash is the parent's to report, in one line
             os.dup2(os.open(os.devnull, os.O_WRONLY), 2)
             _walk(path)
-        except BaseException:
-            pass
         os._exit(0)
     deadline = time.monotonic() + budget
     while True:
@@ -143,10 +151,8 @@ class H5Reader:
         return self
 
     def __exit__(self, kind, exc, tb) -> None:
-        try:
+        with contextlib.suppress(OSError, RuntimeError, ValueError):  # a damaged file's close
             self.file.close()
-        except (OSError, RuntimeError, ValueError):
-            pass
         if _from_h5py(kind, tb):
             # a damaged file fails inside h5py wherever it is walked (keys, membership,
             # attributes): bad input, one line, whatever the reader was doing
@@ -239,13 +245,10 @@ class H5Reader:
         """The attribute ``key`` of the group or dataset ``obj``, None when it has none;
         ConfigError (``label`` naming it) when it is damaged or declares more than
         :data:`MAX_ATTRIBUTE_BYTES`, checked before anything is allocated."""
-        import h5py
-
         try:
             if obj is None or key not in obj.attrs:
                 return None
-            declared = h5py.h5a.open(obj.id, key.encode())
-            size = math.prod(declared.shape) * max(declared.dtype.itemsize, 1)
+            size = _declared_bytes(obj, key)
             if size > MAX_ATTRIBUTE_BYTES:
                 raise ConfigError(
                     f"{self.where}: {label}: declares {size} bytes, more than the "

@@ -35,6 +35,7 @@ are variable-length UTF-8 strings. :func:`open_dataset` reads a group back as an
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import fcntl
 import os
@@ -241,9 +242,8 @@ def atomic_file(path: str | Path, force: bool = False) -> Iterator:
         except OSError:
             return
         try:
-            os.fsync(folder)
-        except OSError:
-            pass
+            with contextlib.suppress(OSError):  # a folder some file systems cannot sync
+                os.fsync(folder)
         finally:
             os.close(folder)
 

@@ -14,6 +14,7 @@ once at the start. The process then keeps its peak memory until it exits.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import ctypes.util
 
@@ -97,14 +98,12 @@ def available() -> int:
     import resource
 
     free = None
-    try:
+    with contextlib.suppress(OSError):  # no /proc: the sysconf figure below
         with open("/proc/meminfo") as info:
             for line in info:
                 if line.startswith("MemAvailable:"):
                     free = int(line.split()[1]) * 1024
                     break
-    except OSError:
-        pass
     if free is None:
         try:
             free = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
