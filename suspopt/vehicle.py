@@ -460,8 +460,9 @@ def modal_analysis(model: VehicleModel) -> ModalResult:
         Natural frequencies ``(P, n)`` [Hz], mode shapes ``(P, n, n)`` (largest entry 1, in
         m or rad), kinetic-energy shares ``(P, n, n)`` [-] and a label per mode.
     """
-    frequency, shape = model.linear.modes()
-    m = model.linear.mass
+    linear = model.linear
+    frequency, shape = linear.modes()
+    m = linear.mass
     shape = shape / np.max(np.abs(shape), axis=1, keepdims=True)
     energy = m[:, :, None] * shape**2
     energy = energy / energy.sum(axis=1, keepdims=True)
