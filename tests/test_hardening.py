@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import pickle
+import shlex
 import signal
 import subprocess
 import sys
@@ -661,6 +662,60 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
     assert proc.returncode == 130, (out, err)
     assert "Traceback" not in err and err.strip().splitlines()[-1] == "interrupted"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.yaml"]
+
+
+@pytest.mark.cli
+def test_a_reader_that_goes_away_is_not_an_error(tmp_path):
+    """``suspopt simulate ... | head -1``: the file is written, nothing on stderr, exit 0 (the
+    command's own code), not rich's SystemExit(1)."""
+    out = tmp_path / "q.h5"
+    proc = subprocess.run(
+        f"{shlex.quote(sys.executable)} -m suspopt simulate configs/quickstart.yaml"
+        f" -o {shlex.quote(str(out))} | head -c 1; exit ${{PIPESTATUS[0]}}",
+        shell=True,
+        executable="/bin/bash",
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
+    )
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    with h5py.File(out) as h5:
+        assert "signals" in h5 and "metrics" in h5
+
+
+@pytest.mark.cli
+def test_printed_lines_drop_control_characters(tmp_path):
+    """A config whose name holds an escape sequence: the line that names it does not colour
+    or move the terminal."""
+    path = tmp_path / "q\x1b[31m\x07\r.yaml"
+    path.write_text((ROOT / "configs" / "quickstart.yaml").read_text())
+    proc = subprocess.run(
+        [sys.executable, "-m", "suspopt", "validate", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 0 and "valid" in proc.stdout, proc
+    assert not set(proc.stdout) & {"\x1b", "\x07", "\r"}
+
+
+@pytest.mark.cli
+def test_the_command_sizes_blas_to_one_thread_unless_told():
+    code = (
+        "import os, sys\n"
+        "import suspopt._entry as e\n"
+        "e.main = lambda: print(os.environ.get('OPENBLAS_NUM_THREADS')) or 0\n"
+        "e.run()\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    for given, seen in ((None, "1"), ("2", "2")):
+        if given is not None:
+            env["OPENBLAS_NUM_THREADS"] = given
+        proc = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60
+        )
+        assert proc.returncode == 0 and proc.stdout.strip() == seen, proc
 
 
 def test_numpy_warnings_are_one_line_each():

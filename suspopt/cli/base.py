@@ -2,16 +2,22 @@
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import os
 import shlex
 import sys
 from contextlib import ExitStack
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import typer
-from rich.console import Console
-from rich.table import Table
 
 from ..errors import ConfigError
+
+if TYPE_CHECKING:
+    from rich.console import Console
+    from rich.table import Table
 
 app = typer.Typer(
     add_completion=True,
@@ -19,10 +25,79 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     help="Simulate, optimise and select vehicle and seat suspensions from YAML.",
 )
-# text from files and arguments is printed as it is: no rich markup, no emoji codes
-# (":x:" in a file name), no highlighting
-out = Console(markup=False, emoji=False, highlight=False, soft_wrap=True)
-err = Console(stderr=True, markup=False, emoji=False, highlight=False, soft_wrap=True)
+#: The control characters a printed line drops (all of C0 but tab and newline, and DEL): text
+#: from files and arguments must not move the cursor or colour the terminal.
+_CONTROL = dict.fromkeys([*range(9), *range(11, 32), 127])
+
+
+class LazyConsole:
+    """Where the commands print: plain text lines are written as they are (their control
+    characters dropped), anything else (tables, progress bars) through a rich ``Console``
+    made on first use - rich takes about 17 ms to import, which a command that prints only
+    lines (``validate``) does not pay. Text from files and arguments is never read as rich
+    markup, emoji codes (":x:" in a file name) or highlighted. ``quiet`` silences both."""
+
+    def __init__(self, stderr: bool = False):
+        self._stderr, self._quiet, self._console = stderr, False, None
+
+    @property
+    def console(self) -> Console:
+        if self._console is None:
+            from rich.console import Console
+
+            class _Console(Console):
+                def on_broken_pipe(console) -> None:  # rich's default: SystemExit(1)
+                    self._reader_gone()
+
+            self._console = _Console(
+                stderr=self._stderr,
+                markup=False,
+                emoji=False,
+                highlight=False,
+                soft_wrap=True,
+                quiet=self._quiet,
+            )
+        return self._console
+
+    @property
+    def quiet(self) -> bool:
+        return self._quiet
+
+    @quiet.setter
+    def quiet(self, value: bool) -> None:
+        self._quiet = value
+        if self._console is not None:
+            self._console.quiet = value
+
+    def print(self, *objects: Any, **kwargs: Any) -> None:
+        """Print ``objects``: text alone as one line (soft-wrapped, as rich would with
+        ``soft_wrap``), anything else through rich."""
+        if all(isinstance(o, str) for o in objects) and set(kwargs) <= {"soft_wrap"}:
+            if not self._quiet:
+                try:
+                    self._stream().write(" ".join(objects).translate(_CONTROL) + "\n")
+                except BrokenPipeError:
+                    self._reader_gone()
+            return
+        self.console.print(*objects, **kwargs)
+
+    def _stream(self):
+        return sys.stderr if self._stderr else sys.stdout
+
+    def _reader_gone(self) -> None:
+        """The reader of the stream went away (``suspopt simulate ... | head``): the command
+        goes on, its outputs are written and its exit code is its own; what it would still
+        print goes to the null device."""
+        self.quiet = True
+        with contextlib.suppress(OSError, ValueError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream().fileno())
+
+    def __getattr__(self, name: str) -> Any:  # width, is_terminal, ...
+        return getattr(self.console, name)
+
+
+out = LazyConsole()
+err = LazyConsole(stderr=True)
 
 #: Exit code of a run that finished but whose every design failed to simulate.
 EXIT_ALL_FAILED = 3
@@ -92,28 +167,35 @@ def _main(
     reuse_memory()  # a command's repeated batches reuse their memory (suspopt.memory)
 
 
-class FoldingTable(Table):
-    """A table whose cells fold onto further lines when the terminal is narrow (a CI log's
-    80 columns) instead of being cut to "…"."""
-
-    def __init__(self, *args, **kwargs) -> None:
-        super().__init__(*args, **kwargs)
-        self.cells: list[tuple[str, ...]] = []  # the rows as given, for show_table
-
-    def add_column(self, *args, **kwargs) -> None:
-        kwargs.setdefault("overflow", "fold")
-        super().add_column(*args, **kwargs)
-
-    def add_row(self, *cells, **kwargs) -> None:
-        self.cells.append(tuple(str(c) for c in cells))
-        super().add_row(*cells, **kwargs)
-
-
 def new_table(title: str | None = None) -> Table:
-    return FoldingTable(title=title)
+    """A rich table whose cells fold onto further lines when the terminal is narrow (a CI
+    log's 80 columns) instead of being cut to "…"; its rows as given are kept in ``cells``
+    for :func:`show_table`."""
+    return _folding_table()(title=title)
 
 
-def show_table(table: FoldingTable, keys: int = 1) -> None:
+@functools.cache
+def _folding_table() -> type:
+    """The class of :func:`new_table` (made when first needed: it needs rich)."""
+    from rich.table import Table
+
+    class FoldingTable(Table):
+        def __init__(self, *args, **kwargs) -> None:
+            super().__init__(*args, **kwargs)
+            self.cells: list[tuple[str, ...]] = []
+
+        def add_column(self, *args, **kwargs) -> None:
+            kwargs.setdefault("overflow", "fold")
+            super().add_column(*args, **kwargs)
+
+        def add_row(self, *cells, **kwargs) -> None:
+            self.cells.append(tuple(str(c) for c in cells))
+            super().add_row(*cells, **kwargs)
+
+    return FoldingTable
+
+
+def show_table(table: Table, keys: int = 1) -> None:
     """Print ``table``; when it is wider than the terminal (a CI log's 80 columns), as several
     tables of the columns that fit, each with the first ``keys`` columns again, so that no
     number is cut or broken across lines."""

@@ -4,13 +4,16 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
-from rich.table import Table
 
 from ..errors import ConfigError
 from . import base
 from .base import app, err, out
+
+if TYPE_CHECKING:
+    from rich.table import Table
 
 
 def _progress_line(p) -> str:

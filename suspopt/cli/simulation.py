@@ -5,13 +5,16 @@ from __future__ import annotations
 import time
 from contextlib import ExitStack
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
-from rich.table import Table
 
 from ..errors import ConfigError
 from . import base
 from .base import app, err, out
+
+if TYPE_CHECKING:
+    from rich.table import Table
 
 
 def _summary_table(result) -> Table:

@@ -92,4 +92,8 @@ class Section(BaseModel):
     without a point), never a boolean or a string, and a text field takes text.
     """
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False, strict=True)
+    # defer_build: a section's validator is built inside the one of the config that holds it,
+    # when a config is first read, not once more per section class at import
+    model_config = ConfigDict(
+        extra="forbid", validate_assignment=True, frozen=False, strict=True, defer_build=True
+    )

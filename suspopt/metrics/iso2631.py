@@ -98,7 +98,8 @@ COMFORT_REACTIONS: tuple[tuple[float, float, str], ...] = (
 )
 """ISO 2631-1 Annex C.2.3 comfort reactions: (lower, upper, wording), a_w in m/s²."""
 
-_ZONE_EDGES = np.unique([edge for band in COMFORT_REACTIONS for edge in band[:2]])[1:-1]
+# sorted() of a set, not np.unique: np.unique of an array holding inf imports numpy.ma (26 ms)
+_ZONE_EDGES = np.array(sorted({edge for band in COMFORT_REACTIONS for edge in band[:2]}))[1:-1]
 _ZONE_LABELS = np.array(
     [
         " / ".join(label for lower, upper, label in COMFORT_REACTIONS if lower <= start < upper)
