@@ -11,7 +11,9 @@ and tyre coefficients) and the bump from the road section, integrates it with RK
 (``rtol = 1e-4``, ``max_step`` a quarter of the bump's duration), samples it on the same 1 ms
 grid and computes the same objectives and constraints with the public metric functions. It runs
 on the first ``--per-design`` designs (default 40) and its rate is per design. The batched
-path is timed as the best of ``REPEATS`` calls on the whole population.
+path is timed as the best of ``REPEATS`` calls on the whole population, on the numpy engine
+and (when numba is installed) the compiled engine (``simulation.engine: compiled``), whose
+objectives are also compared with the numpy engine's.
 
 Run: ``python benchmarks/bench_optimise.py``. Prints a table; asserts nothing.
 Like the command line, it first makes the allocator reuse freed memory
@@ -121,9 +123,17 @@ def main() -> None:
     args = parser.parse_args()
     memory = "reused" if not args.default_allocator and suspopt.reuse_memory() else "default"
     cfg = suspopt.load_config(CONFIG)
-    problem = suspopt.Problem.from_config(cfg)
+    from suspopt.integrator import compiled_available
+
+    problems = {}
+    for engine in ["numpy"] + (["compiled"] if compiled_available() else []):
+        c = cfg.model_copy(deep=True)
+        c.simulation.engine = engine
+        problems[engine] = suspopt.Problem.from_config(c)
+    problem = problems["numpy"]
     rng = np.random.default_rng(2026)
-    problem.evaluate(problem.xl[None] + 0.5 * (problem.xu - problem.xl)[None])  # warm-up
+    for p in problems.values():  # warm-up (imports, the compiled engine's cache)
+        p.evaluate(problem.xl[None] + 0.5 * (problem.xu - problem.xl)[None])
     print(
         f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
         f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}"
@@ -135,16 +145,19 @@ def main() -> None:
     )
     time_grid = np.arange(cfg.simulation.n_steps + 1) * cfg.simulation.dt
     print(
-        f"{'P':>6} {'batched [s]':>12} {'batched /s':>11} {'solve_ivp /s':>13} "
-        f"{'speed-up':>9} {'max rel. diff f1-f3':>20}"
+        f"{'P':>6} {'engine':>9} {'batched [s]':>12} {'batched /s':>11} {'solve_ivp /s':>13} "
+        f"{'speed-up':>9} {'vs solve_ivp f1-f3':>19} {'vs numpy f1-f3':>15}"
     )
     for P in (200, 1000):
         X = problem.xl + rng.random((P, problem.n_var)) * (problem.xu - problem.xl)
-        batched = np.inf
-        for _ in range(REPEATS):  # the optimiser's steady state, one generation
-            start = time.perf_counter()
-            F, G = problem.evaluate(X, return_values_of=["F", "G"])
-            batched = min(batched, time.perf_counter() - start)
+        results = {}
+        for engine, p in problems.items():
+            batched = np.inf
+            for _ in range(REPEATS):  # the optimiser's steady state, one generation
+                start = time.perf_counter()
+                F, G = p.evaluate(X, return_values_of=["F", "G"])
+                batched = min(batched, time.perf_counter() - start)
+            results[engine] = (batched, F, G)
         designs = problem.to_physical(X[: args.per_design])
         start = time.perf_counter()
         reference = np.array(
@@ -154,12 +167,15 @@ def main() -> None:
             ]
         )
         single = (time.perf_counter() - start) / len(designs)
-        diff = np.max(np.abs(F[: len(designs)] - reference[:, :3]) / np.abs(reference[:, :3]))
-        rc = np.max(np.abs(G[: len(designs), 0] + 0.8 - reference[:, 3]) / reference[:, 3])
-        print(
-            f"{P:>6} {batched:>12.2f} {P / batched:>11.1f} {1 / single:>13.2f} "
-            f"{single * P / batched:>8.1f}x {diff:>20.2e}   (RC: {rc:.1e})"
-        )
+        F0 = results["numpy"][1]
+        for engine, (batched, F, G) in results.items():
+            diff = np.max(np.abs(F[: len(designs)] - reference[:, :3]) / np.abs(reference[:, :3]))
+            rc = np.max(np.abs(G[: len(designs), 0] + 0.8 - reference[:, 3]) / reference[:, 3])
+            same = np.max(np.abs(F - F0) / np.abs(F0))
+            print(
+                f"{P:>6} {engine:>9} {batched:>12.2f} {P / batched:>11.1f} {1 / single:>13.2f} "
+                f"{single * P / batched:>8.1f}x {diff:>19.2e} {same:>15.1e}   (RC: {rc:.1e})"
+            )
 
 
 if __name__ == "__main__":

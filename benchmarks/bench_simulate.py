@@ -1,11 +1,16 @@
-"""Designs simulated per second for the Chapter 5 HC2 problem, at P = 1, 100 and 1000.
+"""Designs simulated per second for the Chapter 5 HC2 problem, at P = 1, 100, 1000 and 10000,
+on the numpy engine and (when numba is installed) the compiled engine, in the same run, with
+the peak memory of each call (tracemalloc: numpy's arrays included) and the agreement of the
+two engines' body accelerations.
 
 Table 5.1 half car with Duffing springs, half-sine bump 0.05 m (base 1 m) at 40 km/h, 3 s at
 dt = 1 ms (configs/quickstart.yaml); designs drawn uniformly inside the Table 5.2 bounds (with
 the k_nl range of docs/thesis-slips.md#table-52). Each size is timed as the best of three calls
 (the first call of a size also pays the operating system for memory the process has not touched
 before). Run:
-``python benchmarks/bench_simulate.py``. Prints a table; asserts nothing.
+``python benchmarks/bench_simulate.py [--sizes 1,100,1000,10000]``. Prints a table; asserts
+nothing. The compiled engine's first call (compiling, or loading numba's cache) is printed
+first.
 Like the command line, it first makes the allocator reuse freed memory
 (:func:`suspopt.reuse_memory`); ``--default-allocator`` leaves it as it is.
 """
@@ -36,7 +41,28 @@ def designs(P: int, rng: np.random.Generator) -> dict[str, np.ndarray]:
     return {k: rng.uniform(lo, hi, P) for k, (lo, hi) in BOUNDS.items()}
 
 
+def timed(cfg, params, engine: str):
+    """Best wall time of three calls [s], the peak memory of one [B], the result."""
+    import tracemalloc
+
+    c = cfg.model_copy(deep=True)
+    c.simulation.engine = engine
+    wall = np.inf
+    for _ in range(3):
+        start = time.perf_counter()
+        res = suspopt.simulate(c, params=params)
+        wall = min(wall, time.perf_counter() - start)
+    tracemalloc.start()
+    suspopt.simulate(c, params=params)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return wall, peak, res
+
+
 def main() -> None:
+    sizes = (1, 100, 1000, 10000)
+    if "--sizes" in sys.argv:
+        sizes = tuple(int(p) for p in sys.argv[sys.argv.index("--sizes") + 1].split(","))
     memory = (
         "reused"
         if "--default-allocator" not in sys.argv[1:] and suspopt.reuse_memory()
@@ -45,24 +71,49 @@ def main() -> None:
     cfg = suspopt.load_config(CONFIG)
     rng = np.random.default_rng(2026)
     suspopt.simulate(cfg, params=designs(2, rng))  # warm-up (imports, caches)
+    from suspopt.integrator import compiled_available
+
+    engines = ["numpy"] + (["compiled"] if compiled_available() else [])
     print(
         f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
         f"numpy {np.__version__} | {platform.machine()} | freed memory {memory}"
     )
+    if "compiled" in engines:
+        import numba
+
+        c = cfg.model_copy(deep=True)
+        c.simulation.engine = "compiled"
+        start = time.perf_counter()
+        suspopt.simulate(c, params=designs(2, rng))
+        print(
+            f"numba {numba.__version__}, {numba.get_num_threads()} threads: first compiled call "
+            f"{time.perf_counter() - start:.1f} s (compiling, or loading the cache)"
+        )
     print(
         f"HC2 Ch. 5 problem: {cfg.simulation.duration} s at dt = {cfg.simulation.dt} s "
         f"({cfg.simulation.n_steps} RK4 steps)"
     )
-    print(f"{'P':>6} {'wall [s]':>10} {'designs/s':>12} {'body acc metric (mean RMS)':>28}")
-    for P in (1, 100, 1000):
+    print(
+        f"{'P':>6} {'engine':>9} {'wall [s]':>9} {'designs/s':>10} {'x numpy':>8} "
+        f"{'peak [MB]':>10} {'MB/design':>10} {'body acc RMS':>13} {'max rel diff':>13}"
+    )
+    for P in sizes:
         params = designs(P, rng)
-        wall = np.inf
-        for _ in range(3):
-            start = time.perf_counter()
-            res = suspopt.simulate(cfg, params=params)
-            rms = np.sqrt(np.mean(res.signals["body.heave_acc"] ** 2, axis=-1))
-            wall = min(wall, time.perf_counter() - start)
-        print(f"{P:>6} {wall:>10.3f} {P / wall:>12.1f} {rms.mean():>28.4f}")
+        base = None
+        for engine in engines:
+            wall, peak, res = timed(cfg, params, engine)
+            acc = res.signals["body.heave_acc"]
+            rms = np.sqrt(np.mean(acc**2, axis=-1))
+            if base is None:
+                base, ref = wall, acc
+                diff = "-"
+            else:
+                scale = np.max(np.abs(ref), axis=-1, keepdims=True)
+                diff = f"{np.max(np.abs(acc - ref) / scale):.1e}"
+            print(
+                f"{P:>6} {res.engine:>9} {wall:>9.3f} {P / wall:>10.1f} {base / wall:>8.2f} "
+                f"{peak / 1e6:>10.1f} {peak / 1e6 / P:>10.3f} {rms.mean():>13.4f} {diff:>13}"
+            )
 
 
 if __name__ == "__main__":

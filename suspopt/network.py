@@ -84,7 +84,10 @@ class Elements:
     design columns (its parameters widened to them, :func:`widen`), with ``extra_slope`` its
     derivative dF_x/dδ at rest (m, P, 1) [N/m] for the linearised model (None for 0) and
     ``extra_uses_force`` whether F_x reads its third argument; ``reacts`` (n,) bool marks the
-    DOFs that feel the group's force (None: all - a one-way seat's links do not push the body).
+    DOFs that feel the group's force (None: all - a one-way seat's links do not push the body);
+    ``extra_law`` the same F_x as a law the compiled integrator knows
+    (:data:`suspopt.integrator.compiled.LAWS`), ``(name, parameters)`` with each parameter
+    (m, P, 1), or None (the numpy integrator only).
     """
 
     name: str
@@ -96,6 +99,7 @@ class Elements:
     extra_slope: np.ndarray | None = None
     extra_uses_force: bool = False
     reacts: np.ndarray | None = None
+    extra_law: tuple[str, tuple[np.ndarray, ...]] | None = None
 
     @property
     def size(self) -> int:

@@ -204,6 +204,8 @@ class Result:
         The config's metrics ``(P,)`` by name, units in ``metric_units``.
     metric_units : dict of str to str
         SI unit of each metric.
+    engine : str
+        The integrator that ran: ``numpy`` or ``compiled`` (:mod:`suspopt.integrator`).
     """
 
     config: Config
@@ -222,6 +224,7 @@ class Result:
     controller_units: dict[str, str] = field(default_factory=dict)
     metrics: dict[str, np.ndarray] = field(default_factory=dict)
     metric_units: dict[str, str] = field(default_factory=dict)
+    engine: str = "numpy"
 
     def __post_init__(self):
         self._signal_cache: dict[str, np.ndarray] = {}

@@ -175,7 +175,7 @@ def _run(
         )
         edges = Edges(times, jumps.T, inputs, no_pull)
     traj = integrate(
-        asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller, edges
+        asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller, edges, sim.engine
     )
     out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
     return Result(
@@ -193,4 +193,5 @@ def _run(
         held_damping=traj.damping,
         controller_records=traj.records,
         controller_units=dict(getattr(controller, "units", {})),
+        engine=traj.engine,
     )

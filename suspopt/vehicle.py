@@ -246,6 +246,7 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
     if veh.tyre_lift_off:
         tyre = network.group("tyre")
         tyre.extra, tyre.extra_uses_force = tyre_lift_off(static), True
+        tyre.extra_law = ("cap", (parameter_rows(static),))
     offsets = _wheelbase_offsets(cfg, pv, corners)
     sides = tuple("right" if cn[1] == "1" else "left" for cn in corners)
     e = (slice(None), None, slice(None))
@@ -314,6 +315,9 @@ def vehicle_network(
             parameter_rows(spring_linear),
             parameter_rows(damper),
             extra=duffing if np.any(spring_cubic) else None,
+            extra_law=("poly3", (0.0 * cubic, 0.0 * cubic, cubic))
+            if np.any(spring_cubic)
+            else None,
         )
     ]
     wheels = np.zeros((N, n))

@@ -114,7 +114,7 @@ def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> No
     bar = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
-        console=err,
+        console=err.console,
         disable=not err.is_terminal or out.quiet,
     )
     task = bar.add_task("starting", total=total)

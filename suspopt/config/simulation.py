@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from pydantic import Field, model_validator
+from typing import Literal
+
+from pydantic import Field, field_validator, model_validator
 
 from .base import Duration, Section, Step
 
@@ -17,6 +19,23 @@ class Simulation(Section):
     output_dt: Step | None = Field(
         None, description="output sample interval [s], a whole multiple of dt (default dt)"
     )
+    engine: Literal["numpy", "compiled", "auto"] = Field(
+        "numpy",
+        description="the integrator: numpy (the reference, covers every run), compiled "
+        '(numba, pip install "suspopt[fast]"; runs without a controller or an exact NSS '
+        "mechanism, the others fall back to numpy), or auto (compiled when numba is "
+        "installed); the two agree to rounding",
+    )
+
+    @field_validator("engine")
+    @classmethod
+    def _engine_installed(cls, engine: str) -> str:
+        if engine == "compiled":
+            from ..integrator import INSTALL_FAST, compiled_available
+
+            if not compiled_available():
+                raise ValueError(f"the compiled engine needs numba: {INSTALL_FAST}")
+        return engine
 
     @model_validator(mode="after")
     def _check_steps(self) -> Simulation:

@@ -265,6 +265,14 @@ class Mechanism:
         rest, preload = widen(self.rest[None], width), widen(self._preload[None], width)
         return lambda d, r, f, out: np.add(negated(rest + d), preload, out=out)
 
+    def compiled_law(self) -> tuple[str, tuple[np.ndarray, ...]] | None:
+        """:meth:`element_force` as a law of the compiled integrator: the Taylor form as
+        ``("poly3", (-k1, -k2, -k3))`` (each (1, P, 1)); the exact laws have none (yet), so a
+        seat with one runs on the numpy integrator."""
+        if self.series is None:
+            return None
+        return ("poly3", tuple(-np.asarray(k, float).reshape(1, -1, 1) for k in self.series))
+
     def slope(self) -> np.ndarray:
         """``dF/dδ`` at rest, (P,) [N/m] (a positive slope is a negative stiffness), by
         complex-step differentiation: ``Im F(i h) / h`` is exact to rounding for these

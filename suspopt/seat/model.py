@@ -342,6 +342,7 @@ def seat_network(
                 zero,
                 zero,
                 extra=mechanism.element_force,
+                extra_law=mechanism.compiled_law(),
                 extra_slope=-mechanism.slope()[None, :, None],
             )
         )

@@ -53,7 +53,7 @@ from typing import NamedTuple, Protocol
 
 import numpy as np
 
-from .network import Assembled, widen
+from ..network import Assembled, widen
 
 __all__ = [
     "Controller",
@@ -190,6 +190,7 @@ class Trajectory:
     damping: Held | np.ndarray | None
     records: Mapping[str, Held]
     diverged_at: np.ndarray
+    engine: str = "numpy"  #: the integrator that ran (:mod:`suspopt.integrator`)
 
 
 def _stacked(arrays: list[np.ndarray]) -> np.ndarray:
@@ -431,27 +432,48 @@ class _RK4:
         return out
 
 
+class EdgePlan:
+    """Where the road's edges fall on the step grid of a run: ``steps`` maps each step k
+    with edges in ``(t_k, t_k+1]`` to their indices (the grid as the run's, ``t_k = 2k dt/2``),
+    ``at_start`` the edges at t = 0, and :meth:`sub_steps` a split step's sub-steps."""
+
+    def __init__(self, edges: Edges, dt: float, n_steps: int):
+        self.edges = edges
+        self.bounds = np.arange(2 * n_steps + 1)[::2] * (0.5 * dt)
+        self.steps: dict[int, list[int]] = {}
+        for e, k in enumerate(np.searchsorted(self.bounds, edges.times) - 1):
+            if edges.times[e] >= 0.0 and k < n_steps:
+                self.steps.setdefault(int(k), []).append(e)
+        self.at_start = [e for e in self.steps.pop(-1, []) if edges.jumps[e].any()]
+
+    def sub_steps(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Step ``k``'s sub-steps between its edges: their lengths ``h`` (J,) [s] and the
+        inputs' part of the deformations (J, 2R, 1, 1) at their starts (right limits), their
+        middles and their ends (left limits). Sub-step j ends on the step's j-th edge."""
+        edges = self.edges
+        times, end = edges.times[self.steps[k]], self.bounds[k + 1]
+        ends = np.append(times[times < end], end)
+        starts = np.insert(ends[:-1], 0, self.bounds[k])
+        h = ends - starts
+        rights, middles = edges.inputs(starts, False), edges.inputs(starts + 0.5 * h, False)
+        return h, rights, middles, edges.inputs(ends, True)
+
+
 class _Splitter:
     """The steps that hold road edges (:class:`Edges`), split at them into RK4 sub-steps with
     each edge's impulse applied at its instant (see :func:`integrate`)."""
 
     def __init__(self, rk4: _RK4, asm: Assembled, edges: Edges, n_steps: int):
         self.rk4, self.asm, self.edges = rk4, asm, edges
-        half = 0.5 * rk4.dt
-        # the steps k with road edges in (t_k, t_k+1] (the grid as the run's, t_k = 2k dt/2)
-        self.bounds = np.arange(2 * n_steps + 1)[::2] * half
-        self.steps: dict[int, list[int]] = {}
-        for e, k in enumerate(np.searchsorted(self.bounds, edges.times) - 1):
-            if edges.times[e] >= 0.0 and k < n_steps:
-                self.steps.setdefault(int(k), []).append(e)
+        self.plan = EdgePlan(edges, rk4.dt, n_steps)
+        self.steps = self.plan.steps
         R = asm.R
         self.rate_forces = asm.G2[..., R : 2 * R]  # q'' per unit viscous force, times M
 
     def at_start(self) -> None:
         """The impulses of edges at t = 0, before the first sample."""
-        for e in self.steps.pop(-1, []):
-            if self.edges.jumps[e].any():
-                self.impulse(e)
+        for e in self.plan.at_start:
+            self.impulse(e)
 
     def impulse(self, e: int) -> None:
         """The velocity jump M^-1 G (c D_u Δu) of the inputs' jump Δu at edge ``e``."""
@@ -472,12 +494,7 @@ class _Splitter:
         instant (the first stage, at t_k, is the step's as always)."""
         found, edges, rk4 = self.steps[k], self.edges, self.rk4
         y = rk4.y
-        times, end = edges.times[found], self.bounds[k + 1]
-        ends = np.append(times[times < end], end)
-        starts = np.insert(ends[:-1], 0, self.bounds[k])
-        h = ends - starts
-        rights, middles = edges.inputs(starts, False), edges.inputs(starts + 0.5 * h, False)
-        lefts = edges.inputs(ends, True)
+        h, rights, middles, lefts = self.plan.sub_steps(k)
         for j, step in enumerate(h):
             k1 = rk4.derivative(y, rk4.offsets[2 * k] if j == 0 else rights[j])
             k2 = rk4.derivative(y + 0.5 * step * k1, middles[j])

@@ -1,0 +1,220 @@
+"""The numba kernel of :mod:`.compiled` (imported only when that engine runs: it needs numba).
+
+A block of :data:`LANES` designs keeps everything in a few arrays indexed by constants and
+offsets, so the hot loop creates no array views and passes no tuples (each would cost atomic
+reference counts): ``W (11, 2n, LANES)`` holds the state ``y``, the stage state ``ys``, the
+slopes ``s1..s4`` of a regular step, those of a split step ``k1..k4`` and a scratch block;
+``F (3, R, LANES)`` the deformations ``δ, δ̇`` and the element forces; ``par (rows, LANES)``
+every per-design number, ``idx`` every index and ``lay`` where each part starts
+(:func:`.compiled._packed`):
+
+- ``lay = (nD, nG, R, X, n, oD, oG, oK, oC, oL, oM)``: the entries of D_q and of G, the
+  elements, the non-linear laws, the DOFs; then the first row in ``par`` of the values of
+  D_q's entries, of G's, of ``k``, of ``c``, of the laws' parameters (3 per law) and of the
+  inverse masses times 1, dt/2, dt and dt/6 (n rows each);
+- ``idx``: D_q's rows and columns, G's rows (DOFs) and columns (elements), the laws' codes
+  (:data:`.compiled.LAWS`) and element rows.
+
+The lane is every loop's innermost index.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+_jit = numba.njit(cache=True, nogil=True)
+
+#: Lanes of a block (a compile-time constant: the lane loops unroll); the caller pads the
+#: designs to a whole number of blocks.
+LANES = 16
+#: The blocks of W.
+Y, YS, S1, S2, S3, S4, K1, K2, K3, K4, TMP = range(11)
+
+
+@_jit
+def _stage(W, F, par, idx, lay, src, o, oi, has_input, scale, out):
+    """The accelerations at the state ``W[src] = [q; v]`` with the inputs' part ``o[oi]``
+    (when ``has_input``), times the inverse masses' row set ``scale`` (0: 1, 1: dt/2, 2: dt,
+    3: dt/6), into ``W[out, n:]``: ``δ = D_q q + D_u u``, ``F = k δ + c δ̇`` plus the laws,
+    ``q'' = M^-1 G F``."""
+    nD, nG, R, X, n = lay[0], lay[1], lay[2], lay[3], lay[4]
+    oD, oG, oK, oC, oL, oM = lay[5], lay[6], lay[7], lay[8], lay[9], lay[10]
+    for r in range(R):
+        for b in range(LANES):
+            F[0, r, b] = 0.0
+            F[1, r, b] = 0.0
+    for z in range(nD):
+        r, j = idx[z], idx[nD + z]
+        for b in range(LANES):
+            F[0, r, b] += par[oD + z, b] * W[src, j, b]
+            F[1, r, b] += par[oD + z, b] * W[src, n + j, b]
+    if has_input:
+        for r in range(R):
+            for b in range(LANES):
+                F[0, r, b] += o[oi, r]
+                F[1, r, b] += o[oi, R + r]
+    for r in range(R):
+        for b in range(LANES):
+            F[2, r, b] = par[oK + r, b] * F[0, r, b] + par[oC + r, b] * F[1, r, b]
+    for x in range(X):
+        r, p = idx[2 * nD + 2 * nG + X + x], oL + 3 * x
+        if idx[2 * nD + 2 * nG + x] == 0:  # poly3: ((c3 δ + c2) δ + c1) δ
+            for b in range(LANES):
+                d = F[0, r, b]
+                F[2, r, b] += ((par[p + 2, b] * d + par[p + 1, b]) * d + par[p, b]) * d
+        else:  # cap: the force no larger than the limit (NaN stays NaN)
+            for b in range(LANES):
+                if F[2, r, b] > par[p, b]:
+                    F[2, r, b] = par[p, b]
+    for i in range(n):
+        for b in range(LANES):
+            W[out, n + i, b] = 0.0
+    for z in range(nG):
+        i, r = idx[2 * nD + z], idx[2 * nD + nG + z]
+        for b in range(LANES):
+            W[out, n + i, b] += par[oG + z, b] * F[2, r, b]
+    for i in range(n):
+        for b in range(LANES):
+            W[out, n + i, b] *= par[oM + scale * n + i, b]
+
+
+@_jit
+def _rates(W, src, h, out, n):
+    """``W[out, :n] = h v`` of the state ``W[src]``: a stage's displacement rates times its
+    step."""
+    for i in range(n):
+        for b in range(LANES):
+            W[out, i, b] = W[src, n + i, b] * h
+
+
+@_jit
+def _plus(W, a, s, w, out, n):
+    """``W[out] = W[a] + w W[s]``."""
+    for i in range(2 * n):
+        for b in range(LANES):
+            W[out, i, b] = W[a, i, b] + w * W[s, i, b]
+
+
+@_jit
+def _regular_step(h0, dt, W, F, par, idx, lay, off, active):
+    """One RK4 step from half step ``h0`` with the numpy engine's arithmetic: ``s1`` holds
+    the first stage's accelerations (unscaled) in its lower rows; each stage is scaled by its
+    step, ``y += (s1 + 2 s2 + s3)/3 + s4``."""
+    n, half = lay[4], 0.5 * dt
+    for i in range(n):
+        for b in range(LANES):
+            W[S1, n + i, b] *= half
+    _rates(W, Y, half, S1, n)
+    for stage in range(3):  # s2, s3, s4
+        h = half if stage == 0 else (dt if stage == 1 else dt / 6.0)
+        hi = h0 + 1 if stage < 2 else h0 + 2
+        _plus(W, Y, S1 + stage, 1.0, YS, n)
+        _stage(W, F, par, idx, lay, YS, off, hi, active[hi], stage + 1, S2 + stage)
+        _rates(W, YS, h, S2 + stage, n)
+    third = 1.0 / 3.0
+    for i in range(2 * n):
+        for b in range(LANES):
+            W[Y, i, b] += (((W[S1, i, b] + W[S3, i, b]) + W[S2, i, b] * 2.0) * third) + W[S4, i, b]
+
+
+@_jit
+def _impulse(jumps, u, no_pull, W, F, par, idx, lay):
+    """The velocity jump ``M^-1 G (c D_u Δu)`` of an inputs' jump with ``D_u Δu = jumps[u]
+    (R,)``; a row that cannot pull takes no pulling impulse."""
+    nD, nG, R, n, oG, oC, oM = lay[0], lay[1], lay[2], lay[4], lay[6], lay[8], lay[10]
+    for r in range(R):
+        for b in range(LANES):
+            force = par[oC + r, b] * jumps[u, r]
+            if no_pull[r] and force > 0.0:
+                force = 0.0
+            F[2, r, b] = force
+    for i in range(n):
+        for b in range(LANES):
+            W[TMP, i, b] = 0.0
+    for z in range(nG):
+        i, r = idx[2 * nD + z], idx[2 * nD + nG + z]
+        for b in range(LANES):
+            W[TMP, i, b] += par[oG + z, b] * F[2, r, b]
+    for i in range(n):
+        for b in range(LANES):
+            W[Y, n + i, b] += W[TMP, i, b] * par[oM + i, b]
+
+
+@_jit
+def _split_step(s, W, F, par, idx, lay, road):
+    """Split step ``s``: RK4 sub-steps between its edges (``k = f(y + w k_prev)`` unscaled),
+    each edge's impulse at its end."""
+    sub_first, sub_h, sub_right, sub_middle, sub_left = road[3], road[4], road[5], road[6], road[7]
+    sub_jump, sub_kick, no_pull = road[8], road[9], road[11]
+    n = lay[4]
+    for u in range(sub_first[s], sub_first[s + 1]):
+        hu = sub_h[u]
+        for stage in range(4):
+            w = 0.0 if stage == 0 else (hu if stage == 3 else 0.5 * hu)
+            inputs = sub_right if stage == 0 else (sub_left if stage == 3 else sub_middle)
+            _plus(W, Y, Y if stage == 0 else K1 + stage - 1, w, TMP, n)
+            _stage(W, F, par, idx, lay, TMP, inputs, u, True, 0, K1 + stage)
+            _rates(W, TMP, 1.0, K1 + stage, n)
+        for i in range(2 * n):
+            for b in range(LANES):
+                W[Y, i, b] += (
+                    hu / 6.0 * (W[K1, i, b] + 2.0 * (W[K2, i, b] + W[K3, i, b]) + W[K4, i, b])
+                )
+        if sub_kick[u]:
+            _impulse(sub_jump, u, no_pull, W, F, par, idx, lay)
+
+
+@_jit
+def _check(W, at, limit, time):
+    """Lanes whose state left ``|x| < limit`` (or is not finite): their time and NaN."""
+    for b in range(LANES):
+        bad = False
+        for i in range(W.shape[1]):
+            if not (abs(W[Y, i, b]) < limit):
+                bad = True
+        if bad:
+            if np.isnan(at[b]):
+                at[b] = time
+            for i in range(W.shape[1]):
+                W[Y, i, b] = np.nan
+
+
+@_jit
+def _block(p0, dt, n_steps, every, limit, check_every, par_all, idx, lay, road, out):
+    """Designs ``p0 .. p0 + LANES - 1``: every step, sample and check of the run."""
+    states, accelerations, diverged_at = out
+    par = np.ascontiguousarray(par_all[:, p0 : p0 + LANES])
+    n, R = lay[4], lay[2]
+    W, F = np.zeros((11, 2 * n, LANES)), np.empty((3, R, LANES))
+    off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
+    at = np.full(LANES, np.nan)
+    for u in range(start_jumps.shape[0]):
+        _impulse(start_jumps, u, no_pull, W, F, par, idx, lay)
+    for step in range(n_steps + 1):
+        _stage(W, F, par, idx, lay, Y, off, 2 * step, active[2 * step], 0, S1)
+        if step % every == 0:  # the sample: the state and the first stage's accelerations
+            j = step // every
+            for i in range(2 * n):
+                for b in range(LANES):
+                    states[i, p0 + b, j] = W[Y, i, b]
+            for i in range(n):
+                for b in range(LANES):
+                    accelerations[i, p0 + b, j] = W[S1, n + i, b]
+        if step == n_steps:
+            break
+        if split_of[step] < 0:
+            _regular_step(2 * step, dt, W, F, par, idx, lay, off, active)
+        else:
+            _split_step(split_of[step], W, F, par, idx, lay, road)
+        if (step + 1) % check_every == 0 or step + 1 == n_steps:
+            _check(W, at, limit, (step + 1) * dt)
+    diverged_at[p0 : p0 + LANES] = at
+
+
+@numba.njit(cache=True, parallel=True, nogil=True)
+def run(dt, n_steps, every, limit, check_every, par, idx, lay, road, out):
+    """Integrate every design, :data:`LANES` at a time, the blocks over the cores (the
+    arrays: :func:`.compiled._packed`; the designs a whole number of blocks)."""
+    for blk in numba.prange(par.shape[1] // LANES):
+        _block(blk * LANES, dt, n_steps, every, limit, check_every, par, idx, lay, road, out)

@@ -1,0 +1,204 @@
+"""The compiled RK4 engine: the same integration as :mod:`.rk4` in one numba call.
+
+The assembled network (:class:`suspopt.network.Assembled`) is packed, not re-described: the
+deformation map ``D_q`` and the force map ``G = -D_qᵀ`` (masked where a one-way seat does not
+push the body) become lists of their non-zero entries with one value per design (the maps are
+shared or per design alike), the element coefficients ``k, c`` and the inverse masses rows
+over the designs, and each non-linear part a law of :data:`LAWS` with its parameters. An
+evaluation of the accelerations is then
+
+    δ = D_q q + D_u u,   δ̇ = D_q q̇ + D_u u̇,   F = k δ + c δ̇ (+ F_x),   q̈ = M^-1 G F
+
+as loops over those entries (about 300 floating-point operations for the Ch. 5 half car,
+where the dense products of the numpy engine take about 1,000).
+
+Designs run in blocks of :data:`._kernel.LANES` lanes (the last design repeated to fill the
+last block): every loop's innermost index is the lane,
+over contiguous rows, which the compiler vectorises; the blocks are spread over the cores
+(``numba.prange``). A lane's arithmetic never involves another lane, so a design gives the
+same bits whatever its batch, its block or the number of threads. Every step, sample, road
+edge (a split step's sub-steps and its exact impulse, planned by :class:`.rk4.EdgePlan`) and
+the divergence rule are the numpy engine's; the regular step uses its arithmetic (stages
+scaled by their step, ``y += (s1 + 2 s2 + s3)/3 + s4``). The two agree to rounding: sums are
+taken in another order (and BLAS may fuse multiply-adds), about 1e-15 relative per step
+(``tests/test_compiled.py`` checks 1e-12 on the bundled configs).
+
+Not covered (the numpy engine runs them, :func:`unsupported` says why): a semi-active
+controller, and a non-linear part without a compiled law (the seats' exact NSS mechanisms).
+A new law is a branch of :func:`_forces` and an entry of :data:`LAWS`, beside the numpy
+closure that defines it (:attr:`suspopt.network.Elements.extra`).
+
+The first call on a machine compiles the kernel (``cache=True`` keeps it in the package's
+``__pycache__`` for later processes; ``benchmarks/bench_simulate.py`` reports the time).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..network import Assembled
+from .rk4 import _CHECK_EVERY, DIVERGENCE_LIMIT, EdgePlan, Edges, Trajectory
+
+#: The non-linear element laws the kernel knows: name -> (code, number of parameters).
+#: ``poly3 (c1, c2, c3)``: ``F_x = ((c3 δ + c2) δ + c1) δ`` (a Duffing spring, Eq 2.31, as
+#: ``(0, 0, k_nl)``; a seat's Taylor mechanism, Sec 8.2.2); ``cap (limit,)``: the element's
+#: force ``k δ + c δ̇`` capped at ``limit`` (a tyre that cannot pull, capped at its static
+#: load).
+LAWS = {"poly3": (0, 3), "cap": (1, 1)}
+
+
+def unsupported(asm: Assembled, controller: object | None) -> str | None:
+    """Why the compiled engine cannot run this network, or None when it can."""
+    if controller is not None:
+        return "a semi-active controller"
+    for g in asm.network.groups:
+        if g.extra is not None and (g.extra_law is None or g.extra_law[0] not in LAWS):
+            return f"the non-linear part of {g.name!r} has no compiled law"
+    return None
+
+
+def _padded(a: np.ndarray, P: int) -> np.ndarray:
+    """``a (..., 1 | P0)`` over ``P >= P0`` designs, the last one repeated, contiguous."""
+    if a.shape[-1] == 1:
+        return np.ascontiguousarray(np.broadcast_to(a, a.shape[:-1] + (P,)))
+    extra = np.repeat(a[..., -1:], P - a.shape[-1], axis=-1)
+    return np.ascontiguousarray(np.concatenate([a, extra], axis=-1))
+
+
+def _entries(matrix: np.ndarray, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The non-zero entries of ``matrix`` (r, c) or (P0, r, c): rows, columns (nnz,) and
+    values (nnz, P)."""
+    mask = (matrix != 0).any(axis=0) if matrix.ndim == 3 else matrix != 0
+    rows, cols = np.nonzero(mask)
+    values = matrix[..., rows, cols]  # (nnz,) or (P0, nnz)
+    values = values.T if matrix.ndim == 3 else values[:, None]
+    return rows.astype(np.int64), cols.astype(np.int64), _padded(values, P)
+
+
+def _laws(asm: Assembled, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The non-linear parts element by element: law codes and element rows (X,), parameters
+    (3, X, P)."""
+    codes, rows, params, start = [], [], [], 0
+    for g in asm.network.groups:
+        if g.extra is not None:
+            name, values = g.extra_law
+            code, count = LAWS[name]
+            for i in range(g.size):
+                codes.append(code)
+                rows.append(start + i)
+                row = np.zeros((3, P))
+                for j in range(count):
+                    row[j] = _padded(values[j][i, :, 0], P)
+                params.append(row)
+        start += g.size
+    stacked = np.stack(params, axis=1) if params else np.zeros((3, 0, P))
+    return np.array(codes, np.int64), np.array(rows, np.int64), np.ascontiguousarray(stacked)
+
+
+def _edge_arrays(asm: Assembled, edges: Edges | None, dt: float, n_steps: int, offsets):
+    """The road's edges as arrays for the kernel: for each step the index of its split plan
+    or -1 (n_steps,); per split step its first sub-step (S + 1,); per sub-step its length,
+    the inputs' part at its start, middle and end (U, 2R), the inputs' jump at its end
+    (U, R: the impulse's ``D_u Δu``) and whether there is one; the jumps at t = 0 (Q, R); the
+    rows that cannot pull (R,)."""
+    R = asm.R
+    split_of = np.full(n_steps, -1, np.int64)
+    first, h_all, rights, middles, lefts, jumps, kicks = [0], [], [], [], [], [], []
+    start_jumps = np.zeros((0, R))
+    no_pull = np.zeros(R, np.bool_)
+    if edges is not None:
+        plan = EdgePlan(edges, dt, n_steps)
+        if edges.no_pull is not None:
+            no_pull[:] = edges.no_pull
+        start_jumps = np.array([asm.input_map @ edges.jumps[e] for e in plan.at_start])
+        start_jumps = start_jumps.reshape(-1, R)
+        for s, k in enumerate(sorted(plan.steps)):
+            split_of[k] = s
+            found = plan.steps[k]
+            h, right, middle, left = plan.sub_steps(k)
+            right = right.reshape(len(h), 2 * R).copy()
+            right[0] = offsets[2 * k]  # the step's first stage, as every step's
+            for j in range(len(h)):
+                h_all.append(h[j])
+                rights.append(right[j])
+                middles.append(middle[j].reshape(2 * R))
+                lefts.append(left[j].reshape(2 * R))
+                kick = j < len(found) and bool(edges.jumps[found[j]].any())
+                kicks.append(kick)
+                jumps.append(asm.input_map @ edges.jumps[found[j]] if kick else np.zeros(R))
+            first.append(len(h_all))
+
+    def rows(a, width):
+        return np.ascontiguousarray(np.array(a, float).reshape(-1, width))
+
+    return (
+        split_of,
+        np.array(first, np.int64),
+        np.array(h_all, float),
+        rows(rights, 2 * R),
+        rows(middles, 2 * R),
+        rows(lefts, 2 * R),
+        rows(jumps, R),
+        np.array(kicks, np.bool_),
+        rows(start_jumps, R),
+        no_pull,
+    )
+
+
+def _packed(asm: Assembled, dt: float, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The network for the kernel (:mod:`._kernel`): every per-design number ``par (rows,
+    P)``, every index ``idx`` and where each part starts, ``lay``."""
+    n, R = asm.n, asm.R
+    d_row, d_col, d_val = _entries(asm.D2[..., :R, :n], P)
+    g_row, g_col, g_val = _entries(asm.G2[..., :R], P)
+    law_code, law_row, law_par = _laws(asm, P)
+    im = _padded(asm.inverse_mass[:, :, 0], P)
+    parts = [
+        d_val,
+        g_val,
+        _padded(asm.coef[:R, :, 0], P),
+        _padded(asm.coef[R:, :, 0], P),
+        law_par.transpose(1, 0, 2).reshape(-1, P),  # (3 X, P): the laws' parameters in turn
+        im,
+        im * (0.5 * dt),
+        im * dt,
+        im * (dt / 6.0),
+    ]
+    starts = np.cumsum([0] + [p.shape[0] for p in parts])
+    lay = [d_row.size, g_row.size, R, law_code.size, n, *starts[[0, 1, 2, 3, 4, 5]]]
+    idx = np.concatenate([d_row, d_col, g_row, g_col, law_code, law_row]).astype(np.int64)
+    return np.ascontiguousarray(np.concatenate(parts)), idx, np.array(lay, np.int64)
+
+
+def integrate(
+    asm: Assembled,
+    offsets: np.ndarray,
+    dt: float,
+    n_steps: int,
+    every: int,
+    edges: Edges | None = None,
+) -> Trajectory:
+    """The compiled engine's :func:`suspopt.integrator.integrate` (no controller: see
+    :func:`unsupported`); ``offsets`` (2 n_steps + 1, 2R, 1|P, 1) shared by the designs."""
+    from . import _kernel
+
+    n = asm.n
+    P = -(-asm.P // _kernel.LANES) * _kernel.LANES  # whole blocks: the last design repeated
+    par, idx, lay = _packed(asm, dt, P)
+    off = np.ascontiguousarray(offsets[:, :, 0, 0])
+    road = (off, off.any(axis=1)) + _edge_arrays(asm, edges, dt, n_steps, off)
+    n_out = n_steps // every + 1
+    states, accelerations = np.empty((2 * n, P, n_out)), np.empty((n, P, n_out))
+    diverged_at = np.full(P, np.nan)
+    out = (states, accelerations, diverged_at)
+    _kernel.run(dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par, idx, lay, road, out)
+    P = asm.P
+    states, accelerations, diverged_at = states[:, :P], accelerations[:, :P], diverged_at[:P]
+    return Trajectory(
+        states=states,
+        accelerations=accelerations,
+        damping=None,
+        records={},
+        diverged_at=diverged_at,
+        engine="compiled",
+    )
