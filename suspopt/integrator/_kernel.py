@@ -1,10 +1,10 @@
 """The numba kernel of :mod:`.compiled` (imported only when that engine runs: it needs numba).
 
-A block of :data:`LANES` designs keeps everything in a few arrays indexed by constants and
-offsets, so the hot loop creates no array views and passes no tuples (each would cost atomic
-reference counts): ``W (11, 2n, LANES)`` holds the state ``y``, the stage state ``ys``, the
+A block of ``B`` designs (at most :data:`MAX_LANES`) keeps everything in a few arrays indexed
+by constants and offsets, so the hot loop creates no array views and passes no tuples (each
+would cost atomic reference counts): ``W (11, 2n, B)`` holds the state ``y``, the stage state ``ys``, the
 slopes ``s1..s4`` of a regular step, those of a split step ``k1..k4`` and a scratch block;
-``F (3, R, LANES)`` the deformations ``δ, δ̇`` and the element forces; ``par (rows, LANES)``
+``F (3, R, B)`` the deformations ``δ, δ̇`` and the element forces; ``par (rows, B)``
 every per-design number, ``idx`` every index and ``lay`` where each part starts
 (:func:`.compiled._packed`):
 
@@ -15,7 +15,8 @@ every per-design number, ``idx`` every index and ``lay`` where each part starts
 - ``idx``: D_q's rows and columns, G's rows (DOFs) and columns (elements), the laws' codes
   (:data:`.compiled.LAWS`) and element rows.
 
-The lane is every loop's innermost index.
+The lane is every loop's innermost index (a loop the compiler vectorises, with a run-time
+check that its arrays do not overlap).
 """
 
 from __future__ import annotations
@@ -25,9 +26,11 @@ import numpy as np
 
 _jit = numba.njit(cache=True, nogil=True)
 
-#: Lanes of a block (a compile-time constant: the lane loops unroll); the caller pads the
-#: designs to a whole number of blocks.
-LANES = 16
+#: The most lanes of a block: enough to amortise each lane loop's set-up, few enough for the
+#: block's buffers to stay in the core's cache (about 80 KB for the Ch. 5 half car).
+MAX_LANES = 64
+#: Samples a block buffers before writing them to the records.
+SAMPLES = 32
 #: The blocks of W.
 Y, YS, S1, S2, S3, S4, K1, K2, K3, K4, TMP = range(11)
 
@@ -41,41 +44,41 @@ def _stage(W, F, par, idx, lay, src, o, oi, has_input, scale, out):
     nD, nG, R, X, n = lay[0], lay[1], lay[2], lay[3], lay[4]
     oD, oG, oK, oC, oL, oM = lay[5], lay[6], lay[7], lay[8], lay[9], lay[10]
     for r in range(R):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             F[0, r, b] = 0.0
             F[1, r, b] = 0.0
     for z in range(nD):
         r, j = idx[z], idx[nD + z]
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             F[0, r, b] += par[oD + z, b] * W[src, j, b]
             F[1, r, b] += par[oD + z, b] * W[src, n + j, b]
     if has_input:
         for r in range(R):
-            for b in range(LANES):
+            for b in range(W.shape[2]):
                 F[0, r, b] += o[oi, r]
                 F[1, r, b] += o[oi, R + r]
     for r in range(R):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             F[2, r, b] = par[oK + r, b] * F[0, r, b] + par[oC + r, b] * F[1, r, b]
     for x in range(X):
         r, p = idx[2 * nD + 2 * nG + X + x], oL + 3 * x
         if idx[2 * nD + 2 * nG + x] == 0:  # poly3: ((c3 δ + c2) δ + c1) δ
-            for b in range(LANES):
+            for b in range(W.shape[2]):
                 d = F[0, r, b]
                 F[2, r, b] += ((par[p + 2, b] * d + par[p + 1, b]) * d + par[p, b]) * d
         else:  # cap: the force no larger than the limit (NaN stays NaN)
-            for b in range(LANES):
+            for b in range(W.shape[2]):
                 if F[2, r, b] > par[p, b]:
                     F[2, r, b] = par[p, b]
     for i in range(n):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[out, n + i, b] = 0.0
     for z in range(nG):
         i, r = idx[2 * nD + z], idx[2 * nD + nG + z]
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[out, n + i, b] += par[oG + z, b] * F[2, r, b]
     for i in range(n):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[out, n + i, b] *= par[oM + scale * n + i, b]
 
 
@@ -84,7 +87,7 @@ def _rates(W, src, h, out, n):
     """``W[out, :n] = h v`` of the state ``W[src]``: a stage's displacement rates times its
     step."""
     for i in range(n):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[out, i, b] = W[src, n + i, b] * h
 
 
@@ -92,7 +95,7 @@ def _rates(W, src, h, out, n):
 def _plus(W, a, s, w, out, n):
     """``W[out] = W[a] + w W[s]``."""
     for i in range(2 * n):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[out, i, b] = W[a, i, b] + w * W[s, i, b]
 
 
@@ -103,7 +106,7 @@ def _regular_step(h0, dt, W, F, par, idx, lay, off, active):
     step, ``y += (s1 + 2 s2 + s3)/3 + s4``."""
     n, half = lay[4], 0.5 * dt
     for i in range(n):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[S1, n + i, b] *= half
     _rates(W, Y, half, S1, n)
     for stage in range(3):  # s2, s3, s4
@@ -114,7 +117,7 @@ def _regular_step(h0, dt, W, F, par, idx, lay, off, active):
         _rates(W, YS, h, S2 + stage, n)
     third = 1.0 / 3.0
     for i in range(2 * n):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[Y, i, b] += (((W[S1, i, b] + W[S3, i, b]) + W[S2, i, b] * 2.0) * third) + W[S4, i, b]
 
 
@@ -124,20 +127,20 @@ def _impulse(jumps, u, no_pull, W, F, par, idx, lay):
     (R,)``; a row that cannot pull takes no pulling impulse."""
     nD, nG, R, n, oG, oC, oM = lay[0], lay[1], lay[2], lay[4], lay[6], lay[8], lay[10]
     for r in range(R):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             force = par[oC + r, b] * jumps[u, r]
             if no_pull[r] and force > 0.0:
                 force = 0.0
             F[2, r, b] = force
     for i in range(n):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[TMP, i, b] = 0.0
     for z in range(nG):
         i, r = idx[2 * nD + z], idx[2 * nD + nG + z]
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[TMP, i, b] += par[oG + z, b] * F[2, r, b]
     for i in range(n):
-        for b in range(LANES):
+        for b in range(W.shape[2]):
             W[Y, n + i, b] += W[TMP, i, b] * par[oM + i, b]
 
 
@@ -157,7 +160,7 @@ def _split_step(s, W, F, par, idx, lay, road):
             _stage(W, F, par, idx, lay, TMP, inputs, u, True, 0, K1 + stage)
             _rates(W, TMP, 1.0, K1 + stage, n)
         for i in range(2 * n):
-            for b in range(LANES):
+            for b in range(W.shape[2]):
                 W[Y, i, b] += (
                     hu / 6.0 * (W[K1, i, b] + 2.0 * (W[K2, i, b] + W[K3, i, b]) + W[K4, i, b])
                 )
@@ -168,7 +171,7 @@ def _split_step(s, W, F, par, idx, lay, road):
 @_jit
 def _check(W, at, limit, time):
     """Lanes whose state left ``|x| < limit`` (or is not finite): their time and NaN."""
-    for b in range(LANES):
+    for b in range(W.shape[2]):
         bad = False
         for i in range(W.shape[1]):
             if not (abs(W[Y, i, b]) < limit):
@@ -181,26 +184,50 @@ def _check(W, at, limit, time):
 
 
 @_jit
-def _block(p0, dt, n_steps, every, limit, check_every, par_all, idx, lay, road, out):
-    """Designs ``p0 .. p0 + LANES - 1``: every step, sample and check of the run."""
+def _keep(W, rec, t, n):
+    """Sample into row ``t`` of the time-major buffer ``rec``: the state, the accelerations."""
+    for i in range(2 * n):
+        for b in range(W.shape[2]):
+            rec[t, i, b] = W[Y, i, b]
+    for i in range(n):
+        for b in range(W.shape[2]):
+            rec[t, 2 * n + i, b] = W[S1, n + i, b]
+
+
+@_jit
+def _flush(rec, j0, count, p0, n, states, accelerations):
+    """The buffer's first ``count`` samples to samples ``j0 ..`` of the records: a transposed
+    copy that writes each design's row as a contiguous run (writing every sample straight to
+    the ``(rows, P, T)`` records touches a new cache line per value and took two thirds of
+    the run)."""
+    for i in range(3 * n):
+        for b in range(rec.shape[2]):
+            for t in range(count):
+                if i < 2 * n:
+                    states[i, p0 + b, j0 + t] = rec[t, i, b]
+                else:
+                    accelerations[i - 2 * n, p0 + b, j0 + t] = rec[t, i, b]
+
+
+@_jit
+def _block(p0, B, dt, n_steps, every, limit, check_every, par_all, idx, lay, road, out):
+    """Designs ``p0 .. p0 + B - 1``: every step, sample and check of the run."""
     states, accelerations, diverged_at = out
-    par = np.ascontiguousarray(par_all[:, p0 : p0 + LANES])
+    par = np.ascontiguousarray(par_all[:, p0 : p0 + B])
     n, R = lay[4], lay[2]
-    W, F = np.zeros((11, 2 * n, LANES)), np.empty((3, R, LANES))
+    W, F = np.zeros((11, 2 * n, B)), np.empty((3, R, B))
+    rec = np.empty((SAMPLES, 3 * n, B))  # the latest samples, time-major
     off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
-    at = np.full(LANES, np.nan)
+    at = np.full(B, np.nan)
     for u in range(start_jumps.shape[0]):
         _impulse(start_jumps, u, no_pull, W, F, par, idx, lay)
     for step in range(n_steps + 1):
         _stage(W, F, par, idx, lay, Y, off, 2 * step, active[2 * step], 0, S1)
         if step % every == 0:  # the sample: the state and the first stage's accelerations
             j = step // every
-            for i in range(2 * n):
-                for b in range(LANES):
-                    states[i, p0 + b, j] = W[Y, i, b]
-            for i in range(n):
-                for b in range(LANES):
-                    accelerations[i, p0 + b, j] = W[S1, n + i, b]
+            _keep(W, rec, j % SAMPLES, n)
+            if j % SAMPLES == SAMPLES - 1 or j == states.shape[2] - 1:
+                _flush(rec, j - j % SAMPLES, j % SAMPLES + 1, p0, n, states, accelerations)
         if step == n_steps:
             break
         if split_of[step] < 0:
@@ -209,12 +236,12 @@ def _block(p0, dt, n_steps, every, limit, check_every, par_all, idx, lay, road, 
             _split_step(split_of[step], W, F, par, idx, lay, road)
         if (step + 1) % check_every == 0 or step + 1 == n_steps:
             _check(W, at, limit, (step + 1) * dt)
-    diverged_at[p0 : p0 + LANES] = at
+    diverged_at[p0 : p0 + B] = at
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)
-def run(dt, n_steps, every, limit, check_every, par, idx, lay, road, out):
-    """Integrate every design, :data:`LANES` at a time, the blocks over the cores (the
-    arrays: :func:`.compiled._packed`; the designs a whole number of blocks)."""
-    for blk in numba.prange(par.shape[1] // LANES):
-        _block(blk * LANES, dt, n_steps, every, limit, check_every, par, idx, lay, road, out)
+def run(B, dt, n_steps, every, limit, check_every, par, idx, lay, road, out):
+    """Integrate every design, ``B`` lanes at a time, the blocks over the cores (the arrays:
+    :func:`.compiled._packed`; the designs a whole number of blocks)."""
+    for blk in numba.prange(par.shape[1] // B):
+        _block(blk * B, B, dt, n_steps, every, limit, check_every, par, idx, lay, road, out)

@@ -12,7 +12,7 @@ evaluation of the accelerations is then
 as loops over those entries (about 300 floating-point operations for the Ch. 5 half car,
 where the dense products of the numpy engine take about 1,000).
 
-Designs run in blocks of :data:`._kernel.LANES` lanes (the last design repeated to fill the
+Designs run in blocks of lanes (:func:`block_width`; the last design repeated to fill the
 last block): every loop's innermost index is the lane,
 over contiguous rows, which the compiler vectorises; the blocks are spread over the cores
 (``numba.prange``). A lane's arithmetic never involves another lane, so a design gives the
@@ -170,6 +170,12 @@ def _packed(asm: Assembled, dt: float, P: int) -> tuple[np.ndarray, np.ndarray, 
     return np.ascontiguousarray(np.concatenate(parts)), idx, np.array(lay, np.int64)
 
 
+def block_width(P: int, threads: int) -> int:
+    """Designs per block: as many as fill the threads evenly, at most
+    :data:`._kernel.MAX_LANES` (64). A design's arithmetic does not depend on it."""
+    return max(1, min(64, -(-P // max(threads, 1))))
+
+
 def integrate(
     asm: Assembled,
     offsets: np.ndarray,
@@ -180,10 +186,13 @@ def integrate(
 ) -> Trajectory:
     """The compiled engine's :func:`suspopt.integrator.integrate` (no controller: see
     :func:`unsupported`); ``offsets`` (2 n_steps + 1, 2R, 1|P, 1) shared by the designs."""
+    import numba
+
     from . import _kernel
 
     n = asm.n
-    P = -(-asm.P // _kernel.LANES) * _kernel.LANES  # whole blocks: the last design repeated
+    B = block_width(asm.P, numba.get_num_threads())
+    P = -(-asm.P // B) * B  # whole blocks: the last design repeated
     par, idx, lay = _packed(asm, dt, P)
     off = np.ascontiguousarray(offsets[:, :, 0, 0])
     road = (off, off.any(axis=1)) + _edge_arrays(asm, edges, dt, n_steps, off)
@@ -191,7 +200,7 @@ def integrate(
     states, accelerations = np.empty((2 * n, P, n_out)), np.empty((n, P, n_out))
     diverged_at = np.full(P, np.nan)
     out = (states, accelerations, diverged_at)
-    _kernel.run(dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par, idx, lay, road, out)
+    _kernel.run(B, dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par, idx, lay, road, out)
     P = asm.P
     states, accelerations, diverged_at = states[:, :P], accelerations[:, :P], diverged_at[:P]
     return Trajectory(
