@@ -36,6 +36,28 @@ Y, YS, S1, S2, S3, S4, K1, K2, K3, K4, TMP = range(11)
 
 
 @_jit
+def _law(code, r, p, F, par):
+    """Element ``r``'s non-linear part, law ``code`` (:data:`.compiled.LAWS`) with its
+    parameters in rows ``p ..`` of ``par``, added to its force ``F[2, r]`` at ``δ = F[0, r]``
+    (the numpy closures' arithmetic)."""
+    for b in range(F.shape[2]):
+        d = F[0, r, b]
+        if code == 0:  # poly3: ((c3 δ + c2) δ + c1) δ
+            F[2, r, b] += ((par[p + 2, b] * d + par[p + 1, b]) * d + par[p, b]) * d
+        elif code == 1:  # cap: the force no larger than the limit (NaN stays NaN)
+            if F[2, r, b] > par[p, b]:
+                F[2, r, b] = par[p, b]
+        elif code == 2:  # link: (a + b / sqrt(l^2 - w^2)) w + F0, w = w0 + δ
+            w = par[p + 3, b] + d
+            F[2, r, b] += (par[p, b] + par[p + 1, b] / np.sqrt(par[p + 2, b] - w * w)) * w
+            F[2, r, b] += par[p + 4, b]
+        else:  # carrella: (b / sqrt(w^2 + l^2) + a) w + F0
+            w = par[p + 3, b] + d
+            F[2, r, b] += (par[p + 1, b] / np.sqrt(w * w + par[p + 2, b]) + par[p, b]) * w
+            F[2, r, b] += par[p + 4, b]
+
+
+@_jit
 def _stage(W, F, par, idx, lay, src, o, oi, has_input, scale, out):
     """The accelerations at the state ``W[src] = [q; v]`` with the inputs' part ``o[oi]``
     (when ``has_input``), times the inverse masses' row set ``scale`` (0: 1, 1: dt/2, 2: dt,
@@ -61,15 +83,7 @@ def _stage(W, F, par, idx, lay, src, o, oi, has_input, scale, out):
         for b in range(W.shape[2]):
             F[2, r, b] = par[oK + r, b] * F[0, r, b] + par[oC + r, b] * F[1, r, b]
     for x in range(X):
-        r, p = idx[2 * nD + 2 * nG + X + x], oL + 3 * x
-        if idx[2 * nD + 2 * nG + x] == 0:  # poly3: ((c3 δ + c2) δ + c1) δ
-            for b in range(W.shape[2]):
-                d = F[0, r, b]
-                F[2, r, b] += ((par[p + 2, b] * d + par[p + 1, b]) * d + par[p, b]) * d
-        else:  # cap: the force no larger than the limit (NaN stays NaN)
-            for b in range(W.shape[2]):
-                if F[2, r, b] > par[p, b]:
-                    F[2, r, b] = par[p, b]
+        _law(idx[2 * nD + 2 * nG + x], idx[2 * nD + 2 * nG + X + x], oL + 5 * x, F, par)
     for i in range(n):
         for b in range(W.shape[2]):
             W[out, n + i, b] = 0.0

@@ -24,7 +24,7 @@ taken in another order (and BLAS may fuse multiply-adds), about 1e-15 relative p
 (``tests/test_compiled.py`` checks 1e-12 on the bundled configs).
 
 Not covered (the numpy engine runs them, :func:`unsupported` says why): a semi-active
-controller, and a non-linear part without a compiled law (the seats' exact NSS mechanisms).
+controller, and a non-linear part without a compiled law.
 A new law is a branch of :func:`_forces` and an entry of :data:`LAWS`, beside the numpy
 closure that defines it (:attr:`suspopt.network.Elements.extra`).
 
@@ -43,8 +43,14 @@ from .rk4 import _CHECK_EVERY, DIVERGENCE_LIMIT, EdgePlan, Edges, Trajectory
 #: ``poly3 (c1, c2, c3)``: ``F_x = ((c3 δ + c2) δ + c1) δ`` (a Duffing spring, Eq 2.31, as
 #: ``(0, 0, k_nl)``; a seat's Taylor mechanism, Sec 8.2.2); ``cap (limit,)``: the element's
 #: force ``k δ + c δ̇`` capped at ``limit`` (a tyre that cannot pull, capped at its static
-#: load).
-LAWS = {"poly3": (0, 3), "cap": (1, 1)}
+#: load); ``link (a, b, ℓ², w0, F0)``: ``F_x = (a + b / sqrt(ℓ² - w²)) w + F0`` with ``w = w0 +
+#: δ`` (the exact NSS2-NSS4 mechanisms, :func:`suspopt.seat.mechanisms._link_law`);
+#: ``carrella (a, b, ℓ², w0, F0)``: ``F_x = (b / sqrt(w² + ℓ²) + a) w + F0`` (NSS1,
+#: :func:`suspopt.seat.mechanisms.carrella_law`). Each is the numpy closure's arithmetic,
+#: operation for operation.
+LAWS = {"poly3": (0, 3), "cap": (1, 1), "link": (2, 5), "carrella": (3, 5)}
+#: Parameters per law in the kernel's arrays (the most any law takes).
+LAW_PARAMETERS = 5
 
 
 def unsupported(asm: Assembled, controller: object | None) -> str | None:
@@ -77,7 +83,7 @@ def _entries(matrix: np.ndarray, P: int) -> tuple[np.ndarray, np.ndarray, np.nda
 
 def _laws(asm: Assembled, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The non-linear parts element by element: law codes and element rows (X,), parameters
-    (3, X, P)."""
+    (:data:`LAW_PARAMETERS`, X, P)."""
     codes, rows, params, start = [], [], [], 0
     for g in asm.network.groups:
         if g.extra is not None:
@@ -86,12 +92,12 @@ def _laws(asm: Assembled, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             for i in range(g.size):
                 codes.append(code)
                 rows.append(start + i)
-                row = np.zeros((3, P))
+                row = np.zeros((LAW_PARAMETERS, P))
                 for j in range(count):
                     row[j] = _padded(values[j][i, :, 0], P)
                 params.append(row)
         start += g.size
-    stacked = np.stack(params, axis=1) if params else np.zeros((3, 0, P))
+    stacked = np.stack(params, axis=1) if params else np.zeros((LAW_PARAMETERS, 0, P))
     return np.array(codes, np.int64), np.array(rows, np.int64), np.ascontiguousarray(stacked)
 
 
@@ -158,7 +164,7 @@ def _packed(asm: Assembled, dt: float, P: int) -> tuple[np.ndarray, np.ndarray, 
         g_val,
         _padded(asm.coef[:R, :, 0], P),
         _padded(asm.coef[R:, :, 0], P),
-        law_par.transpose(1, 0, 2).reshape(-1, P),  # (3 X, P): the laws' parameters in turn
+        law_par.transpose(1, 0, 2).reshape(-1, P),  # (5 X, P): the laws' parameters in turn
         im,
         im * (0.5 * dt),
         im * dt,

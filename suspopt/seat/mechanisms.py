@@ -72,14 +72,24 @@ def _link_law(stiffness, offset, length) -> Callable[[np.ndarray], np.ndarray]:
     folded once, so the simulator evaluates it in six array operations."""
     a = 2.0 * stiffness
     b, square = a * offset, length * length
-    return lambda w, out=None: np.multiply(a + b / np.sqrt(square - w * w), w, out=out)
+
+    def law(w, out=None):
+        return np.multiply(a + b / np.sqrt(square - w * w), w, out=out)
+
+    law.compiled = ("link", (a, b, square))  # its form in suspopt.integrator.compiled.LAWS
+    return law
 
 
 def carrella_law(stiffness, wall_distance, spring_free_length):
     """``u -> 2 K_h (L_o / sqrt(u² + a_o²) - 1) u`` (:func:`nss1_force`), constants folded."""
     a, b = -2.0 * stiffness, 2.0 * stiffness * spring_free_length
     square = wall_distance * wall_distance
-    return lambda u, out=None: np.multiply(b / np.sqrt(u * u + square) + a, u, out=out)
+
+    def law(u, out=None):
+        return np.multiply(b / np.sqrt(u * u + square) + a, u, out=out)
+
+    law.compiled = ("carrella", (a, b, square))  # its form in suspopt.integrator.compiled.LAWS
+    return law
 
 
 def _link_series(rest, stiffness, offset, length):
@@ -266,12 +276,21 @@ class Mechanism:
         return lambda d, r, f, out: np.add(negated(rest + d), preload, out=out)
 
     def compiled_law(self) -> tuple[str, tuple[np.ndarray, ...]] | None:
-        """:meth:`element_force` as a law of the compiled integrator: the Taylor form as
-        ``("poly3", (-k1, -k2, -k3))`` (each (1, P, 1)); the exact laws have none (yet), so a
-        seat with one runs on the numpy integrator."""
-        if self.series is None:
-            return None
-        return ("poly3", tuple(-np.asarray(k, float).reshape(1, -1, 1) for k in self.series))
+        """:meth:`element_force` as a law of the compiled integrator
+        (:data:`suspopt.integrator.compiled.LAWS`), each parameter (1, P, 1): the Taylor form
+        as ``("poly3", (-k1, -k2, -k3))``; the exact form as the negated law's own constants
+        ``(a, b, ℓ²)`` (``"link"``: ``(a + b / sqrt(ℓ² - w²)) w``; ``"carrella"``: ``(b /
+        sqrt(w² + ℓ²) + a) w``) with ``w = rest + δ`` and the static part added back."""
+
+        def rows(x) -> np.ndarray:
+            return np.asarray(x, float).reshape(1, -1, 1)
+
+        if self.series is not None:
+            return ("poly3", tuple(rows(-np.asarray(k, float)) for k in self.series))
+        name, constants = self.law(-1.0).compiled
+        rest = np.zeros_like(constants[0]) if self.rest is None else self.rest
+        preload = np.zeros_like(constants[0]) if self._preload is None else self._preload
+        return (name, tuple(rows(c) for c in (*constants, rest, preload)))
 
     def slope(self) -> np.ndarray:
         """``dF/dδ`` at rest, (P,) [N/m] (a positive slope is a negative stiffness), by
