@@ -7,8 +7,9 @@ rounding (``simulation.engine``):
 - ``compiled`` (:mod:`.compiled`, needs numba: ``pip install "suspopt[fast]"``): the whole
   run in one compiled call, the element network as sparse loops, designs in blocks of lanes
   the compiler vectorises, the blocks spread over the cores. It covers the networks whose
-  non-linear parts have a compiled law (Duffing springs, tyre lift-off, the seats' Taylor
-  mechanisms) without a controller; any other run goes to the numpy engine, and
+  non-linear parts have a compiled law (Duffing springs, tyre lift-off, the seats' exact and
+  Taylor mechanisms), with or without a semi-active controller (asked at its samples), but
+  without an actuator lag; any other run goes to the numpy engine, and
   :attr:`Trajectory.engine` says which one ran.
 - ``auto``: ``compiled`` when numba is installed, else ``numpy``.
 
@@ -84,5 +85,7 @@ def integrate(
         from . import compiled
 
         if compiled.unsupported(asm, controller) is None:
-            return compiled.integrate(asm, offsets, dt, n_steps, every, edges)
+            return compiled.integrate(
+                asm, n_vehicle, offsets, dt, n_steps, every, controller, edges
+            )
     return integrate_numpy(asm, n_vehicle, offsets, dt, n_steps, every, controller, edges)

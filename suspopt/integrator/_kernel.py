@@ -224,38 +224,57 @@ def _flush(rec, j0, count, p0, n, states, accelerations):
 
 
 @_jit
-def _block(p0, B, dt, n_steps, every, limit, check_every, par_all, idx, lay, road, out):
-    """Designs ``p0 .. p0 + B - 1``: every step, sample and check of the run."""
+def _advance(blk, k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out):
+    """Block ``blk``'s steps ``k0 .. k1 - 1`` from its kept state (step ``n_steps`` is the
+    final sample alone): the sample's first stage, the sample when one is due, the step, the
+    divergence check."""
+    W_all, F_all, rec_all, at_all = state
     states, accelerations, diverged_at = out
-    par = np.ascontiguousarray(par_all[:, p0 : p0 + B])
-    n, R = lay[4], lay[2]
-    W, F = np.zeros((11, 2 * n, B)), np.empty((3, R, B))
-    rec = np.empty((SAMPLES, 3 * n, B))  # the latest samples, time-major
+    W, F, rec, at, pb = W_all[blk], F_all[blk], rec_all[blk], at_all[blk], par[blk]
+    n, B = lay[4], W.shape[2]
     off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
-    at = np.full(B, np.nan)
-    for u in range(start_jumps.shape[0]):
-        _impulse(start_jumps, u, no_pull, W, F, par, idx, lay)
-    for step in range(n_steps + 1):
-        _stage(W, F, par, idx, lay, Y, off, 2 * step, active[2 * step], 0, S1)
+    if k0 == 0:
+        for u in range(start_jumps.shape[0]):
+            _impulse(start_jumps, u, no_pull, W, F, pb, idx, lay)
+    for step in range(k0, k1):
+        _stage(W, F, pb, idx, lay, Y, off, 2 * step, active[2 * step], 0, S1)
         if step % every == 0:  # the sample: the state and the first stage's accelerations
             j = step // every
             _keep(W, rec, j % SAMPLES, n)
             if j % SAMPLES == SAMPLES - 1 or j == states.shape[2] - 1:
-                _flush(rec, j - j % SAMPLES, j % SAMPLES + 1, p0, n, states, accelerations)
+                _flush(rec, j - j % SAMPLES, j % SAMPLES + 1, blk * B, n, states, accelerations)
         if step == n_steps:
             break
         if split_of[step] < 0:
-            _regular_step(2 * step, dt, W, F, par, idx, lay, off, active)
+            _regular_step(2 * step, dt, W, F, pb, idx, lay, off, active)
         else:
-            _split_step(split_of[step], W, F, par, idx, lay, road)
+            _split_step(split_of[step], W, F, pb, idx, lay, road)
         if (step + 1) % check_every == 0 or step + 1 == n_steps:
             _check(W, at, limit, (step + 1) * dt)
-    diverged_at[p0 : p0 + B] = at
+    diverged_at[blk * B : blk * B + B] = at
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)
-def run(B, dt, n_steps, every, limit, check_every, par, idx, lay, road, out):
-    """Integrate every design, ``B`` lanes at a time, the blocks over the cores (the arrays:
-    :func:`.compiled._packed`; the designs a whole number of blocks)."""
-    for blk in numba.prange(par.shape[1] // B):
-        _block(blk * B, B, dt, n_steps, every, limit, check_every, par, idx, lay, road, out)
+def run(k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out):
+    """Steps ``k0 .. k1 - 1`` of every block (in parallel over the cores) from the kept
+    ``state = (W, F, rec, at)`` of each, ``par (blocks, rows, B)`` (the arrays:
+    :func:`.compiled._packed`)."""
+    for blk in numba.prange(par.shape[0]):
+        _advance(
+            blk, k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out
+        )
+
+
+@numba.njit(cache=True, parallel=True, nogil=True)
+def accelerations_now(h, par, idx, lay, road, state, out):
+    """The accelerations ``out (blocks, n, B)`` at every block's current state with the
+    inputs of half step ``h`` and the coefficients in ``par`` (what a controller's sample
+    reads; scratch rows of ``W`` only)."""
+    off, active = road[0], road[1]
+    n = lay[4]
+    for blk in numba.prange(par.shape[0]):
+        W, F = state[0][blk], state[1][blk]
+        _stage(W, F, par[blk], idx, lay, Y, off, h, active[h], 0, TMP)
+        for i in range(n):
+            for b in range(W.shape[2]):
+                out[blk, i, b] = W[TMP, n + i, b]

@@ -23,8 +23,13 @@ scaled by their step, ``y += (s1 + 2 s2 + s3)/3 + s4``). The two agree to roundi
 taken in another order (and BLAS may fuse multiply-adds), about 1e-15 relative per step
 (``tests/test_compiled.py`` checks 1e-12 on the bundled configs).
 
-Not covered (the numpy engine runs them, :func:`unsupported` says why): a semi-active
-controller, and a non-linear part without a compiled law.
+A semi-active controller stays the one in :mod:`suspopt.control` (numpy, every law and
+threshold): the kernel runs the steps between its samples, and at each sample the
+controller reads the vehicle's velocities (and, for the laws that need them, the
+accelerations, computed by the kernel with the coefficients in force) and its command goes
+into the blocks' damper coefficients, as the numpy engine's hold does it. Not covered (the
+numpy engine runs them, :func:`unsupported` says why): an actuator lag, and a non-linear
+part without a compiled law.
 A new law is a branch of :func:`_forces` and an entry of :data:`LAWS`, beside the numpy
 closure that defines it (:attr:`suspopt.network.Elements.extra`).
 
@@ -37,7 +42,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..network import Assembled
-from .rk4 import _CHECK_EVERY, DIVERGENCE_LIMIT, EdgePlan, Edges, Trajectory
+from .rk4 import (
+    _CHECK_EVERY,
+    DIVERGENCE_LIMIT,
+    Controller,
+    EdgePlan,
+    Edges,
+    Trajectory,
+    _ControllerHold,
+    _VehicleState,
+)
 
 #: The non-linear element laws the kernel knows: name -> (code, number of parameters).
 #: ``poly3 (c1, c2, c3)``: ``F_x = ((c3 δ + c2) δ + c1) δ`` (a Duffing spring, Eq 2.31, as
@@ -53,10 +67,10 @@ LAWS = {"poly3": (0, 3), "cap": (1, 1), "link": (2, 5), "carrella": (3, 5)}
 LAW_PARAMETERS = 5
 
 
-def unsupported(asm: Assembled, controller: object | None) -> str | None:
+def unsupported(asm: Assembled, controller: Controller | None) -> str | None:
     """Why the compiled engine cannot run this network, or None when it can."""
-    if controller is not None:
-        return "a semi-active controller"
+    if controller is not None and controller.lag_decay is not None:
+        return "a semi-active damper with an actuator lag"
     for g in asm.network.groups:
         if g.extra is not None and (g.extra_law is None or g.extra_law[0] not in LAWS):
             return f"the non-linear part of {g.name!r} has no compiled law"
@@ -184,36 +198,119 @@ def block_width(P: int, threads: int) -> int:
 
 def integrate(
     asm: Assembled,
+    n_vehicle: int,
     offsets: np.ndarray,
     dt: float,
     n_steps: int,
     every: int,
+    controller: Controller | None = None,
     edges: Edges | None = None,
 ) -> Trajectory:
-    """The compiled engine's :func:`suspopt.integrator.integrate` (no controller: see
-    :func:`unsupported`); ``offsets`` (2 n_steps + 1, 2R, 1|P, 1) shared by the designs."""
+    """The compiled engine's :func:`suspopt.integrator.integrate` (what it covers:
+    :func:`unsupported`); ``offsets`` (2 n_steps + 1, 2R, 1, 1) shared by the designs. A
+    controller is asked at its samples between compiled stretches of steps (below)."""
     import numba
 
     from . import _kernel
 
-    n = asm.n
-    B = block_width(asm.P, numba.get_num_threads())
-    P = -(-asm.P // B) * B  # whole blocks: the last design repeated
-    par, idx, lay = _packed(asm, dt, P)
+    n, R, P0 = asm.n, asm.R, asm.P
+    B = block_width(P0, numba.get_num_threads())
+    blocks = -(-P0 // B)
+    P = blocks * B  # whole blocks: the last design repeated
+    flat, idx, lay = _packed(asm, dt, P)
+    par = np.ascontiguousarray(flat.reshape(flat.shape[0], blocks, B).transpose(1, 0, 2))
     off = np.ascontiguousarray(offsets[:, :, 0, 0])
     road = (off, off.any(axis=1)) + _edge_arrays(asm, edges, dt, n_steps, off)
     n_out = n_steps // every + 1
     states, accelerations = np.empty((2 * n, P, n_out)), np.empty((n, P, n_out))
-    diverged_at = np.full(P, np.nan)
-    out = (states, accelerations, diverged_at)
-    _kernel.run(B, dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par, idx, lay, road, out)
-    P = asm.P
-    states, accelerations, diverged_at = states[:, :P], accelerations[:, :P], diverged_at[:P]
+    out = (states, accelerations, np.full(P, np.nan))
+    state = (
+        np.zeros((blocks, 11, 2 * n, B)),
+        np.empty((blocks, 3, R, B)),
+        np.empty((blocks, _kernel.SAMPLES, 3 * n, B)),
+        np.full((blocks, B), np.nan),
+    )
+
+    def advance(k0: int, k1: int) -> None:
+        _kernel.run(k0, k1, dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par, idx, lay,
+                    road, state, out)  # fmt: skip
+
+    damping, records = None, {}
+    if controller is None:
+        advance(0, n_steps + 1)
+    else:
+        lanes = _Lanes(par, idx, state, lay, road, P0, n_vehicle)
+        damping, records = _controlled(controller, asm, lanes, advance, dt, n_steps, every)
     return Trajectory(
-        states=states,
-        accelerations=accelerations,
-        damping=None,
-        records={},
-        diverged_at=diverged_at,
+        states=states[:, :P0],
+        accelerations=accelerations[:, :P0],
+        damping=damping,
+        records=records,
+        diverged_at=out[2][:P0],
         engine="compiled",
     )
+
+
+class _Lanes:
+    """The controller's view of the compiled blocks: the vehicle's velocities and
+    accelerations as ``(n_vehicle, P)`` rows, and the damper coefficients written into the
+    blocks' parameters."""
+
+    def __init__(self, par, idx, state, lay, road, P: int, n_vehicle: int):
+        self.par, self.idx, self.state, self.lay, self.road, self.P = par, idx, state, lay, road, P
+        self.n, self.n_vehicle = int(lay[4]), n_vehicle
+        self.velocity = np.zeros((n_vehicle, P))
+
+    def rows(self, a: np.ndarray) -> np.ndarray:
+        """``(blocks, rows, B)`` as ``(rows, P)`` (the real designs only)."""
+        return a.transpose(1, 0, 2).reshape(a.shape[1], -1)[:, : self.P]
+
+    def read_velocity(self) -> None:
+        n = self.n
+        self.velocity[...] = self.rows(self.state[0][:, 0, n : n + self.n_vehicle])
+
+    def acceleration(self, h: int) -> np.ndarray:
+        from . import _kernel
+
+        blocks, _, B = self.par.shape
+        acc = np.empty((blocks, self.n, B))
+        _kernel.accelerations_now(h, self.par, self.idx, self.lay, self.road, self.state, acc)
+        return self.rows(acc)[: self.n_vehicle].copy()
+
+    def set_damping(self, elements: np.ndarray, c: np.ndarray) -> None:
+        """The damping coefficients ``c (N, P)`` of element rows ``elements``."""
+        blocks, _, B = self.par.shape
+        c = _padded(c, blocks * B)
+        self.par[:, int(self.lay[8]) + elements, :] = c.reshape(len(elements), blocks, B).transpose(
+            1, 0, 2
+        )
+
+
+def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps, every):
+    """The run with ``controller``: compiled stretches of steps between its samples, each
+    sample taken as the numpy engine's :class:`.rk4._ControllerHold` takes it (zero-order
+    hold, the records kept at the first output sample after each change)."""
+    R, n_out = asm.R, n_steps // every + 1
+    elements = np.arange(asm.damper_rows.start - R, asm.damper_rows.stop - R)
+    coef = np.array(asm.coef)  # the hold's coefficients (its damper rows)
+    vehicle = _VehicleState(lanes.velocity, lambda: lanes.acceleration(hold.sample_index))
+    hold = _ControllerHold(controller, coef, asm.damper_rows, asm.P, n_out, dt, vehicle)
+    lanes.set_damping(elements, hold.damping[:, :, 0])
+    every_c = controller.sample_every
+    samples = list(range(0, n_steps, every_c))
+    if n_steps % every == 0 and n_steps % every_c == 0:
+        samples.append(n_steps)  # the final instant is an output sample
+    k0, pending = 0, None
+    for k in samples:
+        advance(k0, k)
+        lanes.read_velocity()
+        first_output = -(-k // every)
+        if pending is not None and pending != first_output:
+            hold.kept(pending)  # the previous sample's records, at its first output sample
+        hold.control(k)
+        lanes.set_damping(elements, hold.damping[:, :, 0])
+        pending, k0 = (first_output if first_output < n_out else None), k
+    advance(k0, n_steps + 1)
+    if pending is not None:
+        hold.kept(pending)
+    return hold.held(n_out)
