@@ -92,6 +92,29 @@ def test_compiled_and_numpy_engines_agree_on_every_chapter_config(name):
     _agree(numpy_run, compiled_run)
 
 
+@pytest.mark.parametrize("lag", [0.0, 0.01])
+@pytest.mark.parametrize(
+    "name", ["ch4/sh_2_class_b.yaml", "ch4/sh_add_2_bump.yaml", "ch4/sh_2_cdf_class_a.yaml"]
+)
+def test_the_controller_decides_the_same_on_both_engines(name, lag):
+    """Its records (state, condition, threshold) and the damping (held, or lagged every step)
+    agree, with and without an actuator lag."""
+    cfg = suspopt.load_config(CONFIGS / name)
+    cfg.control.actuator_lag = lag
+    cfg.simulation.duration = min(cfg.simulation.duration, getattr(cfg.road, "start", 0.0) + 1.0)
+    params = _designs(cfg)
+    numpy_run, compiled_run = _run(cfg, "numpy", params), _run(cfg, "compiled", params)
+    assert compiled_run.engine == "compiled"
+    _agree(numpy_run, compiled_run)
+    assert set(numpy_run.controller_records) == set(compiled_run.controller_records)
+    for key, held in numpy_run.controller_records.items():
+        x, y = held.full(), compiled_run.controller_records[key].full()
+        np.testing.assert_allclose(y, x, rtol=1e-9, atol=1e-9 * np.abs(x).max(), err_msg=key)
+    damping = [getattr(r.held_damping, "full", lambda r=r: r.held_damping)() for r in
+               (numpy_run, compiled_run)]  # fmt: skip
+    np.testing.assert_allclose(damping[1], damping[0], rtol=1e-12)
+
+
 def test_a_design_gives_the_same_bits_in_any_batch():
     cfg = suspopt.load_config(CONFIGS / "ch5" / "case1_s1.yaml")
     cfg.simulation.duration = 1.0

@@ -8,12 +8,13 @@ slopes ``s1..s4`` of a regular step, those of a split step ``k1..k4`` and a scra
 every per-design number, ``idx`` every index and ``lay`` where each part starts
 (:func:`.compiled._packed`):
 
-- ``lay = (nD, nG, R, X, n, oD, oG, oK, oC, oL, oM)``: the entries of D_q and of G, the
-  elements, the non-linear laws, the DOFs; then the first row in ``par`` of the values of
-  D_q's entries, of G's, of ``k``, of ``c``, of the laws' parameters (3 per law) and of the
-  inverse masses times 1, dt/2, dt and dt/6 (n rows each);
+- ``lay = (nD, nG, R, X, n, oD, oG, oK, oC, oL, oM, Nl, oE, oU)``: the entries of D_q and
+  of G, the elements, the non-linear laws, the DOFs; the first row in ``par`` of the values
+  of D_q's entries, of G's, of ``k``, of ``c``, of the laws' parameters (5 per law) and of the
+  inverse masses times 1, dt/2, dt and dt/6 (n rows each); the lagged dampers, the first row
+  of their decay per step ``e`` and of their command's share ``c_cmd (1 - e)``;
 - ``idx``: D_q's rows and columns, G's rows (DOFs) and columns (elements), the laws' codes
-  (:data:`.compiled.LAWS`) and element rows.
+  (:data:`.compiled.LAWS`) and element rows, the lagged dampers' element rows.
 
 The lane is every loop's innermost index (a loop the compiler vectorises, with a run-time
 check that its arrays do not overlap).
@@ -198,29 +199,50 @@ def _check(W, at, limit, time):
 
 
 @_jit
-def _keep(W, rec, t, n):
-    """Sample into row ``t`` of the time-major buffer ``rec``: the state, the accelerations."""
+def _keep(W, rec, t, n, pb, idx, lay):
+    """Sample into row ``t`` of the time-major buffer ``rec``: the state, the accelerations
+    and the lagged damping coefficients."""
     for i in range(2 * n):
         for b in range(W.shape[2]):
             rec[t, i, b] = W[Y, i, b]
     for i in range(n):
         for b in range(W.shape[2]):
             rec[t, 2 * n + i, b] = W[S1, n + i, b]
+    base = 2 * lay[0] + 2 * lay[1] + 2 * lay[3]
+    for m in range(lay[11]):
+        for b in range(W.shape[2]):
+            rec[t, 3 * n + m, b] = pb[lay[8] + idx[base + m], b]
 
 
 @_jit
-def _flush(rec, j0, count, p0, n, states, accelerations):
+def _flush(rec, j0, count, p0, n, out):
     """The buffer's first ``count`` samples to samples ``j0 ..`` of the records: a transposed
     copy that writes each design's row as a contiguous run (writing every sample straight to
     the ``(rows, P, T)`` records touches a new cache line per value and took two thirds of
     the run)."""
-    for i in range(3 * n):
+    states, accelerations, lagged = out[0], out[1], out[3]
+    for i in range(rec.shape[1]):
         for b in range(rec.shape[2]):
             for t in range(count):
                 if i < 2 * n:
                     states[i, p0 + b, j0 + t] = rec[t, i, b]
-                else:
+                elif i < 3 * n:
                     accelerations[i - 2 * n, p0 + b, j0 + t] = rec[t, i, b]
+                else:
+                    lagged[i - 3 * n, p0 + b, j0 + t] = rec[t, i, b]
+
+
+@_jit
+def _lag(pb, idx, lay):
+    """The actuators' first-order lag, once per step: ``c <- c e + c_cmd (1 - e)`` (the
+    command's share ``c_cmd (1 - e)`` set at each controller sample), as the numpy engine's
+    hold does it."""
+    base, oC, oDecay, oPulled = 2 * lay[0] + 2 * lay[1] + 2 * lay[3], lay[8], lay[12], lay[13]
+    for m in range(lay[11]):
+        r = idx[base + m]
+        for b in range(pb.shape[1]):
+            pb[oC + r, b] = pb[oC + r, b] * pb[oDecay + m, b]
+            pb[oC + r, b] = pb[oC + r, b] + pb[oPulled + m, b]
 
 
 @_jit
@@ -229,7 +251,7 @@ def _advance(blk, k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay,
     final sample alone): the sample's first stage, the sample when one is due, the step, the
     divergence check."""
     W_all, F_all, rec_all, at_all = state
-    states, accelerations, diverged_at = out
+    states, diverged_at = out[0], out[2]
     W, F, rec, at, pb = W_all[blk], F_all[blk], rec_all[blk], at_all[blk], par[blk]
     n, B = lay[4], W.shape[2]
     off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
@@ -237,12 +259,13 @@ def _advance(blk, k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay,
         for u in range(start_jumps.shape[0]):
             _impulse(start_jumps, u, no_pull, W, F, pb, idx, lay)
     for step in range(k0, k1):
+        _lag(pb, idx, lay)
         _stage(W, F, pb, idx, lay, Y, off, 2 * step, active[2 * step], 0, S1)
         if step % every == 0:  # the sample: the state and the first stage's accelerations
             j = step // every
-            _keep(W, rec, j % SAMPLES, n)
+            _keep(W, rec, j % SAMPLES, n, pb, idx, lay)
             if j % SAMPLES == SAMPLES - 1 or j == states.shape[2] - 1:
-                _flush(rec, j - j % SAMPLES, j % SAMPLES + 1, blk * B, n, states, accelerations)
+                _flush(rec, j - j % SAMPLES, j % SAMPLES + 1, blk * B, n, out)
         if step == n_steps:
             break
         if split_of[step] < 0:

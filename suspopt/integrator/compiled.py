@@ -27,9 +27,9 @@ A semi-active controller stays the one in :mod:`suspopt.control` (numpy, every l
 threshold): the kernel runs the steps between its samples, and at each sample the
 controller reads the vehicle's velocities (and, for the laws that need them, the
 accelerations, computed by the kernel with the coefficients in force) and its command goes
-into the blocks' damper coefficients, as the numpy engine's hold does it. Not covered (the
-numpy engine runs them, :func:`unsupported` says why): an actuator lag, and a non-linear
-part without a compiled law.
+into the blocks' damper coefficients (with an actuator lag, the command's share, the kernel
+applying the lag at every step), as the numpy engine's hold does it. Not covered (the numpy
+engine runs it, :func:`unsupported` says why): a non-linear part without a compiled law.
 A new law is a branch of :func:`_forces` and an entry of :data:`LAWS`, beside the numpy
 closure that defines it (:attr:`suspopt.network.Elements.extra`).
 
@@ -67,10 +67,13 @@ LAWS = {"poly3": (0, 3), "cap": (1, 1), "link": (2, 5), "carrella": (3, 5)}
 LAW_PARAMETERS = 5
 
 
+def _damper_elements(asm: Assembled) -> np.ndarray:
+    """The element rows of the semi-active dampers."""
+    return np.arange(asm.damper_rows.start - asm.R, asm.damper_rows.stop - asm.R)
+
+
 def unsupported(asm: Assembled, controller: Controller | None) -> str | None:
     """Why the compiled engine cannot run this network, or None when it can."""
-    if controller is not None and controller.lag_decay is not None:
-        return "a semi-active damper with an actuator lag"
     for g in asm.network.groups:
         if g.extra is not None and (g.extra_law is None or g.extra_law[0] not in LAWS):
             return f"the non-linear part of {g.name!r} has no compiled law"
@@ -165,9 +168,13 @@ def _edge_arrays(asm: Assembled, edges: Edges | None, dt: float, n_steps: int, o
     )
 
 
-def _packed(asm: Assembled, dt: float, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _packed(
+    asm: Assembled, dt: float, P: int, lagged: np.ndarray | None = None, decay=None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The network for the kernel (:mod:`._kernel`): every per-design number ``par (rows,
-    P)``, every index ``idx`` and where each part starts, ``lay``."""
+    P)``, every index ``idx`` and where each part starts, ``lay``; ``lagged`` the element rows
+    of dampers with an actuator lag, ``decay (1, P0)`` its decay per step."""
+    lagged = np.zeros(0, np.int64) if lagged is None else lagged
     n, R = asm.n, asm.R
     d_row, d_col, d_val = _entries(asm.D2[..., :R, :n], P)
     g_row, g_col, g_val = _entries(asm.G2[..., :R], P)
@@ -183,10 +190,16 @@ def _packed(asm: Assembled, dt: float, P: int) -> tuple[np.ndarray, np.ndarray, 
         im * (0.5 * dt),
         im * dt,
         im * (dt / 6.0),
+        _padded(np.broadcast_to(decay, (lagged.size, decay.shape[-1])), P)
+        if lagged.size
+        else np.zeros((0, P)),
+        np.zeros((lagged.size, P)),  # the command's share, set at each controller sample
     ]
     starts = np.cumsum([0] + [p.shape[0] for p in parts])
     lay = [d_row.size, g_row.size, R, law_code.size, n, *starts[[0, 1, 2, 3, 4, 5]]]
-    idx = np.concatenate([d_row, d_col, g_row, g_col, law_code, law_row]).astype(np.int64)
+    lay += [lagged.size, starts[9], starts[10]]
+    idx = np.concatenate([d_row, d_col, g_row, g_col, law_code, law_row, lagged])
+    idx = idx.astype(np.int64)
     return np.ascontiguousarray(np.concatenate(parts)), idx, np.array(lay, np.int64)
 
 
@@ -217,17 +230,22 @@ def integrate(
     B = block_width(P0, numba.get_num_threads())
     blocks = -(-P0 // B)
     P = blocks * B  # whole blocks: the last design repeated
-    flat, idx, lay = _packed(asm, dt, P)
+    lagged = decay = None
+    if controller is not None and controller.lag_decay is not None:
+        lagged = _damper_elements(asm)
+        decay = controller.lag_decay.reshape(1, -1)
+    flat, idx, lay = _packed(asm, dt, P, lagged, decay)
+    Nl = int(lay[11])
     par = np.ascontiguousarray(flat.reshape(flat.shape[0], blocks, B).transpose(1, 0, 2))
     off = np.ascontiguousarray(offsets[:, :, 0, 0])
     road = (off, off.any(axis=1)) + _edge_arrays(asm, edges, dt, n_steps, off)
     n_out = n_steps // every + 1
     states, accelerations = np.empty((2 * n, P, n_out)), np.empty((n, P, n_out))
-    out = (states, accelerations, np.full(P, np.nan))
+    out = (states, accelerations, np.full(P, np.nan), np.empty((Nl, P, n_out)))
     state = (
         np.zeros((blocks, 11, 2 * n, B)),
         np.empty((blocks, 3, R, B)),
-        np.empty((blocks, _kernel.SAMPLES, 3 * n, B)),
+        np.empty((blocks, _kernel.SAMPLES, 3 * n + Nl, B)),
         np.full((blocks, B), np.nan),
     )
 
@@ -241,6 +259,8 @@ def integrate(
     else:
         lanes = _Lanes(par, idx, state, lay, road, P0, n_vehicle)
         damping, records = _controlled(controller, asm, lanes, advance, dt, n_steps, every)
+        if Nl:
+            damping = out[3][:, :P0]  # a lagged coefficient changes every step
     return Trajectory(
         states=states[:, :P0],
         accelerations=accelerations[:, :P0],
@@ -277,25 +297,25 @@ class _Lanes:
         _kernel.accelerations_now(h, self.par, self.idx, self.lay, self.road, self.state, acc)
         return self.rows(acc)[: self.n_vehicle].copy()
 
-    def set_damping(self, elements: np.ndarray, c: np.ndarray) -> None:
-        """The damping coefficients ``c (N, P)`` of element rows ``elements``."""
+    def set_rows(self, rows: np.ndarray, values: np.ndarray) -> None:
+        """Rows ``rows`` of the blocks' parameters to ``values (rows, P)``."""
         blocks, _, B = self.par.shape
-        c = _padded(c, blocks * B)
-        self.par[:, int(self.lay[8]) + elements, :] = c.reshape(len(elements), blocks, B).transpose(
-            1, 0, 2
-        )
+        values = _padded(values, blocks * B)
+        self.par[:, rows, :] = values.reshape(len(rows), blocks, B).transpose(1, 0, 2)
 
 
 def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps, every):
     """The run with ``controller``: compiled stretches of steps between its samples, each
     sample taken as the numpy engine's :class:`.rk4._ControllerHold` takes it (zero-order
     hold, the records kept at the first output sample after each change)."""
-    R, n_out = asm.R, n_steps // every + 1
-    elements = np.arange(asm.damper_rows.start - R, asm.damper_rows.stop - R)
+    n_out, lay = n_steps // every + 1, lanes.lay
+    dampers = int(lay[8]) + _damper_elements(asm)  # their rows of c among the parameters
     coef = np.array(asm.coef)  # the hold's coefficients (its damper rows)
     vehicle = _VehicleState(lanes.velocity, lambda: lanes.acceleration(hold.sample_index))
     hold = _ControllerHold(controller, coef, asm.damper_rows, asm.P, n_out, dt, vehicle)
-    lanes.set_damping(elements, hold.damping[:, :, 0])
+    lanes.set_rows(dampers, hold.damping[:, :, 0])
+    lagged = hold.decay is not None
+    shares = int(lay[13]) + np.arange(int(lay[11]))  # the lagged command's share
     every_c = controller.sample_every
     samples = list(range(0, n_steps, every_c))
     if n_steps % every == 0 and n_steps % every_c == 0:
@@ -308,7 +328,10 @@ def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps,
         if pending is not None and pending != first_output:
             hold.kept(pending)  # the previous sample's records, at its first output sample
         hold.control(k)
-        lanes.set_damping(elements, hold.damping[:, :, 0])
+        if lagged:  # the kernel applies the lag at every step from here
+            lanes.set_rows(shares, hold.pulled[:, :, 0])
+        else:
+            lanes.set_rows(dampers, hold.damping[:, :, 0])
         pending, k0 = (first_output if first_output < n_out else None), k
     advance(k0, n_steps + 1)
     if pending is not None:
