@@ -38,7 +38,8 @@ class LazyConsole:
     markup, emoji codes (":x:" in a file name) or highlighted. ``quiet`` silences both."""
 
     def __init__(self, stderr: bool = False):
-        self._stderr, self._quiet, self._console = stderr, False, None
+        self._stderr, self._quiet = stderr, False
+        self._console: Console | None = None
 
     @property
     def console(self) -> Console:

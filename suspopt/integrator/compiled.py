@@ -69,7 +69,9 @@ LAW_PARAMETERS = 5
 
 def _damper_elements(asm: Assembled) -> np.ndarray:
     """The element rows of the semi-active dampers."""
-    return np.arange(asm.damper_rows.start - asm.R, asm.damper_rows.stop - asm.R)
+    rows = asm.damper_rows
+    assert rows is not None  # (a controlled network)
+    return np.arange(rows.start - asm.R, rows.stop - asm.R)
 
 
 def unsupported(asm: Assembled, controller: Controller | None) -> str | None:
@@ -104,6 +106,7 @@ def _laws(asm: Assembled, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     codes, rows, params, start = [], [], [], 0
     for g in asm.network.groups:
         if g.extra is not None:
+            assert g.extra_law is not None  # (unsupported() said so)
             name, values = g.extra_law
             code, count = LAWS[name]
             for i in range(g.size):
@@ -312,7 +315,9 @@ def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps,
     dampers = int(lay[8]) + _damper_elements(asm)  # their rows of c among the parameters
     coef = np.array(asm.coef)  # the hold's coefficients (its damper rows)
     vehicle = _VehicleState(lanes.velocity, lambda: lanes.acceleration(hold.sample_index))
-    hold = _ControllerHold(controller, coef, asm.damper_rows, asm.P, n_out, dt, vehicle)
+    rows = asm.damper_rows
+    assert rows is not None
+    hold = _ControllerHold(controller, coef, rows, asm.P, n_out, dt, vehicle)
     lanes.set_rows(dampers, hold.damping[:, :, 0])
     lagged = hold.decay is not None
     shares = int(lay[13]) + np.arange(int(lay[11]))  # the lagged command's share

@@ -76,7 +76,7 @@ def _link_law(stiffness, offset, length) -> Callable[[np.ndarray], np.ndarray]:
     def law(w, out=None):
         return np.multiply(a + b / np.sqrt(square - w * w), w, out=out)
 
-    law.compiled = ("link", (a, b, square))  # its form in suspopt.integrator.compiled.LAWS
+    law.compiled = ("link", (a, b, square))  # type: ignore[attr-defined]  (compiled.LAWS)
     return law
 
 
@@ -88,7 +88,7 @@ def carrella_law(stiffness, wall_distance, spring_free_length):
     def law(u, out=None):
         return np.multiply(b / np.sqrt(u * u + square) + a, u, out=out)
 
-    law.compiled = ("carrella", (a, b, square))  # its form in suspopt.integrator.compiled.LAWS
+    law.compiled = ("carrella", (a, b, square))  # type: ignore[attr-defined]  (compiled.LAWS)
     return law
 
 
@@ -287,7 +287,7 @@ class Mechanism:
 
         if self.series is not None:
             return ("poly3", tuple(rows(-np.asarray(k, float)) for k in self.series))
-        name, constants = self.law(-1.0).compiled
+        name, constants = self.law(-1.0).compiled  # type: ignore[attr-defined]
         rest = np.zeros_like(constants[0]) if self.rest is None else self.rest
         preload = np.zeros_like(constants[0]) if self._preload is None else self._preload
         return (name, tuple(rows(c) for c in (*constants, rest, preload)))
