@@ -1,12 +1,12 @@
 """The numba kernel of :mod:`.compiled` (imported only when that engine runs: it needs numba).
 
-A block of ``B`` designs (at most :data:`MAX_LANES`) keeps everything in a few arrays indexed
-by constants and offsets, so the hot loop creates no array views and passes no tuples (each
-would cost atomic reference counts): ``W (11, 2n, B)`` holds the state ``y``, the stage state ``ys``, the
-slopes ``s1..s4`` of a regular step, those of a split step ``k1..k4`` and a scratch block;
-``F (3, R, B)`` the deformations ``δ, δ̇`` and the element forces; ``par (rows, B)``
-every per-design number, ``idx`` every index and ``lay`` where each part starts
-(:func:`.compiled._packed`):
+A block of ``B`` designs (:func:`.compiled.block_width`) keeps everything in a few arrays
+indexed by constants and offsets, so the hot loop creates no array views and passes no tuples
+(each would cost atomic reference counts): ``W (11, 2n, B)`` holds the state ``y``, the stage
+state ``ys``, the slopes ``s1..s4`` of a regular step, those of a split step ``k1..k4`` and a
+scratch block; ``F (3, R, B)`` the deformations ``δ, δ̇`` and the element forces;
+``par (rows, B)`` every per-design number, ``idx`` every index and ``lay`` where each part
+starts (:func:`.compiled._packed`):
 
 - ``lay = (nD, nG, R, X, n, oD, oG, oK, oC, oL, oM, Nl, oE, oU)``: the entries of D_q and
   of G, the elements, the non-linear laws, the DOFs; the first row in ``par`` of the values
@@ -27,9 +27,6 @@ import numpy as np
 
 _jit = numba.njit(cache=True, nogil=True)
 
-#: The most lanes of a block: enough to amortise each lane loop's set-up, few enough for the
-#: block's buffers to stay in the core's cache (about 80 KB for the Ch. 5 half car).
-MAX_LANES = 64
 #: Samples a block buffers before writing them to the records.
 SAMPLES = 32
 #: The blocks of W.

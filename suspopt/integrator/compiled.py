@@ -1,4 +1,4 @@
-"""The compiled RK4 engine: the same integration as :mod:`.rk4` in one numba call.
+"""The compiled RK4 engine: the same integration as :mod:`.rk4`, its steps in numba.
 
 The assembled network (:class:`suspopt.network.Assembled`) is packed, not re-described: the
 deformation map ``D_q`` and the force map ``G = -D_qᵀ`` (masked where a one-way seat does not
@@ -9,13 +9,13 @@ evaluation of the accelerations is then
 
     δ = D_q q + D_u u,   δ̇ = D_q q̇ + D_u u̇,   F = k δ + c δ̇ (+ F_x),   q̈ = M^-1 G F
 
-as loops over those entries (about 300 floating-point operations for the Ch. 5 half car,
-where the dense products of the numpy engine take about 1,000).
+as loops over those entries (432 floating-point operations per step for the Ch. 5 half car,
+as ``benchmarks/bench_simulate.py`` counts them, where the numpy engine's dense products
+take about 1,000).
 
 Designs run in blocks of lanes (:func:`block_width`; the last design repeated to fill the
-last block): every loop's innermost index is the lane,
-over contiguous rows, which the compiler vectorises; the blocks are spread over the cores
-(``numba.prange``). A lane's arithmetic never involves another lane, so a design gives the
+last block): every loop's innermost index is the lane, over contiguous rows, which the
+compiler vectorises; the blocks are spread over the cores (``numba.prange``). A lane's arithmetic never involves another lane, so a design gives the
 same bits whatever its batch, its block or the number of threads. Every step, sample, road
 edge (a split step's sub-steps and its exact impulse, planned by :class:`.rk4.EdgePlan`) and
 the divergence rule are the numpy engine's; the regular step uses its arithmetic (stages
@@ -30,7 +30,7 @@ accelerations, computed by the kernel with the coefficients in force) and its co
 into the blocks' damper coefficients (with an actuator lag, the command's share, the kernel
 applying the lag at every step), as the numpy engine's hold does it. Not covered (the numpy
 engine runs it, :func:`unsupported` says why): a non-linear part without a compiled law.
-A new law is a branch of :func:`_forces` and an entry of :data:`LAWS`, beside the numpy
+A new law is a branch of ``_kernel._law`` and an entry of :data:`LAWS`, beside the numpy
 closure that defines it (:attr:`suspopt.network.Elements.extra`).
 
 The first call on a machine compiles the kernel (``cache=True`` keeps it in the package's
@@ -206,10 +206,15 @@ def _packed(
     return np.ascontiguousarray(np.concatenate(parts)), idx, np.array(lay, np.int64)
 
 
+#: The most lanes of a block: enough to amortise each lane loop's set-up, few enough for the
+#: block's buffers to stay in the core's cache (about 80 KB for the Ch. 5 half car).
+MAX_LANES = 64
+
+
 def block_width(P: int, threads: int) -> int:
-    """Designs per block: as many as fill the threads evenly, at most
-    :data:`._kernel.MAX_LANES` (64). A design's arithmetic does not depend on it."""
-    return max(1, min(64, -(-P // max(threads, 1))))
+    """Designs per block: as many as fill the threads evenly, at most :data:`MAX_LANES`. A
+    design's arithmetic does not depend on it."""
+    return max(1, min(MAX_LANES, -(-P // max(threads, 1))))
 
 
 def integrate(
