@@ -20,7 +20,7 @@ from . import memory
 from .checks import check_steps, full_network
 from .config import Config
 from .control.controller import build_controller
-from .integrator import DIVERGENCE_LIMIT, Controller, Edges, integrate
+from .integrator import DIVERGENCE_LIMIT, Controller, Edges, Run, integrate
 from .network import Assembled
 from .params import ParamView
 from .result import Attachment, Result, SignalMap, signal_names, signal_table
@@ -174,9 +174,8 @@ def _run(
             else None
         )
         edges = Edges(times, jumps.T, inputs, no_pull)
-    traj = integrate(
-        asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller, edges, sim.engine
-    )
+    run = Run(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller, edges)
+    traj = integrate(run, sim.engine)
     out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
     return Result(
         config=cfg,

@@ -19,9 +19,6 @@ divergence rule; see :mod:`.rk4` for what those are.
 
 from __future__ import annotations
 
-import numpy as np
-
-from ..network import Assembled
 from .rk4 import (
     DIVERGENCE_LIMIT,
     Controller,
@@ -29,23 +26,13 @@ from .rk4 import (
     Edges,
     Held,
     HeldRecords,
+    Run,
     Trajectory,
 )
 from .rk4 import integrate as integrate_numpy
 
-__all__ = [
-    "Controller",
-    "Held",
-    "HeldRecords",
-    "Trajectory",
-    "Edges",
-    "EdgePlan",
-    "integrate",
-    "integrate_numpy",
-    "DIVERGENCE_LIMIT",
-    "ENGINES",
-    "compiled_available",
-]
+__all__ = ["Controller", "Held", "HeldRecords", "Trajectory", "Edges", "EdgePlan", "Run"]
+__all__ += ["integrate", "integrate_numpy", "DIVERGENCE_LIMIT", "ENGINES", "compiled_available"]
 
 #: The values of ``simulation.engine``.
 ENGINES = ("numpy", "compiled", "auto")
@@ -61,20 +48,8 @@ def compiled_available() -> bool:
     return importlib.util.find_spec("numba") is not None
 
 
-def integrate(
-    asm: Assembled,
-    n_vehicle: int,
-    offsets: np.ndarray,
-    dt: float,
-    n_steps: int,
-    every: int,
-    controller: Controller | None = None,
-    edges: Edges | None = None,
-    engine: str = "numpy",
-) -> Trajectory:
-    """Classical RK4 over ``n_steps`` on ``engine`` (module docstring); ``offsets`` (2 n_steps
-    + 1, 2R, 1, 1) are the inputs' part of the deformations on the half-step grid ``t = j
-    dt/2`` (their right limits at a road edge); samples every ``every``-th step. A
+def integrate(run: Run, engine: str = "numpy") -> Trajectory:
+    """Classical RK4 of ``run`` (:class:`Run`) on ``engine`` (module docstring). A
     ``compiled`` request without numba is a ``RuntimeError`` naming the install command (the
     config's checks turn it into bad input first)."""
     if engine not in ENGINES:
@@ -84,8 +59,6 @@ def integrate(
     if engine != "numpy" and compiled_available():
         from . import compiled
 
-        if compiled.unsupported(asm, controller) is None:
-            return compiled.integrate(
-                asm, n_vehicle, offsets, dt, n_steps, every, controller, edges
-            )
-    return integrate_numpy(asm, n_vehicle, offsets, dt, n_steps, every, controller, edges)
+        if compiled.unsupported(run.asm, run.controller) is None:
+            return compiled.integrate(run)
+    return integrate_numpy(run)

@@ -48,6 +48,7 @@ from .rk4 import (
     Controller,
     EdgePlan,
     Edges,
+    Run,
     Trajectory,
     _ControllerHold,
     _VehicleState,
@@ -217,19 +218,11 @@ def block_width(P: int, threads: int) -> int:
     return max(1, min(MAX_LANES, -(-P // max(threads, 1))))
 
 
-def integrate(
-    asm: Assembled,
-    n_vehicle: int,
-    offsets: np.ndarray,
-    dt: float,
-    n_steps: int,
-    every: int,
-    controller: Controller | None = None,
-    edges: Edges | None = None,
-) -> Trajectory:
+def integrate(run: Run) -> Trajectory:
     """The compiled engine's :func:`suspopt.integrator.integrate` (what it covers:
-    :func:`unsupported`); ``offsets`` (2 n_steps + 1, 2R, 1, 1) shared by the designs. A
-    controller is asked at its samples between compiled stretches of steps (below)."""
+    :func:`unsupported`); the run's offsets are shared by the designs. A controller is asked
+    at its samples between compiled stretches of steps (:func:`_controlled`)."""
+    asm, n_vehicle, offsets, dt, n_steps, every, controller, edges = run
     import numba
 
     from . import _kernel

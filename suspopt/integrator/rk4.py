@@ -61,6 +61,7 @@ __all__ = [
     "HeldRecords",
     "Trajectory",
     "Edges",
+    "Run",
     "integrate",
     "DIVERGENCE_LIMIT",
 ]
@@ -521,21 +522,29 @@ def _controller_hold(
     return hold
 
 
-def integrate(
-    asm: Assembled,
-    n_vehicle: int,
-    offsets: np.ndarray,
-    dt: float,
-    n_steps: int,
-    every: int,
-    controller: Controller | None = None,
-    edges: Edges | None = None,
-) -> Trajectory:
-    """Classical RK4 over ``n_steps``; ``offsets`` (2 n_steps + 1, 2R, 1, 1) are the inputs'
-    part of the deformations on the half-step grid ``t = j dt/2`` (their right limits at a
-    road edge). Samples are kept every ``every``-th step. Road edges, the samples, the
-    controller's hold and the batch width: see the module docstring.
+class Run(NamedTuple):
+    """One integration, as every engine takes it: the assembled network (its first
+    ``n_vehicle`` DOFs the vehicle's), the inputs' part of the deformations on the half-step
+    grid ``t = j dt/2``, ``offsets`` (2 n_steps + 1, 2R, 1, 1) (their right limits at a road
+    edge), the step ``dt`` [s], the number of steps, the samples' spacing ``every`` in steps,
+    the semi-active controller and the road's edges (or None)."""
+
+    asm: Assembled
+    n_vehicle: int
+    offsets: np.ndarray
+    dt: float
+    n_steps: int
+    every: int
+    controller: Controller | None = None
+    edges: Edges | None = None
+
+
+def integrate(run: Run) -> Trajectory:
+    """Classical RK4 of ``run`` (:class:`Run`) over its steps, samples kept every ``every``-th
+    step. Road edges, the samples, the controller's hold and the batch width: see the module
+    docstring.
     """
+    asm, n_vehicle, offsets, dt, n_steps, every, controller, edges = run
     n, P = asm.n, asm.P
     width = max(P, 2)
     active = offsets.any(axis=(1, 2, 3))
