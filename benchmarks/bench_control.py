@@ -17,7 +17,8 @@ also contains the simulator keeping the controller's records (three per-corner s
 coefficient) once per change (every ΔT) and publishing them, which a run does only when one is
 first read and the benchmark makes it do (expanding them to every output sample, when a signal
 is read, is not timed); the last row keeps every 4th step instead of every step. Run:
-``python benchmarks/bench_control.py``.
+``python benchmarks/bench_control.py [--engine compiled]`` (``simulation.engine`` of every
+variant; default numpy).
 Like the command line, it first makes the allocator reuse freed memory
 (:func:`suspopt.reuse_memory`); ``--default-allocator`` leaves it as it is.
 Prints a table; asserts nothing.
@@ -150,10 +151,13 @@ def main() -> None:
         "cells: CPU time over the passive run's (total) / time inside the controller over "
         "the passive run's (own)"
     )
+    engine = sys.argv[sys.argv.index("--engine") + 1] if "--engine" in sys.argv else "numpy"
+    print(f"engine: {engine}")
     rng = np.random.default_rng(2026)
     for title, (path, duration) in PROBLEMS.items():
         cfg = suspopt.load_config(path)
         cfg.simulation.duration = duration
+        cfg.simulation.engine = engine
         configs = variants(cfg)
         k = cfg.vehicle.corners["F1"].spring.linear
         print(f"\n{title}: {cfg.simulation.n_steps} RK4 steps")

@@ -298,11 +298,16 @@ class _Lanes:
         _kernel.accelerations_now(h, self.par, self.idx, self.lay, self.road, self.state, acc)
         return self.rows(acc)[: self.n_vehicle].copy()
 
-    def set_rows(self, rows: np.ndarray, values: np.ndarray) -> None:
-        """Rows ``rows`` of the blocks' parameters to ``values (rows, P)``."""
+    def set_rows(self, rows: slice, values: np.ndarray) -> None:
+        """Rows ``rows`` of the blocks' parameters to ``values (rows, P)``, the last design
+        repeated over the padding (at every controller sample: no allocation)."""
         blocks, _, B = self.par.shape
-        values = _padded(values, blocks * B)
-        self.par[:, rows, :] = values.reshape(len(rows), blocks, B).transpose(1, 0, 2)
+        target = self.par[:, rows, :]  # (blocks, rows, B), a view
+        whole, P = self.P // B, self.P
+        target[:whole] = values[:, : whole * B].reshape(-1, whole, B).transpose(1, 0, 2)
+        if whole < blocks:  # the last, padded block
+            target[whole, :, : P - whole * B] = values[:, whole * B :]
+            target[whole, :, P - whole * B :] = values[:, -1:]
 
 
 def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps, every):
@@ -310,7 +315,8 @@ def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps,
     sample taken as the numpy engine's :class:`.rk4._ControllerHold` takes it (zero-order
     hold, the records kept at the first output sample after each change)."""
     n_out, lay = n_steps // every + 1, lanes.lay
-    dampers = int(lay[8]) + _damper_elements(asm)  # their rows of c among the parameters
+    elements = _damper_elements(asm)  # contiguous: their rows of c among the parameters
+    dampers = slice(int(lay[8]) + elements[0], int(lay[8]) + elements[-1] + 1)
     coef = np.array(asm.coef)  # the hold's coefficients (its damper rows)
     vehicle = _VehicleState(lanes.velocity, lambda: lanes.acceleration(hold.sample_index))
     rows = asm.damper_rows
@@ -318,7 +324,7 @@ def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps,
     hold = _ControllerHold(controller, coef, rows, asm.P, n_out, dt, vehicle)
     lanes.set_rows(dampers, hold.damping[:, :, 0])
     lagged = hold.decay is not None
-    shares = int(lay[13]) + np.arange(int(lay[11]))  # the lagged command's share
+    shares = slice(int(lay[13]), int(lay[13]) + int(lay[11]))  # the lagged command's share
     every_c = controller.sample_every
     samples = list(range(0, n_steps, every_c))
     if n_steps % every == 0 and n_steps % every_c == 0:
