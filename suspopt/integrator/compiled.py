@@ -76,7 +76,8 @@ def _damper_elements(asm: Assembled) -> np.ndarray:
 
 
 def unsupported(asm: Assembled, controller: Controller | None) -> str | None:
-    """Why the compiled engine cannot run this network, or None when it can."""
+    """Why the compiled engine cannot run this network, or None when it can (every
+    ``controller`` is covered: it is asked at its samples)."""
     for g in asm.network.groups:
         if g.extra is not None and (g.extra_law is None or g.extra_law[0] not in LAWS):
             return f"the non-linear part of {g.name!r} has no compiled law"
