@@ -21,10 +21,10 @@ class Simulation(Section):
     )
     engine: Literal["numpy", "compiled", "auto"] = Field(
         "numpy",
-        description="the integrator: numpy (the reference, covers every run), compiled "
-        '(numba, pip install "suspopt[fast]"; runs without a controller or an exact NSS '
-        "mechanism, the others fall back to numpy), or auto (compiled when numba is "
-        "installed); the two agree to rounding",
+        description="the integrator: numpy (the reference), compiled (numba, pip install "
+        '"suspopt[fast]": every vehicle, seat, road and controller; a non-linear element '
+        "without a compiled law runs on numpy), or auto (compiled when numba is installed); "
+        "the two agree to rounding",
     )
 
     @field_validator("engine")
