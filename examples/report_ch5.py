@@ -16,7 +16,7 @@ from report_common import (
     SAME,
     SCENARIOS,
     STALLED,
-    THESIS,
+    Chapter,
     Doc,
     batched_performance,
     budget_row,
@@ -88,31 +88,28 @@ def late_gain_sentence(gains) -> str:
 
 
 def chapter5(out, doc) -> list[str]:
-    ch = _Chapter5(out)
-    ch.what_was_run(doc)
-    ch.reproduced(doc)
-    ch.case_tables(doc)
-    ch.table_5_14(doc)
-    ch.f4_figure(doc)
-    ch.figure_list(doc)
-    ch.gradient_runs(doc)
-    ch.bump_length(doc)
-    ch.bounds_reached(doc)
-    ch.budgets(doc)
-    return ch.headline(doc)
+    return _Chapter5(out).write(doc)
 
 
-class _Chapter5:
-    """chapter5, one method per table or paragraph; what a part measures and a later one
-    reads is kept on the instance."""
+class _Chapter5(Chapter):
+    """Chapter 5, one method per table or paragraph (:class:`report_common.Chapter`)."""
 
-    def __init__(self, out: Path):
-        self.out = out
+    NAME = "ch5"
+    SECTIONS = (
+        "what_was_run",
+        "reproduced",
+        "case_tables",
+        "table_5_14",
+        "f4_figure",
+        "figure_list",
+        "gradient_runs",
+        "bump_length",
+        "bounds_reached",
+        "budgets",
+    )
 
     def what_was_run(self, doc: Doc) -> None:
-        out = self.out
-        d = out / "ch5"
-        ref = THESIS["ch5"]
+        d, ref = self.d, self.ref
         runs = {(c, s): read_run(d / f"case{c}_s{s}.h5") for c in range(1, 6) for s in range(1, 6)}
         perf = batched_performance({key: (run.path, run.X[:1]) for key, run in runs.items()})
         weights = runs[4, 1].weights

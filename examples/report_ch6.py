@@ -15,6 +15,7 @@ from report_common import (
     BUDGET_HEADER,
     SAME,
     THESIS,
+    Chapter,
     Doc,
     budget_row,
     command_list,
@@ -40,30 +41,27 @@ def chosen_design(ke: dict, index: int | None = None) -> tuple[Path, np.ndarray,
 
 
 def chapter6(out, doc) -> list[str]:
-    ch = _Chapter6(out)
-    ch.what_was_run(doc)
-    ch.objectives(doc)
-    ch.variables(doc)
-    ch.dynamics(doc)
-    ch.times(doc)
-    ch.figures(doc)
-    ch.f1_unit(doc)
-    ch.f2_to_f6(doc)
-    ch.design_variables(doc)
-    return ch.headline(doc)
+    return _Chapter6(out).write(doc)
 
 
-class _Chapter6:
-    """chapter6, one method per table or paragraph; what a part measures and a later one
-    reads is kept on the instance."""
+class _Chapter6(Chapter):
+    """Chapter 6, one method per table or paragraph (:class:`report_common.Chapter`)."""
 
-    def __init__(self, out: Path):
-        self.out = out
+    NAME = "ch6"
+    SECTIONS = (
+        "what_was_run",
+        "objectives",
+        "variables",
+        "dynamics",
+        "times",
+        "figures",
+        "f1_unit",
+        "f2_to_f6",
+        "design_variables",
+    )
 
     def what_was_run(self, doc: Doc) -> None:
-        out = self.out
-        d = out / "ch6"
-        ref = THESIS["ch6"]
+        d, ref = self.d, self.ref
         parts = {p: read_kesort(d / f"{f}.h5") for p, f in PARTS.items()}
         chosen = {p: chosen_design(k) for p, k in parts.items()}
         perf = {p: performance(path, X[None, :]) for p, (path, _, X) in chosen.items()}

@@ -16,7 +16,7 @@ from report_ch7 import read_pseudo
 from report_common import (
     BUDGET_HEADER,
     SAME,
-    THESIS,
+    Chapter,
     Doc,
     budget_row,
     command_list,
@@ -115,31 +115,28 @@ def edge_change_cells(
 
 
 def chapter8(out, doc) -> list[str]:
-    ch = _Chapter8(out)
-    ch.what_was_run(doc)
-    ch.table_8_12(doc)
-    ch.table_8_13(doc)
-    ch.fig_8_26(doc)
-    ch.class_b_fronts(doc)
-    ch.fronts_figure(doc)
-    ch.figure_list(doc)
-    ch.fronts_ends(doc)
-    ch.road_changes(doc)
-    ch.resonances(doc)
-    return ch.headline(doc)
+    return _Chapter8(out).write(doc)
 
 
-class _Chapter8:
-    """chapter8, one method per table or paragraph; what a part measures and a later one
-    reads is kept on the instance."""
+class _Chapter8(Chapter):
+    """Chapter 8, one method per table or paragraph (:class:`report_common.Chapter`)."""
 
-    def __init__(self, out: Path):
-        self.out = out
+    NAME = "ch8"
+    SECTIONS = (
+        "what_was_run",
+        "table_8_12",
+        "table_8_13",
+        "fig_8_26",
+        "class_b_fronts",
+        "fronts_figure",
+        "figure_list",
+        "fronts_ends",
+        "road_changes",
+        "resonances",
+    )
 
     def what_was_run(self, doc: Doc) -> None:
-        out = self.out
-        d = out / "ch8"
-        ref = THESIS["ch8"]
+        d, ref = self.d, self.ref
         runs = {(s, r): read_run(d / f"pareto_{s}_class_{r}.h5") for s in SEATS for r in "ab"}
         roads = {s: read_pseudo(d / f"{s}_roads.h5") for s in SEATS}
         masses = {s: read_pseudo(d / f"{s}_masses.h5") for s in SEATS}

@@ -438,6 +438,27 @@ class Doc:
         return "\n".join(self.lines).rstrip() + "\n"
 
 
+class Chapter:
+    """A chapter of the report, read from ``out/NAME`` against ``THESIS[NAME]``: its
+    ``SECTIONS`` are the methods that write its tables and paragraphs, in order (what one
+    measures and a later one reads is kept on the instance); ``headline(doc)`` returns the
+    chapter's lines for the report's summary."""
+
+    NAME = ""
+    SECTIONS: tuple[str, ...] = ()
+
+    def __init__(self, out: Path):
+        self.out, self.d, self.ref = out, out / self.NAME, THESIS[self.NAME]
+
+    def write(self, doc: Doc) -> list[str]:
+        for section in self.SECTIONS:
+            getattr(self, section)(doc)
+        return self.headline(doc)
+
+    def headline(self, doc: Doc) -> list[str]:
+        raise NotImplementedError
+
+
 def span(values, fmt=md.pct) -> str:
     """'a to b' of the finite values."""
     v = np.asarray([x for x in values if not md.missing(x)], dtype=float)
