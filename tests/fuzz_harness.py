@@ -1643,6 +1643,18 @@ def _last_running(log: str) -> str:
     return (lines[-1].split(": running ", 1)[1] if lines else "?") + " | log: " + log[-300:]
 
 
+def selected_case_ids(request) -> set[str]:
+    """The ids of the ``case`` parameters of the requesting module's collected tests (all of
+    them unless ``-k`` deselected some), so that its module fixture runs only those."""
+    return {
+        item.callspec.params["case"].id
+        for item in request.session.items
+        if getattr(item, "callspec", None)
+        and "case" in item.callspec.params
+        and item.module is request.module
+    }
+
+
 def run_cases(
     cases: list[Case],
     workers: int | None = None,

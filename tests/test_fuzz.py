@@ -29,13 +29,7 @@ CASES = fh.config_cases(fh.case_count(DEFAULT_CASES))
 @pytest.fixture(scope="module")
 def results(request):
     """Run the selected cases (all of them unless -k deselects some) in one worker pool."""
-    wanted = {
-        item.callspec.params["case"].id
-        for item in request.session.items
-        if getattr(item, "callspec", None)
-        and "case" in item.callspec.params
-        and item.module is request.module
-    }
+    wanted = fh.selected_case_ids(request)
     return fh.run_cases([c for c in CASES if c.id in wanted])
 
 

@@ -30,13 +30,7 @@ CASES = fh.h5_cases(VARIANTS)
 
 @pytest.fixture(scope="module")
 def results(request, tmp_path_factory):
-    wanted = {
-        item.callspec.params["case"].id
-        for item in request.session.items
-        if getattr(item, "callspec", None)
-        and "case" in item.callspec.params
-        and item.module is request.module
-    }
+    wanted = fh.selected_case_ids(request)
     cases = fh.build_h5_cases(
         [c for c in CASES if c.id in wanted], VARIANTS, tmp_path_factory.mktemp("fuzz_h5")
     )
