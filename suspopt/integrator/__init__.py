@@ -19,6 +19,8 @@ divergence rule; see :mod:`.rk4` for what those are.
 
 from __future__ import annotations
 
+import functools
+
 from .rk4 import (
     DIVERGENCE_LIMIT,
     Controller,
@@ -41,8 +43,10 @@ ENGINES = ("numpy", "compiled", "auto")
 INSTALL_FAST = 'pip install "suspopt[fast]"'
 
 
+@functools.cache
 def compiled_available() -> bool:
-    """Whether numba can be imported (the compiled engine's one dependency)."""
+    """Whether numba can be imported (the compiled engine's one dependency); looked up once
+    per process, not at every simulation."""
     import importlib.util
 
     return importlib.util.find_spec("numba") is not None
