@@ -119,6 +119,10 @@ def full_network(model, attachments) -> Network:
     return network
 
 
+#: Directions per pass of :func:`_rk4_radius` (its grid takes 300 complex numbers each).
+_RADIUS_CHUNK = 20_000
+
+
 def _rk4_radius(direction: np.ndarray) -> np.ndarray:
     """For unit complex numbers ``direction`` in the closed left half-plane, the largest
     ``r`` with ``|R(r d)| <= 1`` on the whole segment from 0, ``R(z) = 1 + z + z^2/2 + z^3/6
@@ -129,6 +133,13 @@ def _rk4_radius(direction: np.ndarray) -> np.ndarray:
         z = r * direction
         return np.abs(1 + z * (1 + z * (1 / 2 + z * (1 / 6 + z / 24)))) > 1 + 1e-12
 
+    if direction.size > _RADIUS_CHUNK:  # the grid below is (300, size): bounded memory
+        return np.concatenate(
+            [
+                _rk4_radius(direction[i : i + _RADIUS_CHUNK])
+                for i in range(0, direction.size, _RADIUS_CHUNK)
+            ]
+        )
     grid = np.linspace(0.0, 3.0, 301)[1:, None]
     first = np.argmax(grows(grid), axis=0)  # the first radius that grows
     low, high = np.where(first > 0, grid[first - 1, 0], 0.0), grid[first, 0]

@@ -16,7 +16,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from conftest import CONFIGS
+from conftest import CONFIGS, run
 
 import suspopt
 import suspopt.cli  # noqa: F401  (imported before any timing)
@@ -793,3 +793,34 @@ def test_an_intact_file_passes_the_probe(tmp_path):
         h5.create_dataset("names", data=["a", "b"])
     with h5read.H5Reader(path) as h5:
         assert h5.text_attr("config") == "vehicle: {}"
+
+
+@pytest.mark.slow
+@pytest.mark.cli
+def test_a_million_swept_designs_is_bad_input_before_any_mode_is_computed(tmp_path):
+    """The memory check comes before the stability check's eigenvalues (once 36 GB)."""
+    out = tmp_path / "huge.h5"
+    proc = run(
+        "simulate",
+        ROOT / "configs" / "quickstart.yaml",
+        "--sweep",
+        "vehicle.corners.F1.damper.c=500:3000:1000000",
+        "-o",
+        out,
+        "--max-memory",
+        "2G",
+    )
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+    assert proc.stderr.count("\n") == 1 and "1000000 designs" in proc.stderr
+    assert not out.exists()
+
+
+def test_the_stability_radius_in_chunks_is_the_radius_in_one_pass(monkeypatch):
+    import suspopt.checks as checks
+
+    rng = np.random.default_rng(3)
+    angle = rng.uniform(np.pi / 2, 3 * np.pi / 2, 1000)
+    direction = np.exp(1j * angle)
+    whole = checks._rk4_radius(direction)
+    monkeypatch.setattr(checks, "_RADIUS_CHUNK", 64)
+    np.testing.assert_array_equal(checks._rk4_radius(direction), whole)

@@ -191,6 +191,13 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
     cfg, params, picked = _inputs(source, pick, sets, sweeps, zipped)
     check_config(cfg, optimisation=False)
     pv, model, controller, attachments = prepare(cfg, params)
+    written = (
+        cfg.output.signals
+        if cfg.output.signals != "all"
+        else signal_names(model, getattr(controller, "units", {}), attachments)
+    )
+    # the memory first: a batch too large to run is said so before its modes are computed
+    check_memory(cfg, model, attachments, pv.P, signals=len(written) + len(cfg.metrics))
     if params:
         check_stability(
             cfg,
@@ -199,12 +206,6 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
             attachments,
             what=" for a picked design" if picked else " for a swept design",
         )
-    written = (
-        cfg.output.signals
-        if cfg.output.signals != "all"
-        else signal_names(model, getattr(controller, "units", {}), attachments)
-    )
-    check_memory(cfg, model, attachments, pv.P, signals=len(written) + len(cfg.metrics))
     if base.VERBOSE[0]:
         from ..memory import describe
         from ..simulate import run_memory
