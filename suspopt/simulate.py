@@ -20,7 +20,7 @@ from . import memory
 from .checks import check_steps, full_network
 from .config import Config
 from .control.controller import build_controller
-from .integrator import DIVERGENCE_LIMIT, Controller, Edges, Run, integrate
+from .integrator import DIVERGENCE_LIMIT, Controller, Edges, Held, Run, Trajectory, integrate
 from .network import Assembled
 from .params import ParamView
 from .result import Attachment, Result, SignalMap, signal_names, signal_table
@@ -151,6 +151,47 @@ def _run(
     controller: Controller | None,
     attachments: Sequence[Attachment],
 ) -> Result:
+    """The integration and its :class:`Result`; a batch of several designs goes to the
+    executor in force (:mod:`suspopt.execution`) in chunks when that is not ``local``."""
+    from . import execution
+
+    sim = cfg.simulation
+    run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments)
+    if pv.P > 1 and pv.params and not execution.is_local(cfg.execution):
+        rows = execution.chunks(pv.P, execution.chunk_width(cfg.execution))
+        designs = [{k: np.asarray(v)[r] for k, v in pv.params.items()} for r in rows]
+        traj = _joined(execution.map_chunks(_chunk_trajectory, cfg, designs, cfg.execution))
+    else:
+        traj = integrate(run, sim.engine)
+    out_idx = np.arange(0, 2 * sim.n_steps + 1, 2 * sim.output_every)
+    return Result(
+        config=cfg,
+        model=model,
+        time=t_grid[out_idx],
+        states=traj.states,
+        accelerations=traj.accelerations,
+        road=z[:, None, out_idx],
+        road_vel=zd[:, None, out_idx],
+        diverged_at=traj.diverged_at,
+        designs=dict(pv.params),
+        _assembled=run.asm,
+        attachments=tuple(attachments),
+        held_damping=traj.damping,
+        controller_records=traj.records,
+        controller_units=dict(getattr(controller, "units", {})),
+        engine=traj.engine,
+    )
+
+
+def _setup(
+    cfg: Config,
+    pv: ParamView,
+    model: VehicleModel,
+    controller: Controller | None,
+    attachments: Sequence[Attachment],
+) -> tuple[Run, np.ndarray, np.ndarray, np.ndarray]:
+    """The integrator's :class:`~suspopt.integrator.Run` of the designs, the road's inputs
+    ``z, zd`` on the half-step grid and that grid [s]."""
     sim = cfg.simulation
     n_steps, every = sim.n_steps, sim.output_every
     t_grid = np.arange(2 * n_steps + 1) * (0.5 * sim.dt)
@@ -175,22 +216,42 @@ def _run(
         )
         edges = Edges(times, jumps.T, inputs, no_pull)
     run = Run(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller, edges)
-    traj = integrate(run, sim.engine)
-    out_idx = np.arange(0, 2 * n_steps + 1, 2 * every)
-    return Result(
-        config=cfg,
-        model=model,
-        time=t_grid[out_idx],
-        states=traj.states,
-        accelerations=traj.accelerations,
-        road=z[:, None, out_idx],
-        road_vel=zd[:, None, out_idx],
-        diverged_at=traj.diverged_at,
-        designs=dict(pv.params),
-        _assembled=asm,
-        attachments=tuple(attachments),
-        held_damping=traj.damping,
-        controller_records=traj.records,
-        controller_units=dict(getattr(controller, "units", {})),
-        engine=traj.engine,
+    return run, z, zd, t_grid
+
+
+def _chunk_trajectory(cfg: Config, params: dict[str, np.ndarray]) -> Trajectory:
+    """In a worker: the trajectory of one chunk of designs, every held quantity made (so that
+    it travels as arrays)."""
+    pv, model, controller, attachments = prepare(cfg, params)
+    run, _, _, _ = _setup(cfg, pv, model, controller, attachments)
+    traj = integrate(run, cfg.simulation.engine)
+    damping = traj.damping
+    if isinstance(damping, Held):
+        damping = Held(damping.values, damping.index)
+    records = {name: Held(h.values, h.index) for name, h in traj.records.items()}
+    return Trajectory(
+        traj.states, traj.accelerations, damping, records, traj.diverged_at, traj.engine
+    )
+
+
+def _joined(parts: list[Trajectory]) -> Trajectory:
+    """The chunks' trajectories as one, designs in order (a held quantity changes at the same
+    samples in every design: the controller's instants)."""
+
+    def held(pieces: list[Held]) -> Held:
+        return Held(np.concatenate([h.values for h in pieces], axis=1), pieces[0].index)
+
+    first = parts[0]
+    damping: Held | np.ndarray | None = None
+    if isinstance(first.damping, Held):
+        damping = held([p.damping for p in parts])  # type: ignore[misc]
+    elif first.damping is not None:
+        damping = np.concatenate([p.damping for p in parts], axis=1)  # type: ignore[misc]
+    return Trajectory(
+        states=np.concatenate([p.states for p in parts], axis=1),
+        accelerations=np.concatenate([p.accelerations for p in parts], axis=1),
+        damping=damping,
+        records={name: held([p.records[name] for p in parts]) for name in first.records},
+        diverged_at=np.concatenate([p.diverged_at for p in parts]),
+        engine=first.engine,
     )

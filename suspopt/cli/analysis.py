@@ -31,6 +31,26 @@ def _analysis_kinds(incomplete: str) -> list[str]:
     return [k for k in SUMMARIES if k.startswith(incomplete)]
 
 
+def _checked(kind: str, sources: list[Path], given: dict):
+    """The analysis of ``kind`` and the options given to it, checked as bad input."""
+    from ..analyse import analysis_kinds
+
+    kinds = analysis_kinds()
+    if kind not in kinds:
+        base.fail(f"analyse: unknown kind {kind!r}; available: {', '.join(sorted(kinds))}")
+    spec = kinds[kind]
+    if len(sources) > 1 and not spec.many:
+        base.fail(f"analyse {kind} takes one SOURCE, got {len(sources)}")
+    for source in sources:
+        if not source.exists():
+            base.fail(f"{source}: no such file")
+    options = {key: value for key, value in given.items() if value is not None}
+    wrong = [_ANALYSE_OPTIONS[key] for key in options if key not in spec.options]
+    if wrong:
+        base.fail(f"analyse {kind} does not take {', '.join(wrong)}")
+    return spec, options
+
+
 @app.command()
 def analyse(
     kind: str = typer.Argument(..., help=_analysis_help(), autocompletion=_analysis_kinds),
@@ -63,33 +83,23 @@ def analyse(
     ),
     force: bool = base.force_option(),
     max_memory: str | None = base.max_memory_option(),
+    executor: str | None = base.executor_option(),
+    scheduler: str | None = base.scheduler_option(),
+    workers: int | None = base.workers_option(),
 ) -> None:
     """Run an analysis of configs or of a Pareto file and print its table: models, roads,
     masses, controllers, transmissibility or cdf-sensitivity (see KIND below)."""
-    from ..analyse import analysis_kinds
     from ..plots import check_path
 
-    kinds = analysis_kinds()
-    if kind not in kinds:
-        base.fail(f"analyse: unknown kind {kind!r}; available: {', '.join(sorted(kinds))}")
-    spec = kinds[kind]
-    if len(sources) > 1 and not spec.many:
-        base.fail(f"analyse {kind} takes one SOURCE, got {len(sources)}")
-    for source in sources:
-        if not source.exists():
-            base.fail(f"{source}: no such file")
     given = {
         "reference": reference,
         "road": road or None,
         "with_": with_ or None,
         "mass_change": mass_change or None,
     }
-    options = {key: value for key, value in given.items() if value is not None}
-    wrong = [_ANALYSE_OPTIONS[key] for key in options if key not in spec.options]
-    if wrong:
-        base.fail(f"analyse {kind} does not take {', '.join(wrong)}")
+    spec, options = _checked(kind, sources, given)
     base.set_memory_limit(max_memory)
-    with ExitStack() as stack:
+    with ExitStack() as stack, base.executing(executor, scheduler, workers):
         try:
             if plot is not None:
                 check_path(plot)

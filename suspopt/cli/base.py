@@ -7,7 +7,8 @@ import functools
 import os
 import shlex
 import sys
-from contextlib import ExitStack
+from collections.abc import Iterator
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -123,6 +124,76 @@ def plot_option(what: str):
 def max_memory_option():
     """``--max-memory SIZE``: the most memory a run may take."""
     return typer.Option(None, "--max-memory", help=MEMORY_HELP)
+
+
+EXECUTOR_HELP = (
+    "where designs are simulated: local (this process), processes (a local pool) or dask; "
+    "wins over the config's execution: section"
+)
+
+
+def executor_option():
+    """``--executor``: where designs are simulated (:mod:`suspopt.execution`)."""
+    return typer.Option(None, "--executor", help=EXECUTOR_HELP)
+
+
+def scheduler_option():
+    """``--scheduler``: the address of a running Dask scheduler."""
+    return typer.Option(
+        None, "--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786"
+    )
+
+
+def workers_option():
+    """``--workers``: the worker processes an executor starts."""
+    return typer.Option(
+        None,
+        "--workers",
+        help="worker processes that processes, or dask without --scheduler, starts "
+        "(default: the machine's cores)",
+    )
+
+
+@contextmanager
+def executing(
+    executor: str | None,
+    scheduler: str | None,
+    workers: int | None,
+    progress=None,
+    lost_hint: str = "",
+) -> Iterator[None]:
+    """The command's ``--executor``, ``--scheduler`` and ``--workers`` in force (checked as
+    bad input first) for the block; the executors it opens are stopped at its end. A lost
+    executor is an error (exit 1) that names it, followed by ``lost_hint``; one that never
+    answered is bad input."""
+    from .. import execution
+
+    if executor is not None and executor not in execution.EXECUTORS:
+        fail(f"--executor {executor}: choose one of {', '.join(execution.EXECUTORS)}")
+    if executor == "dask" and not execution.dask_available():
+        fail(f"--executor dask needs dask.distributed: {execution.INSTALL_DASK}")
+    if scheduler is not None and executor not in ("dask", None):
+        fail("--scheduler is the address of a Dask scheduler: give --executor dask")
+    if scheduler is not None and not scheduler.strip():
+        fail("--scheduler: give an address such as tcp://host:8786")
+    if workers is not None and not 1 <= workers <= execution.max_local_workers():
+        fail(
+            f"--workers {workers}: give a number of worker processes from 1 to "
+            f"{execution.max_local_workers()} (4 per core of this machine)"
+        )
+    if workers is not None and scheduler is not None:
+        fail("--workers starts local workers; a running --scheduler has its own")
+    if workers is not None and executor == "local":
+        fail("--workers needs --executor processes or dask")
+    executor = "dask" if scheduler is not None and executor is None else executor
+    with execution.use(executor, scheduler, workers, progress=progress):
+        try:
+            yield
+        except execution.SchedulerUnreachable as exc:
+            fail(str(exc))
+        except execution.ExecutionLost as exc:
+            err.print(f"error: {exc}{lost_hint}", soft_wrap=True)
+            raise typer.Exit(code=1) from None
 
 
 #: ``-v``: what each step did and how long it took, on stderr.

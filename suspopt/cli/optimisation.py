@@ -78,6 +78,9 @@ def optimise(
     ),
     force: bool = base.force_option(),
     max_memory: str | None = base.max_memory_option(),
+    executor: str | None = base.executor_option(),
+    scheduler: str | None = base.scheduler_option(),
+    workers: int | None = base.workers_option(),
 ) -> None:
     """Optimise the config's design variables; write the optimum or Pareto set to HDF5.
 
@@ -96,10 +99,16 @@ def optimise(
                 base.fail(str(exc))
         base.claim_output(stack, output, force)
         base.claim_output(stack, plot, force, "--plot")
-        _optimise(config, output, resume, plot)
+        _optimise(config, output, resume, plot, (executor, scheduler, workers))
 
 
-def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> None:
+def _optimise(
+    config: Path,
+    output: Path,
+    resume: bool,
+    plot: Path | None,
+    executing: tuple[str | None, str | None, int | None],
+) -> None:
     from rich.progress import BarColumn, Progress, TextColumn
 
     from ..checks import check_config
@@ -119,13 +128,23 @@ def _optimise(config: Path, output: Path, resume: bool, plot: Path | None) -> No
     )
     task = bar.add_task("starting", total=total)
 
+    line = ["starting"]
+
     def report(p) -> None:
-        bar.update(task, completed=p.generation, description=_progress_line(p))
+        line[0] = _progress_line(p)
+        bar.update(task, completed=p.generation, description=line[0])
         if not err.is_terminal and not out.quiet:
-            err.print(_progress_line(p))
+            err.print(line[0])
+
+    def chunk_done(done: int, total: int) -> None:  # chunks of an executor other than local
+        bar.update(task, description=f"{line[0]} (chunks {done}/{total})")
 
     try:
-        with bar:
+        lost = (
+            f"; {output} keeps the last generation's checkpoint: continue with suspopt "
+            f"optimise {config} -o {output} --resume (on any executor)"
+        )
+        with bar, base.executing(*executing, progress=chunk_done, lost_hint=lost):
             result = run(cfg, output, resume=resume, callback=report, command=base.command_line())
     except ConfigError as exc:
         base.fail(str(exc))

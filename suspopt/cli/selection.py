@@ -130,11 +130,14 @@ def kesort(
     ),
     force: bool = base.force_option(),
     max_memory: str | None = base.max_memory_option(),
+    executor: str | None = base.executor_option(),
+    scheduler: str | None = base.scheduler_option(),
+    workers: int | None = base.workers_option(),
 ) -> None:
     """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12); supplementary
     objectives are re-simulated in one batch."""
     base.set_memory_limit(max_memory)
-    with ExitStack() as stack:
+    with ExitStack() as stack, base.executing(executor, scheduler, workers):
         base.claim_output(stack, output, force)
         base.claim_output(stack, plot, force, "--plot")
         _kesort(

@@ -112,10 +112,13 @@ def simulate(
     ),
     force: bool = base.force_option(),
     max_memory: str | None = base.max_memory_option(),
+    executor: str | None = base.executor_option(),
+    scheduler: str | None = base.scheduler_option(),
+    workers: int | None = base.workers_option(),
 ) -> None:
     """Simulate a config (or designs picked from a result file) and write signals to HDF5."""
     base.set_memory_limit(max_memory)
-    with ExitStack() as stack:
+    with ExitStack() as stack, base.executing(executor, scheduler, workers):
         base.claim_output(stack, output, force)
         base.claim_output(stack, plot, force, "--plot")
         try:

@@ -22,7 +22,7 @@ from .metrics import MetricSpec
 from .optimise import Constraint, DesignVariable, Objectives, Optimiser
 from .road import RoadConfig
 from .seat import SeatConfig
-from .simulation import Output, Simulation
+from .simulation import Execution, Output, Simulation
 from .vehicle import Vehicle, corner_defaults_schema
 from .yamlio import YamlError, parse_yaml, read_text
 
@@ -78,6 +78,10 @@ class Config(Section):
     )
     optimiser: Optimiser | None = Field(
         None, description="algorithm, budget and seed of suspopt optimise"
+    )
+    execution: Execution = Field(
+        default_factory=Execution,
+        description="where populations are simulated: this process, local processes or Dask",
     )
 
     _source: Path | None = PrivateAttr(None)

@@ -6,9 +6,10 @@ from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
 
+from ..execution import DEFAULT_CHUNK
 from .base import Duration, Section, Step
 
-__all__ = ["Simulation", "Output"]
+__all__ = ["Simulation", "Output", "Execution"]
 
 
 class Simulation(Section):
@@ -82,4 +83,64 @@ class Output(Section):
     def _check(self) -> Output:
         if isinstance(self.signals, str) and self.signals != "all":
             raise ValueError("signals must be 'all' or a list of signal names")
+        return self
+
+
+class Execution(Section):
+    """Where a population is simulated (:mod:`suspopt.execution`): in this process, a local
+    pool of processes or a Dask cluster. Every executor gives the same bits; the command
+    line's ``--executor``, ``--scheduler`` and ``--workers`` win over this section."""
+
+    executor: Literal["local", "processes", "dask"] = Field(
+        "local",
+        description="local (this process), processes (a local pool of workers) or dask (a "
+        'Dask scheduler, or a local Dask cluster; pip install "suspopt[dask]")',
+    )
+    workers: int | None = Field(
+        None,
+        ge=1,
+        le=4096,
+        description="worker processes that processes, or dask without a scheduler, starts "
+        "(default: the machine's cores)",
+    )
+    scheduler: str | None = Field(
+        None,
+        min_length=1,
+        max_length=500,
+        description="address of a running Dask scheduler, e.g. tcp://host:8786 (dask only; "
+        "without it suspopt starts a local cluster)",
+    )
+    chunk: int = Field(
+        DEFAULT_CHUNK,
+        ge=1,
+        le=1_000_000,
+        description="designs per chunk sent to a worker: the same whatever the number of "
+        "workers, so every design meets the same arithmetic",
+    )
+
+    @field_validator("executor")
+    @classmethod
+    def _executor_installed(cls, executor: str) -> str:
+        if executor == "dask":
+            from ..execution import INSTALL_DASK, dask_available
+
+            if not dask_available():
+                raise ValueError(f"the dask executor needs dask.distributed: {INSTALL_DASK}")
+        return executor
+
+    @model_validator(mode="after")
+    def _check(self) -> Execution:
+        if self.scheduler is not None and self.executor != "dask":
+            raise ValueError("scheduler is the address of a Dask scheduler: set executor: dask")
+        if self.workers is not None and self.executor == "local":
+            raise ValueError("workers needs executor: processes or dask")
+        if self.workers is not None and self.scheduler is not None:
+            raise ValueError("workers are started without a scheduler; a running one has its own")
+        from ..execution import max_local_workers
+
+        if self.workers is not None and self.workers > max_local_workers():
+            raise ValueError(
+                f"workers ({self.workers}) is more than {max_local_workers()} (4 per core of "
+                f"this machine); use a Dask scheduler for more"
+            )
         return self

@@ -8,8 +8,8 @@ rounding (``simulation.engine``):
   run in one compiled call, the element network as sparse loops, designs in blocks of lanes
   the compiler vectorises, the blocks spread over the cores. It covers the networks whose
   non-linear parts have a compiled law (Duffing springs, tyre lift-off, the seats' exact and
-  Taylor mechanisms), with or without a semi-active controller (asked at its samples), but
-  without an actuator lag; any other run goes to the numpy engine, and
+  Taylor mechanisms), with or without a semi-active controller (asked at its samples, its
+  actuator lag applied in the kernel); any other run goes to the numpy engine, and
   :attr:`Trajectory.engine` says which one ran.
 - ``auto``: ``compiled`` when numba is installed, else ``numpy``.
 

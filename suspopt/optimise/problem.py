@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from pymoo.core.problem import Problem as _PymooProblem
 
+from .. import execution
 from ..config import Config, ConfigError
 from ..config.optimise import DesignVariable, Objective
 from ..control.controller import build_controller
@@ -197,10 +198,19 @@ class Problem(_PymooProblem):
         return self._width
 
     def _evaluate(self, X, out, *args, **kwargs):
-        width = self.batch_width() if self._simulates else max(len(X), 1)
-        parts = [
-            self._evaluate_batch(X[i : i + width], "S" in out) for i in range(0, len(X), width)
-        ]
+        supplementary = "S" in out
+        if not self._simulates:
+            parts = [self._evaluate_batch(X, supplementary)] if len(X) else []
+        elif execution.is_local(self.cfg.execution):
+            width = self.batch_width()
+            parts = [
+                self._evaluate_batch(X[i : i + width], supplementary)
+                for i in range(0, len(X), width)
+            ]
+        else:  # chunks of a fixed width on the executor in force (suspopt.execution)
+            width = min(execution.chunk_width(self.cfg.execution), self.batch_width())
+            rows = [(X[s], supplementary) for s in execution.chunks(len(X), width)]
+            parts = execution.map_chunks(_chunk_values, self, rows, self.cfg.execution)
         for j, key in enumerate(("F", "G", "S")):
             if key in out or key != "S":
                 out[key] = (
@@ -249,6 +259,11 @@ class Problem(_PymooProblem):
                 if term.spec.max is not None:
                     columns.append(values[:, j] - term.spec.max)
         return np.column_stack(columns) if columns else np.empty((P, 0))
+
+
+def _chunk_values(problem: Problem, rows: tuple[np.ndarray, bool]):
+    """In a worker: ``(F, G, S)`` of one chunk of designs (:mod:`suspopt.execution`)."""
+    return problem._evaluate_batch(*rows)
 
 
 def _stack(terms: Sequence[_Term], cfg: Config, result, params, P: int) -> np.ndarray:

@@ -1,0 +1,238 @@
+"""The executors of suspopt.execution: a population evaluated in chunks on local processes or a
+Dask cluster (a distributed.LocalCluster of 2 worker processes, started and stopped here)
+gives the same bits as in this process, survives a killed worker, and says so when the
+scheduler is lost or the extra is missing."""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+
+import h5py
+import numpy as np
+import pytest
+from conftest import CONFIGS, TINY, write
+
+import suspopt
+from suspopt import execution
+from suspopt._entry import main
+from suspopt.optimise import optimise
+
+pytestmark = pytest.mark.slow
+distributed = pytest.importorskip("distributed")
+
+#: A chunk width that splits the tiny populations into several chunks.
+CHUNK = 3
+
+
+def cli(capsys, *args) -> tuple[int, str, str]:
+    code = main([str(a) for a in args])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as c:
+        yield c
+
+
+def _pareto(path):
+    with h5py.File(path) as h5:
+        return {k: h5[f"pareto/{k}"][()] for k in ("X", "F", "G")}
+
+
+def _optimised(tmp_path, name, text=TINY, **use):
+    config = write(tmp_path, text, f"{name}.yaml")
+    out = tmp_path / f"{name}.h5"
+    with execution.use(**use):
+        optimise(suspopt.load_config(config), out)
+    return _pareto(out)
+
+
+def _same(a: dict, b: dict) -> None:
+    for key in a:
+        np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+
+
+def test_nsga2_on_dask_and_on_processes_gives_the_local_pareto_set(tmp_path, cluster):
+    local = _optimised(tmp_path, "local")
+    on_dask = _optimised(
+        tmp_path, "dask", executor="dask", scheduler=cluster.scheduler_address, chunk=CHUNK
+    )
+    _same(local, on_dask)
+    on_processes = _optimised(tmp_path, "processes", executor="processes", workers=2, chunk=CHUNK)
+    _same(local, on_processes)
+
+
+METRICS = """\
+metrics:
+  - {metric: var, signal: body.heave_acc}
+  - {metric: rms_weighted, signal: body.heave_acc, weighting: Wk}
+  - {metric: max_abs, signal: travel}
+"""
+
+
+def test_a_batch_simulate_gives_the_same_metric_bits_on_dask(tmp_path, cluster, capsys):
+    text = (CONFIGS / "quickstart.yaml").read_text() + METRICS + f"execution: {{chunk: {CHUNK}}}\n"
+    path = write(tmp_path, text)
+    sweep = ("--sweep", "vehicle.corners.F1.damper.c=1000:6000:7")
+    outputs = {}
+    for name, extra in (("local", ()), ("dask", ("--scheduler", cluster.scheduler_address))):
+        out = tmp_path / f"{name}.h5"
+        code, _, err = cli(capsys, "simulate", path, *sweep, "-o", out, *extra)
+        assert code == 0, err
+        with h5py.File(out) as h5:
+            outputs[name] = {
+                f"{group}/{k}": h5[group][k][()]
+                for group in ("metrics", "signals")
+                for k in h5[group]
+            }
+    assert outputs["local"].keys() == outputs["dask"].keys() and len(outputs["local"]) > 20
+    _same(outputs["local"], outputs["dask"])
+
+
+def _kill_a_busy_worker(client, pids: dict, done: list) -> None:
+    """Kill (SIGKILL) the first worker seen processing a chunk."""
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not done:
+        busy = [w for w, tasks in client.processing().items() if tasks]
+        if busy:
+            os.kill(pids[busy[0]], signal.SIGKILL)
+            done.append(busy[0])
+            return
+        time.sleep(0.005)
+
+
+def test_a_worker_killed_during_a_generation_does_not_change_the_result(tmp_path, cluster):
+    local = _optimised(tmp_path, "local")
+    client = distributed.Client(cluster)
+    pids = client.run(os.getpid)
+    killed: list = []
+    killer = threading.Thread(target=_kill_a_busy_worker, args=(client, pids, killed))
+    killer.start()
+    try:
+        survived = _optimised(
+            tmp_path, "killed", executor="dask", scheduler=cluster.scheduler_address, chunk=1
+        )
+    finally:
+        killed.append("stop")
+        killer.join()
+        client.close()
+    assert killed[0] != "stop", "no worker was seen busy: the test killed nothing"
+    _same(local, survived)
+
+
+def test_a_killed_process_worker_has_its_chunks_run_again(tmp_path):
+    cfg = suspopt.load_config(write(tmp_path, TINY))
+    problem = suspopt.Problem.from_config(cfg)
+    X = problem.xl + np.random.default_rng(3).random((12, problem.n_var)) * (
+        problem.xu - problem.xl
+    )
+    whole = problem.evaluate(X, return_values_of=["F", "G"])
+    executor = execution.ProcessExecutor(workers=2)
+    try:
+        executor.map(_pid, None, [0])  # the pool is up
+        victim = next(iter(executor._pool._processes))
+        os.kill(victim, signal.SIGKILL)
+        time.sleep(0.2)
+        parts = executor.map(_chunk, problem, [X[s] for s in execution.chunks(len(X), CHUNK)])
+    finally:
+        executor.close()
+    np.testing.assert_array_equal(np.concatenate([p[0] for p in parts]), whole[0])
+    np.testing.assert_array_equal(np.concatenate([p[1] for p in parts]), whole[1])
+
+
+def _pid(shared, item):
+    return os.getpid()
+
+
+def _chunk(problem, X):
+    return problem._evaluate_batch(X, False)
+
+
+def test_a_lost_scheduler_keeps_the_checkpoint_and_resume_continues_locally(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.setattr(execution, "CONNECT_TIMEOUT", 2)
+    config = write(tmp_path, TINY.replace("generations: 4", "generations: 6"))
+    complete = tmp_path / "complete.h5"
+    code, _, err = cli(capsys, "optimise", config, "-o", complete)
+    assert code == 0, err
+    out = tmp_path / "lost.h5"
+    cluster = distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+    )
+    address = cluster.scheduler_address
+    real = execution.DaskExecutor.map
+    calls = []
+
+    def map_then_lose(self, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == 3:  # after two generations: the scheduler goes away
+            cluster.close()
+        return real(self, *args, **kwargs)
+
+    execution.DaskExecutor.map = map_then_lose
+    try:
+        code, _, err = cli(capsys, "optimise", config, "-o", out, "--scheduler", address)
+    finally:
+        execution.DaskExecutor.map = real
+        cluster.close()
+    assert code == 1, err
+    errors = [line for line in err.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and "Traceback" not in err, err
+    assert "lost the Dask scheduler" in errors[0] and "--resume" in errors[0]
+    with h5py.File(out) as h5:
+        assert h5.attrs["status"] == "running" and h5.attrs["generations"] == 2
+    code, _, err = cli(capsys, "optimise", config, "-o", out, "--resume")
+    assert code == 0, err
+    _same(_pareto(complete), _pareto(out))
+
+
+def test_the_dask_executor_without_its_extra_is_bad_input(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(execution, "dask_available", lambda: False)
+    code, _, err = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "--executor", "dask")
+    assert code == 2 and 'pip install "suspopt[dask]"' in err and len(err.splitlines()) == 1
+    config = write(
+        tmp_path, (CONFIGS / "quickstart.yaml").read_text() + "execution: {executor: dask}\n"
+    )
+    code, _, err = cli(capsys, "validate", config)
+    assert code == 2 and 'pip install "suspopt[dask]"' in err and "execution.executor" in err
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (("--executor", "cluster"), "choose one of local, processes, dask"),
+        (("--executor", "processes", "--workers", "0"), "4 per core"),
+        (("--executor", "local", "--workers", "2"), "needs --executor processes or dask"),
+        (("--executor", "processes", "--scheduler", "tcp://h:1"), "give --executor dask"),
+    ],
+)
+def test_bad_executor_options_exit_2_with_one_line(capsys, args, needle):
+    code, _, err = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", *args)
+    assert code == 2 and needle in err and len(err.splitlines()) == 1, err
+
+
+@pytest.mark.parametrize(
+    "section, needle",
+    [
+        ("{executor: local, workers: 2}", "workers needs executor"),
+        ("{scheduler: tcp://h:1}", "set executor: dask"),
+        ("{executor: processes, chunk: 0}", "execution.chunk"),
+        ("{executor: processes, workers: 1000}", "4 per core"),
+        ("{executor: dask, workers: 2, scheduler: tcp://h:1}", "a running one has its own"),
+        ("{executor: processes, chunk: 1.0e9}", "execution.chunk"),
+        ("5", "execution"),
+        ("{executor: [dask]}", "execution.executor"),
+    ],
+)
+def test_a_bad_execution_section_is_bad_input(tmp_path, capsys, section, needle):
+    config = write(tmp_path, (CONFIGS / "quickstart.yaml").read_text() + f"execution: {section}\n")
+    code, _, err = cli(capsys, "validate", config)
+    assert code == 2 and needle in err and len(err.splitlines()) == 1, err
