@@ -86,7 +86,7 @@ class ExecutionLost(RuntimeError):
 
 
 class SchedulerUnreachable(ExecutionLost):
-    """No Dask scheduler answered at the address given (bad input)."""
+    """No Dask scheduler answered at the address given."""
 
 
 def dask_available() -> bool:
@@ -140,7 +140,7 @@ def _in_worker(function: Callable[[Any, Any], Any], shared: Any, item: Any) -> A
     """``function(shared, item)`` in a worker process, which first makes the allocator reuse
     freed memory as the command line does (:func:`suspopt.reuse_memory`: without it a worker
     ran the Ch. 6 Part B chunks about 1.5 times slower)."""
-    if not _READY:
+    if not _READY:  # this process is a worker: what it simulates stays in it (settings)
         from .memory import reuse_memory
 
         reuse_memory()
@@ -344,11 +344,13 @@ def use(
 
 def settings(execution=None) -> dict[str, Any]:
     """The settings in force for a config's ``execution`` section (or None): the section's,
-    then the command line's (:func:`use`)."""
+    then the command line's (:func:`use`); in a worker process always ``local``."""
     found = {"executor": "local", "scheduler": None, "workers": None, "chunk": DEFAULT_CHUNK}
     if execution is not None:
         found.update({k: getattr(execution, k) for k in found})
     found.update(_OVERRIDES)
+    if _READY:  # a worker never hands its chunk on
+        found.update(executor="local", scheduler=None, workers=None)
     return found
 
 

@@ -77,6 +77,18 @@ metrics:
 """
 
 
+def test_an_execution_section_runs_its_chunks_in_the_workers_only(tmp_path, capsys):
+    """With ``execution: {executor: processes}`` in the config, the workers simulate their
+    chunks themselves (they never hand them on) and the front is the local one."""
+    local = write(tmp_path, TINY, "local.yaml")
+    section = f"execution: {{executor: processes, workers: 2, chunk: {CHUNK}}}\n"
+    pooled = write(tmp_path, TINY + section, "pooled.yaml")
+    for path in (local, pooled):
+        code, _, err = cli(capsys, "optimise", path, "-o", path.with_suffix(".h5"))
+        assert code == 0, err
+    _same(_pareto(local.with_suffix(".h5")), _pareto(pooled.with_suffix(".h5")))
+
+
 def test_a_batch_simulate_gives_the_same_metric_bits_on_dask(tmp_path, cluster, capsys):
     text = (CONFIGS / "quickstart.yaml").read_text() + METRICS + f"execution: {{chunk: {CHUNK}}}\n"
     path = write(tmp_path, text)

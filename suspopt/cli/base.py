@@ -164,8 +164,9 @@ def executing(
 ) -> Iterator[None]:
     """The command's ``--executor``, ``--scheduler`` and ``--workers`` in force (checked as
     bad input first) for the block; the executors it opens are stopped at its end. A lost
-    executor is an error (exit 1) that names it, followed by ``lost_hint``; one that never
-    answered is bad input."""
+    executor is an error (exit 1) that names it, followed by ``lost_hint``; so is a scheduler
+    that never answered (what ``validate`` accepts stays accepted: an address is checked, not
+    whether a server listens there)."""
     from .. import execution
 
     if executor is not None and executor not in execution.EXECUTORS:
@@ -189,8 +190,9 @@ def executing(
     with execution.use(executor, scheduler, workers, progress=progress):
         try:
             yield
-        except execution.SchedulerUnreachable as exc:
-            fail(str(exc))
+        except execution.SchedulerUnreachable as exc:  # the machine's state, not the input's
+            err.print(f"error: {exc}", soft_wrap=True)
+            raise typer.Exit(code=1) from None
         except execution.ExecutionLost as exc:
             err.print(f"error: {exc}{lost_hint}", soft_wrap=True)
             raise typer.Exit(code=1) from None
