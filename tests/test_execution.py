@@ -139,7 +139,7 @@ def test_a_worker_killed_during_a_generation_does_not_change_the_result(tmp_path
     _same(local, survived)
 
 
-def test_a_killed_process_worker_has_its_chunks_run_again(tmp_path):
+def test_process_workers_rerun_a_killed_workers_chunks_and_never_hand_one_on(tmp_path):
     cfg = suspopt.load_config(write(tmp_path, TINY))
     problem = suspopt.Problem.from_config(cfg)
     X = problem.xl + np.random.default_rng(3).random((12, problem.n_var)) * (
@@ -153,10 +153,17 @@ def test_a_killed_process_worker_has_its_chunks_run_again(tmp_path):
         os.kill(victim, signal.SIGKILL)
         time.sleep(0.2)
         parts = executor.map(_chunk, problem, [X[s] for s in execution.chunks(len(X), CHUNK)])
+        # in a worker, a config's own section never hands a chunk on
+        section = suspopt.load_config(write(tmp_path, TINY + "execution: {executor: processes}\n"))
+        assert executor.map(_executor_in_worker, section.execution, [0]) == ["local"]
     finally:
         executor.close()
     np.testing.assert_array_equal(np.concatenate([p[0] for p in parts]), whole[0])
     np.testing.assert_array_equal(np.concatenate([p[1] for p in parts]), whole[1])
+
+
+def _executor_in_worker(section, item):
+    return execution.settings(section)["executor"]
 
 
 def _pid(shared, item):
