@@ -17,8 +17,8 @@ Executors (``execution.executor``, or ``--executor`` on the command line, which 
   batches its memory allows), as without this module;
 - ``processes``: a pool of ``workers`` local processes (default: the machine's cores),
   started with ``spawn`` (the parent may hold BLAS or numba threads, which ``fork`` does not
-  copy safely); the shared object is written once to a private temporary file that each
-  worker reads once; a worker that dies has its chunks run again in a new pool;
+  copy safely); the shared object goes to each worker once, as its pool's start-up argument;
+  a worker that dies has its chunks run again in a new pool;
 - ``dask``: a running Dask scheduler at ``scheduler`` (``tcp://host:8786``), or without one a
   ``distributed.LocalCluster`` of ``workers`` single-threaded processes that suspopt starts
   and stops. The shared object is scattered to every worker once (``broadcast``); a chunk's
@@ -36,9 +36,6 @@ from __future__ import annotations
 import atexit
 import contextlib
 import os
-import pickle
-import tempfile
-import uuid
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
@@ -101,7 +98,6 @@ class Executor:
     ``local`` one in this process."""
 
     name = "local"
-    workers = 1
 
     def map(
         self,
@@ -123,14 +119,16 @@ class Executor:
 
 # --- processes ---------------------------------------------------------------------------------
 
-_WORKER_SHARED: dict[str, Any] = {}
+#: In a ``processes`` worker: the shared object its pool was started with.
+_WORKER_SHARED: list[Any] = []
 
 
-def _one_thread() -> None:
+def _start_worker(shared: Any) -> None:
     """A ``processes`` worker's set-up: one thread for BLAS and numba (the workers are the
-    parallelism)."""
+    parallelism) and the shared object, handed over once by the pool."""
     for name in _ONE_THREAD:
         os.environ[name] = "1"
+    _WORKER_SHARED[:] = [shared]
 
 
 _READY: list[bool] = []
@@ -148,65 +146,56 @@ def _in_worker(function: Callable[[Any, Any], Any], shared: Any, item: Any) -> A
     return function(shared, item)
 
 
-def _call_shared(path: str, function: Callable[[Any, Any], Any], item: Any) -> Any:
-    """In a worker: ``function(shared, item)``, the shared object read from ``path`` once per
-    worker (a file this run wrote)."""
-    if path not in _WORKER_SHARED:
-        _WORKER_SHARED.clear()
-        with open(path, "rb") as f:
-            _WORKER_SHARED[path] = pickle.load(f)
-    return _in_worker(function, _WORKER_SHARED[path], item)
+def _call_shared(function: Callable[[Any, Any], Any], item: Any) -> Any:
+    """In a ``processes`` worker: ``function(shared, item)`` with its pool's shared object."""
+    return _in_worker(function, _WORKER_SHARED[0], item)
 
 
 class ProcessExecutor(Executor):
-    """A pool of local worker processes (module docstring)."""
+    """A pool of local worker processes (module docstring). The shared object goes to each
+    worker once, as the argument of the pool's initializer (multiprocessing's own pipe, no
+    file); a call with another shared object starts a new pool."""
 
     name = "processes"
 
     def __init__(self, workers: int | None = None):
         self.workers = workers or os.cpu_count() or 1
         self._pool: Any = None  # a concurrent.futures.ProcessPoolExecutor once started
-        self._dir = tempfile.mkdtemp(prefix="suspopt-shared-")
-        self._shared: tuple[Any, str] | None = None
+        self._shared: Any = None  # the object the pool's workers hold
 
-    def _new_pool(self):
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
+    def _pool_for(self, shared: Any):
+        if self._pool is not None and self._shared is not shared:
+            self.close()
+        if self._pool is None:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
 
-        return ProcessPoolExecutor(
-            self.workers, mp_context=multiprocessing.get_context("spawn"), initializer=_one_thread
-        )
-
-    def _path(self, shared: Any) -> str:
-        if self._shared is None or self._shared[0] is not shared:
-            path = os.path.join(self._dir, f"{uuid.uuid4().hex}.pickle")
-            with open(path, "wb") as f:
-                pickle.dump(shared, f, protocol=pickle.HIGHEST_PROTOCOL)
-            self._shared = (shared, path)
-        return self._shared[1]
+            self._pool = ProcessPoolExecutor(
+                self.workers,
+                mp_context=multiprocessing.get_context("spawn"),
+                initializer=_start_worker,
+                initargs=(shared,),
+            )
+            self._shared = shared
+        return self._pool
 
     def map(self, function, shared, items, progress=None):
         from concurrent.futures import as_completed
         from concurrent.futures.process import BrokenProcessPool
 
-        path = self._path(shared)
         results: dict[int, Any] = {}
         for _ in range(_POOL_RESTARTS + 1):
-            if self._pool is None:
-                self._pool = self._new_pool()
             todo = [i for i in range(len(items)) if i not in results]
             try:
-                futures = {
-                    self._pool.submit(_call_shared, path, function, items[i]): i for i in todo
-                }
+                pool = self._pool_for(shared)
+                futures = {pool.submit(_call_shared, function, items[i]): i for i in todo}
                 for future in as_completed(futures):
                     results[futures[future]] = future.result()
                     if progress is not None:
                         progress(len(results), len(items))
                 return [results[i] for i in range(len(items))]
             except BrokenProcessPool:  # a worker died: its chunks again, in a new pool
-                self._pool.shutdown(cancel_futures=True)
-                self._pool = None
+                self.close()
         raise ExecutionLost(
             f"the processes executor lost a worker {_POOL_RESTARTS + 1} times in one "
             f"evaluation (out of memory?)"
@@ -215,10 +204,7 @@ class ProcessExecutor(Executor):
     def close(self) -> None:
         if self._pool is not None:
             self._pool.shutdown(cancel_futures=True)
-            self._pool = None
-        import shutil
-
-        shutil.rmtree(self._dir, ignore_errors=True)
+            self._pool, self._shared = None, None
 
 
 # --- dask --------------------------------------------------------------------------------------
@@ -245,7 +231,6 @@ class DaskExecutor(Executor):
             self.client = Client(self._cluster)
         else:
             self.client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT}s")
-        self.workers = len(self.client.scheduler_info().get("workers", {})) or (workers or 1)
         self._shared: tuple[Any, Any] | None = None
 
     @property
@@ -259,10 +244,14 @@ class DaskExecutor(Executor):
         return self._shared[1]
 
     def map(self, function, shared, items, progress=None):
+        import uuid
+        from concurrent.futures import CancelledError
+
         from distributed import as_completed
         from distributed.comm import CommClosedError
 
-        lost = (CommClosedError, OSError, TimeoutError)
+        # the scheduler went away: its connection closed, or the futures cancelled with it
+        lost = (CommClosedError, OSError, TimeoutError, CancelledError)
         try:
             scattered = self._scattered(shared)
             token = uuid.uuid4().hex
@@ -283,10 +272,6 @@ class DaskExecutor(Executor):
             return [results[i] for i in range(len(items))]
         except lost as exc:
             raise ExecutionLost(f"lost the Dask scheduler {self.address}: {exc}") from None
-        except Exception as exc:  # a cancelled future: the scheduler went away
-            if type(exc).__name__ in ("CancelledError", "FutureCancelledError"):
-                raise ExecutionLost(f"lost the Dask scheduler {self.address}: {exc}") from None
-            raise
 
     def close(self) -> None:
         with contextlib.suppress(Exception):

@@ -148,7 +148,7 @@ def test_process_workers_rerun_a_killed_workers_chunks_and_never_hand_one_on(tmp
     whole = problem.evaluate(X, return_values_of=["F", "G"])
     executor = execution.ProcessExecutor(workers=2)
     try:
-        executor.map(_pid, None, [0])  # the pool is up
+        executor.map(_chunk, problem, [X[:1]])  # the pool is up, holding the problem
         victim = next(iter(executor._pool._processes))
         os.kill(victim, signal.SIGKILL)
         time.sleep(0.2)
@@ -164,10 +164,6 @@ def test_process_workers_rerun_a_killed_workers_chunks_and_never_hand_one_on(tmp
 
 def _executor_in_worker(section, item):
     return execution.settings(section)["executor"]
-
-
-def _pid(shared, item):
-    return os.getpid()
 
 
 def _chunk(problem, X):
