@@ -1,7 +1,9 @@
 """Designs simulated per second for the Chapter 5 HC2 problem, at P = 1, 100, 1000 and 10000,
 on the numpy engine and (when numba is installed) the compiled engine, in the same run, with
 the peak memory of each call (tracemalloc: numpy's arrays included) and the agreement of the
-two engines' body accelerations.
+two engines' body accelerations; then the same sizes for objectives and constraints only
+(``Problem.evaluate`` of configs/ch5/case1_s1.yaml, which keeps no (P, T) signal it does not
+need: :mod:`suspopt.streaming`).
 
 Table 5.1 half car with Duffing springs, half-sine bump 0.05 m (base 1 m) at 40 km/h, 3 s at
 dt = 1 ms (configs/quickstart.yaml); designs drawn uniformly inside the Table 5.2 bounds (with
@@ -117,6 +119,7 @@ def main() -> None:
             )
             if engine == "compiled":
                 best_rate = max(best_rate, P / wall)
+    objectives_only(sizes, engines, rng)
     if "compiled" in engines:
         flops, machine = flops_per_design_step(cfg), peak_flops()
         achieved = best_rate * cfg.simulation.n_steps * flops
@@ -126,6 +129,39 @@ def main() -> None:
             f"{achieved / 1e9:.2f} Gflop/s, {100 * achieved / machine[0]:.1f} % of the peak "
             f"({machine[1]} flops/cycle = {machine[0] / 1e9:.0f} Gflop/s)"
         )
+
+
+def objectives_only(sizes, engines, rng) -> None:
+    """The same sizes for what an optimisation asks: the objectives and constraints of the
+    Ch. 5 Case 1 problem (configs/ch5/case1_s1.yaml, 3 s at dt = 2 ms) by
+    ``Problem.evaluate``, which keeps no (P, T) signal but the one its Wk constraint weights
+    (:mod:`suspopt.streaming`) and runs batches of at most ``MAX_BATCH`` designs; best of
+    two calls, peak memory of a third."""
+    import tracemalloc
+
+    from suspopt.optimise.problem import MAX_BATCH
+
+    base = suspopt.load_config(CONFIG.parent / "ch5" / "case1_s1.yaml")
+    print(
+        f"objectives and constraints only: Problem.evaluate, Ch. 5 Case 1 (batches <= {MAX_BATCH})"
+    )
+    print(f"{'P':>6} {'engine':>9} {'wall [s]':>9} {'us/design':>10} {'peak [MB]':>10}")
+    for P in sizes:
+        for engine in engines:
+            cfg = base.model_copy(deep=True)
+            cfg.simulation.engine = engine
+            problem = suspopt.Problem.from_config(cfg)
+            X = rng.uniform(problem.xl, problem.xu, (P, problem.n_var))
+            wall = np.inf
+            for _ in range(2):
+                start = time.perf_counter()
+                problem.evaluate(X)
+                wall = min(wall, time.perf_counter() - start)
+            tracemalloc.start()
+            problem.evaluate(X)
+            peak = tracemalloc.get_traced_memory()[1]
+            tracemalloc.stop()
+            print(f"{P:>6} {engine:>9} {wall:>9.3f} {wall / P * 1e6:>10.1f} {peak / 1e6:>10.1f}")
 
 
 def flops_per_design_step(cfg) -> int:

@@ -242,6 +242,12 @@ class Result:
         """SI unit of a signal of this result."""
         return self._table[name].unit
 
+    def metric(self, spec, name: str) -> np.ndarray:
+        """The (P,) values of metric spec ``spec`` on signal ``name`` (:mod:`suspopt.specs`)."""
+        from .specs import METRICS
+
+        return METRICS[spec.metric].compute(spec, self, name)
+
     @property
     def P(self) -> int:
         return self.states.shape[1]

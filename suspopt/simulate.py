@@ -104,14 +104,22 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:
 
 
 def run_memory(
-    cfg: Config, model: VehicleModel, attachments: Sequence[Attachment], P: int, signals: int = 0
+    cfg: Config,
+    model: VehicleModel,
+    attachments: Sequence[Attachment],
+    P: int,
+    signals: int = 0,
+    window: int | None = None,
+    kept: int = 0,
 ) -> tuple[float, float]:
     """Peak bytes of a run of P designs, ``(shared, per_design)``: what does not grow with P
     (the road's inputs on the half-step grid, their part of the element deformations) and
     what each design adds (its states and accelerations at every output sample, the
     controller's records, the caches behind its signals, ``signals`` signals computed from
-    them, the ISO 2631 weighting's transforms). An estimate from the arrays the integrator and
-    :class:`Result` allocate, rounded up."""
+    them, the ISO 2631 weighting's transforms). A run in windows of ``window`` samples
+    (:mod:`suspopt.streaming`) holds those for one window only, and ``kept`` signals over
+    the whole run. An estimate from the arrays the integrator and :class:`Result` allocate,
+    rounded up."""
     sim, road = cfg.simulation, cfg.road
     n = model.n_dof + sum(len(att.dof_names) for att in attachments)
     rows = sum(g.size for g in model.network.groups) + sum(
@@ -123,16 +131,17 @@ def run_memory(
     span = road.speed * sim.duration + float(np.max(model.offsets, initial=0.0))
     shared = road_memory(road, corners, half_steps, span) + 8.0 * half_steps * 2 * rows
     # states, accelerations, deformation and force caches, held records, signals, transforms
-    per_design = 8.0 * samples * (3 * n + 8 * corners + 4 * corners + signals + 6)
-    return shared, per_design
+    held = min(samples, window or samples)
+    per_design = 8.0 * held * (3 * n + 8 * corners + 4 * corners + signals + 6)
+    return shared, per_design + 8.0 * samples * kept
 
 
 def check_memory(
-    cfg: Config, model: VehicleModel, attachments: Sequence[Attachment], P: int, signals: int = 0
+    cfg: Config, model: VehicleModel, attachments: Sequence[Attachment], P: int, **sizes: Any
 ) -> None:
-    """ConfigError when a run of P designs (:func:`run_memory`) needs more memory than the
-    limit (:func:`suspopt.memory.check`)."""
-    shared, per_design = run_memory(cfg, model, attachments, P, signals)
+    """ConfigError when a run of P designs (:func:`run_memory`, with its ``signals``,
+    ``window`` and ``kept``) needs more memory than the limit (:func:`suspopt.memory.check`)."""
+    shared, per_design = run_memory(cfg, model, attachments, P, **sizes)
     memory.check(
         shared + P * per_design,
         f"simulating {P} design{'s' if P > 1 else ''} for "
@@ -163,7 +172,28 @@ def _run(
         traj = _joined(execution.map_chunks(_chunk_trajectory, cfg, designs, cfg.execution))
     else:
         traj = integrate(run, sim.engine)
-    out_idx = np.arange(0, 2 * sim.n_steps + 1, 2 * sim.output_every)
+    return _result(cfg, pv, model, controller, attachments, run, (z, zd, t_grid), traj)
+
+
+def _result(
+    cfg: Config,
+    pv: ParamView,
+    model: VehicleModel,
+    controller: Controller | None,
+    attachments: Sequence[Attachment],
+    run: Run,
+    grid: tuple[np.ndarray, np.ndarray, np.ndarray],
+    traj: Trajectory,
+    first: int = 0,
+) -> Result:
+    """The :class:`Result` of trajectory ``traj``, its samples from output sample ``first``
+    on (a window of the run, :func:`suspopt.integrator.windows`); ``grid`` is the road's
+    inputs ``z, zd`` on the half-step grid and that grid [s] (:func:`_setup`)."""
+    sim = cfg.simulation
+    z, zd, t_grid = grid
+    samples = traj.states.shape[-1]
+    step = 2 * sim.output_every
+    out_idx = np.arange(first * step, (first + samples) * step, step)
     return Result(
         config=cfg,
         model=model,

@@ -30,14 +30,21 @@ class MetricDef:
     """A metric: ``kind`` says what it is computed from (statistic | iso2631 | transient |
     switches | derived), ``unit`` maps the signal's unit to the metric's, ``compute(spec,
     result, signal)`` gives its (P,) values from one signal of a Result, and a ``derived``
-    metric reads the per-corner signals of ``family`` (it takes no ``signal``). Adding a
-    metric is adding one entry to :data:`METRICS`."""
+    metric reads the per-corner signals of ``family`` (it takes no ``signal``) and, when
+    ``also`` names another family, that family's signal of the same corner. ``stream`` says
+    how a run that keeps no (P, T) signal (:mod:`suspopt.streaming`) gets it: ``moments``
+    (from the signal's count, mean and squared deviations), ``extremes`` (its maximum and
+    minimum), ``window_max`` (the largest of ``compute`` over the windows of time: a maximum
+    over time of a value per sample) or ``keep`` (``compute`` on the signal kept whole).
+    Adding a metric is adding one entry to :data:`METRICS`."""
 
     kind: str
     unit: Callable[[str], str]
     description: str
     compute: Callable[[Any, Any, str], np.ndarray]
     family: str | None = None
+    also: str | None = None
+    stream: str = "keep"
 
 
 def _same(u: str) -> str:
@@ -74,6 +81,7 @@ def _statistic(name: str) -> MetricDef:
         _square if name == "var" else _same,
         description,
         lambda spec, r, signal: function(r.signals[signal]),
+        stream="moments" if name in ("var", "std", "rms", "mean") else "extremes",
     )
 
 
@@ -168,9 +176,15 @@ METRICS: dict[str, MetricDef] = {
         "mean damper power DE (Eq 2.92)",
         _dissipated_power,
         family="travel_vel",
+        also="damper_force",
     ),
     "spring_usage": MetricDef(
-        "derived", _fixed("1"), "non-linear spring usage (Eq 5.3)", _spring_usage, family="travel"
+        "derived",
+        _fixed("1"),
+        "non-linear spring usage (Eq 5.3)",
+        _spring_usage,
+        family="travel",
+        stream="window_max",
     ),
     "dynamic_tyre_load": MetricDef(
         "derived",
@@ -222,8 +236,7 @@ def evaluate_spec(
     names = spec_signals(spec, list(result.signals), result.model.corners)
     base = spec.name or ".".join(filter(None, [spec.metric, spec.signal or None, spec.weighting]))
     unit = metric_unit(spec, signal_units(names[0]))
-    compute = METRICS[spec.metric].compute
-    values = [np.asarray(compute(spec, result, n), dtype=float) for n in names]
+    values = [np.asarray(result.metric(spec, n), dtype=float) for n in names]
     if len(names) == 1 and spec.signal in result.signals:
         return [(base, values[0], unit)]
     if spec.reduce != "none":

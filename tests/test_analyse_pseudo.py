@@ -284,7 +284,10 @@ def test_a_hand_written_front_on_its_own_road_gives_the_simulated_objective(seat
     res = suspopt.simulate(cfg, params={"vehicle.corners.F1.damper.c": np.array([3000.0, 4000.0])})
     same = suspopt.analyse.pseudo.config_with(pareto, lambda data: None, "no change")
     values = evaluate_pareto(pareto, same)
-    np.testing.assert_array_equal(values.F[:, 0], np.var(res.signals["body.heave_acc"], axis=1))
+    # (the evaluation merges the variance over windows of time: equal to rounding)
+    np.testing.assert_allclose(
+        values.F[:, 0], np.var(res.signals["body.heave_acc"], axis=1), rtol=1e-13
+    )
 
 
 @pytest.mark.parametrize(

@@ -330,16 +330,19 @@ def test_large_evaluations_run_in_batches_of_bounded_memory(monkeypatch):
     X = problem.xl + np.random.default_rng(0).random((9, problem.n_var)) * (problem.xu - problem.xl)
     whole = problem.evaluate(X, return_values_of=["F", "G"])
     batched = suspopt.Problem.from_config(cfg)
+    monkeypatch.setattr(problem_module, "MAX_BATCH", 10**9)  # (the memory bound alone)
     width = batched.batch_width()
     monkeypatch.setattr(problem_module, "BATCH_BYTES", problem_module.BATCH_BYTES * 4 / width)
     batched._width = None
     assert batched.batch_width() == 4
     calls = []
-    real = problem_module.simulate
+    real = problem_module.streaming.reduce
     monkeypatch.setattr(
-        problem_module,
-        "simulate",
-        lambda cfg, params: calls.append(len(next(iter(params.values())))) or real(cfg, params),
+        problem_module.streaming,
+        "reduce",
+        lambda cfg, params, requests: (
+            calls.append(len(next(iter(params.values())))) or real(cfg, params, requests)
+        ),
     )
     parts = batched.evaluate(X, return_values_of=["F", "G"])
     assert calls == [4, 4, 1]

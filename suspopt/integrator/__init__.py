@@ -20,6 +20,7 @@ divergence rule; see :mod:`.rk4` for what those are.
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterator
 
 from .rk4 import (
     DIVERGENCE_LIMIT,
@@ -32,10 +33,21 @@ from .rk4 import (
     Trajectory,
 )
 from .rk4 import integrate as integrate_numpy
+from .rk4 import windows as windows_numpy
 
 __all__ = ["Controller", "Held", "HeldRecords", "Trajectory", "Edges", "EdgePlan", "Run"]
-__all__ += ["integrate", "integrate_numpy", "DIVERGENCE_LIMIT", "ENGINES", "compiled_available"]
+__all__ += [
+    "integrate",
+    "integrate_numpy",
+    "windows",
+    "WINDOW_MULTIPLE",
+    "DIVERGENCE_LIMIT",
+    "ENGINES",
+    "compiled_available",
+]
 
+#: A window's samples are a multiple of this (the compiled kernel's sample buffer).
+WINDOW_MULTIPLE = 32
 #: The values of ``simulation.engine``.
 ENGINES = ("numpy", "compiled", "auto")
 
@@ -56,6 +68,16 @@ def integrate(run: Run, engine: str = "numpy") -> Trajectory:
     """Classical RK4 of ``run`` (:class:`Run`) on ``engine`` (module docstring). A
     ``compiled`` request without numba is a ``RuntimeError`` naming the install command (the
     config's checks turn it into bad input first)."""
+    return next(windows(run, engine))[1]
+
+
+def windows(
+    run: Run, engine: str = "numpy", width: int | None = None
+) -> Iterator[tuple[int, Trajectory]]:
+    """The integration of :func:`integrate` as consecutive windows of at most ``width``
+    output samples, a multiple of :data:`WINDOW_MULTIPLE` (all of them when None):
+    ``(first sample, trajectory of the window)``; the windows joined are the whole run bit
+    for bit, on either engine (:func:`.rk4.windows`). A controlled run comes whole."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, not {engine!r}")
     if engine == "compiled" and not compiled_available():
@@ -64,5 +86,5 @@ def integrate(run: Run, engine: str = "numpy") -> Trajectory:
         from . import compiled
 
         if compiled.unsupported(run.asm, run.controller) is None:
-            return compiled.integrate(run)
-    return integrate_numpy(run)
+            return compiled.windows(run, width)
+    return windows_numpy(run, width)

@@ -37,20 +37,24 @@ Y, YS, S1, S2, S3, S4, K1, K2, K3, K4, TMP = range(11)
 def _law(code, r, p, F, par):
     """Element ``r``'s non-linear part, law ``code`` (:data:`.compiled.LAWS`) with its
     parameters in rows ``p ..`` of ``par``, added to its force ``F[2, r]`` at ``δ = F[0, r]``
-    (the numpy closures' arithmetic)."""
-    for b in range(F.shape[2]):
-        d = F[0, r, b]
-        if code == 0:  # poly3: ((c3 δ + c2) δ + c1) δ
+    (the numpy closures' arithmetic); the law chosen once, outside the lane loops."""
+    B = F.shape[2]
+    if code == 0:  # poly3: ((c3 δ + c2) δ + c1) δ
+        for b in range(B):
+            d = F[0, r, b]
             F[2, r, b] += ((par[p + 2, b] * d + par[p + 1, b]) * d + par[p, b]) * d
-        elif code == 1:  # cap: the force no larger than the limit (NaN stays NaN)
+    elif code == 1:  # cap: the force no larger than the limit (NaN stays NaN)
+        for b in range(B):
             if F[2, r, b] > par[p, b]:
                 F[2, r, b] = par[p, b]
-        elif code == 2:  # link: (a + b / sqrt(l^2 - w^2)) w + F0, w = w0 + δ
-            w = par[p + 3, b] + d
+    elif code == 2:  # link: (a + b / sqrt(l^2 - w^2)) w + F0, w = w0 + δ
+        for b in range(B):
+            w = par[p + 3, b] + F[0, r, b]
             F[2, r, b] += (par[p, b] + par[p + 1, b] / np.sqrt(par[p + 2, b] - w * w)) * w
             F[2, r, b] += par[p + 4, b]
-        else:  # carrella: (b / sqrt(w^2 + l^2) + a) w + F0
-            w = par[p + 3, b] + d
+    else:  # carrella: (b / sqrt(w^2 + l^2) + a) w + F0
+        for b in range(B):
+            w = par[p + 3, b] + F[0, r, b]
             F[2, r, b] += (par[p + 1, b] / np.sqrt(w * w + par[p + 2, b]) + par[p, b]) * w
             F[2, r, b] += par[p + 4, b]
 
@@ -243,10 +247,13 @@ def _lag(pb, idx, lay):
 
 
 @_jit
-def _advance(blk, k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out):
+def _advance(
+    blk, k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out
+):
     """Block ``blk``'s steps ``k0 .. k1 - 1`` from its kept state (step ``n_steps`` is the
-    final sample alone): the sample's first stage, the sample when one is due, the step, the
-    divergence check."""
+    final sample alone): the sample's first stage, the sample when one is due (sample ``j``
+    written at ``j - origin`` of the records, ``origin`` a multiple of :data:`SAMPLES`), the
+    step, the divergence check."""
     W_all, F_all, rec_all, at_all = state
     states, diverged_at = out[0], out[2]
     W, F, rec, at, pb = W_all[blk], F_all[blk], rec_all[blk], at_all[blk], par[blk]
@@ -261,8 +268,8 @@ def _advance(blk, k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay,
         if step % every == 0:  # the sample: the state and the first stage's accelerations
             j = step // every
             _keep(W, rec, j % SAMPLES, n, pb, idx, lay)
-            if j % SAMPLES == SAMPLES - 1 or j == states.shape[2] - 1:
-                _flush(rec, j - j % SAMPLES, j % SAMPLES + 1, blk * B, n, out)
+            if j % SAMPLES == SAMPLES - 1 or j - origin == states.shape[2] - 1:
+                _flush(rec, j - j % SAMPLES - origin, j % SAMPLES + 1, blk * B, n, out)
         if step == n_steps:
             break
         if split_of[step] < 0:
@@ -275,14 +282,15 @@ def _advance(blk, k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay,
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)
-def run(k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out):
+def run(k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out):
     """Steps ``k0 .. k1 - 1`` of every block (in parallel over the cores) from the kept
     ``state = (W, F, rec, at)`` of each, ``par (blocks, rows, B)`` (the arrays:
-    :func:`.compiled._packed`)."""
+    :func:`.compiled._packed`), samples from ``origin`` on in ``out``."""
     for blk in numba.prange(par.shape[0]):
         _advance(
-            blk, k0, k1, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out
-        )
+            blk, k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road,
+            state, out,
+        )  # fmt: skip
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)

@@ -39,6 +39,8 @@ The first call on a machine compiles the kernel (``cache=True`` keeps it in the 
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 
 from ..network import Assembled
@@ -223,12 +225,25 @@ def integrate(run: Run) -> Trajectory:
     """The compiled engine's :func:`suspopt.integrator.integrate` (what it covers:
     :func:`unsupported`); the run's offsets are shared by the designs. A controller is asked
     at its samples between compiled stretches of steps (:func:`_controlled`)."""
+    return next(windows(run))[1]
+
+
+def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajectory]]:
+    """The compiled engine's :func:`.rk4.windows`: the run in windows of ``width`` output
+    samples (a multiple of :data:`._kernel.SAMPLES`; all of them when None), a controlled run
+    whole."""
     asm, n_vehicle, offsets, dt, n_steps, every, controller, edges = run
     import numba
 
     from . import _kernel
 
     n, R, P0 = asm.n, asm.R, asm.P
+    n_out = n_steps // every + 1
+    width = n_out if width is None else width
+    if controller is not None and width < n_out:
+        raise ValueError("a controlled run is integrated whole (width >= its samples)")
+    if width < n_out and width % _kernel.SAMPLES:
+        raise ValueError(f"a window is a multiple of {_kernel.SAMPLES} samples")
     B = block_width(P0, numba.get_num_threads())
     blocks = -(-P0 // B)
     P = blocks * B  # whole blocks: the last design repeated
@@ -241,36 +256,41 @@ def integrate(run: Run) -> Trajectory:
     par = np.ascontiguousarray(flat.reshape(flat.shape[0], blocks, B).transpose(1, 0, 2))
     off = np.ascontiguousarray(offsets[:, :, 0, 0])
     road = (off, off.any(axis=1)) + _edge_arrays(asm, edges, dt, n_steps, off)
-    n_out = n_steps // every + 1
-    states, accelerations = np.empty((2 * n, P, n_out)), np.empty((n, P, n_out))
-    out = (states, accelerations, np.full(P, np.nan), np.empty((Nl, P, n_out)))
     state = (
         np.zeros((blocks, 11, 2 * n, B)),
         np.empty((blocks, 3, R, B)),
         np.empty((blocks, _kernel.SAMPLES, 3 * n + Nl, B)),
         np.full((blocks, B), np.nan),
     )
+    diverged_at = np.full(P, np.nan)
+    for j0 in range(0, n_out, width):
+        T = min(width, n_out - j0)
+        states, accelerations = np.empty((2 * n, P, T)), np.empty((n, P, T))
+        out = (states, accelerations, diverged_at, np.empty((Nl, P, T)))
 
-    def advance(k0: int, k1: int) -> None:
-        _kernel.run(k0, k1, dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par, idx, lay,
-                    road, state, out)  # fmt: skip
+        def advance(k0: int, k1: int, out=out, j0=j0) -> None:
+            _kernel.run(k0, k1, j0, dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par,
+                        idx, lay, road, state, out)  # fmt: skip
 
-    damping, records = None, {}
-    if controller is None:
-        advance(0, n_steps + 1)
-    else:
-        lanes = _Lanes(par, idx, state, lay, road, P0, n_vehicle)
-        damping, records = _controlled(controller, asm, lanes, advance, dt, n_steps, every)
-        if Nl:
-            damping = out[3][:, :P0]  # a lagged coefficient changes every step
-    return Trajectory(
-        states=states[:, :P0],
-        accelerations=accelerations[:, :P0],
-        damping=damping,
-        records=records,
-        diverged_at=out[2][:P0],
-        engine="compiled",
-    )
+        damping, records = None, {}
+        if controller is None:
+            advance(j0 * every, (j0 + T) * every if j0 + T < n_out else n_steps + 1)
+        else:
+            lanes = _Lanes(par, idx, state, lay, road, P0, n_vehicle)
+            damping, records = _controlled(controller, asm, lanes, advance, dt, n_steps, every)
+            if Nl:
+                damping = out[3][:, :P0]  # a lagged coefficient changes every step
+        yield (
+            j0,
+            Trajectory(
+                states=states[:, :P0],
+                accelerations=accelerations[:, :P0],
+                damping=damping,
+                records=records,
+                diverged_at=diverged_at[:P0].copy(),
+                engine="compiled",
+            ),
+        )
 
 
 class _Lanes:

@@ -8,9 +8,7 @@ preallocated buffers, with no Python loop over designs. Its parts are separate: 
 (:class:`_RK4`, and :class:`_Splitter` for the steps that meet a road edge), the samples
 (:class:`_Recorder`), the controller's samples, hold and actuator lag
 (:class:`_ControllerHold`, for a :class:`Controller`) and the divergence check
-(:class:`_Divergence`). The road is sampled on the half-step grid the stages need, and a step
-that meets a bump's edge is split there, the step bump's Dirac in the road's rate entering as
-an exact impulse, so every edge is seen at its instant.
+(:class:`_Divergence`). The road is sampled on the half-step grid the stages need.
 
 Road edges (``edges``; the bumps' jumps in z or its rate, Eq 2.101-2.104) are seen at their
 instants. A step whose interior holds edges is split at them into RK4 sub-steps; each
@@ -20,19 +18,16 @@ starting on it (the grid) the right limit. Where the inputs jump by ``Δu`` thei
 holds a Dirac ``Δu δ(t - t_e)``, integrated exactly: an impulse ``c D_u Δu`` [N s] of the
 viscous elements that see the road (the tyre damping c_T, Eq 2.29), so the velocities
 jump by ``M^-1 (-D_qᵀ) (c D_u Δu)`` at the edge (the elastic forces stay bounded and give
-no impulse). A tyre that may lift off cannot pull: its force is capped at the static load,
-so its impulse at an edge where it would pull (the road dropping away) is not applied; one
-that pushes is. A split step still makes one output sample, its controller sample (at the
-step's start) and one actuator-lag update; the sample's accelerations are the first stage
-of the step, as for any step. Only the few split steps allocate and call the road again;
-the others pay one dictionary look-up.
+no impulse). A tyre that may lift off cannot pull (its force capped at the static load):
+its impulse at an edge where it would pull is not applied. A split step still makes one
+output sample (the accelerations of its first stage), its controller sample (at its start)
+and one actuator-lag update. Only the few split steps allocate and call the road again.
 
-The parts: :class:`_RK4` (the steps), :class:`_Recorder` (the samples),
-:class:`_ControllerHold` (the controller's samples, hold and lag) and
-:class:`_Divergence` (the check). A sample at ``t_k`` holds the state, the accelerations
-``f(y_k)`` - the first stage of step k, so they cost nothing more - and the controller's
-coefficients and records in force over step k (from ``t_k`` on); the last sample, where
-no step begins, asks the controller once more and evaluates the accelerations.
+A sample at ``t_k`` holds the state, the accelerations ``f(y_k)`` - the first stage of
+step k, so they cost nothing more - and the controller's coefficients and records in force
+over step k (from ``t_k`` on); the last sample, where no step begins, asks the controller
+once more and evaluates the accelerations. :func:`windows` hands the samples over in
+windows of time, for a run that keeps no whole record (:mod:`suspopt.streaming`).
 
 A single design is integrated as two identical columns: BLAS multiplies one column by a
 matrix-vector kernel whose rounding differs from the matrix-matrix kernel's. Beyond that,
@@ -41,8 +36,7 @@ some rows differently (by an ulp): a design re-simulated in a batch of another w
 with its first run to rounding, while the same batch repeats bit for bit.
 
 A design whose state becomes non-finite or exceeds :data:`DIVERGENCE_LIMIT` gets its time in
-``Trajectory.diverged_at`` and NaN samples from then on, so a diverged design can never pass
-for a valid one.
+``Trajectory.diverged_at`` and NaN samples from then on: it never passes for a valid one.
 """
 
 from __future__ import annotations
@@ -63,6 +57,7 @@ __all__ = [
     "Edges",
     "Run",
     "integrate",
+    "windows",
     "DIVERGENCE_LIMIT",
 ]
 
@@ -544,53 +539,62 @@ def integrate(run: Run) -> Trajectory:
     step. Road edges, the samples, the controller's hold and the batch width: see the module
     docstring.
     """
+    return next(windows(run))[1]
+
+
+def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajectory]]:
+    """The integration of ``run`` as consecutive windows of at most ``width`` output samples
+    (all when None): ``(j0, trajectory of samples j0 ..)``, the steps those of
+    :func:`integrate` (the windows joined are its trajectory, bit for bit), ``diverged_at``
+    as known at the window's end. A controlled run comes whole (a smaller ``width`` is a
+    ValueError): its hold keeps records over the run."""
     asm, n_vehicle, offsets, dt, n_steps, every, controller, edges = run
     n, P = asm.n, asm.P
-    width = max(P, 2)
+    n_out = n_steps // every + 1
+    width = n_out if width is None else width
+    if controller is not None and width < n_out:
+        raise ValueError("a controlled run is integrated whole (width >= its samples)")
+    window, width = width, max(P, 2)
     active = offsets.any(axis=(1, 2, 3))
     if offsets.size * width <= _WIDE_OFFSETS:  # small batches: no broadcasting
         offsets = widen(offsets, width)
     # the inputs' part of each half-step, None where it is zero (a bump's road before and after)
     rk4 = _RK4(asm, width, dt, [o if a else None for o, a in zip(offsets, active)])
-    n_out = n_steps // every + 1
-    states, accelerations = np.empty((2 * n, P, n_out)), np.empty((n, P, n_out))
-    buffers = [(rk4.y, states), (rk4.acc, accelerations)]
     hold = None
     if controller is not None:
         hold = _controller_hold(controller, rk4, asm, n_vehicle, n_out, dt)
-        if hold.lagged is not None:
-            buffers.append((hold.damping, hold.lagged))
-    recorder, divergence = _Recorder(buffers, P, n_out), _Divergence(rk4.y2, P, dt)
+    divergence = _Divergence(rk4.y2, P, dt)
     splitter = _Splitter(rk4, asm, edges, n_steps) if edges is not None else None
     split = splitter.steps if splitter is not None else {}
-    with np.errstate(over="ignore", invalid="ignore"):
-        if splitter is not None:
-            splitter.at_start()
-        for k in range(n_steps):
-            if hold is not None and hold.due(k):
-                hold.control(k)
-            rk4.first(2 * k)
-            if k % every == 0:
-                recorder.keep(k // every)
+    for j0 in range(0, n_out, window):
+        j1 = min(j0 + window, n_out)
+        states, accelerations = np.empty((2 * n, P, j1 - j0)), np.empty((n, P, j1 - j0))
+        buffers = [(rk4.y, states), (rk4.acc, accelerations)]
+        if hold is not None and hold.lagged is not None:
+            buffers.append((hold.damping, hold.lagged))
+        recorder = _Recorder(buffers, P, j1 - j0)
+        with np.errstate(over="ignore", invalid="ignore"):
+            if j0 == 0 and splitter is not None:
+                splitter.at_start()
+            for k in range(j0 * every, j1 * every if j1 < n_out else n_steps):
+                if hold is not None and hold.due(k):
+                    hold.control(k)
+                rk4.first(2 * k)
+                if k % every == 0:
+                    recorder.keep(k // every - j0)
+                    if hold is not None:
+                        hold.kept(k // every)
+                if k in split:
+                    splitter.step(k)
+                else:
+                    rk4.rest(2 * k)
+                divergence.check(k, rk4.y, n_steps)
+            if j1 == n_out and n_steps % every == 0:  # the final instant is a sample
                 if hold is not None:
-                    hold.kept(k // every)
-            if k in split:
-                splitter.step(k)
-            else:
-                rk4.rest(2 * k)
-            divergence.check(k, rk4.y, n_steps)
-        if n_steps % every == 0:  # the final instant is a sample
-            if hold is not None:
-                hold.control(n_steps)
-            rk4.first(2 * n_steps)
-            recorder.keep(n_out - 1)
-            if hold is not None:
-                hold.kept(n_out - 1)
-    damping, records = hold.held(n_out) if hold is not None else (None, {})
-    return Trajectory(
-        states=states,
-        accelerations=accelerations,
-        damping=damping,
-        records=records,
-        diverged_at=divergence.at,
-    )
+                    hold.control(n_steps)
+                rk4.first(2 * n_steps)
+                recorder.keep(j1 - 1 - j0)
+                if hold is not None:
+                    hold.kept(n_out - 1)
+        damping, records = hold.held(n_out) if hold is not None else (None, {})
+        yield j0, Trajectory(states, accelerations, damping, records, divergence.at.copy())

@@ -1,8 +1,10 @@
 """``suspopt.Problem``: the YAML optimisation problem as a vectorised pymoo ``Problem``.
 
 ``Problem.from_config(cfg)`` reads ``design_variables``, ``objectives`` and ``constraints``
-(:mod:`suspopt.config.optimise`); ``evaluate(X)`` runs ONE :func:`suspopt.simulate` for the
-whole population ``X (N, n_var)`` and returns ``F (N, n_obj)`` and ``G (N, n_ieq_constr)``
+(:mod:`suspopt.config.optimise`); ``evaluate(X)`` runs ONE batched simulation for the
+whole population ``X (N, n_var)`` (in batches of at most :data:`MAX_BATCH` designs, or fewer
+when memory asks), keeping no (P, T) signal its metrics do not need
+(:func:`suspopt.streaming.reduce`), and returns ``F (N, n_obj)`` and ``G (N, n_ieq_constr)``
 (``G <= 0`` feasible, Eq 6.3).
 
 Search coordinates. ``X`` holds each variable's value in its SI unit, except that a variable
@@ -26,17 +28,17 @@ from dataclasses import dataclass
 import numpy as np
 from pymoo.core.problem import Problem as _PymooProblem
 
-from .. import execution
+from .. import execution, streaming
 from ..config import Config, ConfigError
 from ..config.optimise import DesignVariable, Objective
 from ..control.controller import build_controller
 from ..params import ParamView, numeric_paths, one_per_run
 from ..seat import CONSTRAINT_UNITS, build_attachments, seat_constraints, seat_static_deflection
-from ..simulate import signal_table, simulate
+from ..simulate import signal_table
 from ..specs import evaluate_spec, metric_unit, spec_signals
 from ..vehicle import build_vehicle
 
-__all__ = ["Problem", "PENALTY", "BATCH_BYTES"]
+__all__ = ["Problem", "PENALTY", "BATCH_BYTES", "MAX_BATCH"]
 
 #: Objective and constraint value given to a failed (diverged, NaN) design.
 PENALTY = 1.0e10
@@ -44,6 +46,10 @@ PENALTY = 1.0e10
 #: population larger than that (a Ch. 8 seat on 1000 m of road takes about 11 MB per design)
 #: is simulated in batches of equal width, one after the other.
 BATCH_BYTES = 2 << 30
+
+#: The most designs of one batch: beyond about this many the working set of a batch leaves
+#: the caches and the time per design grows (``benchmarks/bench_simulate.py``).
+MAX_BATCH = 2048
 
 _FAILED = "simulation_failed"
 
@@ -183,18 +189,29 @@ class Problem(_PymooProblem):
     def batch_width(self) -> int:
         """Designs simulated in one batch: as many as fit in :data:`BATCH_BYTES` (or half of
         ``--max-memory`` when that is smaller) by :func:`suspopt.simulate.run_memory`, at
-        least one. It depends on the config (and an explicit memory limit) only, never on the
-        memory free at the moment, so that a run repeats bit for bit."""
+        least one, at most :data:`MAX_BATCH` (so that the time per design does not grow with
+        the population). It depends on the config (and an explicit memory limit) only, never
+        on the memory free at the moment, so that a run repeats bit for bit."""
         if self._width is None:
             from .. import memory
             from ..simulate import prepare, run_memory
+            from ..specs import METRICS
 
-            _, model, _, attachments = prepare(self._sim_cfg)
-            signals = len({n for t in self._all_terms() if t.spec.metric for n in t.signals})
-            _, per_design = run_memory(self._sim_cfg, model, attachments, 1, signals)
+            _, model, controller, attachments = prepare(self._sim_cfg)
+            terms = [t for t in self._all_terms() if t.spec.metric]
+            signals = len({n for t in terms for n in t.signals})
+            window, kept = None, 0
+            if controller is None:  # streamed: one window, and the kept signals whole
+                window = streaming.WINDOW
+                kept = sum(
+                    len(t.signals) for t in terms if METRICS[str(t.spec.metric)].stream == "keep"
+                )
+            _, per_design = run_memory(
+                self._sim_cfg, model, attachments, 1, signals, window, 2 * kept
+            )
             cap = memory.explicit_limit()
             budget = BATCH_BYTES if cap is None else min(BATCH_BYTES, cap // 2)
-            self._width = max(1, int(budget // per_design))
+            self._width = max(1, min(MAX_BATCH, int(budget // per_design)))
         return self._width
 
     def _evaluate(self, X, out, *args, **kwargs):
@@ -222,10 +239,14 @@ class Problem(_PymooProblem):
                 )
 
     def _evaluate_batch(self, X, supplementary: bool):
-        """F, G (and S, or None) of one batch of designs, in one simulation."""
+        """F, G (and S, or None) of one batch of designs, in one simulation that keeps no
+        signal it does not need (:func:`suspopt.streaming.reduce`)."""
         params = self.params(X)
+        terms = self._objectives + self._constraints
+        terms += self._supplementary if supplementary else []
+        requests = [(t.spec, t.signals) for t in terms if t.spec.metric]
         with np.errstate(all="ignore"):  # failed designs are flagged, not warned about
-            result = simulate(self._sim_cfg, params) if self._simulates else None
+            result = streaming.reduce(self._sim_cfg, params, requests) if requests else None
         return self.values(result, params, len(X), supplementary)
 
     def values(self, result, params: dict[str, np.ndarray], P: int, supplementary: bool = False):

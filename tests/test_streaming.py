@@ -1,0 +1,150 @@
+"""Metrics of a run that keeps no (P, T) signal (:mod:`suspopt.streaming`) against the same
+metrics of the whole run (:func:`suspopt.simulate`), and the integrator's windows against the
+whole integration.
+
+- The windows of either engine joined are the whole run bit for bit (a bump's edges, a random
+  road, a seat with its passenger).
+- Every metric of :data:`suspopt.specs.METRICS` that a passive run has, reduced in windows,
+  equals the whole run's: to 1e-13 relative for the moments (a merge of blocks, not one sum),
+  exactly for the extremes, the windows' maxima and the kept signals.
+- The moments do not depend on the batch and match the whole signal's for any windows; a
+  diverged design comes out NaN as in the whole run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import CONFIGS
+
+from suspopt import integrator, streaming
+from suspopt.config import load_config
+from suspopt.config.metrics import MetricSpec
+from suspopt.integrator import compiled_available
+from suspopt.simulate import _setup, prepare, simulate
+from suspopt.specs import METRICS, spec_signals
+
+ENGINES = ["numpy"] + (["compiled"] if compiled_available() else [])
+
+
+def _designs(cfg, P: int) -> dict[str, np.ndarray]:
+    share = np.linspace(0.1, 0.9, P)
+    return {v.path: v.lower + share * (v.upper - v.lower) for v in cfg.design_variables}
+
+
+def _short(name: str, duration: float):
+    cfg = load_config(CONFIGS / name)
+    cfg.simulation.duration = duration
+    return cfg
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize(
+    "name", ["ch5/case1_s1.yaml", "ch3/part1a_qc_class_b.yaml", "ch8/nss4_class_a_passenger.yaml"]
+)
+def test_windows_joined_are_the_whole_run(name, engine):
+    cfg = _short(name, 1.3)
+    cfg.simulation.engine = engine
+    pv, model, controller, attachments = prepare(cfg, _designs(cfg, 5) or None)
+    run = _setup(cfg, pv, model, controller, attachments)[0]
+    whole = integrator.integrate(run, engine)
+    for width in (32, 96):
+        parts = list(integrator.windows(run, engine, width))
+        assert [j0 for j0, _ in parts] == list(range(0, whole.states.shape[-1], width))
+        for field in ("states", "accelerations"):
+            joined = np.concatenate([getattr(t, field) for _, t in parts], axis=-1)
+            assert np.array_equal(joined, getattr(whole, field), equal_nan=True)
+        assert np.array_equal(parts[-1][1].diverged_at, whole.diverged_at, equal_nan=True)
+
+
+def test_a_controlled_run_comes_whole():
+    cfg = _short("ch3/part1b_qc_bump.yaml", 2.5)
+    pv, model, controller, attachments = prepare(cfg)
+    run = _setup(cfg, pv, model, controller, attachments)[0]
+    assert controller is not None
+    with pytest.raises(ValueError, match="whole"):
+        next(integrator.windows(run, "numpy", 32))
+
+
+def _every_metric(cfg):
+    """A request for every metric of METRICS on a signal it applies to."""
+    pv, model, controller, attachments = prepare(cfg)
+    from suspopt.result import signal_names
+
+    available = signal_names(model, {}, attachments)
+    requests = []
+    for metric, definition in METRICS.items():
+        if definition.kind == "switches":
+            continue  # (a passive run has no switching signal)
+        fields: dict = {"metric": metric}
+        if definition.kind != "derived":
+            fields["signal"] = "body.heave_acc" if definition.kind == "iso2631" else "travel"
+        if definition.kind == "iso2631":
+            fields["weighting"] = "Wk"
+        spec = MetricSpec(**fields)
+        requests.append((spec, spec_signals(spec, available, model.corners)))
+    return requests
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_every_metric_reduced_in_windows_is_the_whole_runs(engine, monkeypatch):
+    monkeypatch.setattr(streaming, "WEIGHTED_ROWS", 4)  # the weighting in blocks of 4 and 2
+    cfg = _short("ch5/case1_s1.yaml", 2.0)
+    cfg.simulation.engine = engine
+    params = _designs(cfg, 6)
+    requests = _every_metric(cfg)
+    assert {METRICS[s.metric].stream for s, _ in requests} == {
+        "moments", "extremes", "window_max", "keep"
+    }  # fmt: skip
+    reduced = streaming.reduce(cfg, params, requests)
+    whole = simulate(cfg, params)
+    assert isinstance(reduced, streaming.Reduced)
+    for spec, names in requests:
+        for name in names:
+            got, want = reduced.metric(spec, name), whole.metric(spec, name)
+            if METRICS[spec.metric].stream == "moments":
+                np.testing.assert_allclose(got, want, rtol=1e-13, err_msg=spec.metric)
+            else:
+                assert np.array_equal(got, want, equal_nan=True), spec.metric
+    assert np.array_equal(reduced.diverged_at, whole.diverged_at, equal_nan=True)
+
+
+def test_moments_do_not_depend_on_the_batch_and_match_the_whole_signal():
+    rng = np.random.default_rng(3)
+    x = rng.normal(2.0, 0.5, (4, 1000))
+
+    def fed(widths, rows=slice(None)):
+        moments = streaming._Moments()
+        start = 0
+        for width in widths:
+            moments.add(x[rows, start : start + width])
+            start += width
+        assert start >= x.shape[1]
+        return {m: moments.value(m) for m in ("var", "std", "rms", "mean")}
+
+    windows = [256] * 4
+    batch, single = fed(windows), fed(windows, slice(2, 3))
+    assert all(np.array_equal(batch[m][2:3], single[m]) for m in batch)
+    for widths in (windows, [32] * 32, [64, 512, 448], [1000]):
+        moments = fed(widths)
+        np.testing.assert_allclose(moments["var"], np.var(x, axis=-1), rtol=1e-14)
+        np.testing.assert_allclose(moments["std"], np.std(x, axis=-1), rtol=1e-14)
+        np.testing.assert_allclose(moments["mean"], np.mean(x, axis=-1), rtol=1e-14)
+        np.testing.assert_allclose(moments["rms"], np.sqrt(np.mean(x**2, axis=-1)), rtol=1e-14)
+
+
+def test_a_diverged_design_is_nan_as_in_the_whole_run():
+    cfg = _short("ch5/case1_s1.yaml", 1.8)
+    cfg.simulation.dt = 9.0e-3  # RK4 unstable for the stiffest tyre: the design diverges
+    cfg.road.length = 2.0  # (the bump spans enough steps)
+    cfg.simulation.output_dt = None
+    params = {"vehicle.corners.F1.tyre.stiffness": np.array([4.0e5, 4.0e7])}
+    requests = [(s, n) for s, n in _every_metric(cfg) if s.metric in ("var", "max", "rms_weighted")]
+    reduced = streaming.reduce(cfg, params, requests)
+    whole = simulate(cfg, params)
+    assert whole.diverged.tolist() == [False, True]
+    assert np.array_equal(reduced.diverged_at, whole.diverged_at, equal_nan=True)
+    for spec, names in requests:
+        for name in names:
+            got = reduced.metric(spec, name)
+            assert np.isfinite(got[0]) and np.isnan(got[1]), spec.metric
