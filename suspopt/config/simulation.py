@@ -27,6 +27,13 @@ class Simulation(Section):
         "without a compiled law runs on numpy), or auto (compiled when numba is installed); "
         "the two agree to rounding",
     )
+    method: Literal["time", "spectral"] = Field(
+        "time",
+        description="how objectives and constraints are evaluated: time (integrated over "
+        "duration) or spectral (stationary statistics by the frequency integral over the "
+        "road's band; a linear model on an iso8608 road; var, std, rms, mean, rms_weighted, "
+        "dissipated_power and dynamic_tyre_load only); simulate always integrates in time",
+    )
 
     @field_validator("engine")
     @classmethod

@@ -24,6 +24,7 @@ import difflib
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from pymoo.core.problem import Problem as _PymooProblem
@@ -150,6 +151,18 @@ class Problem(_PymooProblem):
                 for i, spec in enumerate(specs)
             ]
 
+        if cfg.simulation.method == "spectral":
+            from .. import spectral
+
+            specs: list[tuple[Any, tuple]] = [
+                (s, ("objectives", "main", i)) for i, s in enumerate(cfg.objectives.main)
+            ]
+            specs += [(s, ("constraints", i)) for i, s in enumerate(cfg.constraints)]
+            specs += [
+                (s, ("objectives", "supplementary", i))
+                for i, s in enumerate(cfg.objectives.supplementary)
+            ]
+            spectral.check(cfg, specs)
         return cls(
             cfg,
             compile_all(cfg.objectives.main, ("objectives", "main"), True),
@@ -245,8 +258,13 @@ class Problem(_PymooProblem):
         terms = self._objectives + self._constraints
         terms += self._supplementary if supplementary else []
         requests = [(t.spec, t.signals) for t in terms if t.spec.metric]
+        reduce = streaming.reduce
+        if self.cfg.simulation.method == "spectral":
+            from .. import spectral
+
+            reduce = spectral.reduce
         with np.errstate(all="ignore"):  # failed designs are flagged, not warned about
-            result = streaming.reduce(self._sim_cfg, params, requests) if requests else None
+            result = reduce(self._sim_cfg, params, requests) if requests else None
         return self.values(result, params, len(X), supplementary)
 
     def values(self, result, params: dict[str, np.ndarray], P: int, supplementary: bool = False):

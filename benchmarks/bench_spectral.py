@@ -1,0 +1,111 @@
+"""Designs evaluated per second by ``simulation.method: spectral`` and by the time domain, in
+the same run, on two linear random-road problems:
+
+- the Ch. 3 class-B quarter car (configs/ch3/part1a_qc_class_b.yaml: 60 s at dt = 1 ms),
+  objectives the body acceleration's variance and Wk r.m.s. and the travel's variance, its
+  spring and damper drawn within -50 % .. +100 % of the config's;
+- the Ch. 8 PS seat problem (configs/ch8/pareto_ps_class_a.yaml: the seat's Wk r.m.s. over
+  1000 m of class A, 30 s at dt = 1 ms), its K_v and C_v drawn inside their bounds.
+
+Each is ``Problem.evaluate`` of P designs (best of two calls; the time domain on the engine
+``--engine`` names, default compiled when numba is installed), with the largest relative
+difference of the objectives between the two methods (the time domain's finite road and its
+start from rest against the stationary value). The time domain at P = 10000 is timed once.
+Run: ``python benchmarks/bench_spectral.py [--sizes 1,100,10000]``. Prints a table; asserts
+nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+
+import suspopt
+from suspopt.integrator import compiled_available
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+QC = """
+design_variables:
+  - {name: k, path: vehicle.corners.F1.spring.linear, lower: LOWK, upper: HIGHK}
+  - {name: c, path: vehicle.corners.F1.damper.c, lower: LOWC, upper: HIGHC}
+objectives:
+  main:
+    - {name: acc_var, metric: var, signal: body.heave_acc}
+    - {name: acc_Wk, metric: rms_weighted, signal: body.heave_acc, weighting: Wk}
+    - {name: travel_var, metric: var, signal: travel.F1}
+optimiser: {algorithm: nsga2, seed: 1, population: 10, generations: 1}
+"""
+
+
+def _qc_config():
+    cfg = suspopt.load_config(CONFIGS / "ch3" / "part1a_qc_class_b.yaml")
+    corner = cfg.vehicle.corners["F1"]
+    k, c = corner.spring.linear, corner.damper.c
+    text = (CONFIGS / "ch3" / "part1a_qc_class_b.yaml").read_text() + QC.replace(
+        "LOWK", f"{0.5 * k:g}"
+    ).replace("HIGHK", f"{2 * k:g}").replace("LOWC", f"{0.5 * c:g}").replace("HIGHC", f"{2 * c:g}")
+    from suspopt.config.loader import load_config_text
+
+    return load_config_text(text, CONFIGS / "ch3" / "qc_study.yaml")
+
+
+def _problems(method: str, engine: str):
+    out = {}
+    for label, cfg in (
+        ("Ch. 3 QC class B", _qc_config()),
+        ("Ch. 8 PS class A", suspopt.load_config(CONFIGS / "ch8" / "pareto_ps_class_a.yaml")),
+    ):
+        cfg = cfg.model_copy(deep=True)
+        cfg.simulation.method = method
+        cfg.simulation.engine = engine
+        out[label] = suspopt.Problem.from_config(cfg)
+    return out
+
+
+def _timed(problem, X, repeats: int):
+    wall, F = np.inf, None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        F = problem.evaluate(X, return_values_of=["F"])
+        wall = min(wall, time.perf_counter() - start)
+    return wall, F
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--sizes", default="1,100,10000")
+    parser.add_argument("--engine", default="compiled" if compiled_available() else "numpy")
+    args = parser.parse_args()
+    suspopt.reuse_memory()
+    sizes = [int(s) for s in args.sizes.split(",")]
+    spectral, timed = _problems("spectral", args.engine), _problems("time", args.engine)
+    print(
+        f"suspopt {suspopt.__version__} | Python {platform.python_version()} | "
+        f"numpy {np.__version__} | time domain on the {args.engine} engine"
+    )
+    print(
+        f"{'problem':<18} {'P':>6} {'spectral [designs/s]':>21} {'time [designs/s]':>17} "
+        f"{'ratio':>8} {'max rel diff F':>15}"
+    )
+    rng = np.random.default_rng(2026)
+    for label in spectral:
+        problem = spectral[label]
+        for P in sizes:
+            X = rng.uniform(problem.xl, problem.xu, (P, problem.n_var))
+            timed[label].evaluate(X[:2])  # warm-up (imports, compilation)
+            problem.evaluate(X[:2])
+            s_wall, Fs = _timed(problem, X, 2)
+            t_wall, Ft = _timed(timed[label], X, 1 if P >= 10000 else 2)
+            diff = np.max(np.abs(Fs / Ft - 1.0))
+            print(
+                f"{label:<18} {P:>6} {P / s_wall:>21.0f} {P / t_wall:>17.1f} "
+                f"{t_wall / s_wall:>7.0f}x {diff:>15.2e}"
+            )
+
+
+if __name__ == "__main__":
+    main()

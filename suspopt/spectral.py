@@ -1,0 +1,287 @@
+"""Stationary statistics of linear designs on ISO 8608 roads: ``simulation.method: spectral``.
+
+For a model that is linear (no Duffing term, no tyre lift-off, no semi-active controller, a
+linear seat such as PS) on an ISO 8608 road, each response is a linear filter of the road,
+and its stationary variance is the integral of the road's spectrum through the frequency
+response (the Wiener-Khinchin relation):
+
+    σ_y² = Σ_tracks ∫ G_z(f) |Σ_i H_y,i(f) e^{-j2πf τ_i}|² df,    G_z(f) = G_d(f / V) / V,
+
+with ``G_d(n) = G_d(n0) (n / n0)^-w`` (Eq 2.93) at the level the road's ``convention`` gives
+(:func:`suspopt.road.iso8608_level`), over the road's band ``V n_min .. V n_max`` [Hz] (the
+time-domain road's band), ``H_y,i`` the response of signal ``y`` to wheel ``i``'s road
+height, ``τ_i = d_i / V`` its wheelbase delay (an exact phase here, where a Lyapunov form
+would need an approximation), and one track (``identical``) or two (``independent``: the
+right and the left wheels each on their own realisation; a ``*_only`` flat side contributes
+nothing). The ISO 2631 weighted r.m.s. multiplies the integrand by ``|W(f)|²``, the
+weighting's exact analogue response (:func:`suspopt.metrics.iso2631.weighting_response`).
+
+The frequency responses of the DOFs come from the element network's linear matrices
+(:meth:`suspopt.network.LinearModel.modal_response`: one eigen-decomposition per design,
+then a few products per frequency), batched over designs and frequencies; each signal's response is the one signal table's computation
+(:class:`suspopt.result.Result`) applied to the complex amplitudes (the signal of the
+response minus the signal of rest, so that a static part such as the tyre's static load
+drops out). The integral is Simpson's rule over ``ln f`` on a grid of frequencies equally spaced in
+``ln f``, refined by adding the midpoints until no value changes by more than
+:data:`TOLERANCE` relative (from :data:`FIRST_POINTS` to at most :data:`MAX_POINTS` points;
+more is an error).
+
+Metrics with a stationary closed form: ``var``, ``std``, ``rms`` (the response has zero
+mean: ``rms = std``, ``mean = 0``), ``rms_weighted``, ``dissipated_power`` (the mean of
+``F_C ṠT``: the real part of the cross-spectrum of the damper force and the travel rate,
+integrated; Eq 2.92 for a stationary run) and ``dynamic_tyre_load`` (the tyre force's
+standard deviation over the static load); every other metric (maxima, VDV, MTVV, crest
+factor, switch counts, transient and derived metrics) needs a time history and is bad input
+under this method. ``simulate`` integrates in time whatever the method: the method applies
+to objectives and constraints (``optimise``, ``kesort``, ``analyse``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from .config import Config, ConfigError
+from .config.road import Iso8608Road
+
+__all__ = ["METRICS", "reduce", "check", "TOLERANCE", "FIRST_POINTS", "MAX_POINTS"]
+
+#: The metrics this method gives.
+METRICS = ("var", "std", "rms", "mean", "rms_weighted", "dissipated_power", "dynamic_tyre_load")
+#: Largest relative change of any value when the frequency grid is doubled.
+TOLERANCE = 1e-6
+#: Frequencies of the first grid, and the most of the last (each grid adds the midpoints).
+FIRST_POINTS = 129
+MAX_POINTS = 65537
+#: Frequencies whose responses are computed at a time (bounds the memory of a batch).
+BLOCK = 256
+#: ISO 8608's reference spatial frequency n0 [cycles/m].
+_N0 = 0.1
+
+
+def _nonlinear(cfg: Config, model, controller, network) -> tuple[tuple, str] | None:
+    """``(config key, why)`` when the run is not linear for the chosen designs, else None."""
+    if controller is not None:
+        return ("control",), "a semi-active controller switches the damping"
+    if cfg.road.kind != "iso8608":
+        return ("road", "kind"), f"road kind {cfg.road.kind!r} is not a random ISO 8608 road"
+    if cfg.vehicle.tyre_lift_off:
+        return ("vehicle", "tyre_lift_off"), "a tyre that lifts off is not linear"
+    for g in network.groups:
+        if g.extra is None:
+            continue
+        law = g.extra_law
+        if law is not None and law[0] == "poly3" and all(not np.any(p) for p in law[1]):
+            continue  # a cubic term of zero in every design
+        if g.name == "suspension" and law is not None:
+            corner = model.corners[int(np.flatnonzero(np.any(law[1][2] != 0, axis=(1, 2)))[0])]
+            path = f"vehicle.corners.{corner}.spring.cubic"
+            where = [i for i, v in enumerate(cfg.design_variables) if v.path == path]
+            key = ("design_variables", where[0]) if where else tuple(path.split("."))
+            return key, f"the Duffing spring {path} > 0 is not linear"
+        if cfg.seat is not None:
+            return ("seat", "kind"), f"the {cfg.seat.kind} seat's mechanism is not linear"
+        return ("vehicle",), f"the non-linear part of {g.name!r} is not linear"
+    return None
+
+
+def check(cfg: Config, specs: Sequence[tuple[Any, tuple]]) -> None:
+    """ConfigError (with the YAML line) when ``cfg`` cannot be evaluated by this method:
+    a non-linear model or road (naming the key that makes it so) or a metric of
+    ``specs`` (``(spec, its location in the config)``) without a stationary closed form."""
+    from .checks import full_network
+    from .simulate import prepare
+
+    for spec, loc in specs:
+        if spec.metric is not None and spec.metric not in METRICS:
+            raise cfg.error(
+                loc + ("metric",),
+                f"{spec.metric} needs a time history and has no stationary closed form under "
+                f"simulation.method spectral (it gives {', '.join(METRICS)}); use method time",
+            )
+    bounds = {v.path: np.array([v.lower, v.upper]) for v in cfg.design_variables}
+    _, model, controller, attachments = prepare(cfg, bounds or None)
+    found = _nonlinear(cfg, model, controller, full_network(model, attachments))
+    if found is not None:
+        key, why = found
+        raise cfg.error(
+            key, f"simulation.method spectral needs a linear model on a random road: {why}"
+        )
+
+
+def _tracks(cfg: Config, model) -> list[np.ndarray]:
+    """Per track, which wheels ride on it (N,) as 0/1."""
+    on_road = np.array(
+        [(cfg.road.tracks, side) not in {("right_only", "left"), ("left_only", "right")}
+         for side in model.sides], dtype=float
+    )  # fmt: skip
+    if cfg.road.tracks != "independent":
+        return [on_road]
+    sides = np.array(model.sides)
+    return [on_road * (sides == "right"), on_road * (sides == "left")]
+
+
+class _Linear:
+    """What the responses of a batch need once: the designs, the model and its attachments,
+    the network's linear matrices and its assembly."""
+
+    def __init__(self, cfg: Config, pv, model, attachments):
+        from .checks import full_network
+        from .network import Assembled
+
+        self.cfg, self.pv, self.model, self.attachments = cfg, pv, model, attachments
+        network = full_network(model, attachments)
+        self.n, self.linear, self.asm = network.n, network.linear_model(), Assembled(network, pv.P)
+        self.form = self.linear.modal_form()
+
+
+def _responses(system: _Linear, f, names) -> dict[str, list[np.ndarray]]:
+    """Each signal's complex response to each track's road (P, F) at frequencies ``f``."""
+    from .result import Result
+
+    cfg, pv, model, attachments = system.cfg, system.pv, system.model, system.attachments
+    linear, asm = system.linear, system.asm
+    omega = 2.0 * math.pi * f
+    delay = np.exp(-1j * omega[:, None] * model.offsets[None, :] / cfg.road.speed)  # (F, N)
+
+    def result(states, accelerations, road) -> Result:
+        return Result(
+            config=cfg, model=model, time=f, states=states, accelerations=accelerations,
+            road=road[:, None, :], road_vel=(1j * omega) * road[:, None, :],
+            diverged_at=np.full(pv.P, np.nan), designs=dict(pv.params), _assembled=asm,
+            attachments=tuple(attachments),
+        )  # fmt: skip
+
+    zero = np.zeros((system.n, pv.P, f.size), complex)
+    rest = result(np.concatenate([zero, zero]), zero, np.zeros((model.offsets.size, f.size)))
+    out: dict[str, list[np.ndarray]] = {name: [] for name in names}
+    for wheels in _tracks(cfg, model):
+        inputs = delay * wheels[None, :]  # (F, N)
+        q = np.moveaxis(linear.modal_response(f, inputs, system.form), -1, 0)  # (n, P, F)
+        moving = result(np.concatenate([q, 1j * omega * q]), -(omega**2) * q, inputs.T)
+        for name in names:
+            out[name].append(moving.signals[name] - rest.signals[name])
+    return out
+
+
+def _integrands(system: _Linear, requests, f: np.ndarray) -> dict:
+    """Each requested variance's integrand over ``ln f``, ``f G_z(f) |W|² Σ_tracks |H|²``,
+    (P, F), at frequencies ``f`` (in blocks of :data:`BLOCK` frequencies)."""
+    from .metrics.iso2631 import weighting_response
+    from .road import iso8608_level
+
+    road = system.cfg.road
+    assert isinstance(road, Iso8608Road)  # (check() said so)
+    names = sorted({k for spec, ns in requests for n in ns for k in _reads(spec, n)})
+    out: dict = {(id(spec), n): [] for spec, ns in requests for n in ns}
+    for start in range(0, f.size, BLOCK):
+        fb = f[start : start + BLOCK]
+        psd = iso8608_level(road) * (fb / road.speed / _N0) ** (-road.waviness) / road.speed
+        responses = _responses(system, fb, names)
+        for spec, ns in requests:
+            weight = psd * fb
+            if spec.metric == "rms_weighted":
+                weight = weight * np.abs(weighting_response(fb, spec.weighting)) ** 2
+            for name in ns:
+                first, second = _reads(spec, name)[0], _reads(spec, name)[-1]
+                cross = sum(
+                    (a * np.conj(b)).real for a, b in zip(responses[first], responses[second])
+                )
+                out[(id(spec), name)].append(cross * weight)
+    return {key: np.concatenate(parts, axis=-1) for key, parts in out.items()}
+
+
+def _check_memory(cfg: Config, P: int, points: int, values: int) -> None:
+    """ConfigError (at ``simulation.method``) when the integrands of ``values`` values over
+    ``points`` frequencies for P designs, and one block's responses, exceed the memory
+    limit (:func:`suspopt.memory.check`)."""
+    from . import memory
+
+    try:
+        memory.check(
+            8.0 * P * (points * values + 40 * BLOCK),
+            f"the spectral integral over {points} frequencies for {P} designs",
+            "narrow the road's band (n_min, n_max), evaluate fewer designs at once or use "
+            "method time",
+        )
+    except ConfigError as exc:
+        raise cfg.error(("simulation", "method"), str(exc)) from None
+
+
+def _reads(spec, name: str) -> list[str]:
+    """The signals whose cross-spectrum gives ``spec`` on ``name``: the signal itself (its
+    variance), or for the dissipated power the travel rate and the damper force of the
+    corner (the mean of their product)."""
+    if spec.metric == "dissipated_power":
+        return [name, f"damper_force.{name.rsplit('.', 1)[1]}"]
+    return [name]
+
+
+def _simpson(y: np.ndarray, step: float) -> np.ndarray:
+    """Simpson's rule over the last axis (an odd number of equally spaced points)."""
+    return step / 3.0 * (y[..., 0] + y[..., -1] + 4.0 * y[..., 1:-1:2].sum(-1)
+                         + 2.0 * y[..., 2:-1:2].sum(-1))  # fmt: skip
+
+
+def reduce(
+    cfg: Config, params: Mapping[str, Any] | None, requests: Sequence[tuple[Any, Sequence[str]]]
+):
+    """The metric specs of ``requests`` (``(spec, its signal names)``) of the designs
+    ``params``, stationary, by the frequency integral (module docstring): a
+    :class:`suspopt.streaming.Reduced` (engine ``spectral``)."""
+    from .simulate import prepare
+    from .streaming import Reduced
+
+    pv, model, controller, attachments = prepare(cfg, params)
+    road = cfg.road
+    assert isinstance(road, Iso8608Road)  # (check() said so)
+    low, high = math.log(road.speed * road.n_min), math.log(road.speed * road.n_max)
+    points = FIRST_POINTS
+    grid = np.exp(np.linspace(low, high, points))
+    _check_memory(cfg, pv.P, points, sum(len(ns) for _, ns in requests))
+    system = _Linear(cfg, pv, model, attachments)
+    integrands = _integrands(system, requests, grid)
+    variances = {k: _simpson(y, (high - low) / (points - 1)) for k, y in integrands.items()}
+    while True:
+        if points >= MAX_POINTS:
+            raise cfg.error(
+                ("simulation", "method"),
+                f"spectral: the frequency integral did not converge to {TOLERANCE:g} with "
+                f"{MAX_POINTS} frequencies; narrow the road's band (n_min, n_max) or use time",
+            )
+        points = 2 * points - 1  # the midpoints added
+        _check_memory(cfg, pv.P, points, len(integrands))
+        middle = np.exp(np.linspace(low, high, points)[1::2])
+        added = _integrands(system, requests, middle)
+        change = 0.0
+        for key, y in integrands.items():
+            both = np.empty(y.shape[:-1] + (points,))
+            both[..., 0::2], both[..., 1::2] = y, added[key]
+            integrands[key] = both
+            finer = _simpson(both, (high - low) / (points - 1))
+            scale = np.maximum(np.abs(finer), 1e-300)
+            change = max(change, float(np.nanmax(np.abs(finer - variances[key]) / scale)))
+            variances[key] = finer
+        if change <= TOLERANCE:
+            break
+    values = {}
+    for spec, ns in requests:
+        for name in ns:
+            var = variances[(id(spec), name)]
+            if spec.metric in ("var", "dissipated_power"):
+                value = var
+            elif spec.metric == "mean":
+                value = np.zeros_like(var)  # (a linear response to a zero-mean road)
+            elif spec.metric == "dynamic_tyre_load":
+                corner = model.corners.index(name.rsplit(".", 1)[1])
+                value = np.sqrt(var) / model.static_tyre_load[:, 0, corner]
+            else:
+                value = np.sqrt(var)
+            values[(id(spec), name)] = value
+    from .result import signal_table
+
+    table = signal_table(model, {}, attachments)
+    return Reduced(model, table, values, np.full(pv.P, np.nan), "spectral")
