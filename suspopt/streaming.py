@@ -2,16 +2,17 @@
 
 An optimisation, ``kesort``'s re-simulation and the pseudo-fronts of ``analyse`` need only
 the objectives' and constraints' values, not the signals. :func:`reduce` integrates the run
-in windows of :data:`WINDOW` output samples (:func:`suspopt.integrator.windows`, the same
+in windows of output samples (:func:`window_width`; :func:`suspopt.integrator.windows`, the same
 steps as a whole run, bit for bit), computes each window's signals with the one signal table
 (:class:`suspopt.result.Result` over the window) and lets each metric take what it needs
 from them, as its :class:`suspopt.specs.MetricDef` says (``stream``):
 
-- ``moments`` (variance, standard deviation, r.m.s., mean): each window's count, mean and
-  sum of squared deviations (two passes over the window), merged into the running ones in
-  time order (the pairwise update of Chan, Golub and LeVeque); a design's values depend on
-  :data:`WINDOW` (a constant), not on its batch, and agree with the statistic of the whole
-  signal to rounding (about 1e-15 relative, ``tests/test_streaming.py``);
+- ``moments`` (variance, standard deviation, r.m.s., mean): each block of :data:`BLOCK`
+  samples' count, mean and sum of squared deviations (two passes over the block), merged
+  into the running ones in time order (the pairwise update of Chan, Golub and LeVeque); a
+  design's values depend on :data:`BLOCK` (a constant), not on its batch or the window, and
+  agree with the statistic of the whole signal to rounding (about 1e-15 relative,
+  ``tests/test_streaming.py``);
 - ``extremes`` (maximum, minimum, largest magnitude, range) and ``window_max`` (a maximum over
   time of a value per sample, such as the spring usage of Eq 5.3): the largest (smallest) of
   the windows' values, exactly the whole signal's;
@@ -38,10 +39,14 @@ import numpy as np
 from .config import Config
 from .specs import METRICS
 
-__all__ = ["reduce", "Reduced", "WINDOW"]
+__all__ = ["reduce", "Reduced", "BLOCK", "window_width"]
 
-#: Output samples of one window (a multiple of :data:`suspopt.integrator.WINDOW_MULTIPLE`).
-WINDOW = 256
+#: Samples of one block of the moments' merge, and the least of one window (a multiple of
+#: :data:`suspopt.integrator.WINDOW_MULTIPLE`).
+BLOCK = 256
+#: Memory of one window's states and signals [bytes]: a window is as many whole blocks as
+#: fit (a few designs: the whole run at once), at least one.
+WINDOW_BYTES = 64 << 20
 #: Designs whose ISO 2631 weighting is transformed at a time (each row's arithmetic the
 #: same whatever the block).
 WEIGHTED_ROWS = 128
@@ -56,20 +61,31 @@ class _Moments:
         self.m2: Any = 0.0
 
     def add(self, x: np.ndarray) -> None:
-        """The samples ``x (P, T)`` that follow (a window): its own mean and squared
-        deviations, merged into the running ones."""
+        """The samples ``x (P, T)`` that follow: each block of :data:`BLOCK` samples' own
+        mean and squared deviations (two passes), merged into the running ones in time
+        order (a window holds whole blocks, but for the run's last)."""
         x = np.ascontiguousarray(x)
-        m = x.shape[-1]
-        mean = np.mean(x, axis=-1)
-        m2 = np.sum(np.square(x - mean[:, None]), axis=-1)
-        if self.n == 0:
-            self.n, self.mean, self.m2 = m, mean, m2
-            return
-        n = self.n + m
-        delta = mean - self.mean
-        self.mean = self.mean + delta * (m / n)
-        self.m2 = self.m2 + m2 + np.square(delta) * (self.n * m / n)
-        self.n = n
+        P, T = x.shape
+        whole = T - T % BLOCK
+        parts = []
+        if whole:
+            blocks = x[:, :whole].reshape(P, -1, BLOCK)
+            means = np.mean(blocks, axis=-1)
+            squares = np.sum(np.square(blocks - means[:, :, None]), axis=-1)
+            parts = [(BLOCK, means[:, b], squares[:, b]) for b in range(means.shape[1])]
+        if whole < T:
+            rest = x[:, whole:]
+            mean = np.mean(rest, axis=-1)
+            parts.append((T - whole, mean, np.sum(np.square(rest - mean[:, None]), axis=-1)))
+        for m, mean, m2 in parts:
+            if self.n == 0:
+                self.n, self.mean, self.m2 = m, mean, m2
+                continue
+            n = self.n + m
+            delta = mean - self.mean
+            self.mean = self.mean + delta * (m / n)
+            self.m2 = self.m2 + m2 + np.square(delta) * (self.n * m / n)
+            self.n = n
 
     def value(self, metric: str) -> np.ndarray:
         var = self.m2 / self.n
@@ -140,6 +156,17 @@ class Reduced:
         return self._values[(id(spec), name)]
 
 
+def window_width(cfg: Config, model, attachments, P: int, signals: int) -> int:
+    """Output samples of one window of a run of P designs computing ``signals`` signals: as
+    many whole :data:`BLOCK` s as :data:`WINDOW_BYTES` holds by
+    :func:`suspopt.simulate.run_memory`'s estimate, at least one block."""
+    from .simulate import run_memory
+
+    per_sample = run_memory(cfg, model, attachments, 1, signals, window=1)[1]
+    blocks = int(WINDOW_BYTES // (max(P, 1) * per_sample)) // BLOCK
+    return BLOCK * max(1, blocks)
+
+
 def _kept_names(spec, name: str) -> list[str]:
     """The signals a ``keep`` metric reads: ``name`` and, for a derived metric that reads a
     second family, that family's signal of the same corner."""
@@ -179,9 +206,8 @@ def reduce(
         {k for spec, names in requests if METRICS[spec.metric].stream == "keep"
          for n in names for k in _kept_names(spec, n)}
     )  # fmt: skip
-    check_memory(
-        cfg, model, attachments, pv.P, signals=len(requests), window=WINDOW, kept=len(kept)
-    )
+    width = window_width(cfg, model, attachments, pv.P, len(requests))
+    check_memory(cfg, model, attachments, pv.P, signals=len(requests), window=width, kept=len(kept))
     run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments)
 
     def streamed(kind: str) -> list[str]:
@@ -196,7 +222,7 @@ def reduce(
     window_max: dict[tuple[int, str], Any] = {}
     pieces: dict[str, list[np.ndarray]] = {name: [] for name in kept}
     times, table, traj = [], None, None
-    for first, traj in integrator.windows(run, cfg.simulation.engine, WINDOW):
+    for first, traj in integrator.windows(run, cfg.simulation.engine, width):
         window = _result(cfg, pv, model, controller, attachments, run, (z, zd, t_grid), traj, first)
         table, signals = window._table, window.signals
         times.append(window.time)

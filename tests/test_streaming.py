@@ -148,3 +148,25 @@ def test_a_diverged_design_is_nan_as_in_the_whole_run():
         for name in names:
             got = reduced.metric(spec, name)
             assert np.isfinite(got[0]) and np.isnan(got[1]), spec.metric
+
+
+@pytest.mark.skipif(not compiled_available(), reason="needs numba")
+def test_a_designs_objectives_are_the_same_bits_alone_and_in_a_batch():
+    """The window's width follows the batch (a few designs: the whole run at once), the
+    moments' blocks do not: on the compiled engine a design's F and G do not depend on the
+    batch it is evaluated in."""
+    import suspopt
+
+    cfg = _short("ch5/case1_s1.yaml", 3.0)
+    cfg.simulation.engine = "compiled"
+    problem = suspopt.Problem.from_config(cfg)
+    X = np.random.default_rng(3).uniform(problem.xl, problem.xu, (300, problem.n_var))
+    assert (
+        streaming.window_width(cfg, *prepare(cfg)[1::2], 300, 6)
+        < 1501
+        < (streaming.window_width(cfg, *prepare(cfg)[1::2], 1, 6))
+    )  # (the windows differ)
+    batch = problem.evaluate(X, return_values_of=["F", "G"])
+    alone = problem.evaluate(X[7:8], return_values_of=["F", "G"])
+    for whole, one in zip(batch, alone):
+        assert np.array_equal(whole[7:8], one)

@@ -215,7 +215,7 @@ class Problem(_PymooProblem):
             signals = len({n for t in terms for n in t.signals})
             window, kept = None, 0
             if controller is None:  # streamed: one window, and the kept signals whole
-                window = streaming.WINDOW
+                window = streaming.BLOCK
                 kept = sum(
                     len(t.signals) for t in terms if METRICS[str(t.spec.metric)].stream == "keep"
                 )
