@@ -6,8 +6,8 @@ X_ST) twice: with ``simulation.method: time`` (the bundled configs, on the compi
 when numba is installed) and with ``method: spectral``. Then it evaluates each front's
 designs under the other method (same designs) and prints, per road class, a Markdown table:
 the run times, the front sizes, and the RC_se of the same designs by both methods (the
-largest, median and smallest relative difference), with the hypervolume-free comparison the
-fronts allow: each front's RC_se at three X_ST levels.
+largest, median and smallest relative difference), and each front's RC_se at three X_ST
+levels.
 
 Run: ``python examples/spectral_vs_time_ch8.py OUTDIR`` (a few minutes). Writes the four
 Pareto files into OUTDIR and prints the tables for configs/README.md.

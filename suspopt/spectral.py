@@ -136,34 +136,42 @@ class _Linear:
         network = full_network(model, attachments)
         self.n, self.linear, self.asm = network.n, network.linear_model(), Assembled(network, pv.P)
         self.form = self.linear.modal_form()
+        self.rest: dict[str, np.ndarray] = {}  # each signal at rest (P, 1)
+
+
+def _phasors(system: _Linear, f, q, road):
+    """The :class:`~suspopt.result.Result` whose "samples" are the complex amplitudes at
+    frequencies ``f``: DOF amplitudes ``q (n, P, F)`` and the wheels' road ``(N, F)``."""
+    from .result import Result
+
+    jw = 2j * math.pi * f
+    return Result(
+        config=system.cfg, model=system.model, time=f,
+        states=np.concatenate([q, jw * q]), accelerations=jw**2 * q,
+        road=road[:, None, :], road_vel=jw * road[:, None, :],
+        diverged_at=np.full(system.pv.P, np.nan), designs=dict(system.pv.params),
+        _assembled=system.asm, attachments=tuple(system.attachments),
+    )  # fmt: skip
 
 
 def _responses(system: _Linear, f, names) -> dict[str, list[np.ndarray]]:
-    """Each signal's complex response to each track's road (P, F) at frequencies ``f``."""
-    from .result import Result
-
-    cfg, pv, model, attachments = system.cfg, system.pv, system.model, system.attachments
-    linear, asm = system.linear, system.asm
-    omega = 2.0 * math.pi * f
-    delay = np.exp(-1j * omega[:, None] * model.offsets[None, :] / cfg.road.speed)  # (F, N)
-
-    def result(states, accelerations, road) -> Result:
-        return Result(
-            config=cfg, model=model, time=f, states=states, accelerations=accelerations,
-            road=road[:, None, :], road_vel=(1j * omega) * road[:, None, :],
-            diverged_at=np.full(pv.P, np.nan), designs=dict(pv.params), _assembled=asm,
-            attachments=tuple(attachments),
-        )  # fmt: skip
-
-    zero = np.zeros((system.n, pv.P, f.size), complex)
-    rest = result(np.concatenate([zero, zero]), zero, np.zeros((model.offsets.size, f.size)))
+    """Each signal's complex response to each track's road (P, F) at frequencies ``f``: the
+    signal of the motion less the signal of rest (its static part, the same at every
+    frequency: computed once, at one frequency)."""
+    cfg, model = system.cfg, system.model
+    delay = np.exp(-2j * math.pi * f[:, None] * model.offsets[None, :] / cfg.road.speed)
+    missing = [name for name in names if name not in system.rest]
+    if missing:
+        zero = np.zeros((system.n, system.pv.P, 1), complex)
+        rest = _phasors(system, f[:1], zero, np.zeros((model.offsets.size, 1)))
+        system.rest.update({name: rest.signals[name] for name in missing})
     out: dict[str, list[np.ndarray]] = {name: [] for name in names}
     for wheels in _tracks(cfg, model):
         inputs = delay * wheels[None, :]  # (F, N)
-        q = np.moveaxis(linear.modal_response(f, inputs, system.form), -1, 0)  # (n, P, F)
-        moving = result(np.concatenate([q, 1j * omega * q]), -(omega**2) * q, inputs.T)
+        q = np.moveaxis(system.linear.modal_response(f, inputs, system.form), -1, 0)
+        moving = _phasors(system, f, q, inputs.T)
         for name in names:
-            out[name].append(moving.signals[name] - rest.signals[name])
+            out[name].append(moving.signals[name] - system.rest[name])
     return out
 
 
@@ -283,5 +291,6 @@ def reduce(
             values[(id(spec), name)] = value
     from .result import signal_table
 
-    table = signal_table(model, {}, attachments)
-    return Reduced(model, table, values, np.full(pv.P, np.nan), "spectral")
+    return Reduced(
+        model, signal_table(model, {}, attachments), values, np.full(pv.P, np.nan), "spectral"
+    )

@@ -197,11 +197,12 @@ def reduce(
     :func:`suspopt.simulate`), without keeping the run's signals (module docstring): a
     :class:`Reduced`, or the whole :class:`~suspopt.result.Result` for a controlled run."""
     from . import integrator
-    from .simulate import _result, _setup, check_memory, prepare, simulate
+    from .simulate import _result, _run, _setup, check_memory, prepare
 
     pv, model, controller, attachments = prepare(cfg, params)
-    if controller is not None:
-        return simulate(cfg, params)
+    if controller is not None:  # the whole run (what simulate does, once prepared)
+        check_memory(cfg, model, attachments, pv.P, signals=len(requests))
+        return _run(cfg, pv, model, controller, attachments)
     kept = sorted(
         {k for spec, names in requests if METRICS[spec.metric].stream == "keep"
          for n in names for k in _kept_names(spec, n)}

@@ -554,20 +554,20 @@ def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajector
     width = n_out if width is None else width
     if controller is not None and width < n_out:
         raise ValueError("a controlled run is integrated whole (width >= its samples)")
-    window, width = width, max(P, 2)
+    columns = max(P, 2)  # (a single design as two identical columns)
     active = offsets.any(axis=(1, 2, 3))
-    if offsets.size * width <= _WIDE_OFFSETS:  # small batches: no broadcasting
-        offsets = widen(offsets, width)
+    if offsets.size * columns <= _WIDE_OFFSETS:  # small batches: no broadcasting
+        offsets = widen(offsets, columns)
     # the inputs' part of each half-step, None where it is zero (a bump's road before and after)
-    rk4 = _RK4(asm, width, dt, [o if a else None for o, a in zip(offsets, active)])
+    rk4 = _RK4(asm, columns, dt, [o if a else None for o, a in zip(offsets, active)])
     hold = None
     if controller is not None:
         hold = _controller_hold(controller, rk4, asm, n_vehicle, n_out, dt)
     divergence = _Divergence(rk4.y2, P, dt)
     splitter = _Splitter(rk4, asm, edges, n_steps) if edges is not None else None
     split = splitter.steps if splitter is not None else {}
-    for j0 in range(0, n_out, window):
-        j1 = min(j0 + window, n_out)
+    for j0 in range(0, n_out, width):
+        j1 = min(j0 + width, n_out)
         states, accelerations = np.empty((2 * n, P, j1 - j0)), np.empty((n, P, j1 - j0))
         buffers = [(rk4.y, states), (rk4.acc, accelerations)]
         if hold is not None and hold.lagged is not None:
