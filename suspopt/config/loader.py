@@ -21,6 +21,7 @@ from .control import Control
 from .metrics import MetricSpec
 from .optimise import Constraint, DesignVariable, Objectives, Optimiser
 from .road import RoadConfig
+from .scenarios import Scenarios
 from .seat import SeatConfig
 from .simulation import Execution, Output, Simulation
 from .vehicle import Vehicle, corner_defaults_schema
@@ -78,6 +79,11 @@ class Config(Section):
     )
     optimiser: Optimiser | None = Field(
         None, description="algorithm, budget and seed of suspopt optimise"
+    )
+    scenarios: Scenarios | None = Field(
+        None,
+        description="conditions (roads, speeds, loads) every design of suspopt optimise is "
+        "evaluated under; each objective and constraint combines its values over them",
     )
     execution: Execution = Field(
         default_factory=Execution,

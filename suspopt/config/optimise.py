@@ -26,6 +26,7 @@ from pydantic import Field, field_validator, model_validator
 
 from .base import Section, Seed, bounds, check_known
 from .metrics import MetricSpec
+from .scenarios import Aggregate
 
 __all__ = [
     "QUANTITIES",
@@ -138,6 +139,12 @@ class Objective(MetricSpec):
         description="design quantity computed without simulating: "
         + "; ".join(f"{k}: {v}" for k, v in QUANTITIES.items()),
     )
+    over_scenarios: Aggregate | None = Field(
+        None,
+        description="how the value combines over the scenarios: mean, max, min, std, "
+        "weighted or {quantile: q} (default: mean for an objective; max of the margin g for "
+        "a constraint, which then holds in every scenario)",
+    )
 
     @model_validator(mode="after")
     def _metric_or_quantity(self) -> Objective:
@@ -186,6 +193,11 @@ class Constraint(Objective):
         for key in ("mu", "conditions"):
             if getattr(self, key) is not None and self.quantity != "seat.geometry":
                 raise ValueError(f"{key} belongs to quantity seat.geometry")
+        if self.over_scenarios == "std":
+            raise ValueError(
+                "over_scenarios: a constraint's margin combines by max (every scenario), "
+                "mean, min, weighted or quantile, not std"
+            )
         return self
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import Config, ConfigError
-from ..io import write_dataset
+from ..io import text_array, write_dataset
 from .problem import Problem
 
 #: Format of the ``/checkpoint`` group: every evaluated design and its objectives, in batches.
@@ -39,6 +39,27 @@ def write_pareto(h5, problem: Problem, optimum, weights) -> None:
     values = {"X": optimum.X, "F": optimum.F, "G": optimum.G}
     for key, _, units, dim, names in _tables(problem, problem.var_units):
         write_dataset(pareto, key, values[key], units, dims=("design", dim), names=names)
+    if problem.scenarios is not None:
+        write_scenarios(pareto, problem, optimum.X)
+
+
+def write_scenarios(pareto, problem: Problem, X) -> None:
+    """``/pareto/scenarios``: the objectives ``F (N, S, m)`` and constraint margins
+    ``G (N, S, k)`` of the designs ``X`` (physical values) under each scenario, the scenarios'
+    names (dimension ``scenario``) and ``weight (S,)``; ``/pareto/F`` and ``G`` hold their
+    aggregates, each column's rule in the attribute ``over_scenarios``."""
+    assert problem.scenarios is not None
+    group = pareto.create_group("scenarios")
+    FS, GS = problem.scenario_values(X)
+    names = problem.scenarios.names
+    rules = problem.aggregation()
+    write_dataset(group, "scenario", names, "1", dims=("scenario",))
+    write_dataset(group, "weight", problem.scenarios.weights, "1", dims=("scenario",))
+    for (key, _, units, dim, columns), data, rule in zip(
+        _tables(problem, problem.var_units)[1:], (FS, GS), rules
+    ):
+        write_dataset(group, key, data, units, dims=("design", "scenario", dim), names=columns)
+        pareto[key].attrs["over_scenarios"] = text_array(rule)
 
 
 def write_history(h5, history: dict, best_names, best_units) -> None:

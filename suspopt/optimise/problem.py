@@ -32,12 +32,14 @@ from pymoo.core.problem import Problem as _PymooProblem
 from .. import execution, streaming
 from ..config import Config, ConfigError
 from ..config.optimise import DesignVariable, Objective
+from ..config.scenarios import CONSTRAINT_DEFAULT, OBJECTIVE_DEFAULT
 from ..control.controller import build_controller
 from ..params import ParamView, numeric_paths, one_per_run
 from ..seat import CONSTRAINT_UNITS, build_attachments, seat_constraints, seat_static_deflection
 from ..simulate import signal_table
 from ..specs import evaluate_spec, metric_unit, spec_signals
 from ..vehicle import build_vehicle
+from .scenarios import ScenarioSet, aggregate
 
 __all__ = ["Problem", "PENALTY", "BATCH_BYTES", "MAX_BATCH"]
 
@@ -53,6 +55,8 @@ BATCH_BYTES = 2 << 30
 MAX_BATCH = 2048
 
 _FAILED = "simulation_failed"
+#: The most designs whose values under every scenario an evaluation keeps (for the Pareto file).
+_REMEMBERED = 100_000
 
 
 @dataclass(frozen=True)
@@ -100,6 +104,9 @@ class Problem(_PymooProblem):
         self._supplementary = list(supplementary)
         self._sim_cfg = cfg.model_copy(update={"metrics": []})
         self._width: int | None = None
+        #: the scenarios every design is evaluated under (None: the config alone)
+        self.scenarios = ScenarioSet.from_config(cfg)
+        self._scenario_values: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
         self._simulates = any(t.spec.metric for t in self._all_terms())
         self._log = np.array([v.scale == "log" for v in self.variables])
         self._integer = np.array([v.integer for v in self.variables])
@@ -121,6 +128,21 @@ class Problem(_PymooProblem):
                         scale.append(abs(bound) or 1.0)
         self.constraint_names.append(_FAILED)
         self.constraint_units.append("1")
+        self._how = (
+            [t.spec.over_scenarios or OBJECTIVE_DEFAULT for t in self._objectives for _ in t.names],
+            [
+                t.spec.over_scenarios or CONSTRAINT_DEFAULT
+                for t in self._constraints
+                for _ in t.names
+                for b in (t.spec.min, t.spec.max)
+                if b is not None
+            ],
+            [
+                t.spec.over_scenarios or OBJECTIVE_DEFAULT
+                for t in self._supplementary
+                for _ in t.names
+            ],
+        )
         self.constraint_scale = np.array(scale + [1.0])
         lower[self._log], upper[self._log] = np.log10(lower[self._log]), np.log10(upper[self._log])
         super().__init__(
@@ -163,6 +185,9 @@ class Problem(_PymooProblem):
                 for i, s in enumerate(cfg.objectives.supplementary)
             ]
             spectral.check(cfg, specs)
+            for group in (ScenarioSet.from_config(cfg) or ScenarioSet([], [])).groups:
+                if group.cfg is not cfg:
+                    spectral.check(group.cfg, specs)
         return cls(
             cfg,
             compile_all(cfg.objectives.main, ("objectives", "main"), True),
@@ -210,18 +235,21 @@ class Problem(_PymooProblem):
             from ..simulate import prepare, run_memory
             from ..specs import METRICS
 
-            _, model, controller, attachments = prepare(self._sim_cfg)
             terms = [t for t in self._all_terms() if t.spec.metric]
             signals = len({n for t in terms for n in t.signals})
-            window, kept = None, 0
-            if controller is None:  # streamed: one window, and the kept signals whole
-                window = streaming.BLOCK
-                kept = sum(
-                    len(t.signals) for t in terms if METRICS[str(t.spec.metric)].stream == "keep"
+            kept = sum(len(t.signals) for t in terms if METRICS[str(t.spec.metric)].stream == "keep")
+            runs = [(self._sim_cfg, 1)]
+            if self.scenarios is not None:  # a design takes a column per scenario of a group
+                runs = [(g.sim_cfg, len(g.members)) for g in self.scenarios.groups]
+            per_design = 0.0
+            for sim_cfg, columns in runs:
+                _, model, controller, attachments = prepare(sim_cfg)
+                # streamed: one window, and the kept signals whole
+                window = streaming.BLOCK if controller is None else None
+                _, per_column = run_memory(
+                    sim_cfg, model, attachments, 1, signals, window, 2 * kept if window else 0
                 )
-            _, per_design = run_memory(
-                self._sim_cfg, model, attachments, 1, signals, window, 2 * kept
-            )
+                per_design = max(per_design, columns * per_column)
             cap = memory.explicit_limit()
             budget = BATCH_BYTES if cap is None else min(BATCH_BYTES, cap // 2)
             self._width = max(1, min(MAX_BATCH, int(budget // per_design)))
@@ -241,6 +269,8 @@ class Problem(_PymooProblem):
             width = min(execution.chunk_width(self.cfg.execution), self.batch_width())
             rows = [(X[s], supplementary) for s in execution.chunks(len(X), width)]
             parts = execution.map_chunks(_chunk_values, self, rows, self.cfg.execution)
+        if self.scenarios is not None:
+            self._remember(X, parts)
         for j, key in enumerate(("F", "G", "S")):
             if key in out or key != "S":
                 out[key] = (
@@ -252,8 +282,11 @@ class Problem(_PymooProblem):
                 )
 
     def _evaluate_batch(self, X, supplementary: bool):
-        """F, G (and S, or None) of one batch of designs, in one simulation that keeps no
-        signal it does not need (:func:`suspopt.streaming.reduce`)."""
+        """``(F, G, S, FS, GS)`` of one batch of designs: F, G (and S, or None), in one
+        simulation that keeps no signal it does not need (:func:`suspopt.streaming.reduce`);
+        with scenarios, one simulation per scenario group, the values of every scenario
+        ``FS (P, S, m)``, ``GS (P, S, k)`` (NaN where a scenario failed) and F, G, S their
+        aggregates (:func:`suspopt.optimise.scenarios.aggregate`); else FS, GS are None."""
         params = self.params(X)
         terms = self._objectives + self._constraints
         terms += self._supplementary if supplementary else []
@@ -263,9 +296,78 @@ class Problem(_PymooProblem):
             from .. import spectral
 
             reduce = spectral.reduce
+        if self.scenarios is not None:
+            return self._evaluate_scenarios(params, len(X), supplementary, requests, reduce)
         with np.errstate(all="ignore"):  # failed designs are flagged, not warned about
             result = reduce(self._sim_cfg, params, requests) if requests else None
-        return self.values(result, params, len(X), supplementary)
+        return (*self.values(result, params, len(X), supplementary), None, None)
+
+    def _evaluate_scenarios(self, params, P: int, supplementary: bool, requests, reduce):
+        """:meth:`_evaluate_batch` under the scenarios: every group's P x S_g columns in one
+        simulation; a design that fails in one scenario fails."""
+        assert self.scenarios is not None
+        S = len(self.scenarios.names)
+        shapes = (self.n_obj, self.n_ieq_constr - 1, len(self.supplementary_names))
+        values = [np.full((P, S, k), np.nan) for k in shapes]
+        failed = np.zeros((P, S), dtype=bool)
+        for group in self.scenarios.groups:  # one batch per road and time grid
+            columns = self.scenarios.columns(group, params, P)
+            n = P * len(group.members)
+            with np.errstate(all="ignore"):  # failed designs are flagged, not warned about
+                result = reduce(group.sim_cfg, columns, requests) if requests else None
+                raw = self._raw(result, columns, n, supplementary, group.cfg)
+            for whole, part in zip(values + [failed], raw):
+                if part is not None:  # (S_g P, ...) scenario after scenario -> (P, S_g, ...)
+                    part = part.reshape((len(group.members), P) + part.shape[1:])
+                    whole[:, group.members] = np.moveaxis(part, 0, 1)
+        FS, GS, SS = values
+        weights = self.scenarios.weights
+        with np.errstate(all="ignore"):
+            F, G, Sv = (aggregate(v, how, weights) for v, how in zip(values, self._how))
+            F, G, _ = self._penalised(F, G, None, failed.any(axis=1))
+        FS[failed], GS[failed] = np.nan, np.nan
+        GS = np.concatenate([GS, np.where(failed, PENALTY, -1.0)[..., None]], axis=-1)
+        return F, G, Sv if supplementary else None, FS, GS
+
+    def _remember(self, X, parts) -> None:
+        """Keep every scenario's values of the designs just evaluated, by their physical
+        values, for the Pareto file (:meth:`scenario_values`); at most
+        :data:`_REMEMBERED` designs, the oldest dropped first."""
+        if not len(X):
+            return
+        FS = np.concatenate([p[3] for p in parts])
+        GS = np.concatenate([p[4] for p in parts])
+        for row, fs, gs in zip(self.to_physical(X), FS, GS):
+            self._scenario_values[row.tobytes()] = (fs, gs)
+        while len(self._scenario_values) > _REMEMBERED:
+            del self._scenario_values[next(iter(self._scenario_values))]
+
+    def scenario_values(self, values) -> tuple[np.ndarray, np.ndarray]:
+        """``FS (N, S, m)``, ``GS (N, S, k)``: the objectives and constraint margins of the
+        designs of physical ``values (N, n_var)`` under every scenario (NaN where one failed,
+        and ``simulation_failed`` :data:`PENALTY` there), from the evaluations that found
+        them, else simulated now."""
+        assert self.scenarios is not None
+        values = np.atleast_2d(np.asarray(values, dtype=float))
+        missing = [i for i, row in enumerate(values) if row.tobytes() not in self._scenario_values]
+        if missing:
+            self.evaluate(self.to_search(values[missing]), return_values_of=["F", "G"])
+        found = [self._scenario_values.get(row.tobytes()) for row in values]
+        S = len(self.scenarios.names)
+        empty = (np.full((S, self.n_obj), np.nan), np.full((S, self.n_ieq_constr), np.nan))
+        found = [f if f is not None else empty for f in found]
+        return (
+            np.array([f[0] for f in found]).reshape(len(values), S, self.n_obj),
+            np.array([f[1] for f in found]).reshape(len(values), S, self.n_ieq_constr),
+        )
+
+    def aggregation(self) -> tuple[list[str], list[str]]:
+        """How each objective and each constraint combines over the scenarios, as text
+        (``mean``, ``max``, ``quantile 0.9``, ...; ``any`` for ``simulation_failed``)."""
+        def text(rule) -> str:
+            return rule if isinstance(rule, str) else f"quantile {rule.quantile:g}"
+
+        return [text(r) for r in self._how[0]], [text(r) for r in self._how[1]] + ["any"]
 
     def values(self, result, params: dict[str, np.ndarray], P: int, supplementary: bool = False):
         """``(F, G, S)`` of P designs from their simulation ``result`` (None when no term
@@ -273,25 +375,35 @@ class Problem(_PymooProblem):
         constraints with ``simulation_failed`` last, and the supplementary objectives (None
         unless asked), failed designs penalised (module docstring)."""
         with np.errstate(all="ignore"):  # failed designs are flagged below, not warned about
-            F = _stack(self._objectives, self.cfg, result, params, P)
-            G = self._constraint_values(result, params, P)
-            failed = ~(np.isfinite(F).all(axis=1) & np.isfinite(G).all(axis=1))
-            if result is not None:
-                failed |= result.diverged
-            S = _stack(self._supplementary, self.cfg, result, params, P) if supplementary else None
-            return (
-                np.where(failed[:, None], PENALTY, F),
-                np.column_stack(
-                    [np.where(np.isfinite(G), G, PENALTY), np.where(failed, PENALTY, -1.0)]
-                ),
-                S,
-            )
+            F, G, S, failed = self._raw(result, params, P, supplementary, self.cfg)
+            return self._penalised(F, G, S, failed)
 
-    def _constraint_values(self, result, params, P: int) -> np.ndarray:
+    def _raw(self, result, params, P: int, supplementary: bool, cfg: Config):
+        """``(F, G, S, failed)`` of P designs, unpenalised: G without ``simulation_failed``,
+        S None unless asked, ``failed (P,)`` where a design diverged or a value is not
+        finite."""
+        F = _stack(self._objectives, cfg, result, params, P)
+        G = self._constraint_values(result, params, P, cfg)
+        failed = ~(np.isfinite(F).all(axis=1) & np.isfinite(G).all(axis=1))
+        if result is not None:
+            failed |= result.diverged
+        S = _stack(self._supplementary, cfg, result, params, P) if supplementary else None
+        return F, G, S, failed
+
+    @staticmethod
+    def _penalised(F, G, S, failed):
+        """F, G (with ``simulation_failed`` last) and S, failed designs penalised."""
+        return (
+            np.where(failed[:, None], PENALTY, F),
+            np.column_stack([np.where(np.isfinite(G), G, PENALTY), np.where(failed, PENALTY, -1.0)]),
+            S,
+        )
+
+    def _constraint_values(self, result, params, P: int, cfg: Config) -> np.ndarray:
         """``g = min - value`` and ``g = value - max`` of every constraint column, (P, k)."""
         columns = []
         for term in self._constraints:
-            values = _values(term, self.cfg, result, params)
+            values = _values(term, cfg, result, params)
             for j in range(values.shape[1]):
                 if term.spec.min is not None:
                     columns.append(term.spec.min - values[:, j])
@@ -301,7 +413,7 @@ class Problem(_PymooProblem):
 
 
 def _chunk_values(problem: Problem, rows: tuple[np.ndarray, bool]):
-    """In a worker: ``(F, G, S)`` of one chunk of designs (:mod:`suspopt.execution`)."""
+    """In a worker: ``(F, G, S, FS, GS)`` of one chunk of designs (:mod:`suspopt.execution`)."""
     return problem._evaluate_batch(*rows)
 
 
