@@ -19,7 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .config import Config
+from .config import Config, ConfigError
 from .config.road import BumpHalfSine, BumpStep, Iso8608Road
 from .network import Network
 
@@ -295,5 +295,41 @@ def check_config(cfg: Config, optimisation: bool = True) -> None:
         build_attachments(cfg, pv),
         what=" at a corner of the design variables' bounds",
     )
+    if problem.scenarios is not None:
+        check_scenarios(cfg, problem)
     if cfg.optimiser is not None:
         build_optimiser(cfg, problem)
+
+
+def check_scenarios(cfg: Config, problem) -> None:
+    """What :func:`check_config` checks of the config, for every scenario group of
+    ``problem`` (:mod:`suspopt.optimise.scenarios`): its road and time grid, and RK4's
+    stability limit at the corners of the design variables' bounds under each of its
+    scenarios; reported at the scenario's key."""
+    from .optimise.scenarios import Group
+    from .params import ParamView
+    from .seat import build_attachments
+    from .simulate import prepare
+    from .vehicle import build_vehicle
+
+    corners = bound_corners(cfg)
+    count = len(next(iter(corners.values())))
+    scenarios = problem.scenarios
+    for group in scenarios.groups:
+        for member, values, scales in zip(group.members, group.values, group.scales):
+            scenario = scenarios.scenarios[member]
+            try:
+                if group.cfg is not cfg:
+                    prepare(group.cfg)
+                alone = Group(group.cfg, [member], [values], [scales])
+                pv = ParamView(group.cfg, scenarios.columns(alone, corners, count))
+                check_stability(
+                    group.cfg,
+                    pv,
+                    build_vehicle(group.cfg, pv),
+                    build_attachments(group.cfg, pv),
+                    what=" at a corner of the design variables' bounds",
+                )
+            except ConfigError as exc:
+                message = str(exc).split(": ", 1)[-1]
+                raise cfg.error(scenario.loc, f"in scenario {scenario.name}: {message}") from None

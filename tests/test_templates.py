@@ -44,7 +44,7 @@ def test_an_unknown_template_is_refused_with_the_closest_names():
     with pytest.raises(ValueError, match="unknown template 'quater'; did you mean quarter"):
         template_text("quater")
     with pytest.raises(ValueError, match="unknown template"):
-        template_description("robust")
+        template_description("hovercraft")
 
 
 @pytest.mark.parametrize("name", NAMES)

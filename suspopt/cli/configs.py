@@ -88,7 +88,7 @@ def init(
         claim_output(stack, output, force)
         with atomic_file(output) as stream:
             stream.write(text.encode())
-    command = "optimise" if kind in ("optimise", "kesort", "spectral") else "simulate"
+    command = "optimise" if kind in ("optimise", "kesort", "spectral", "robust") else "simulate"
     out.print(
         f"wrote {output}; next: suspopt validate {output}, then suspopt {command} "
         f"{output} -o {Path(output).with_suffix('.h5')}"

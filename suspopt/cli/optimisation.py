@@ -157,6 +157,16 @@ def _optimise(
             "weighted sum (Eq 5.7): "
             + " + ".join(f"{w:.4g} {name}" for w, name in zip(result.weights, result.obj_names))
         )
+    if cfg.scenarios is not None:
+        from ..optimise import Problem
+
+        problem = Problem.from_config(cfg)
+        rules = problem.aggregation()[0]
+        out.print(
+            f"over {len(problem.scenarios.names)} scenarios: "
+            + ", ".join(f"{name} {rule}" for name, rule in zip(problem.obj_names, rules))
+            + f"; every scenario's values in {output}:/pareto/scenarios"
+        )
     if result.status == "interrupted":
         err.print(
             f"wrote the designs found so far to {output}; continue with "

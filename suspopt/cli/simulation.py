@@ -107,6 +107,12 @@ def simulate(
     zipped: bool = typer.Option(
         False, "--zip", help="pair the --sweep values instead of taking every combination"
     ),
+    scenario: str | None = typer.Option(
+        None,
+        "--scenario",
+        help="NAME: simulate under this scenario of the config's scenarios: section "
+        "(robust design) instead of the config as written",
+    ),
     plot: Path | None = base.plot_option(
         "the signals over time, their PSD and the ISO 2631 comfort levels"
     ),
@@ -122,7 +128,7 @@ def simulate(
         base.claim_output(stack, output, force)
         base.claim_output(stack, plot, force, "--plot")
         try:
-            _simulate(source, output, pick, set_, sweep_, zipped, plot)
+            _simulate(source, output, pick, set_, sweep_, zipped, plot, scenario)
         except (ConfigError, ValueError) as exc:
             base.fail(str(exc))
 
@@ -155,6 +161,55 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
     return cfg, params, picked
 
 
+def _under_scenario(cfg, params, picked, name: str):
+    """The config and designs of ``simulate --scenario NAME``: the scenario's road and time
+    grid, its per-design values over the designs' own; the picks' stored objectives become
+    that scenario's (``/pareto/scenarios/F``), or NaN where the file has none."""
+    import dataclasses
+    import difflib
+
+    import numpy as np
+
+    from ..optimise.scenarios import Group, ScenarioSet
+
+    scenarios = ScenarioSet.from_config(cfg)
+    where = cfg.source if cfg.source is not None else "the config"
+    if scenarios is None:
+        raise ConfigError(f"--scenario {name}: {where} has no scenarios: section")
+    if name not in scenarios.names:
+        close = difflib.get_close_matches(name, scenarios.names, n=3)
+        raise ConfigError(
+            f"--scenario {name}: no such scenario; "
+            + (
+                f"did you mean {', '.join(close)}?"
+                if close
+                else f"it has {', '.join(scenarios.names)}"
+            )
+        )
+    s = scenarios.names.index(name)
+    group = next(g for g in scenarios.groups if s in g.members)
+    k = group.members.index(s)
+    alone = Group(group.cfg, [s], [group.values[k]], [group.scales[k]])
+    P = len(next(iter(params.values()))) if params else 1
+    params = scenarios.columns(alone, dict(params or {}), P) or None
+    if picked is not None:
+        stored = np.full_like(picked.F, np.nan)
+        if picked.table == "pareto":
+            from ..h5read import H5Reader
+
+            with H5Reader(picked.source) as h5:
+                if h5._node("pareto/scenarios/F") is not None:
+                    FS = h5.array("pareto/scenarios/F", ndim=3, columns=picked.F.shape[1])
+                    if FS.shape[1] != len(scenarios.names) or len(FS) <= picked.rows.max():
+                        raise ConfigError(
+                            f"{picked.source}: /pareto/scenarios/F: shape {FS.shape} does "
+                            f"not fit /pareto/F and the config's {len(scenarios.names)} scenarios"
+                        )
+                    stored = FS[picked.rows, s]
+        picked = dataclasses.replace(picked, F=stored)
+    return group.cfg, params, picked
+
+
 def _picks_writer(picked, objectives):
     """Writes the picks' names, rows and objectives (new and stored) beside the signals."""
     from ..io import write_dataset
@@ -179,7 +234,7 @@ def _picks_writer(picked, objectives):
     return extra
 
 
-def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
+def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=None) -> None:
     import numpy as np
 
     from ..checks import check_config, check_stability
@@ -192,6 +247,8 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
 
         check_path(plot)
     cfg, params, picked = _inputs(source, pick, sets, sweeps, zipped)
+    if scenario is not None:
+        cfg, params, picked = _under_scenario(cfg, params, picked, scenario)
     check_config(cfg, optimisation=False)
     pv, model, controller, attachments = prepare(cfg, params)
     written = (
@@ -235,7 +292,7 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
         base.show_table(_metrics_table(result), keys=2)
     extra = None
     if picked is not None:
-        objectives = _pick_objectives(picked, cfg, result)
+        objectives = _pick_objectives(picked, cfg, result, params)
         base.show_table(_picks_table(picked, *objectives), keys=3)
         extra = _picks_writer(picked, objectives)
     if output is not None:
@@ -257,15 +314,15 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot) -> None:
         out.print(f"wrote {plot}")
 
 
-def _pick_objectives(picked, cfg, result):
-    """The picked designs' main and supplementary objectives from their new simulation:
-    ``(F (P, m + s), names, units)``."""
+def _pick_objectives(picked, cfg, result, params):
+    """The picked designs' main and supplementary objectives from their new simulation of
+    ``params``: ``(F (P, m + s), names, units)``."""
     import numpy as np
 
     from ..optimise import Problem
 
     problem = Problem.from_config(cfg)
-    F, _, S = problem.values(result, picked.params(), len(picked.rows), supplementary=True)
+    F, _, S = problem.values(result, params, len(picked.rows), supplementary=True)
     return (
         np.hstack([F, S]),
         problem.obj_names + problem.supplementary_names,

@@ -237,7 +237,9 @@ class Problem(_PymooProblem):
 
             terms = [t for t in self._all_terms() if t.spec.metric]
             signals = len({n for t in terms for n in t.signals})
-            kept = sum(len(t.signals) for t in terms if METRICS[str(t.spec.metric)].stream == "keep")
+            kept = sum(
+                len(t.signals) for t in terms if METRICS[str(t.spec.metric)].stream == "keep"
+            )
             runs = [(self._sim_cfg, 1)]
             if self.scenarios is not None:  # a design takes a column per scenario of a group
                 runs = [(g.sim_cfg, len(g.members)) for g in self.scenarios.groups]
@@ -364,6 +366,7 @@ class Problem(_PymooProblem):
     def aggregation(self) -> tuple[list[str], list[str]]:
         """How each objective and each constraint combines over the scenarios, as text
         (``mean``, ``max``, ``quantile 0.9``, ...; ``any`` for ``simulation_failed``)."""
+
         def text(rule) -> str:
             return rule if isinstance(rule, str) else f"quantile {rule.quantile:g}"
 
@@ -395,7 +398,9 @@ class Problem(_PymooProblem):
         """F, G (with ``simulation_failed`` last) and S, failed designs penalised."""
         return (
             np.where(failed[:, None], PENALTY, F),
-            np.column_stack([np.where(np.isfinite(G), G, PENALTY), np.where(failed, PENALTY, -1.0)]),
+            np.column_stack(
+                [np.where(np.isfinite(G), G, PENALTY), np.where(failed, PENALTY, -1.0)]
+            ),
             S,
         )
 

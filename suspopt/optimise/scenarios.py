@@ -117,14 +117,18 @@ def _combined(cfg: Config, parts: list[Scenario]) -> Scenario:
                 raise cfg.error(part.load_loc or part.loc, "load_mass is given by two lists")
             load, load_loc = part.load_mass, part.load_loc
     weight = float(np.prod([p.weight for p in parts]))
-    return Scenario("/".join(p.name for p in parts), weight, sets, locs, load, load_loc, parts[0].loc)
+    return Scenario(
+        "/".join(p.name for p in parts), weight, sets, locs, load, load_loc, parts[0].loc
+    )
 
 
 def expand(cfg: Config) -> list[Scenario]:
     """The scenarios of ``cfg.scenarios`` in order: nominal, the cases, the product."""
     section = cfg.scenarios
     assert section is not None
-    out = [Scenario("nominal", 1.0, {}, {}, loc=("scenarios", "nominal"))] if section.nominal else []
+    out = (
+        [Scenario("nominal", 1.0, {}, {}, loc=("scenarios", "nominal"))] if section.nominal else []
+    )
     out += [_one(c, ("scenarios", "cases", i)) for i, c in enumerate(section.cases)]
     factors = [
         [_one(c, ("scenarios", "product", i, j)) for j, c in enumerate(factor)]
@@ -171,7 +175,9 @@ def _per_design(cfg: Config, scenario: Scenario, designed: set[str]) -> dict[str
         if path in designed:
             raise cfg.error(loc, f"{path} is a design variable; a scenario cannot fix it")
         low, low_closed, high, high_closed = field_range(cfg, path)
-        if not (low < value < high or (value == low and low_closed) or (value == high and high_closed)):
+        if not (
+            low < value < high or (value == low and low_closed) or (value == high and high_closed)
+        ):
             raise cfg.error(loc, f"{path} must be in [{low:g}, {high:g}], got {value:g}")
         values[path] = float(value)
     return values
@@ -187,7 +193,9 @@ def _load_changes(cfg: Config, scenario: Scenario, designed: set[str], values: d
         raise cfg.error(loc, "load_mass needs a seat: section")
     for path in designed:
         if path == "seat.mass" or path.startswith("seat.passenger."):
-            raise cfg.error(loc, f"load_mass changes the passenger, and {path} is a design variable")
+            raise cfg.error(
+                loc, f"load_mass changes the passenger, and {path} is a design variable"
+            )
     old = float(build_seat(cfg).isolator["load_mass"][0])
     lowest = cfg.seat.mass if cfg.seat.passenger is not None else 0.0
     new = float(scenario.load_mass)  # type: ignore[arg-type]

@@ -27,6 +27,7 @@ TEMPLATES: dict[str, str] = {
     "optimise": "GA on the Ch. 5 half car (Case 1: comfort under Eq 5.2-5.3), small budget",
     "kesort": "NSGA-II front of Ch. 6 Part B with supplementary objectives, for suspopt kesort",
     "spectral": "NSGA-II of the Ch. 8 PS seat on class A by the stationary spectral method",
+    "robust": "the Ch. 8 PS seat in the worst of classes A-C x 75/95/115 kg (scenarios)",
 }
 
 

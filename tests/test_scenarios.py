@@ -1,0 +1,305 @@
+"""Robust design: the scenarios: section, its batches and its aggregates (issue 18)."""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+from conftest import CONFIGS, ROOT
+
+import suspopt
+from suspopt import streaming
+from suspopt.config import ConfigError
+from suspopt.config.loader import load_config_text
+from suspopt.config.scenarios import Quantile
+from suspopt.optimise import Problem
+from suspopt.optimise.scenarios import aggregate
+from suspopt.seat import passenger_mass_change
+
+TEMPLATE = (ROOT / "suspopt" / "templates" / "optimise.yaml").read_text()
+BASE = TEMPLATE.replace("duration: 3.0 ", "duration: 1.5 ")
+assert BASE != TEMPLATE
+
+
+def _problem(extra: str = "", base: str = BASE) -> Problem:
+    return Problem.from_config(load_config_text(base + extra))
+
+
+def _designs(problem: Problem, n: int = 6) -> np.ndarray:
+    return np.random.default_rng(3).uniform(problem.xl, problem.xu, (n, problem.n_var))
+
+
+def _evaluate(problem: Problem, X):
+    return problem.evaluate(X, return_values_of=["F", "G"])
+
+
+def test_one_scenario_is_the_plain_config_bit_for_bit():
+    plain = _problem()
+    X = _designs(plain)
+    F0, G0 = _evaluate(plain, X)
+    for extra in (
+        "scenarios: {nominal: true}\n",
+        "scenarios:\n  nominal: false\n  cases: [{name: only}]\n",
+    ):
+        F, G = _evaluate(_problem(extra), X)
+        assert np.array_equal(F, F0) and np.array_equal(G, G0)
+
+
+def test_max_over_two_identical_scenarios_equals_either():
+    heavy = BASE.replace("mass: 2210 ", "mass: 2500 ")
+    assert heavy != BASE
+    X = _designs(_problem())
+    F1, G1 = _evaluate(_problem(base=heavy), X)
+    twice = """scenarios:
+  nominal: false
+  cases:
+    - {name: one, set: {vehicle.body.mass: 2500}}
+    - {name: two, set: {vehicle.body.mass: 2500}}
+"""
+    text = BASE.replace("signal: body.heave_acc}", "signal: body.heave_acc, over_scenarios: max}")
+    F, G = _evaluate(_problem(twice, base=text), X)
+    assert np.array_equal(F, F1) and np.array_equal(G, G1)
+
+
+def test_a_constraint_violated_in_one_scenario_makes_the_design_infeasible():
+    ratio = "  - {name: ratio, metric: spring_usage, min: 0.1, max: 0.3}\n"
+    assert ratio in BASE
+    base = BASE.replace(ratio, "")
+    X = _designs(_problem(base=base), 40)
+    _, G = _evaluate(_problem(base=base), X)
+    limit = float(np.median(G[:, 0] + 0.8)) * 1.2  # RC_s: about half the designs hold it
+    base = base.replace("max: 0.8}", f"max: {limit!r}}}")
+    _, G0 = _evaluate(_problem(base=base), X)
+    problem = _problem("scenarios:\n  cases: [{name: high, set: {road.height: 0.08}}]\n", base)
+    _, G = _evaluate(problem, X)
+    FS, GS = problem.scenario_values(problem.to_physical(X))
+    only_nominal = (G0 <= 0).all(axis=1) & ~(GS[:, 1] <= 0).all(axis=1)
+    assert only_nominal.any(), "the test needs a design feasible on the nominal bump only"
+    assert not (G[only_nominal] <= 0).all(axis=1).any()
+    # the margins combine by max: every scenario must hold
+    assert np.array_equal(G[:, :-1], np.maximum(GS[:, 0, :-1], GS[:, 1, :-1]))
+    assert np.array_equal(GS[:, 0], G0)
+
+
+def test_designs_times_scenarios_run_in_one_call_per_road(monkeypatch):
+    calls = []
+    reduce = streaming.reduce
+
+    def counted(cfg, params, requests):
+        calls.append((cfg.road.height, len(next(iter(params.values())))))
+        return reduce(cfg, params, requests)
+
+    monkeypatch.setattr(streaming, "reduce", counted)
+    masses = """scenarios:
+  cases:
+    - {name: heavy, set: {vehicle.body.mass: 2500}}
+    - {name: light, set: {vehicle.body.mass: 1900, vehicle.corners.R1.unsprung_mass: 80}}
+    - {name: stiff_tyres, set: {vehicle.corners.F1.tyre.stiffness: 5.0e5}}
+"""
+    problem = _problem(masses)
+    X = _designs(problem, 7)
+    _evaluate(problem, X)
+    assert calls == [(0.05, 7 * 4)]
+    calls.clear()
+    roads = masses + "    - {name: high, set: {road.height: 0.07}}\n"
+    _evaluate(_problem(roads), X)
+    assert calls == [(0.05, 7 * 4), (0.07, 7)]
+
+
+def test_each_scenario_column_is_that_config_simulated_alone():
+    problem = _problem(
+        "scenarios:\n  cases:\n    - {name: heavy, set: {vehicle.body.mass: 2500}}\n"
+        "    - {name: high, set: {road.height: 0.07}}\n"
+    )
+    X = _designs(problem, 4)
+    FS, GS = problem.scenario_values(problem.to_physical(X))
+    for j, (old, new) in enumerate(
+        [("mass: 2210 ", "mass: 2500 "), ("height: 0.05 ", "height: 0.07 ")]
+    ):
+        changed = BASE.replace(old, new)
+        assert changed != BASE
+        F, G = _evaluate(_problem(base=changed), X)
+        assert np.array_equal(FS[:, j + 1], F) and np.array_equal(GS[:, j + 1], G)
+
+
+def test_aggregates_follow_their_definitions():
+    rng = np.random.default_rng(0)
+    values = rng.normal(size=(5, 4, 6))
+    weights = np.array([1.0, 2.0, 0.5, 3.0])
+    how = ["mean", "max", "min", "std", "weighted", Quantile(quantile=0.25)]
+    out = aggregate(values, how, weights)
+    assert np.allclose(out[:, 0], values[:, :, 0].mean(axis=1))
+    assert np.array_equal(out[:, 1], values[:, :, 1].max(axis=1))
+    assert np.array_equal(out[:, 2], values[:, :, 2].min(axis=1))
+    assert np.allclose(out[:, 3], values[:, :, 3].std(axis=1))
+    assert np.allclose(out[:, 4], (values[:, :, 4] * weights).sum(axis=1) / weights.sum())
+    assert np.allclose(out[:, 5], np.quantile(values[:, :, 5], 0.25, axis=1))
+    assert not np.allclose(out[:, 4], values[:, :, 4].mean(axis=1))
+
+
+def test_objective_aggregate_from_the_config():
+    text = BASE.replace(
+        "signal: body.heave_acc}", "signal: body.heave_acc, over_scenarios: {quantile: 0.5}}"
+    )
+    problem = _problem(
+        "scenarios:\n  cases:\n    - {name: a, set: {road.height: 0.04}}\n"
+        "    - {name: b, set: {road.height: 0.06}, weight: 3}\n",
+        base=text,
+    )
+    X = _designs(problem, 5)
+    F, _ = _evaluate(problem, X)
+    FS, _ = problem.scenario_values(problem.to_physical(X))
+    assert np.array_equal(F[:, 0], np.median(FS[:, :, 0], axis=1))
+    assert problem.aggregation()[0] == ["quantile 0.5"]
+
+
+def test_load_mass_follows_the_rule_of_analyse_masses():
+    cfg = suspopt.load_config(CONFIGS / "ch8" / "pareto_ps_class_a.yaml")
+    text = cfg.text.replace("duration: 30.0", "duration: 2.0")
+    plain = Problem.from_config(load_config_text(text))
+    problem = Problem.from_config(
+        load_config_text(text + "scenarios:\n  cases: [{name: heavy, load_mass: 115}]\n")
+    )
+    X = _designs(problem, 3)
+    FS, _ = problem.scenario_values(problem.to_physical(X))
+    params = plain.params(X)
+    params.update({k: np.repeat(v, 3) for k, v in passenger_mass_change(plain.cfg, 115.0).items()})
+    result = suspopt.simulate(
+        plain._sim_cfg.model_copy(update={"metrics": [plain.cfg.objectives.main[0]]}), params
+    )
+    assert np.array_equal(FS[:, 1, 0], result.metrics["RC_se"])
+    # X_ST follows the load: K_v stays, m grows
+    assert np.allclose(FS[:, 1, 1], FS[:, 0, 1] * 115 / 95)
+
+
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        ("  cases: [{name: a, set: {vehicle.body.mas: 1}}]\n", "did you mean vehicle.body.mass"),
+        (
+            "  cases: [{name: a, set: {vehicle.corners.F1.damper.c: 3000}}]\n",
+            "is a design variable",
+        ),
+        ("  cases: [{name: a, set: {optimiser.seed: 3}}]\n", "cannot change optimiser"),
+        ("  cases: [{name: a, set: {vehicle.body.mass: heavy}}]\n", "takes a number"),
+        ("  cases: [{name: a, set: {vehicle.body.mass: -5}}]\n", "must be in"),
+        ("  cases: [{name: a, set: {road.road_class: C}}]\n", "road.road_class: unknown key"),
+        ("  cases: [{name: a}, {name: a}]\n", "two scenarios are named 'a'"),
+        ("  cases: [{name: nominal}]\n", "two scenarios are named 'nominal'"),
+        ("  cases: [{name: a, load_mass: 80}]\n", "load_mass needs a seat"),
+        ("  cases: [{name: a, set: {road.height: .inf}}]\n", "must be finite"),
+        (
+            "  product: [[{name: a, set: {road.height: 0.04}}], [{name: b, set: {road.height: 0.06}}]]\n",
+            "set by another product list",
+        ),
+        (
+            "  product: ["
+            + ", ".join(["[" + ", ".join(f"{{name: n{i}}}" for i in range(7)) + "]"] * 3)
+            + "]\n",
+            "more than 256",
+        ),
+        ("  nominal: false\n", "no scenario"),
+        ("  cases: [{name: a/b}]\n", "String should match pattern"),
+    ],
+)
+def test_bad_scenarios_name_their_key(extra, message):
+    text = BASE + "scenarios:\n" + extra
+    with pytest.raises(ConfigError) as err:
+        Problem.from_config(load_config_text(text))
+    assert message in str(err.value)
+    assert str(err.value).startswith("<config>:")
+    assert "scenarios" in str(err.value)
+
+
+def test_a_constraint_cannot_combine_by_std():
+    text = BASE.replace("max: 0.8}", "max: 0.8, over_scenarios: std}")
+    with pytest.raises(ConfigError, match="not std"):
+        load_config_text(text)
+
+
+def test_validate_checks_stability_in_each_scenario(tmp_path):
+    from suspopt.checks import check_config
+
+    cfg = load_config_text(
+        BASE
+        + "scenarios:\n  cases: [{name: hard_tyre, set: {vehicle.corners.F1.tyre.stiffness: 1.0e9}}]\n"
+    )
+    with pytest.raises(ConfigError, match="in scenario hard_tyre: simulation.dt"):
+        check_config(cfg)
+
+
+def test_the_pareto_file_holds_every_scenario(tmp_path):
+    from suspopt.optimise import optimise
+
+    text = BASE.replace("population: 50 ", "population: 8 ").replace(
+        "generations: 20 ", "generations: 2 "
+    )
+    text = text.replace("algorithm: ga ", "algorithm: nsga2 ")
+    text = text.replace(
+        "  supplementary:",
+        "    - {name: travel, metric: var, signal: travel, reduce: mean, over_scenarios: max}\n  supplementary:",
+    )
+    text += "scenarios:\n  cases: [{name: high, set: {road.height: 0.07}, weight: 2}]\n"
+    path = tmp_path / "robust.yaml"
+    path.write_text(text)
+    out = tmp_path / "robust.h5"
+    optimise(suspopt.load_config(path), out)
+    with h5py.File(out) as h5:
+        F, G = h5["pareto/F"][...], h5["pareto/G"][...]
+        FS, GS = h5["pareto/scenarios/F"][...], h5["pareto/scenarios/G"][...]
+        names = [n.decode() for n in h5["pareto/scenarios/scenario"][...]]
+        assert names == ["nominal", "high"]
+        assert list(h5["pareto/scenarios/weight"][...]) == [1.0, 2.0]
+        assert FS.shape == (len(F), 2, 2) and GS.shape == (len(G), 2, G.shape[1])
+        assert list(h5["pareto/F"].attrs["over_scenarios"]) == ["mean", "max"]
+        assert np.array_equal(F[:, 0], FS[:, :, 0].mean(axis=1))
+        assert np.array_equal(F[:, 1], FS[:, :, 1].max(axis=1))
+        assert np.array_equal(G[:, :-1], GS[:, :, :-1].max(axis=1))
+        assert h5["pareto/scenarios/F"].attrs["units"][0] == h5["pareto/F"].attrs["units"][0]
+    # kesort sorts on the aggregates
+    from suspopt.selection import read_pareto
+
+    assert read_pareto(out).F.shape == F.shape
+
+
+@pytest.mark.cli
+def test_simulate_a_pick_under_one_scenario(tmp_path):
+    from typer.testing import CliRunner
+
+    from suspopt.cli import app
+    from suspopt.templates import template_text
+
+    text = template_text("robust").replace("population: 30 ", "population: 8 ")
+    text = text.replace("generations: 15 ", "generations: 2 ")
+    config = tmp_path / "robust.yaml"
+    config.write_text(text)
+    front = tmp_path / "front.h5"
+    runner = CliRunner()
+    res = runner.invoke(app, ["optimise", str(config), "-o", str(front)])
+    assert res.exit_code == 0, res.output
+    assert "over 9 scenarios: RC_se max, X_ST max" in res.output
+    out = tmp_path / "knee.h5"
+    args = ["simulate", str(front), "--pick", "knee", "--scenario", "C/115kg", "-o", str(out)]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    with h5py.File(front) as h5:
+        rows = h5["pareto/scenarios/F"][...][:, 8]  # C/115kg, the last of the product
+    with h5py.File(out) as h5:
+        row = int(h5["designs/row"][0])
+        stored = h5["objectives/stored_F"][0]
+        simulated = h5["objectives/F"][0]
+        assert h5["signals/seat.acc"].shape[0] == 1
+    assert np.array_equal(stored, rows[row])
+    assert simulated[1] == stored[1]  # X_ST under the 115 kg load, no simulation needed
+    assert abs(simulated[0] / stored[0] - 1) < 0.05  # RC_se: 10 s in time, stationary stored
+    for bad, message in (
+        (["--scenario", "C/115"], "did you mean C/115kg"),
+        (["--scenario", "nominal"], "no such scenario"),
+    ):
+        res = runner.invoke(app, ["simulate", str(front), "--pick", "knee", *bad])
+        assert res.exit_code == 2 and message in res.output, res.output
+        assert len(res.output.strip().splitlines()) == 1
+    plain = tmp_path / "plain.yaml"
+    plain.write_text(template_text("quarter"))
+    res = runner.invoke(app, ["simulate", str(plain), "--scenario", "A"])
+    assert res.exit_code == 2 and "has no scenarios: section" in res.output
