@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 import suspopt
+from suspopt import streaming
 from suspopt.config.loader import edit_config, set_path
 from suspopt.kesort import pareto_picks
 from suspopt.optimise.run import optimise
@@ -83,8 +84,11 @@ def _travel(problem, X: np.ndarray, seat: str) -> np.ndarray:
             data["simulation"]["method"] = "time"
 
         cfg = edit_config(group.cfg.text, timed, group.cfg.source)
-        result = suspopt.simulate(cfg, scenarios.columns(group, params, len(X)))
-        values = result.metrics["travel"].reshape(len(group.members), len(X))
+        spec = cfg.metrics[0]
+        roads = {"roads": group.roads} if group.roads else {}
+        columns = scenarios.columns(group, params, len(X))
+        result = streaming.reduce(cfg, columns, [(spec, [spec.signal])], **roads)
+        values = result.metric(spec, spec.signal).reshape(len(group.members), len(X))
         out[:, group.members] = values.T
     return out
 

@@ -316,18 +316,20 @@ def check_scenarios(cfg: Config, problem) -> None:
     count = len(next(iter(corners.values())))
     scenarios = problem.scenarios
     for group in scenarios.groups:
-        for member, values, scales in zip(group.members, group.values, group.scales):
+        for member, values, scales, member_cfg in zip(
+            group.members, group.values, group.scales, group.configs
+        ):
             scenario = scenarios.scenarios[member]
             try:
-                if group.cfg is not cfg:
-                    prepare(group.cfg)
-                alone = Group(group.cfg, [member], [values], [scales])
-                pv = ParamView(group.cfg, scenarios.columns(alone, corners, count))
+                if member_cfg is not cfg:
+                    prepare(member_cfg)
+                alone = Group(member_cfg, [member], [values], [scales], [member_cfg])
+                pv = ParamView(member_cfg, scenarios.columns(alone, corners, count))
                 check_stability(
-                    group.cfg,
+                    member_cfg,
                     pv,
-                    build_vehicle(group.cfg, pv),
-                    build_attachments(group.cfg, pv),
+                    build_vehicle(member_cfg, pv),
+                    build_attachments(member_cfg, pv),
                     what=" at a corner of the design variables' bounds",
                 )
             except ConfigError as exc:

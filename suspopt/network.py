@@ -455,8 +455,9 @@ class Assembled:
         """A function ``(y2, offset, coef, inverse_mass, acc2, acc) -> None`` that writes
         ``q''`` of ``width`` design columns (default P) into ``acc``.
 
-        ``y2 = [q; v]`` (2n, width); ``offset`` (2R, 1|width, 1), or None where the inputs
-        are zero; ``coef`` (2R, width, 1);
+        ``y2 = [q; v]`` (2n, width); ``offset`` (2R, 1|width, 1), or (2R, G, 1) for G
+        roads, each under its own block of ``width / G`` consecutive columns, or None where
+        the inputs are zero; ``coef`` (2R, width, 1);
         ``inverse_mass`` (n, width, 1), scaled when the caller wants a multiple of q'';
         ``acc2``/``acc`` the (n, width) and (n, width, 1) views of the output. Its buffers for
         the deformations and forces are allocated once, with the non-linear parts' views into
@@ -475,7 +476,10 @@ class Assembled:
         def evaluate(y2, offset, coef, inverse_mass, acc2, acc) -> None:
             product(D2, y2, out=e2)
             if offset is not None:
-                e.__iadd__(offset)
+                if offset.shape[1] in (1, width):
+                    e.__iadd__(offset)
+                else:  # a road per block of columns
+                    e.reshape(2 * R, offset.shape[1], -1).__iadd__(offset)
             multiply(coef, e, out=linear)
             for elastic, viscous, disp, rate, out, fn, uses_force in extras:
                 fn(disp, rate, add(elastic, viscous) if uses_force else None, out)

@@ -159,14 +159,17 @@ def _run(
     model: VehicleModel,
     controller: Controller | None,
     attachments: Sequence[Attachment],
+    roads: Sequence[Any] | None = None,
 ) -> Result:
-    """The integration and its :class:`Result`; a batch of several designs goes to the
-    executor in force (:mod:`suspopt.execution`) in chunks when that is not ``local``."""
+    """The integration and its :class:`Result` (``roads``: :func:`_setup`); a batch of
+    several designs on one road goes to the executor in force (:mod:`suspopt.execution`) in
+    chunks when that is not ``local``."""
     from . import execution
 
     sim = cfg.simulation
-    run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments)
-    if pv.P > 1 and pv.params and not execution.is_local(cfg.execution):
+    run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments, roads)
+    chunked = pv.P > 1 and pv.params and not roads and not execution.is_local(cfg.execution)
+    if chunked:
         rows = execution.chunks(pv.P, execution.chunk_width(cfg.execution))
         designs = [{k: np.asarray(v)[r] for k, v in pv.params.items()} for r in rows]
         traj = _joined(execution.map_chunks(_chunk_trajectory, cfg, designs, cfg.execution))
@@ -187,21 +190,25 @@ def _result(
     first: int = 0,
 ) -> Result:
     """The :class:`Result` of trajectory ``traj``, its samples from output sample ``first``
-    on (a window of the run, :func:`suspopt.integrator.windows`); ``grid`` is the road's
-    inputs ``z, zd`` on the half-step grid and that grid [s] (:func:`_setup`)."""
+    on (a window of the run, :func:`suspopt.integrator.windows`); ``grid`` is the roads'
+    inputs ``z, zd (n_u, G, 2 n_steps + 1)`` on the half-step grid and that grid [s]
+    (:func:`_setup`)."""
     sim = cfg.simulation
     z, zd, t_grid = grid
     samples = traj.states.shape[-1]
     step = 2 * sim.output_every
     out_idx = np.arange(first * step, (first + samples) * step, step)
+    per_road = pv.P // z.shape[1]  # (the designs under each road)
     return Result(
         config=cfg,
         model=model,
         time=t_grid[out_idx],
         states=traj.states,
         accelerations=traj.accelerations,
-        road=z[:, None, out_idx],
-        road_vel=zd[:, None, out_idx],
+        road=z[:, :, out_idx].repeat(per_road, axis=1) if per_road < pv.P else z[:, :, out_idx],
+        road_vel=(
+            zd[:, :, out_idx].repeat(per_road, axis=1) if per_road < pv.P else zd[:, :, out_idx]
+        ),
         diverged_at=traj.diverged_at,
         designs=dict(pv.params),
         _assembled=run.asm,
@@ -219,34 +226,68 @@ def _setup(
     model: VehicleModel,
     controller: Controller | None,
     attachments: Sequence[Attachment],
+    roads: Sequence[Any] | None = None,
 ) -> tuple[Run, np.ndarray, np.ndarray, np.ndarray]:
-    """The integrator's :class:`~suspopt.integrator.Run` of the designs, the road's inputs
-    ``z, zd`` on the half-step grid and that grid [s]."""
+    """The integrator's :class:`~suspopt.integrator.Run` of the designs, the roads' inputs
+    ``z, zd (n_u, G, 2 n_steps + 1)`` on the half-step grid and that grid [s]. ``roads``
+    (road sections without edges, G of them, each checked against the time grid) drive the
+    designs in G equal blocks of consecutive columns; default: the config's road."""
     sim = cfg.simulation
     n_steps, every = sim.n_steps, sim.output_every
     t_grid = np.arange(2 * n_steps + 1) * (0.5 * sim.dt)
-    z, zd = road_inputs(cfg.road, model.offsets, model.sides, t_grid, base_dir=cfg.base_dir)
     network = full_network(model, attachments)
     asm = Assembled(network, pv.P, controlled="suspension" if controller else None)
-    times, jumps = road_edges(cfg.road, model.offsets, model.sides)
+    roads = list(roads) if roads else [cfg.road]
+    inputs = [
+        road_inputs(road, model.offsets, model.sides, t_grid, base_dir=cfg.base_dir)
+        for road in roads
+    ]
+    z, zd = np.stack([u for u, _ in inputs], axis=1), np.stack([v for _, v in inputs], axis=1)
+    times, jumps = _edges(cfg, model, roads, asm.P)
     edges = None
     if times.size:
 
-        def inputs(t: np.ndarray, left: bool) -> np.ndarray:
-            return asm.offsets(
-                *road_inputs(
-                    cfg.road, model.offsets, model.sides, t, base_dir=cfg.base_dir, left=left
+        def at(t: np.ndarray, left: bool) -> np.ndarray:
+            parts = [
+                asm.offsets(
+                    *road_inputs(
+                        road, model.offsets, model.sides, t, base_dir=cfg.base_dir, left=left
+                    )
                 )
-            )
+                for road in roads
+            ]
+            return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=2)
 
         no_pull = (
             np.concatenate([np.full(g.size, g.name == "tyre") for g in network.groups])
             if cfg.vehicle.tyre_lift_off
             else None
         )
-        edges = Edges(times, jumps.T, inputs, no_pull)
-    run = Run(asm, model.n_dof, asm.offsets(z, zd), sim.dt, n_steps, every, controller, edges)
+        edges = Edges(times, jumps, at, no_pull)
+    offsets = (
+        asm.offsets(*inputs[0])
+        if len(roads) == 1
+        else np.concatenate([asm.offsets(u, v) for u, v in inputs], axis=2)
+    )
+    run = Run(asm, model.n_dof, offsets, sim.dt, n_steps, every, controller, edges)
     return run, z, zd, t_grid
+
+
+def _edges(cfg: Config, model: VehicleModel, roads: list, P: int):
+    """The roads' edge times (E,) [s] and their jumps (E, n_u), or (E, G, n_u) for G > 1
+    roads; ValueError unless G roads can drive P designs in G blocks: P divisible by G, each
+    road resolved by the time grid (:func:`suspopt.checks.check_steps`), their edges (if
+    any) at the same instants."""
+    found = [road_edges(road, model.offsets, model.sides) for road in roads]
+    if len(roads) == 1:
+        return found[0][0], found[0][1].T
+    if P % len(roads):
+        raise ValueError(f"{P} designs do not split evenly over {len(roads)} roads")
+    for road, (times, _) in zip(roads, found):
+        check_steps(cfg.model_copy(update={"road": road}))
+        if not np.array_equal(times, found[0][0]):
+            raise ValueError("roads whose edges fall at other instants cannot share a batch")
+    return found[0][0], np.stack([jumps.T for _, jumps in found], axis=1)
 
 
 def _chunk_trajectory(cfg: Config, params: dict[str, np.ndarray]) -> Trajectory:

@@ -190,26 +190,32 @@ def _kept_metric(spec, whole: _Kept, name: str) -> np.ndarray:
 
 
 def reduce(
-    cfg: Config, params: Mapping[str, Any] | None, requests: Sequence[tuple[Any, Sequence[str]]]
+    cfg: Config,
+    params: Mapping[str, Any] | None,
+    requests: Sequence[tuple[Any, Sequence[str]]],
+    roads: Sequence[Any] | None = None,
 ):
     """The metric specs of ``requests`` (``(spec, its signal names)``, names as
     :func:`suspopt.specs.spec_signals` gives them) for the designs ``params`` (as
     :func:`suspopt.simulate`), without keeping the run's signals (module docstring): a
-    :class:`Reduced`, or the whole :class:`~suspopt.result.Result` for a controlled run."""
+    :class:`Reduced`, or the whole :class:`~suspopt.result.Result` for a controlled run.
+    ``roads`` (road sections without edges) drive the designs in equal blocks of
+    consecutive columns instead of the config's road (robust design, one batch for
+    several roads on one time grid)."""
     from . import integrator
     from .simulate import _result, _run, _setup, check_memory, prepare
 
     pv, model, controller, attachments = prepare(cfg, params)
     if controller is not None:  # the whole run (what simulate does, once prepared)
         check_memory(cfg, model, attachments, pv.P, signals=len(requests))
-        return _run(cfg, pv, model, controller, attachments)
+        return _run(cfg, pv, model, controller, attachments, roads)
     kept = sorted(
         {k for spec, names in requests if METRICS[spec.metric].stream == "keep"
          for n in names for k in _kept_names(spec, n)}
     )  # fmt: skip
     width = window_width(cfg, model, attachments, pv.P, len(requests))
     check_memory(cfg, model, attachments, pv.P, signals=len(requests), window=width, kept=len(kept))
-    run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments)
+    run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments, roads)
 
     def streamed(kind: str) -> list[str]:
         return sorted(

@@ -81,13 +81,13 @@ def test_a_constraint_violated_in_one_scenario_makes_the_design_infeasible():
     assert np.array_equal(GS[:, 0], G0)
 
 
-def test_designs_times_scenarios_run_in_one_call_per_road(monkeypatch):
+def test_designs_times_scenarios_run_in_one_call(monkeypatch):
     calls = []
     reduce = streaming.reduce
 
-    def counted(cfg, params, requests):
-        calls.append((cfg.road.height, len(next(iter(params.values())))))
-        return reduce(cfg, params, requests)
+    def counted(cfg, params, requests, **roads):
+        calls.append((len(roads.get("roads") or [None]), len(next(iter(params.values())))))
+        return reduce(cfg, params, requests, **roads)
 
     monkeypatch.setattr(streaming, "reduce", counted)
     masses = """scenarios:
@@ -99,11 +99,15 @@ def test_designs_times_scenarios_run_in_one_call_per_road(monkeypatch):
     problem = _problem(masses)
     X = _designs(problem, 7)
     _evaluate(problem, X)
-    assert calls == [(0.05, 7 * 4)]
+    assert calls == [(1, 7 * 4)]
     calls.clear()
     roads = masses + "    - {name: high, set: {road.height: 0.07}}\n"
     _evaluate(_problem(roads), X)
-    assert calls == [(0.05, 7 * 4), (0.07, 7)]
+    assert calls == [(5, 7 * 5)]  # the higher bump's columns in the same batch
+    calls.clear()
+    longer = roads + "    - {name: long, set: {simulation.duration: 2.0}}\n"
+    _evaluate(_problem(longer), X)
+    assert calls == [(5, 7 * 5), (1, 7)]  # another time grid: a batch of its own
 
 
 def test_each_scenario_column_is_that_config_simulated_alone():
@@ -303,3 +307,90 @@ def test_simulate_a_pick_under_one_scenario(tmp_path):
     plain.write_text(template_text("quarter"))
     res = runner.invoke(app, ["simulate", str(plain), "--scenario", "A"])
     assert res.exit_code == 2 and "has no scenarios: section" in res.output
+
+
+ISO = (
+    (CONFIGS / "ch8" / "pareto_ps_class_a.yaml")
+    .read_text()
+    .replace("duration: 30.0", "duration: 2.0")
+)
+ROADS = """scenarios:
+  cases:
+    - {name: seed7, set: {road.seed: 7}}
+    - {name: class_c, set: {road.road_class: C}, weight: 2}
+    - {name: heavy, load_mass: 115}
+    - {name: slow_c, set: {road.road_class: C, road.speed: 13.9}}
+"""
+
+
+@pytest.mark.parametrize("engine", ["numpy", "compiled"])
+@pytest.mark.parametrize("wide", [True, False])
+def test_roads_of_one_time_grid_are_columns_of_one_batch(engine, wide, monkeypatch):
+    """Scenarios with roads of their own (seed, class, speed) on one time grid are ONE
+    simulation, each scenario's columns under its own road, bit for bit the scenario's
+    config alone; on both engines, and in numpy whether the inputs are widened per column
+    or broadcast per road."""
+    pytest.importorskip("numba") if engine == "compiled" else None
+    from suspopt.integrator import rk4
+
+    if not wide:
+        monkeypatch.setattr(rk4, "_WIDE_OFFSETS", 0)
+    text = ISO.replace("output_dt: 2.0e-3}", f"output_dt: 2.0e-3, engine: {engine}}}")
+    assert text != ISO
+    calls = []
+    reduce = streaming.reduce
+
+    def counted(cfg, params, requests, **roads):
+        calls.append(len(roads.get("roads") or [None]))
+        return reduce(cfg, params, requests, **roads)
+
+    monkeypatch.setattr(streaming, "reduce", counted)
+    problem = _problem(ROADS, base=text)
+    X = _designs(problem, 4)
+    FS, GS = problem.scenario_values(problem.to_physical(X))
+    assert calls == [5]  # nominal, seed7, class_c, heavy, slow_c: one call, five roads' blocks
+    changes = [("seed: 1", "seed: 7"), ("road_class: A", "road_class: C"), None,
+               ("speed: 33.333333", "speed: 13.9")]  # fmt: skip
+    for j, change in enumerate(changes, start=1):
+        if change is None:
+            continue
+        alone = text.replace(*change)
+        if j == 4:
+            alone = alone.replace("road_class: A", "road_class: C")
+        assert alone != text
+        F, G = _evaluate(_problem(base=alone), X)
+        assert np.array_equal(FS[:, j], F) and np.array_equal(GS[:, j], G), j
+
+
+@pytest.mark.parametrize("engine", ["numpy", "compiled"])
+@pytest.mark.parametrize("kind", ["bump_half_sine", "bump_step"])
+def test_bumps_of_other_heights_are_columns_of_one_batch(engine, kind, monkeypatch):
+    """Bumps that differ in height only share their edges' instants: one batch, each
+    scenario's columns under its own bump (split steps and impulses per column), bit for
+    bit the scenario alone."""
+    pytest.importorskip("numba") if engine == "compiled" else None
+    base = BASE.replace("kind: bump_half_sine ", f"kind: {kind} ").replace(
+        "  dt: 2.0e-3 ", f"  engine: {engine}\n  dt: 2.0e-3 "
+    )
+    assert base.count(kind) and "engine" in base
+    calls = []
+    reduce = streaming.reduce
+
+    def counted(cfg, params, requests, **roads):
+        calls.append(len(roads.get("roads") or [None]))
+        return reduce(cfg, params, requests, **roads)
+
+    monkeypatch.setattr(streaming, "reduce", counted)
+    extra = (
+        "scenarios:\n  cases:\n    - {name: low, set: {road.height: 0.03}}\n"
+        "    - {name: heavy, set: {vehicle.body.mass: 2500}}\n"
+        "    - {name: late, set: {road.start: 0.7}}\n"
+    )
+    problem = _problem(extra, base=base)
+    X = _designs(problem, 3)
+    FS, GS = problem.scenario_values(problem.to_physical(X))
+    assert calls == [3, 1]  # nominal, low, heavy in one batch; the later bump alone
+    alone = base.replace("height: 0.05 ", "height: 0.03 ")
+    assert alone != base
+    F, G = _evaluate(_problem(base=alone), X)
+    assert np.array_equal(FS[:, 1], F) and np.array_equal(GS[:, 1], G)

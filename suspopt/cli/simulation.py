@@ -189,7 +189,8 @@ def _under_scenario(cfg, params, picked, name: str):
     s = scenarios.names.index(name)
     group = next(g for g in scenarios.groups if s in g.members)
     k = group.members.index(s)
-    alone = Group(group.cfg, [s], [group.values[k]], [group.scales[k]])
+    member_cfg = group.configs[k]
+    alone = Group(member_cfg, [s], [group.values[k]], [group.scales[k]], [member_cfg])
     P = len(next(iter(params.values()))) if params else 1
     params = scenarios.columns(alone, dict(params or {}), P) or None
     if picked is not None:
@@ -207,7 +208,7 @@ def _under_scenario(cfg, params, picked, name: str):
                         )
                     stored = FS[picked.rows, s]
         picked = dataclasses.replace(picked, F=stored)
-    return group.cfg, params, picked
+    return member_cfg, params, picked
 
 
 def _picks_writer(picked, objectives):

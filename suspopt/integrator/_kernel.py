@@ -60,9 +60,9 @@ def _law(code, r, p, F, par):
 
 
 @_jit
-def _stage(W, F, par, idx, lay, src, o, oi, has_input, scale, out):
+def _stage(W, F, par, idx, lay, src, o, oi, lr, has_input, scale, out):
     """The accelerations at the state ``W[src] = [q; v]`` with the inputs' part ``o[oi]``
-    (when ``has_input``), times the inverse masses' row set ``scale`` (0: 1, 1: dt/2, 2: dt,
+    (when ``has_input``; ``o (.., G, 2R)``, lane ``b`` on road ``lr[b]`` when G > 1), times the inverse masses' row set ``scale`` (0: 1, 1: dt/2, 2: dt,
     3: dt/6), into ``W[out, n:]``: ``δ = D_q q + D_u u``, ``F = k δ + c δ̇`` plus the laws,
     ``q'' = M^-1 G F``."""
     nD, nG, R, X, n = lay[0], lay[1], lay[2], lay[3], lay[4]
@@ -76,11 +76,16 @@ def _stage(W, F, par, idx, lay, src, o, oi, has_input, scale, out):
         for b in range(W.shape[2]):
             F[0, r, b] += par[oD + z, b] * W[src, j, b]
             F[1, r, b] += par[oD + z, b] * W[src, n + j, b]
-    if has_input:
+    if has_input and o.shape[1] == 1:
         for r in range(R):
             for b in range(W.shape[2]):
-                F[0, r, b] += o[oi, r]
-                F[1, r, b] += o[oi, R + r]
+                F[0, r, b] += o[oi, 0, r]
+                F[1, r, b] += o[oi, 0, R + r]
+    elif has_input:  # a road per lane
+        for r in range(R):
+            for b in range(W.shape[2]):
+                F[0, r, b] += o[oi, lr[b], r]
+                F[1, r, b] += o[oi, lr[b], R + r]
     for r in range(R):
         for b in range(W.shape[2]):
             F[2, r, b] = par[oK + r, b] * F[0, r, b] + par[oC + r, b] * F[1, r, b]
@@ -116,7 +121,7 @@ def _plus(W, a, s, w, out, n):
 
 
 @_jit
-def _regular_step(h0, dt, W, F, par, idx, lay, off, active):
+def _regular_step(h0, dt, W, F, par, idx, lay, off, lr, active):
     """One RK4 step from half step ``h0`` with the numpy engine's arithmetic: ``s1`` holds
     the first stage's accelerations (unscaled) in its lower rows; each stage is scaled by its
     step, ``y += (s1 + 2 s2 + s3)/3 + s4``."""
@@ -129,7 +134,7 @@ def _regular_step(h0, dt, W, F, par, idx, lay, off, active):
         h = half if stage == 0 else (dt if stage == 1 else dt / 6.0)
         hi = h0 + 1 if stage < 2 else h0 + 2
         _plus(W, Y, S1 + stage, 1.0, YS, n)
-        _stage(W, F, par, idx, lay, YS, off, hi, active[hi], stage + 1, S2 + stage)
+        _stage(W, F, par, idx, lay, YS, off, hi, lr, active[hi], stage + 1, S2 + stage)
         _rates(W, YS, h, S2 + stage, n)
     third = 1.0 / 3.0
     for i in range(2 * n):
@@ -138,13 +143,14 @@ def _regular_step(h0, dt, W, F, par, idx, lay, off, active):
 
 
 @_jit
-def _impulse(jumps, u, no_pull, W, F, par, idx, lay):
+def _impulse(jumps, u, no_pull, W, F, par, idx, lay, lr):
     """The velocity jump ``M^-1 G (c D_u Δu)`` of an inputs' jump with ``D_u Δu = jumps[u]
-    (R,)``; a row that cannot pull takes no pulling impulse."""
+    (G, R)`` (lane ``b`` on road ``lr[b]``); a row that cannot pull takes no pulling
+    impulse."""
     nD, nG, R, n, oG, oC, oM = lay[0], lay[1], lay[2], lay[4], lay[6], lay[8], lay[10]
     for r in range(R):
         for b in range(W.shape[2]):
-            force = par[oC + r, b] * jumps[u, r]
+            force = par[oC + r, b] * jumps[u, lr[b], r]
             if no_pull[r] and force > 0.0:
                 force = 0.0
             F[2, r, b] = force
@@ -161,7 +167,7 @@ def _impulse(jumps, u, no_pull, W, F, par, idx, lay):
 
 
 @_jit
-def _split_step(s, W, F, par, idx, lay, road):
+def _split_step(s, W, F, par, idx, lay, road, lr):
     """Split step ``s``: RK4 sub-steps between its edges (``k = f(y + w k_prev)`` unscaled),
     each edge's impulse at its end."""
     sub_first, sub_h, sub_right, sub_middle, sub_left = road[3], road[4], road[5], road[6], road[7]
@@ -173,7 +179,7 @@ def _split_step(s, W, F, par, idx, lay, road):
             w = 0.0 if stage == 0 else (hu if stage == 3 else 0.5 * hu)
             inputs = sub_right if stage == 0 else (sub_left if stage == 3 else sub_middle)
             _plus(W, Y, Y if stage == 0 else K1 + stage - 1, w, TMP, n)
-            _stage(W, F, par, idx, lay, TMP, inputs, u, True, 0, K1 + stage)
+            _stage(W, F, par, idx, lay, TMP, inputs, u, lr, True, 0, K1 + stage)
             _rates(W, TMP, 1.0, K1 + stage, n)
         for i in range(2 * n):
             for b in range(W.shape[2]):
@@ -181,7 +187,7 @@ def _split_step(s, W, F, par, idx, lay, road):
                     hu / 6.0 * (W[K1, i, b] + 2.0 * (W[K2, i, b] + W[K3, i, b]) + W[K4, i, b])
                 )
         if sub_kick[u]:
-            _impulse(sub_jump, u, no_pull, W, F, par, idx, lay)
+            _impulse(sub_jump, u, no_pull, W, F, par, idx, lay, lr)
 
 
 @_jit
@@ -259,12 +265,13 @@ def _advance(
     W, F, rec, at, pb = W_all[blk], F_all[blk], rec_all[blk], at_all[blk], par[blk]
     n, B = lay[4], W.shape[2]
     off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
+    lr = road[12][blk]
     if k0 == 0:
         for u in range(start_jumps.shape[0]):
-            _impulse(start_jumps, u, no_pull, W, F, pb, idx, lay)
+            _impulse(start_jumps, u, no_pull, W, F, pb, idx, lay, lr)
     for step in range(k0, k1):
         _lag(pb, idx, lay)
-        _stage(W, F, pb, idx, lay, Y, off, 2 * step, active[2 * step], 0, S1)
+        _stage(W, F, pb, idx, lay, Y, off, 2 * step, lr, active[2 * step], 0, S1)
         if step % every == 0:  # the sample: the state and the first stage's accelerations
             j = step // every
             _keep(W, rec, j % SAMPLES, n, pb, idx, lay)
@@ -273,9 +280,9 @@ def _advance(
         if step == n_steps:
             break
         if split_of[step] < 0:
-            _regular_step(2 * step, dt, W, F, pb, idx, lay, off, active)
+            _regular_step(2 * step, dt, W, F, pb, idx, lay, off, lr, active)
         else:
-            _split_step(split_of[step], W, F, pb, idx, lay, road)
+            _split_step(split_of[step], W, F, pb, idx, lay, road, lr)
         if (step + 1) % check_every == 0 or step + 1 == n_steps:
             _check(W, at, limit, (step + 1) * dt)
     diverged_at[blk * B : blk * B + B] = at
@@ -302,7 +309,7 @@ def accelerations_now(h, par, idx, lay, road, state, out):
     n = lay[4]
     for blk in numba.prange(par.shape[0]):
         W, F = state[0][blk], state[1][blk]
-        _stage(W, F, par[blk], idx, lay, Y, off, h, active[h], 0, TMP)
+        _stage(W, F, par[blk], idx, lay, Y, off, h, road[12][blk], active[h], 0, TMP)
         for i in range(n):
             for b in range(W.shape[2]):
                 out[blk, i, b] = W[TMP, n + i, b]

@@ -125,52 +125,57 @@ def _laws(asm: Assembled, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.array(codes, np.int64), np.array(rows, np.int64), np.ascontiguousarray(stacked)
 
 
+def _jump(asm: Assembled, jumps: np.ndarray) -> np.ndarray:
+    """``D_u Δu`` of an edge's jumps ``(n_u,)`` or ``(G, n_u)``, as (G, R)."""
+    return np.atleast_2d(jumps) @ asm.input_map.T
+
+
 def _edge_arrays(asm: Assembled, edges: Edges | None, dt: float, n_steps: int, offsets):
     """The road's edges as arrays for the kernel: for each step the index of its split plan
     or -1 (n_steps,); per split step its first sub-step (S + 1,); per sub-step its length,
-    the inputs' part at its start, middle and end (U, 2R), the inputs' jump at its end
-    (U, R: the impulse's ``D_u Δu``) and whether there is one; the jumps at t = 0 (Q, R); the
-    rows that cannot pull (R,)."""
-    R = asm.R
+    the inputs' part at its start, middle and end (U, G, 2R), the inputs' jump at its end
+    (U, G, R: the impulse's ``D_u Δu``) and whether there is one; the jumps at t = 0
+    (Q, G, R); the rows that cannot pull (R,). ``offsets (T, G, 2R)``: G roads."""
+    R, G = asm.R, offsets.shape[1]
     split_of = np.full(n_steps, -1, np.int64)
     first, h_all, rights, middles, lefts, jumps, kicks = [0], [], [], [], [], [], []
-    start_jumps = np.zeros((0, R))
+    start_jumps = np.zeros((0, G, R))
     no_pull = np.zeros(R, np.bool_)
     if edges is not None:
         plan = EdgePlan(edges, dt, n_steps)
         if edges.no_pull is not None:
             no_pull[:] = edges.no_pull
-        start_jumps = np.array([asm.input_map @ edges.jumps[e] for e in plan.at_start])
-        start_jumps = start_jumps.reshape(-1, R)
+        start_jumps = np.array([_jump(asm, edges.jumps[e]) for e in plan.at_start])
+        start_jumps = start_jumps.reshape(-1, G, R)
         for s, k in enumerate(sorted(plan.steps)):
             split_of[k] = s
             found = plan.steps[k]
             h, right, middle, left = plan.sub_steps(k)
-            right = right.reshape(len(h), 2 * R).copy()
+            right = right[..., 0].transpose(0, 2, 1).copy()  # (J, G, 2R)
             right[0] = offsets[2 * k]  # the step's first stage, as every step's
             for j in range(len(h)):
                 h_all.append(h[j])
                 rights.append(right[j])
-                middles.append(middle[j].reshape(2 * R))
-                lefts.append(left[j].reshape(2 * R))
+                middles.append(middle[j][..., 0].T)
+                lefts.append(left[j][..., 0].T)
                 kick = j < len(found) and bool(edges.jumps[found[j]].any())
                 kicks.append(kick)
-                jumps.append(asm.input_map @ edges.jumps[found[j]] if kick else np.zeros(R))
+                jumps.append(_jump(asm, edges.jumps[found[j]]) if kick else np.zeros((G, R)))
             first.append(len(h_all))
 
-    def rows(a, width):
-        return np.ascontiguousarray(np.array(a, float).reshape(-1, width))
+    def rows(a, *width):
+        return np.ascontiguousarray(np.array(a, float).reshape(-1, *width))
 
     return (
         split_of,
         np.array(first, np.int64),
         np.array(h_all, float),
-        rows(rights, 2 * R),
-        rows(middles, 2 * R),
-        rows(lefts, 2 * R),
-        rows(jumps, R),
+        rows(rights, G, 2 * R),
+        rows(middles, G, 2 * R),
+        rows(lefts, G, 2 * R),
+        rows(jumps, G, R),
         np.array(kicks, np.bool_),
-        rows(start_jumps, R),
+        rows(start_jumps, G, R),
         no_pull,
     )
 
@@ -223,7 +228,7 @@ def block_width(P: int, threads: int) -> int:
 
 def integrate(run: Run) -> Trajectory:
     """The compiled engine's :func:`suspopt.integrator.integrate` (what it covers:
-    :func:`unsupported`); the run's offsets are shared by the designs. A controller is asked
+    :func:`unsupported`); a road's offsets are shared by its designs. A controller is asked
     at its samples between compiled stretches of steps (:func:`_controlled`)."""
     return next(windows(run))[1]
 
@@ -254,8 +259,13 @@ def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajector
     flat, idx, lay = _packed(asm, dt, P, lagged, decay)
     Nl = int(lay[11])
     par = np.ascontiguousarray(flat.reshape(flat.shape[0], blocks, B).transpose(1, 0, 2))
-    off = np.ascontiguousarray(offsets[:, :, 0, 0])
-    road = (off, off.any(axis=1)) + _edge_arrays(asm, edges, dt, n_steps, off)
+    # the inputs' part (T, G, 2R) of G roads, each under P0/G consecutive designs, and the road
+    # of each lane (the padding's the last design's)
+    off = np.ascontiguousarray(offsets[:, :, :, 0].transpose(0, 2, 1))
+    G = off.shape[1]
+    lane_road = np.minimum(np.arange(P) // (P0 // G), G - 1).reshape(blocks, B)
+    road = (off, off.any(axis=(1, 2))) + _edge_arrays(asm, edges, dt, n_steps, off)
+    road += (lane_road,)
     state = (
         np.zeros((blocks, 11, 2 * n, B)),
         np.empty((blocks, 3, R, B)),

@@ -199,7 +199,7 @@ class Edges(NamedTuple):
     """The road's edges (:func:`suspopt.road.road_edges`) as :func:`integrate` takes them."""
 
     times: np.ndarray  #: (E,) ascending [s]
-    jumps: np.ndarray  #: (E, n_u) the step in the inputs u at each edge [m]
+    jumps: np.ndarray  #: (E, n_u) the step in the inputs u at each edge [m]; (E, G, n_u): G roads
     #: ``inputs(t, left)``: the inputs' part of the deformations (T, 2R, 1, 1) at times ``t``
     #: (T,), their left limits if ``left``, else the right ones
     inputs: Callable[[np.ndarray, bool], np.ndarray]
@@ -473,8 +473,12 @@ class _Splitter:
 
     def impulse(self, e: int) -> None:
         """The velocity jump M^-1 G (c D_u Δu) of the inputs' jump Δu at edge ``e``."""
-        rk4, R, edges = self.rk4, self.asm.R, self.edges
-        force = rk4.coef[R : 2 * R] * (self.asm.input_map @ edges.jumps[e])[:, None, None]  # [N s]
+        rk4, R, edges, jumps = self.rk4, self.asm.R, self.edges, self.edges.jumps[e]
+        if jumps.ndim == 1:
+            du = (self.asm.input_map @ jumps)[:, None, None]
+        else:  # (G, n_u): a road per block of columns
+            du = (self.asm.input_map @ jumps.T).repeat(rk4.width // len(jumps), axis=1)[..., None]
+        force = rk4.coef[R : 2 * R] * du  # [N s]
         if edges.no_pull is not None:  # a tyre that cannot pull takes no pulling impulse
             force[edges.no_pull] = np.minimum(force[edges.no_pull], 0.0)
         force2 = force.reshape(R, rk4.width)
@@ -520,8 +524,8 @@ def _controller_hold(
 class Run(NamedTuple):
     """One integration, as every engine takes it: the assembled network (its first
     ``n_vehicle`` DOFs the vehicle's), the inputs' part of the deformations on the half-step
-    grid ``t = j dt/2``, ``offsets`` (2 n_steps + 1, 2R, 1, 1) (their right limits at a road
-    edge), the step ``dt`` [s], the number of steps, the samples' spacing ``every`` in steps,
+    grid ``t = j dt/2``, ``offsets`` (2 n_steps + 1, 2R, G, 1) (their right limits at a road
+    edge; G > 1 roads without edges, each under P/G consecutive designs), the step ``dt`` [s], the number of steps, the samples' spacing ``every`` in steps,
     the semi-active controller and the road's edges (or None)."""
 
     asm: Assembled
@@ -555,9 +559,9 @@ def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajector
     if controller is not None and width < n_out:
         raise ValueError("a controlled run is integrated whole (width >= its samples)")
     columns = max(P, 2)  # (a single design as two identical columns)
-    active = offsets.any(axis=(1, 2, 3))
-    if offsets.size * columns <= _WIDE_OFFSETS:  # small batches: no broadcasting
-        offsets = widen(offsets, columns)
+    active, roads = offsets.any(axis=(1, 2, 3)), offsets.shape[2]
+    if offsets.size // roads * columns <= _WIDE_OFFSETS:  # small batches: no broadcasting
+        offsets = widen(offsets, columns) if roads == 1 else offsets.repeat(P // roads, axis=2)
     # the inputs' part of each half-step, None where it is zero (a bump's road before and after)
     rk4 = _RK4(asm, columns, dt, [o if a else None for o, a in zip(offsets, active)])
     hold = None

@@ -186,8 +186,9 @@ class Problem(_PymooProblem):
             ]
             spectral.check(cfg, specs)
             for group in (ScenarioSet.from_config(cfg) or ScenarioSet([], [])).groups:
-                if group.cfg is not cfg:
-                    spectral.check(group.cfg, specs)
+                for member_cfg in group.configs:
+                    if member_cfg is not cfg:
+                        spectral.check(member_cfg, specs)
         return cls(
             cfg,
             compile_all(cfg.objectives.main, ("objectives", "main"), True),
@@ -315,8 +316,9 @@ class Problem(_PymooProblem):
         for group in self.scenarios.groups:  # one batch per road and time grid
             columns = self.scenarios.columns(group, params, P)
             n = P * len(group.members)
+            roads = {"roads": group.roads} if group.roads else {}  # a road per scenario
             with np.errstate(all="ignore"):  # failed designs are flagged, not warned about
-                result = reduce(group.sim_cfg, columns, requests) if requests else None
+                result = reduce(group.sim_cfg, columns, requests, **roads) if requests else None
                 raw = self._raw(result, columns, n, supplementary, group.cfg)
             for whole, part in zip(values + [failed], raw):
                 if part is not None:  # (S_g P, ...) scenario after scenario -> (P, S_g, ...)

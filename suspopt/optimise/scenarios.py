@@ -9,11 +9,18 @@
   :func:`suspopt.seat.passenger_mass_change`) become extra design columns: P designs under
   the S_g scenarios of a group are ONE batch of P x S_g columns, scenario after scenario
   (:meth:`ScenarioSet.columns`);
-- a change of the ``road``, ``simulation`` or ``control`` section (class, speed, seed,
-  length, bump height, duration, the controller's sample time) makes a :class:`Group` with its own config, simulated as its own batch:
-  the integrators drive every column of a batch with one road on one time grid, so scenarios
-  with different roads cannot share one. An evaluation therefore makes one simulation call
-  per group (the distinct roads), never one per scenario.
+- a road of its own (another class, speed, seed, profile or bump height) drives its
+  scenario's columns of the same batch (the integrators take a road per block of columns,
+  :func:`suspopt.streaming.reduce`);
+- a change of the ``simulation`` or ``control`` section (duration, time step, the
+  controller's sample time) or ``vehicle.gravity``, of a bump's instants (its start, length,
+  speed), or of any road under ``simulation.method: spectral`` makes a :class:`Group` of its
+  own: a batch shares one time grid, the instants where a bump's edges split its steps, and
+  the spectral method integrates one road's spectrum per batch.
+
+An evaluation therefore makes one simulation call per group (for configs/robust/ps.yaml and
+nss4.yaml one per road class, each driven 1000 m at its own speed, so for its own duration;
+for hc2_bumps.yaml one), never one per scenario.
 
 :func:`aggregate` combines the values of every scenario, ``(P, S, k)``, into ``(P, k)``
 by each column's ``over_scenarios`` (:data:`suspopt.config.scenarios.AGGREGATES`). A
@@ -25,6 +32,7 @@ from __future__ import annotations
 
 import difflib
 import itertools
+import json
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -32,6 +40,7 @@ import numpy as np
 
 from ..config import Config, ConfigError
 from ..config.loader import edit_config, set_path
+from ..config.road import BumpHalfSine, BumpStep
 from ..config.scenarios import Quantile
 from ..params import field_range, numeric_paths
 
@@ -69,15 +78,24 @@ class Scenario:
 
 @dataclass
 class Group:
-    """Scenarios that share a road and time grid: ``cfg`` is their config (the nominal one
-    when they change neither), ``members`` their indices in :attr:`ScenarioSet.names`,
-    ``values`` per member the per-design paths it sets [SI] and ``scales`` the factors it
-    applies to a design variable's own value (``seat.stiffness_ratio`` under ``load_mass``)."""
+    """Scenarios simulated as one batch: ``cfg`` is the first one's config (the nominal one
+    when it changes no section), ``members`` their indices in :attr:`ScenarioSet.names`,
+    ``values`` per member the per-design paths it sets [SI], ``scales`` the factors it applies
+    to a design variable's own value (``seat.stiffness_ratio`` under ``load_mass``) and
+    ``configs`` each member's whole config (they differ from ``cfg`` in their road at most)."""
 
     cfg: Config
     members: list[int] = field(default_factory=list)
     values: list[dict[str, float]] = field(default_factory=list)
     scales: list[dict[str, float]] = field(default_factory=list)
+    configs: list[Config] = field(default_factory=list)
+
+    @property
+    def roads(self) -> list[Any] | None:
+        """Each member's road, one per block of P columns, or None when they share
+        ``cfg``'s."""
+        roads = [c.road for c in self.configs]
+        return None if all(r == self.cfg.road for r in roads) else roads
 
     @property
     def sim_cfg(self) -> Config:
@@ -212,19 +230,32 @@ def _load_changes(cfg: Config, scenario: Scenario, designed: set[str], values: d
     return {**values, **changed}, scales
 
 
-def _group_config(cfg: Config, scenario: Scenario) -> tuple[tuple, Config]:
-    """The key and config of the road and time grid of ``scenario``."""
+def _group_config(cfg: Config, scenario: Scenario) -> tuple[str, Config]:
+    """The key of the batch ``scenario`` can join and its config: the time grid, controller
+    and gravity, and the road where it cannot have a road of its own (module docstring)."""
     shared = {p: v for p, v in scenario.sets.items() if _in(p, GROUP_SECTIONS) is not None}
-    if not shared:
-        return (), cfg
-    key = tuple(sorted((p, repr(v)) for p, v in shared.items()))
+    edited = _edited(cfg, scenario, shared) if shared else cfg
+    parts: list[Any] = [edited.simulation, edited.control, edited.vehicle.gravity]
+    if cfg.simulation.method != "time":  # a batch of the spectral method has one road
+        parts.append(edited.road)
+    elif isinstance(edited.road, (BumpStep, BumpHalfSine)):  # bumps of one batch share edges
+        parts.append(edited.road.model_dump(mode="json", exclude={"height"}))
+    key = json.dumps(
+        [p.model_dump(mode="json") if hasattr(p, "model_dump") else p for p in parts],
+        sort_keys=True,
+    )
+    return key, edited
+
+
+def _edited(cfg: Config, scenario: Scenario, shared: dict) -> Config:
+    """``cfg`` with the scenario's ``shared`` (road, simulation, ...) values written in."""
 
     def put(data: dict) -> None:
         for path, value in shared.items():
             set_path(data, path, value)
 
     try:
-        return key, edit_config(cfg.text, put, cfg.source, f"scenario {scenario.name}")
+        return edit_config(cfg.text, put, cfg.source, f"scenario {scenario.name}")
     except ConfigError as exc:
         message = str(exc).split(": ", 1)[-1]
         raise cfg.error(scenario.locs[next(iter(shared))], message) from None
@@ -260,6 +291,7 @@ class ScenarioSet:
             group.members.append(i)
             group.values.append(values)
             group.scales.append(scales)
+            group.configs.append(group_cfg)
         return cls(scenarios, list(groups.values()))
 
     @property
