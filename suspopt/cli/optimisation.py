@@ -102,6 +102,20 @@ def optimise(
         _optimise(config, output, resume, plot, (executor, scheduler, workers))
 
 
+def _scenarios_line(cfg, output: Path) -> None:
+    """How each objective combined over the config's scenarios, and where their values are."""
+    from ..optimise import Problem
+
+    problem = Problem.from_config(cfg)
+    assert problem.scenarios is not None
+    rules = problem.aggregation()[0]
+    out.print(
+        f"over {len(problem.scenarios.names)} scenarios: "
+        + ", ".join(f"{name} {rule}" for name, rule in zip(problem.obj_names, rules))
+        + f"; every scenario's values in {output}:/pareto/scenarios"
+    )
+
+
 def _optimise(
     config: Path,
     output: Path,
@@ -158,15 +172,7 @@ def _optimise(
             + " + ".join(f"{w:.4g} {name}" for w, name in zip(result.weights, result.obj_names))
         )
     if cfg.scenarios is not None:
-        from ..optimise import Problem
-
-        problem = Problem.from_config(cfg)
-        rules = problem.aggregation()[0]
-        out.print(
-            f"over {len(problem.scenarios.names)} scenarios: "
-            + ", ".join(f"{name} {rule}" for name, rule in zip(problem.obj_names, rules))
-            + f"; every scenario's values in {output}:/pareto/scenarios"
-        )
+        _scenarios_line(cfg, output)
     if result.status == "interrupted":
         err.print(
             f"wrote the designs found so far to {output}; continue with "

@@ -199,9 +199,8 @@ class Edges(NamedTuple):
     """The road's edges (:func:`suspopt.road.road_edges`) as :func:`integrate` takes them."""
 
     times: np.ndarray  #: (E,) ascending [s]
-    jumps: np.ndarray  #: (E, n_u) the step in the inputs u at each edge [m]; (E, G, n_u): G roads
-    #: ``inputs(t, left)``: the inputs' part of the deformations (T, 2R, 1, 1) at times ``t``
-    #: (T,), their left limits if ``left``, else the right ones
+    jumps: np.ndarray  #: (E, n_u) the step in the inputs u at each edge [m] ((E, G, n_u): G roads)
+    #: ``inputs(t, left)``: the inputs' part (T, 2R, G, 1) at ``t`` (T,), left limits if ``left``
     inputs: Callable[[np.ndarray, bool], np.ndarray]
     #: (R,) element rows that cannot pull (a tyre that may lift off), or None
     no_pull: np.ndarray | None
@@ -473,12 +472,9 @@ class _Splitter:
 
     def impulse(self, e: int) -> None:
         """The velocity jump M^-1 G (c D_u Δu) of the inputs' jump Δu at edge ``e``."""
-        rk4, R, edges, jumps = self.rk4, self.asm.R, self.edges, self.edges.jumps[e]
-        if jumps.ndim == 1:
-            du = (self.asm.input_map @ jumps)[:, None, None]
-        else:  # (G, n_u): a road per block of columns
-            du = (self.asm.input_map @ jumps.T).repeat(rk4.width // len(jumps), axis=1)[..., None]
-        force = rk4.coef[R : 2 * R] * du  # [N s]
+        rk4, R, edges = self.rk4, self.asm.R, self.edges
+        du = self.asm.input_map @ np.atleast_2d(edges.jumps[e]).T  # (R, G): a road per block
+        force = rk4.coef[R : 2 * R] * du.repeat(rk4.width // du.shape[1], axis=1)[..., None]
         if edges.no_pull is not None:  # a tyre that cannot pull takes no pulling impulse
             force[edges.no_pull] = np.minimum(force[edges.no_pull], 0.0)
         force2 = force.reshape(R, rk4.width)
