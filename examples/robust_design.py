@@ -30,6 +30,7 @@ import argparse
 import time
 from pathlib import Path
 
+import h5py
 import numpy as np
 
 import suspopt
@@ -59,10 +60,23 @@ def _configs(seat: str, population: int | None, generations: int | None):
     return edit_config(text, budget, path), edit_config(text, nominal, path)
 
 
-def _optimised(cfg, out: Path):
+def _optimised(cfg, out: Path, reuse: bool):
+    """``(run time [s], X, F, G)`` of the front: optimised now, or read from ``out`` with
+    ``reuse`` when it exists (its run time from its history)."""
+    if reuse and out.exists():
+        with h5py.File(out) as h5:
+            wall = float(h5["history/time"][-1])
+            return wall, h5["pareto/X"][...], h5["pareto/F"][...], h5["pareto/G"][...]
     start = time.perf_counter()
     result = optimise(cfg, out)
-    return time.perf_counter() - start, result
+    return time.perf_counter() - start, result.X, result.F, result.G
+
+
+def _dominated(points: np.ndarray, by: np.ndarray) -> np.ndarray:
+    """Which rows of ``points (N, 2)`` some row of ``by (M, 2)`` dominates (both minimised)."""
+    le = (by[None, :, :] <= points[:, None, :]).all(axis=2)
+    lt = (by[None, :, :] < points[:, None, :]).any(axis=2)
+    return (le & lt).any(axis=1)
 
 
 def _travel(problem, X: np.ndarray, seat: str) -> np.ndarray:
@@ -107,19 +121,19 @@ def _row(label, wall, FS, GS, travel, seat, names) -> tuple[str, dict]:
     return text, figures
 
 
-def compare(seat: str, outdir: Path, population: int | None, generations: int | None) -> None:
+def compare(seat: str, outdir: Path, population, generations, reuse: bool) -> None:
     robust_cfg, nominal_cfg = _configs(seat, population, generations)
     runs = {
-        "nominal": _optimised(nominal_cfg, outdir / f"{seat}_nominal.h5"),
-        "robust": _optimised(robust_cfg, outdir / f"{seat}_robust.h5"),
+        "nominal": _optimised(nominal_cfg, outdir / f"{seat}_nominal.h5", reuse),
+        "robust": _optimised(robust_cfg, outdir / f"{seat}_robust.h5", reuse),
     }
     problem = suspopt.Problem.from_config(robust_cfg)
     names = problem.scenarios.names
     knees = {}
-    for key, (_, result) in runs.items():
-        sound = np.flatnonzero((result.G <= 0).all(axis=1))
-        rows = sound if sound.size else np.arange(len(result.X))
-        knees[key] = result.X[rows[pareto_picks(result.F[rows])["knee"]]]
+    for key, (_, X_front, F_front, G_front) in runs.items():
+        sound = np.flatnonzero((G_front <= 0).all(axis=1))
+        rows = sound if sound.size else np.arange(len(X_front))
+        knees[key] = X_front[rows[pareto_picks(F_front[rows])["knee"]]]
     X = np.array([knees["nominal"], knees["robust"]])
     FS, GS = problem.scenario_values(X)
     travel = _travel(problem, X, seat)
@@ -134,12 +148,23 @@ def compare(seat: str, outdir: Path, population: int | None, generations: int | 
     print("|---|---|---|---|---|---|---|---|---|")
     figures = {}
     for i, key in enumerate(("nominal", "robust")):
-        wall, result = runs[key]
+        wall, X_front = runs[key][:2]
         text, figures[key] = _row(
-            f"{key} front ({len(result.X)} designs)", wall, FS[i], GS[i], travel[i],
+            f"{key} front ({len(X_front)} designs)", wall, FS[i], GS[i], travel[i],
             seat, names,
         )  # fmt: skip
         print(text)
+    _fronts_in_the_worst_case(problem, runs, FS[1])
+    simulated = sum(
+        group.cfg.simulation.duration * len(group.members) for group in problem.scenarios.groups
+    )
+    ratio = f"The robust run took {runs['robust'][0] / runs['nominal'][0]:.1f} times the nominal one's time"
+    if nominal_cfg.simulation.method == "time":
+        ratio += (
+            f"; its scenarios are {simulated / nominal_cfg.simulation.duration:.1f} times "
+            f"the nominal's simulated time per design"
+        )
+    print(ratio + ".")
 
     def change(key: str) -> str:
         before, after = figures["nominal"][key], figures["robust"][key]
@@ -154,16 +179,53 @@ def compare(seat: str, outdir: Path, population: int | None, generations: int | 
     )
 
 
+def _fronts_in_the_worst_case(problem, runs, robust_knee: np.ndarray) -> None:
+    """The nominal front's designs under every scenario against the robust front, both as
+    (worst RC_se, worst X_ST): how many of the nominal designs the robust front dominates, and
+    the best worst-case RC_se the nominal designs reach at the robust knee's worst X_ST."""
+    X_nominal = runs["nominal"][1]
+    FS, GS = problem.scenario_values(X_nominal)
+    worst = FS.max(axis=1)  # (N, 2): worst RC_se, worst X_ST
+    holds = (GS <= 0).all(axis=(1, 2))
+    robust = runs["robust"][2][(runs["robust"][3] <= 0).all(axis=1)]  # its F is the worst case
+    beaten = _dominated(worst, robust)
+    front = worst[holds & ~_dominated(worst, worst[holds])]
+    order = np.argsort(front[:, 1])
+    at = robust_knee[:, 1].max()
+    print(
+        f"\nUnder all nine scenarios, {holds.sum()} of the nominal front's {len(worst)} designs "
+        f"hold every constraint, and the robust front dominates {beaten.sum()} of them in "
+        f"(worst RC_se, worst X_ST)."
+    )
+    if front.size and front[order[0], 1] <= at <= front[order[-1], 1]:
+        rc = float(np.interp(at, front[order, 1], front[order, 0]))
+        knee = robust_knee[:, 0].max()
+        percent = 100 * (rc - knee) / rc
+        print(
+            f"At the robust knee's worst X_ST ({1e3 * at:.1f} mm) the nominal designs' worst "
+            f"RC_se is at best {rc:.3f} m/s² (interpolated along their worst-case front); the "
+            f"robust knee's is {knee:.3f} m/s², {abs(percent):.1f} % "
+            f"{'lower' if percent >= 0 else 'higher'}."
+        )
+    else:
+        print(
+            f"The robust knee's worst X_ST ({1e3 * at:.1f} mm) lies outside the worst X_ST "
+            f"the nominal designs reach ({1e3 * front[:, 1].min():.1f}-"
+            f"{1e3 * front[:, 1].max():.1f} mm): no comparison at equal deflection."
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("outdir", type=Path)
     parser.add_argument("--population", type=int)
     parser.add_argument("--generations", type=int)
     parser.add_argument("--seats", nargs="+", default=["ps", "nss4"], choices=["ps", "nss4"])
+    parser.add_argument("--reuse", action="store_true", help="read the fronts OUTDIR already holds")
     args = parser.parse_args()
     args.outdir.mkdir(parents=True, exist_ok=True)
     for seat in args.seats:
-        compare(seat, args.outdir, args.population, args.generations)
+        compare(seat, args.outdir, args.population, args.generations, args.reuse)
 
 
 if __name__ == "__main__":
