@@ -134,7 +134,7 @@ class Problem(_PymooProblem):
                 t.spec.over_scenarios or CONSTRAINT_DEFAULT
                 for t in self._constraints
                 for _ in t.names
-                for b in (t.spec.min, t.spec.max)
+                for b in (getattr(t.spec, "min", None), getattr(t.spec, "max", None))
                 if b is not None
             ],
             [
@@ -294,7 +294,7 @@ class Problem(_PymooProblem):
         terms = self._objectives + self._constraints
         terms += self._supplementary if supplementary else []
         requests = [(t.spec, t.signals) for t in terms if t.spec.metric]
-        reduce = streaming.reduce
+        reduce: Any = streaming.reduce
         if self.cfg.simulation.method == "spectral":
             from .. import spectral
 
@@ -356,10 +356,9 @@ class Problem(_PymooProblem):
         missing = [i for i, row in enumerate(values) if row.tobytes() not in self._scenario_values]
         if missing:
             self.evaluate(self.to_search(values[missing]), return_values_of=["F", "G"])
-        found = [self._scenario_values.get(row.tobytes()) for row in values]
         S = len(self.scenarios.names)
         empty = (np.full((S, self.n_obj), np.nan), np.full((S, self.n_ieq_constr), np.nan))
-        found = [f if f is not None else empty for f in found]
+        found = [self._scenario_values.get(row.tobytes(), empty) for row in values]
         return (
             np.array([f[0] for f in found]).reshape(len(values), S, self.n_obj),
             np.array([f[1] for f in found]).reshape(len(values), S, self.n_ieq_constr),

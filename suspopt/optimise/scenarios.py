@@ -201,7 +201,9 @@ def _per_design(cfg: Config, scenario: Scenario, designed: set[str]) -> dict[str
     return values
 
 
-def _load_changes(cfg: Config, scenario: Scenario, designed: set[str], values: dict) -> dict:
+def _load_changes(
+    cfg: Config, scenario: Scenario, designed: set[str], values: dict
+) -> tuple[dict, dict]:
     """``values`` with the passenger of ``load_mass`` seated (Sec 8.4.3), and the factors on
     design variables that the rule scales; ``({path: value}, {path: factor})``."""
     from ..seat import build_seat, passenger_mass_change
@@ -280,7 +282,7 @@ class ScenarioSet:
             return None
         scenarios = expand(cfg)
         designed = {v.path for v in cfg.design_variables}
-        groups: dict[tuple, Group] = {}
+        groups: dict[str, Group] = {}
         for i, scenario in enumerate(scenarios):
             key, group_cfg = _group_config(cfg, scenario)
             values = _per_design(cfg, scenario, designed)
@@ -331,8 +333,12 @@ def aggregate(values: np.ndarray, how: list, weights: np.ndarray) -> np.ndarray:
             out[:, j] = np.quantile(v, rule.quantile, axis=1)
         elif rule == "weighted":
             out[:, j] = (v * weights).sum(axis=1) / weights.sum()
+        elif rule == "mean":
+            out[:, j] = v.mean(axis=1)
+        elif rule == "max":
+            out[:, j] = v.max(axis=1)
+        elif rule == "min":
+            out[:, j] = v.min(axis=1)
         else:
-            out[:, j] = {"mean": np.mean, "max": np.max, "min": np.min, "std": np.std}[rule](
-                v, axis=1
-            )
+            out[:, j] = v.std(axis=1)
     return out
