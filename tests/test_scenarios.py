@@ -29,6 +29,21 @@ def _designs(problem: Problem, n: int = 6) -> np.ndarray:
     return np.random.default_rng(3).uniform(problem.xl, problem.xu, (n, problem.n_var))
 
 
+def _counted_calls(monkeypatch, columns: bool = True) -> list:
+    """Every simulation an evaluation makes: its roads (1 for the config's own) and, with
+    ``columns``, its columns."""
+    calls = []
+    reduce = streaming.reduce
+
+    def counted(cfg, params, requests, **roads):
+        count = len(roads.get("roads") or [None])
+        calls.append((count, len(next(iter(params.values())))) if columns else count)
+        return reduce(cfg, params, requests, **roads)
+
+    monkeypatch.setattr(streaming, "reduce", counted)
+    return calls
+
+
 def _evaluate(problem: Problem, X):
     return problem.evaluate(X, return_values_of=["F", "G"])
 
@@ -82,14 +97,7 @@ def test_a_constraint_violated_in_one_scenario_makes_the_design_infeasible():
 
 
 def test_designs_times_scenarios_run_in_one_call(monkeypatch):
-    calls = []
-    reduce = streaming.reduce
-
-    def counted(cfg, params, requests, **roads):
-        calls.append((len(roads.get("roads") or [None]), len(next(iter(params.values())))))
-        return reduce(cfg, params, requests, **roads)
-
-    monkeypatch.setattr(streaming, "reduce", counted)
+    calls = _counted_calls(monkeypatch)
     masses = """scenarios:
   cases:
     - {name: heavy, set: {vehicle.body.mass: 2500}}
@@ -330,21 +338,15 @@ def test_roads_of_one_time_grid_are_columns_of_one_batch(engine, wide, monkeypat
     simulation, each scenario's columns under its own road, bit for bit the scenario's
     config alone; on both engines, and in numpy whether the inputs are widened per column
     or broadcast per road."""
-    pytest.importorskip("numba") if engine == "compiled" else None
+    if engine == "compiled":
+        pytest.importorskip("numba")
     from suspopt.integrator import rk4
 
     if not wide:
         monkeypatch.setattr(rk4, "_WIDE_OFFSETS", 0)
     text = ISO.replace("output_dt: 2.0e-3}", f"output_dt: 2.0e-3, engine: {engine}}}")
     assert text != ISO
-    calls = []
-    reduce = streaming.reduce
-
-    def counted(cfg, params, requests, **roads):
-        calls.append(len(roads.get("roads") or [None]))
-        return reduce(cfg, params, requests, **roads)
-
-    monkeypatch.setattr(streaming, "reduce", counted)
+    calls = _counted_calls(monkeypatch, columns=False)
     problem = _problem(ROADS, base=text)
     X = _designs(problem, 4)
     FS, GS = problem.scenario_values(problem.to_physical(X))
@@ -368,19 +370,13 @@ def test_bumps_of_other_heights_are_columns_of_one_batch(engine, kind, monkeypat
     """Bumps that differ in height only share their edges' instants: one batch, each
     scenario's columns under its own bump (split steps and impulses per column), bit for
     bit the scenario alone."""
-    pytest.importorskip("numba") if engine == "compiled" else None
+    if engine == "compiled":
+        pytest.importorskip("numba")
     base = BASE.replace("kind: bump_half_sine ", f"kind: {kind} ").replace(
         "  dt: 2.0e-3 ", f"  engine: {engine}\n  dt: 2.0e-3 "
     )
     assert base.count(kind) and "engine" in base
-    calls = []
-    reduce = streaming.reduce
-
-    def counted(cfg, params, requests, **roads):
-        calls.append(len(roads.get("roads") or [None]))
-        return reduce(cfg, params, requests, **roads)
-
-    monkeypatch.setattr(streaming, "reduce", counted)
+    calls = _counted_calls(monkeypatch, columns=False)
     extra = (
         "scenarios:\n  cases:\n    - {name: low, set: {road.height: 0.03}}\n"
         "    - {name: heavy, set: {vehicle.body.mass: 2500}}\n"
