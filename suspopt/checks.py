@@ -303,13 +303,14 @@ def check_config(cfg: Config, optimisation: bool = True) -> None:
 
 def check_scenarios(cfg: Config, problem) -> None:
     """What :func:`check_config` checks of the config, for every scenario group of
-    ``problem`` (:mod:`suspopt.optimise.scenarios`): its road and time grid, and RK4's
+    ``problem`` (:mod:`suspopt.optimise.scenarios`): its road and time grid, the memory of
+    its road, and RK4's
     stability limit at the corners of the design variables' bounds under each of its
     scenarios; reported at the scenario's key."""
     from .optimise.scenarios import Group
     from .params import ParamView
     from .seat import build_attachments
-    from .simulate import prepare
+    from .simulate import check_memory, prepare
     from .vehicle import build_vehicle
 
     corners = bound_corners(cfg)
@@ -322,7 +323,8 @@ def check_scenarios(cfg: Config, problem) -> None:
             scenario = scenarios.scenarios[member]
             try:
                 if member_cfg is not cfg:
-                    prepare(member_cfg)
+                    _, model, _, attachments = prepare(member_cfg)
+                    check_memory(member_cfg, model, attachments, 1)
                 alone = Group(member_cfg, [member], [values], [scales], [member_cfg])
                 pv = ParamView(member_cfg, scenarios.columns(alone, corners, count))
                 check_stability(

@@ -238,6 +238,10 @@ def _setup(
     network = full_network(model, attachments)
     asm = Assembled(network, pv.P, controlled="suspension" if controller else None)
     roads = list(roads) if roads else [cfg.road]
+    for road in roads[1:] if len(roads) > 1 else ():  # (the first is the config's, checked)
+        alone = cfg.model_copy(update={"road": road})
+        check_steps(alone)
+        check_memory(alone, model, attachments, pv.P)
     inputs = [
         road_inputs(road, model.offsets, model.sides, t_grid, base_dir=cfg.base_dir)
         for road in roads
@@ -275,16 +279,14 @@ def _setup(
 
 def _edges(cfg: Config, model: VehicleModel, roads: list, P: int):
     """The roads' edge times (E,) [s] and their jumps (E, n_u), or (E, G, n_u) for G > 1
-    roads; ValueError unless G roads can drive P designs in G blocks: P divisible by G, each
-    road resolved by the time grid (:func:`suspopt.checks.check_steps`), their edges (if
-    any) at the same instants."""
+    roads; ValueError unless G roads can drive P designs in G blocks: P divisible by G and
+    their edges (if any) at the same instants."""
     found = [road_edges(road, model.offsets, model.sides) for road in roads]
     if len(roads) == 1:
         return found[0][0], found[0][1].T
     if P % len(roads):
         raise ValueError(f"{P} designs do not split evenly over {len(roads)} roads")
-    for road, (times, _) in zip(roads, found):
-        check_steps(cfg.model_copy(update={"road": road}))
+    for times, _ in found:
         if not np.array_equal(times, found[0][0]):
             raise ValueError("roads whose edges fall at other instants cannot share a batch")
     return found[0][0], np.stack([jumps.T for _, jumps in found], axis=1)

@@ -390,3 +390,20 @@ def test_bumps_of_other_heights_are_columns_of_one_batch(engine, kind, monkeypat
     assert alone != base
     F, G = _evaluate(_problem(base=alone), X)
     assert np.array_equal(FS[:, 1], F) and np.array_equal(GS[:, 1], G)
+
+
+def test_a_scenario_road_too_large_for_memory_is_bad_input(monkeypatch):
+    from suspopt import memory
+    from suspopt.checks import check_config
+
+    memory.set_limit(200 << 20)
+    try:
+        text = ISO + "scenarios:\n  cases: [{name: dense, set: {road.n_waves: 2000000}}]\n"
+        cfg = load_config_text(text)
+        with pytest.raises(ConfigError, match="in scenario dense: simulating 1 design"):
+            check_config(cfg)
+        problem = Problem.from_config(cfg)  # the library path checks each road too
+        with pytest.raises(ConfigError, match="needs about"):
+            _evaluate(problem, _designs(problem, 2))
+    finally:
+        memory.set_limit(None)

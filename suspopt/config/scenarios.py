@@ -21,7 +21,7 @@ its own (:mod:`suspopt.optimise.scenarios`).
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -58,7 +58,6 @@ OBJECTIVE_DEFAULT = "mean"
 CONSTRAINT_DEFAULT = "max"
 
 _Name = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[^/\s][^/]*$")]
-_Value = bool | int | float | str
 
 
 class Quantile(Section):
@@ -77,7 +76,7 @@ class Scenario(Section):
     """One condition: config values changed from the nominal config."""
 
     name: _Name = Field(description="the scenario's name in tables and HDF5 (no '/')")
-    set: dict[str, _Value] = Field(
+    set: dict[str, Any] = Field(
         default_factory=dict,
         max_length=64,
         description="dotted config paths and their values in this scenario, e.g. "
@@ -99,6 +98,8 @@ class Scenario(Section):
         for path, item in value.items():
             if not path or any(not part for part in path.split(".")):
                 raise ValueError(f"{path!r} is not a dotted config path")
+            if not isinstance(item, (bool, int, float, str)):
+                raise ValueError(f"{path}: takes a number or a word, not {type(item).__name__}")
             if isinstance(item, float) and not abs(item) < float("inf"):
                 raise ValueError(f"{path}: the value must be finite, got {item}")
         return value
