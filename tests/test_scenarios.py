@@ -315,6 +315,31 @@ def test_simulate_a_pick_under_one_scenario(tmp_path):
     plain.write_text(template_text("quarter"))
     res = runner.invoke(app, ["simulate", str(plain), "--scenario", "A"])
     assert res.exit_code == 2 and "has no scenarios: section" in res.output
+    # analyse scenarios: the stored values of the picks, nothing simulated
+    report = tmp_path / "spread.h5"
+    res = runner.invoke(app, ["analyse", "scenarios", str(front), "-o", str(report)])
+    assert res.exit_code == 0, res.output
+    assert "hold every constraint in all 9 scenarios" in res.output
+    with h5py.File(report) as h5, h5py.File(front) as src:
+        picks = [p.decode() for p in h5["scenarios/pick"][...]]
+        assert "knee" in picks and h5["scenarios/F"].shape == (len(picks), 9, 2)
+        rows = h5["scenarios/row"][...]
+        assert np.array_equal(h5["scenarios/F"][...], src["pareto/scenarios/F"][...][rows])
+        assert list(h5["scenarios/F"].attrs["over_scenarios"]) == ["max", "max"]
+    plain_front = tmp_path / "plain.h5"
+    text = template_text("spectral").replace("population: 40 ", "population: 6 ")
+    text = text.replace("generations: 25 ", "generations: 1 ")
+    (tmp_path / "spectral.yaml").write_text(text)
+    assert runner.invoke(app, ["optimise", str(tmp_path / "spectral.yaml"), "-o",
+                               str(plain_front)]).exit_code == 0  # fmt: skip
+    res = runner.invoke(app, ["analyse", "scenarios", str(plain_front)])
+    assert res.exit_code == 2 and "/pareto/scenarios: missing" in res.output
+    with h5py.File(front, "a") as h5:  # a damaged file: scenarios that do not fit /pareto
+        data = h5["pareto/scenarios/F"][...]
+        del h5["pareto/scenarios/F"]
+        h5["pareto/scenarios/F"] = data[:, :4]
+    res = runner.invoke(app, ["analyse", "scenarios", str(front)])
+    assert res.exit_code == 2 and "does not fit" in res.output, res.output
 
 
 ISO = (

@@ -13,6 +13,7 @@ them and which keyword options it accepts (the CLI passes only those).
 | ``cdf-sensitivity`` | a config with an adaptive threshold (Figs. 4.7, 4.10) | :mod:`.cdf` |
 | ``roads``, ``masses``, ``controllers`` | a Pareto file (Sec 8.4.2-8.4.3, Ch. 7) | :mod:`.pseudo` |
 | ``transmissibility`` | a config with a seat (Eq 2.86, Fig. 8.26) | :mod:`.transmissibility` |
+| ``scenarios`` | a robust optimisation's Pareto file | :mod:`.scenarios` |
 """
 
 from __future__ import annotations
@@ -70,6 +71,7 @@ SUMMARIES = {
     "controllers": "a Pareto file's designs with another controller (Fig. 7.4b)",
     "transmissibility": "seat-to-head and seat transmissibility of a config or of a front's "
     "edges and knee (Eq 2.86, Fig. 8.26)",
+    "scenarios": "a robust front's picks under each of its scenarios (no simulation)",
     "cdf-sensitivity": "the C_max share of an adaptive CDF threshold swept from 20 to 70 % "
     "(Figs. 4.7, 4.10)",
 }
@@ -81,6 +83,7 @@ def analysis_kinds() -> dict[str, Kind]:
         cdf,  # noqa: F401  (registers cdf-sensitivity)
         models,  # noqa: F401  (registers models)
         pseudo,  # noqa: F401  (registers roads, masses, controllers)
+        scenarios,  # noqa: F401  (registers scenarios)
         transmissibility,  # noqa: F401  (registers transmissibility)
     )
 

@@ -23,6 +23,7 @@ Figures of the thesis they correspond to:
 - :func:`pareto_fronts`: a Pareto front and its pseudo-fronts (Figs. 7.4b, 8.22-8.24) with
   chosen designs marked, and the design variables along the front (Figs. 8.11-8.20);
 - :func:`sensitivity`: the CDF threshold sweep (Figs. 4.7, 4.10);
+- :func:`scenario_spread`: a robust front's picks under each scenario (ours);
 - :func:`transmissibilities`: seat transmissibility and STHT (Eq 2.86, Figs. 2.18b, 8.26);
 - :func:`plot_kesort`: the k-ε levels over a front (Figs. 6.7, 7.5, 7.6), from a
   :class:`suspopt.selection.Selection`;
@@ -40,6 +41,7 @@ from .figures import (
     model_figure,
     pareto_fronts,
     plot_kesort,
+    scenario_spread,
     sensitivity,
     transmissibilities,
 )
@@ -92,6 +94,7 @@ __all__ = [
     "model_figure",
     "pareto_fronts",
     "sensitivity",
+    "scenario_spread",
     "transmissibilities",
     "plot_kesort",
     "simulation_figure",

@@ -115,6 +115,27 @@ def sensitivity(
     return save(fig, path)
 
 
+def scenario_spread(
+    path: str | Path,
+    title: str,
+    scenarios: Sequence[str],
+    panels: Sequence[tuple[str, str, Mapping[str, np.ndarray]]],
+) -> Path:
+    """Designs' values under each scenario: one panel per ``(name, unit, {design label: (S,)
+    values})``, the scenarios as named ticks (``suspopt analyse scenarios``)."""
+    fig, axes = new_figure(len(panels), columns=1, panel_size=(7.0, 2.8))
+    x = np.arange(len(scenarios))
+    for ax, (name, unit, curves) in zip(axes, panels):
+        for label, values in curves.items():
+            ax.plot(x, values, "o-", label=label)
+        ax.set_ylabel(axis_label(name, unit))
+        ax.set_xticks(x, list(scenarios), rotation=30 if len(scenarios) > 4 else 0)
+        ax.grid(alpha=0.3)
+    figure_legend(fig, axes[0].get_legend_handles_labels())
+    figure_title(fig, title)
+    return save(fig, path)
+
+
 def transmissibilities(
     path: str | Path,
     title: str,
