@@ -432,3 +432,28 @@ def test_a_scenario_road_too_large_for_memory_is_bad_input(monkeypatch):
             _evaluate(problem, _designs(problem, 2))
     finally:
         memory.set_limit(None)
+
+
+def test_resume_continues_a_robust_run_bit_for_bit(tmp_path):
+    from suspopt.optimise import optimise
+
+    text = BASE.replace("population: 50 ", "population: 6 ").replace(
+        "generations: 20 ", "generations: 3 "
+    )
+    text += "scenarios:\n  cases: [{name: high, set: {road.height: 0.07}}]\n"
+    path = tmp_path / "robust.yaml"
+    path.write_text(text)
+    cfg = suspopt.load_config(path)
+
+    def stop(progress):
+        if progress.generation == 2:
+            raise KeyboardInterrupt
+
+    cut, whole = tmp_path / "cut.h5", tmp_path / "whole.h5"
+    assert optimise(cfg, cut, callback=stop).status == "interrupted"
+    optimise(cfg, cut, resume=True)
+    optimise(cfg, whole)
+    with h5py.File(cut) as a, h5py.File(whole) as b:
+        assert a.attrs["status"] == "finished"
+        for key in ("X", "F", "G", "scenarios/F", "scenarios/G"):
+            assert np.array_equal(a[f"pareto/{key}"][...], b[f"pareto/{key}"][...], equal_nan=True)
