@@ -12,7 +12,7 @@ it on the app when imported here.
 
 from __future__ import annotations
 
-from . import analysis, configs, optimisation, selection, simulation  # noqa: F401  (register)
+from . import analysis, configs, optimisation, report, selection, simulation  # noqa: F401  (register)
 from .base import EXIT_ALL_FAILED, app, err, out
 
 __all__ = ["app", "out", "err", "EXIT_ALL_FAILED"]

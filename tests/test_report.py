@@ -1,0 +1,185 @@
+"""``suspopt report``: the self-contained Pareto explorer, checked as text and in headless
+Chromium (the ``browser`` tests: Debian's chromium and chromium-driver, which ``.ci/run``
+installs; without them the browser tests skip, unless ``SUSPOPT_BROWSER_REQUIRED=1``)."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import time
+from pathlib import Path
+
+import h5py
+import pytest
+from typer.testing import CliRunner
+
+from suspopt.cli import app
+from suspopt.templates import template_text
+
+pytest.importorskip("plotly")
+
+runner = CliRunner()
+
+
+def _invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory) -> dict[str, Path]:
+    """A seat front (spectral, fast), its kesort file and its pseudo-fronts on class B, and a
+    robust front; each written by the commands."""
+    folder = tmp_path_factory.mktemp("report")
+    text = template_text("spectral").replace("population: 40 ", "population: 12 ")
+    text = text.replace("generations: 25 ", "generations: 3 ")
+    text = text.replace("# A seat designed", "# </script><script>alert(1)</script> A seat designed")
+    (folder / "seat.yaml").write_text(text)
+    out = {
+        "front": folder / "front.h5",
+        "kesort": folder / "picks.h5",
+        "roads": folder / "roads.h5",
+    }
+    assert _invoke("optimise", folder / "seat.yaml", "-o", out["front"]).exit_code == 0
+    assert _invoke("kesort", out["front"], "-o", out["kesort"]).exit_code == 0
+    res = _invoke("analyse", "roads", out["front"], "--road", "B", "-o", out["roads"])
+    assert res.exit_code == 0, res.output
+    robust = template_text("robust").replace("population: 30 ", "population: 8 ")
+    (folder / "robust.yaml").write_text(robust.replace("generations: 15 ", "generations: 2 "))
+    out["robust"] = folder / "robust.h5"
+    assert _invoke("optimise", folder / "robust.yaml", "-o", out["robust"]).exit_code == 0
+    return out
+
+
+def _payload(page: str) -> dict:
+    found = re.search(
+        r"<script type='application/json' id='suspopt-data'>(.*?)</script>", page, re.S
+    )
+    assert found
+    return json.loads(found.group(1))
+
+
+def test_the_page_holds_every_design_and_nothing_from_a_file_as_markup(files, tmp_path):
+    page = tmp_path / "study.html"
+    res = _invoke("report", files["front"], files["kesort"], files["roads"], "-o", page,
+                  "--with-signals", "0")  # fmt: skip
+    assert res.exit_code == 0, res.output
+    text = page.read_text()
+    assert "<meta name='generator' content='suspopt" in text[:4096]
+    assert "<script src" not in text and "<link" not in text  # everything inline
+    assert "alert(1)</script>" not in text  # the config's text is escaped everywhere
+    studies = _payload(text)["studies"]
+    with h5py.File(files["front"]) as h5:
+        N = len(h5["pareto/X"])
+    assert [s["data"]["rows"] for s in studies] == [N, N, N]
+    assert [s["kind"] for s in studies] == ["optimise", "kesort", "roads"]
+    front, kesort, roads = (s["data"] for s in studies)
+    assert len(front["F"]) == N and "history" in front and front["feasible"]
+    assert "k_eps" in kesort and "chosen" in kesort["picks"]
+    assert roads["pseudo"] and len(roads["pseudo"][0]["F"]) == N
+    assert 0 in front["signals"]["rows"] and "seat.acc" in front["signals"]["signals"]
+    assert len(front["signals"]["time"]) <= 2000
+    assert page.stat().st_size < 10 << 20
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["{yaml}"], "not an HDF5 file"),
+        (["{front}", "--with-signals", "knees"], "no such pick"),
+        (["{front}", "--with-signals", "9999"], "has rows 0 to"),
+        (["{text}"], "not an HDF5 file"),
+        (["{missing}"], "no such file"),
+    ],
+)
+def test_bad_input_is_one_line_and_writes_nothing(files, tmp_path, args, message):
+    (tmp_path / "notes.txt").write_text("not a result\n")
+    names = {"yaml": files["front"].with_name("seat.yaml"), "front": files["front"],
+             "text": tmp_path / "notes.txt", "missing": tmp_path / "none.h5"}  # fmt: skip
+    page = tmp_path / "out.html"
+    res = _invoke("report", *[a.format(**names) for a in args], "-o", page)
+    assert res.exit_code == 2, res.output
+    assert message in res.output and len(res.output.strip().splitlines()) == 1
+    assert not page.exists()
+
+
+def test_an_existing_file_of_someone_else_is_not_replaced(files, tmp_path):
+    page = tmp_path / "mine.html"
+    page.write_text("<html>my own page</html>")
+    res = _invoke("report", files["front"], "-o", page)
+    assert res.exit_code == 2 and "mine.html" in res.output
+    assert page.read_text() == "<html>my own page</html>"
+
+
+def _browser():
+    """A headless Chromium driven by selenium, or a skip (a failure when required)."""
+    required = os.environ.get("SUSPOPT_BROWSER_REQUIRED") == "1"
+    chromium, driver = shutil.which("chromium"), shutil.which("chromedriver")
+    try:
+        from selenium import webdriver
+        from selenium.webdriver.chrome.service import Service
+    except ImportError:
+        webdriver = None
+    if webdriver is None or chromium is None or driver is None:
+        if required:
+            pytest.fail(
+                "SUSPOPT_BROWSER_REQUIRED=1 but chromium, chromedriver or selenium is missing"
+            )
+        pytest.skip("needs chromium, chromium-driver (Debian) and selenium")
+    options = webdriver.ChromeOptions()
+    options.binary_location = chromium
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                "--window-size=1400,2600"):  # fmt: skip
+        options.add_argument(arg)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL", "performance": "ALL"})
+    return webdriver.Chrome(options=options, service=Service(driver))
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+@pytest.mark.parametrize("which", ["front", "kesort", "roads", "robust"])
+def test_the_report_in_a_real_browser(files, tmp_path, which):
+    """In headless Chromium: the plots render, the console has no error, the front has one
+    point per design, a click shows the design's row, and the page asks the network for
+    nothing. A screenshot is kept in ``$SUSPOPT_ARTEFACTS`` (default: the test's folder)."""
+    page = tmp_path / f"{which}.html"
+    assert _invoke("report", files[which], "-o", page).exit_code == 0
+    with h5py.File(files[which]) as h5:
+        N = len(h5["kesort/X" if which == "kesort" else "pareto/X"])
+    browser = _browser()
+    try:
+        browser.get(page.resolve().as_uri())
+        deadline = time.monotonic() + 60
+        while not browser.execute_script("return document.body.getAttribute('data-rendered')"):
+            assert time.monotonic() < deadline, "the plots did not render in 60 s"
+            time.sleep(0.1)
+        errors = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+        assert errors == []
+        points, drawn = browser.execute_script(
+            "return [window.suspoptReport.studies[0].points,"
+            " document.getElementById('front-0').data[0].x.length]"
+        )
+        assert points == drawn == N
+        row = N - 1
+        browser.execute_script(
+            "document.getElementById('front-0')"
+            ".emit('plotly_click', {points: [{customdata: arguments[0]}]})",
+            row,
+        )
+        shown = browser.execute_script(
+            "const box = document.getElementById('design-0');"
+            " return [box.getAttribute('data-row'), box.textContent, window.suspoptReport.selected.row]"
+        )
+        assert shown[0] == str(row) and f"row {row}" in shown[1] and shown[2] == row
+        requests = [
+            json.loads(entry["message"])["message"]["params"]["request"]["url"]
+            for entry in browser.get_log("performance")
+            if '"Network.requestWillBeSent"' in entry["message"]
+        ]
+        assert requests and all(url == page.resolve().as_uri() for url in requests), requests
+        artefacts = Path(os.environ.get("SUSPOPT_ARTEFACTS", tmp_path))
+        artefacts.mkdir(parents=True, exist_ok=True)
+        browser.save_screenshot(str(artefacts / f"report_{which}.png"))
+    finally:
+        browser.quit()
