@@ -9,7 +9,8 @@
 # (default out/report/chN/, one log per step in OUT/logs/, the steps' wall times in
 # OUT/run.tsv), then examples/report.py writes REPORT (default report/): README.md (header,
 # budgets, headlines) and ch3.md ... ch8.md, each thesis table beside ours with the
-# difference and its reason, and the figures in REPORT/figures/.
+# difference and its reason, and the figures in REPORT/figures/. OUT/html/ch5.html ...
+# ch8.html are the chapters' interactive reports (examples/chapter_reports.sh).
 #
 # Budgets (the report states them next to each table):
 #   Ch. 3, 4   the configs as they are (full runs);
@@ -91,5 +92,6 @@ step ch7_pseudo "$here/examples/ch7_pseudo_fronts.sh" "$out/ch7"
 step ch8 "$here/examples/ch8_optimise.sh" "$out/ch8" a b
 step ch8_pseudo "$here/examples/ch8_pseudo_fronts.sh" "$out/ch8"
 step ch8_stht "$here/examples/ch8_stht.sh" "$out/ch8"
+step reports "$here/examples/chapter_reports.sh" "$out" "$out/html"
 step report python "$here/examples/report.py" "$out" "$report" --wall "$((SECONDS - start))"
 echo "report: $report/README.md ($((SECONDS - start)) s)"

@@ -1,0 +1,79 @@
+"""Each report page drawn in headless Chromium (Debian's chromium and chromium-driver, and
+selenium): waits until its plots have rendered, checks that the console has no error and
+that the page asked the network for nothing, and writes a screenshot beside it
+(``PAGE.png``). Run: ``python examples/report_screenshots.py PAGE.html ... [--crop
+SELECTOR=OUT.png ...]`` (``--crop``: also the element the CSS selector finds in the first
+page, e.g. ``#front-0`` for the README's pictures); exit 1 with the page and the problem on
+the first that fails."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+import time
+from pathlib import Path
+
+from selenium import webdriver
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.by import By
+
+
+def _browser(width: int = 1400, height: int = 2000):
+    options = webdriver.ChromeOptions()
+    options.binary_location = shutil.which("chromium") or "/usr/bin/chromium"
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                f"--window-size={width},{height}"):  # fmt: skip
+        options.add_argument(arg)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL", "performance": "ALL"})
+    return webdriver.Chrome(
+        options=options, service=Service(shutil.which("chromedriver") or "/usr/bin/chromedriver")
+    )
+
+
+def check(page: Path, crops: dict[str, str] | None = None) -> str | None:
+    """The problem with ``page`` in the browser, or None; its screenshot is written, and
+    each ``crops`` element (CSS selector -> PNG path)."""
+    browser = _browser()
+    try:
+        browser.get(page.resolve().as_uri())
+        deadline = time.monotonic() + 120
+        while not browser.execute_script("return document.body.getAttribute('data-rendered')"):
+            if time.monotonic() > deadline:
+                return "the plots did not render in 120 s"
+            time.sleep(0.2)
+        errors = [e["message"] for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+        if errors:
+            return f"console errors: {errors[:3]}"
+        urls = [
+            json.loads(e["message"])["message"]["params"]["request"]["url"]
+            for e in browser.get_log("performance")
+            if '"Network.requestWillBeSent"' in e["message"]
+        ]
+        if any(url != page.resolve().as_uri() for url in urls):
+            return f"network requests: {urls[:3]}"
+        browser.save_screenshot(str(page.with_suffix(".png")))
+        for selector, target in (crops or {}).items():
+            browser.find_element(By.CSS_SELECTOR, selector).screenshot(target)
+    finally:
+        browser.quit()
+    return None
+
+
+def main() -> None:
+    args = sys.argv[1:]
+    crops = (
+        dict(a.split("=", 1) for a in args[args.index("--crop") + 1 :]) if "--crop" in args else {}
+    )
+    pages = args[: args.index("--crop")] if "--crop" in args else args
+    for i, name in enumerate(pages):
+        problem = check(Path(name), crops if i == 0 else None)
+        if problem:
+            sys.exit(f"{name}: {problem}")
+        print(
+            f"{name}: rendered, no console error, no network request; {Path(name).with_suffix('.png')}"
+        )
+
+
+if __name__ == "__main__":
+    main()
