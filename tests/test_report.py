@@ -79,6 +79,10 @@ def test_the_page_holds_every_design_and_nothing_from_a_file_as_markup(files, tm
     assert "k_eps" in kesort and "chosen" in kesort["picks"]
     assert roads["pseudo"] and len(roads["pseudo"][0]["F"]) == N
     assert 0 in front["signals"]["rows"] and "seat.acc" in front["signals"]["signals"]
+    tr = front["signals"]["transmissibility"]  # a seat: floor to seat (Eq 2.86, linearised)
+    assert sorted(tr["rows"]) == sorted(front["signals"]["rows"]) and len(
+        tr["dofs"]["seat"]
+    ) == len(tr["rows"])
     assert len(front["signals"]["time"]) <= 2000
     assert page.stat().st_size < 10 << 20
 
