@@ -313,7 +313,7 @@ class Problem(_PymooProblem):
         shapes = (self.n_obj, self.n_ieq_constr - 1, len(self.supplementary_names))
         values = [np.full((P, S, k), np.nan) for k in shapes]
         failed = np.zeros((P, S), dtype=bool)
-        for group in self.scenarios.groups:  # one batch per road and time grid
+        for group in self.scenarios.groups:  # one simulation per group (a time grid)
             columns = self.scenarios.columns(group, params, P)
             n = P * len(group.members)
             roads = {"roads": group.roads} if group.roads else {}  # a road per scenario
