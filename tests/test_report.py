@@ -13,6 +13,7 @@ from pathlib import Path
 
 import h5py
 import pytest
+from conftest import CONFIGS, tiny
 from typer.testing import CliRunner
 
 from suspopt.cli import app
@@ -50,6 +51,49 @@ def files(tmp_path_factory) -> dict[str, Path]:
     out["robust"] = folder / "robust.h5"
     assert _invoke("optimise", folder / "robust.yaml", "-o", out["robust"]).exit_code == 0
     return out
+
+
+#: Each chapter's report, from tiny runs of its bundled configs (Chapters 3-4 simulate given
+#: designs: they have no design sets to explore): (configs, what is made of the fronts).
+CHAPTERS = {
+    "ch5": (["ch5/case1_s1", "ch5/case4_s1"], None),
+    "ch6": (["ch6/part_b"], "kesort"),
+    "ch7": (["ch7/sh_2"], "controllers"),
+    "ch8": (["ch8/pareto_ps_class_a", "ch8/pareto_nss4_class_a"], "roads"),
+}
+
+
+@pytest.fixture(scope="module")
+def chapters(tmp_path_factory) -> dict[str, Path]:
+    """Each chapter's report page (examples/chapter_reports.sh does the same at full
+    budget)."""
+    folder = tmp_path_factory.mktemp("chapters")
+    pages = {}
+    for chapter, (names, then) in CHAPTERS.items():
+        fronts = []
+        for name in names:
+            config = folder / f"{name.replace('/', '_')}.yaml"
+            config.write_text(tiny((CONFIGS / f"{name}.yaml").read_text(), 2.0, 8, 2))
+            front = config.with_suffix(".h5")
+            assert _invoke("optimise", config, "-o", front).exit_code == 0
+            fronts.append(front)
+        if then == "kesort":
+            fronts.append(folder / f"{chapter}_kesort.h5")
+            res = _invoke("kesort", fronts[0], "--keep-infeasible", "-o", fronts[-1])
+            assert res.exit_code == 0, res.output
+        elif then == "controllers":
+            fronts.append(folder / f"{chapter}_cdf.h5")
+            res = _invoke("analyse", "controllers", fronts[0], "--with",
+                          CONFIGS / "ch7" / "sh_2_cdf.yaml", "-o", fronts[-1])  # fmt: skip
+            assert res.exit_code == 0, res.output
+        elif then == "roads":
+            fronts.append(folder / f"{chapter}_roads.h5")
+            res = _invoke("analyse", "roads", fronts[0], "--road", "B", "-o", fronts[-1])
+            assert res.exit_code == 0, res.output
+        pages[chapter] = folder / f"{chapter}.html"
+        res = _invoke("report", *fronts, "--title", f"Chapter {chapter[2:]}", "-o", pages[chapter])
+        assert res.exit_code == 0, res.output
+    return pages
 
 
 def _payload(page: str) -> dict:
@@ -142,15 +186,20 @@ def _browser():
 
 @pytest.mark.browser
 @pytest.mark.slow
-@pytest.mark.parametrize("which", ["front", "kesort", "roads", "robust"])
-def test_the_report_in_a_real_browser(files, tmp_path, which):
+@pytest.mark.parametrize("which", ["front", "kesort", "roads", "robust", *CHAPTERS])
+def test_the_report_in_a_real_browser(files, chapters, tmp_path, which):
     """In headless Chromium: the plots render, the console has no error, the front has one
     point per design, a click shows the design's row, and the page asks the network for
-    nothing. A screenshot is kept in ``$SUSPOPT_ARTEFACTS`` (default: the test's folder)."""
-    page = tmp_path / f"{which}.html"
-    assert _invoke("report", files[which], "-o", page).exit_code == 0
-    with h5py.File(files[which]) as h5:
-        N = len(h5["kesort/X" if which == "kesort" else "pareto/X"])
+    nothing. A screenshot is kept in ``$SUSPOPT_ARTEFACTS`` (default: the test's folder):
+    one per chapter's report and per kind of file."""
+    if which in chapters:
+        page = chapters[which]
+        N = _payload(page.read_text())["studies"][0]["data"]["rows"]
+    else:
+        page = tmp_path / f"{which}.html"
+        assert _invoke("report", files[which], "-o", page).exit_code == 0
+        with h5py.File(files[which]) as h5:
+            N = len(h5["kesort/X" if which == "kesort" else "pareto/X"])
     browser = _browser()
     try:
         browser.get(page.resolve().as_uri())
