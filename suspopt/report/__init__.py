@@ -1,0 +1,247 @@
+"""``suspopt report FILE.h5 ... -o study.html``: an interactive Pareto explorer in one file.
+
+:func:`build_report` reads the result files of ``suspopt optimise``, ``kesort`` and
+``analyse roads|masses|controllers|scenarios`` (each a *study*: :func:`collect`) and writes
+one self-contained HTML page (:mod:`.page`): every script and style inline, plotly.js
+included (the optional extra ``pip install 'suspopt[report]'``), so it opens offline in any
+browser and makes no network request. Per study:
+
+- the front as a scatter of any two columns (objectives or design variables) chosen from
+  drop-downs, in 3D for three objectives; colour by feasibility, k-ε level (kesort), case,
+  or any objective or variable; the picks (edges, knee, the k-ε optimum) marked;
+- a parallel-coordinates view of the objectives and variables (drag along an axis to
+  brush);
+- hover and click on a design: its row, objectives with units, variables, constraint
+  margins, in the panel beside the plot;
+- the picks' (and ``with_signals`` rows') time histories and power spectral densities
+  [unit²/Hz], simulated when the report is built (from each design's own config, in one
+  batch per config), thinned to at most :data:`MAX_SAMPLES` samples per signal (the page
+  says when); where there is a seat, their transmissibility from the floor to the seat and
+  to the head (STHT, Eq 2.86) of the seat linearised about its static equilibrium;
+- pseudo-fronts (``analyse roads|masses|controllers``): each changed front over the stored
+  one, with a line from each design to its moved point;
+- the history per generation (best value, hypervolume, feasible share) and the run's
+  provenance (config, seeds, version, command) in a collapsible section.
+
+Nothing read from a file runs as code: the data go into the page as JSON (``<`` escaped) and
+are shown as text. The page's JavaScript API ``window.suspoptReport`` (``studies[i].points``,
+``select(i, row)``, ``selected``) is what the browser test drives.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..config import ConfigError
+
+__all__ = ["build_report", "collect", "Study", "MAX_SAMPLES", "MAX_BYTES"]
+
+#: The most samples a time history or spectrum keeps in the page (others are thinned).
+MAX_SAMPLES = 2000
+#: The page may not grow beyond this [bytes] (a 1000-design front with 5 picks' signals
+#: stays far below it).
+MAX_BYTES = 10 << 20
+#: The most designs whose signals a report simulates.
+MAX_SIGNAL_DESIGNS = 12
+
+
+@dataclass
+class Study:
+    """One result file as the page shows it (all arrays as lists, NaN as None)."""
+
+    label: str
+    kind: str
+    data: dict[str, Any] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+
+def _list(a) -> Any:
+    """An array as nested lists, non-finite values as None (JSON has no NaN)."""
+    a = np.asarray(a, dtype=float)
+    out = a.astype(object)
+    out[~np.isfinite(a)] = None
+    return out.tolist()
+
+
+def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
+    """The study of one result file (module docstring); ConfigError naming the file for
+    anything that is not a suspopt front, or a ``with_signals`` row it does not have."""
+    from ..h5read import H5Reader
+    from ..picks import read_table
+
+    path = Path(path)
+    table = read_table(path)
+    with H5Reader(path) as h5:
+        attrs = {
+            key: h5.text_attr(key)
+            for key in ("suspopt_version", "created", "command", "config", "analysis", "status",
+                        "algorithm")
+            if h5.has_attr(key)
+        }  # fmt: skip
+        for key in ("seed", "optimiser_seed"):
+            if h5.has_attr(key):
+                attrs[key] = str(h5.attribute(h5.file, key, key))
+        kind = "kesort" if table.table == "kesort" else attrs.get("analysis", "optimise")
+        extra = _extras(h5, table)
+    data: dict[str, Any] = {
+        "rows": len(table.X),
+        "objectives": table.obj_names,
+        "objective_units": table.obj_units,
+        "variables": table.var_names,
+        "variable_units": table.var_units,
+        "F": _list(table.F),
+        "X": _list(table.X),
+        "picks": table.picks,
+        "provenance": attrs,
+        **extra,
+    }
+    study = Study(path.name, kind, data)
+    rows = sorted(set(table.picks.values()) | {table.resolve(r) for r in with_signals})
+    if len(rows) > MAX_SIGNAL_DESIGNS:
+        raise ConfigError(
+            f"--with-signals: {len(rows)} designs with signals, more than {MAX_SIGNAL_DESIGNS}"
+        )
+    data["signals"] = _signals(path, table, rows, study.notes)
+    return study
+
+
+def _extras(h5, table) -> dict[str, Any]:
+    """Feasibility, constraints, k-ε levels, cases, history and pseudo-fronts, where the
+    file has them."""
+    out: dict[str, Any] = {}
+    N = len(table.X)
+    group = table.table
+    if group == "pareto" and h5._node("pareto/G") is not None:
+        G = h5.array("pareto/G", ndim=2)
+        if len(G) == N:
+            out["G"] = _list(G)
+            out["constraints"] = h5.labels("pareto/G", "names", G.shape[1])
+            out["constraint_units"] = h5.labels("pareto/G", "units", G.shape[1])
+            out["feasible"] = (G <= 0).all(axis=1).tolist()
+    if group == "kesort":
+        out["k_eps"] = _list(h5.array("kesort/k_eps", ndim=1))
+        out["feasible"] = [bool(v) for v in h5.array("kesort/feasible", ndim=1)]
+        case = h5.dataset("kesort/case")[()]
+        out["case"] = [h5.text(v, "kesort/case") for v in np.atleast_1d(case)]
+    if h5._node("history/generation") is not None:
+        history = {"generation": _list(h5.array("history/generation", ndim=1))}
+        for key in ("hypervolume", "feasible"):
+            if h5._node(f"history/{key}") is not None:
+                history[key] = _list(h5.array(f"history/{key}", ndim=1))
+        if h5._node("history/best") is not None:
+            best = h5.array("history/best", ndim=2)
+            history["best"] = _list(best.T)
+            history["best_names"] = h5.labels("history/best", "names", best.shape[1])
+        out["history"] = history
+    if h5._node("pseudo") is not None:
+        fronts = []
+        for label in h5.group("pseudo"):
+            F = h5.array(f"pseudo/{label}/F", ndim=2, columns=table.F.shape[1])
+            if len(F) == N:
+                fronts.append({"label": str(label), "F": _list(F)})
+        out["pseudo"] = fronts
+    return out
+
+
+def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, Any]:
+    """Time histories and spectra of the designs ``rows``, simulated in one batch per config
+    of the table (each design with its own config)."""
+    from ..metrics.spectral import psd
+    from ..picks import read_picks
+    from ..plots.runs import default_signals
+    from ..simulate import simulate
+
+    out: dict[str, Any] = {"rows": [], "time": [], "signals": {}, "units": {}, "psd": {}}
+    by_config: dict[int, list[int]] = {}
+    for row in rows:
+        by_config.setdefault(int(table.config_of[row]), []).append(row)
+    results = []
+    for group_rows in by_config.values():  # one batch per config (the pooled sets of kesort)
+        picked = read_picks(path, [str(r) for r in group_rows])
+        with np.errstate(all="ignore"):
+            results.append((group_rows, simulate(picked.config, picked.params())))
+        if picked.config.seat is not None:
+            _transmissibility(picked, group_rows, out)
+    if not results:
+        return out
+    names = default_signals(results[0][1])
+    names = [n for n in names if n.startswith(("seat.", "head."))] + [
+        n for n in names if not n.startswith(("seat.", "head."))
+    ]  # a seat's own first
+    time = results[0][1].time
+    step = max(1, -(-len(time) // MAX_SAMPLES))
+    if step > 1:
+        notes.append(
+            f"time histories thinned for size: one sample in {step} of {len(time)} shown "
+            f"(the spectra are computed from all of them)"
+        )
+    out["time"] = _list(time[::step])
+    fs = 1.0 / float(time[1] - time[0])
+    for group_rows, result in results:
+        for i, row in enumerate(group_rows):
+            out["rows"].append(row)
+            for name in names:
+                if name not in result.signals:
+                    continue
+                y = np.asarray(result.signals[name][i], dtype=float)
+                out["signals"].setdefault(name, []).append(_list(y[::step]))
+                out["units"][name] = result.signal_unit(name)
+                f, p = psd(y, fs)
+                keep = max(1, -(-len(f) // MAX_SAMPLES))
+                out["psd"].setdefault(name, []).append(_list(p[::keep]))
+                out["psd_f"] = _list(f[::keep])
+    return out
+
+
+def _transmissibility(picked, rows: list[int], out: dict) -> None:
+    """The seat's linear transmissibility ``|z̈_i / z̈_s|`` [1] from the floor to the seat and
+    (with a passenger) to the head, the STHT of Eq 2.86, of the designs ``rows``
+    (:func:`suspopt.seat.base_transmissibility` of the seat linearised about its static
+    equilibrium, as ``suspopt analyse transmissibility`` computes its ``linear`` curves)."""
+    from ..analyse.transmissibility import LINEAR_FREQUENCIES
+    from ..params import ParamView
+    from ..seat import base_transmissibility, build_seat, linearise
+
+    cfg = picked.config
+    seat = build_seat(cfg, ParamView(cfg, picked.params()))
+    with np.errstate(all="ignore"):
+        curves = np.abs(base_transmissibility(linearise(seat), LINEAR_FREQUENCIES))
+    tr = out.setdefault("transmissibility", {"f": _list(LINEAR_FREQUENCIES), "rows": [], "dofs": {}})
+    tr["rows"] += rows
+    for j, name in enumerate(seat.dof_names):
+        if name in ("seat", "head"):
+            tr["dofs"].setdefault(name, []).extend(_list(curves[:, :, j]))
+
+
+def build_report(
+    paths: Sequence[str | Path],
+    output: str | Path,
+    with_signals: Sequence[str] = (),
+    title: str | None = None,
+) -> tuple[Path, int, list[str]]:
+    """Write the report of the result files ``paths`` to ``output`` (module docstring);
+    ``with_signals`` rows (or pick names) of every file get their signals too. Returns the
+    path, its size [bytes] and the notes (what was thinned). ConfigError for a file that is
+    not a suspopt front, a missing pick or row, or without plotly."""
+    from .page import render
+
+    if not paths:
+        raise ConfigError("report: give at least one result file")
+    studies = [collect(p, with_signals) for p in paths]
+    html = render(studies, title or ", ".join(s.label for s in studies))
+    size = len(html.encode())
+    if size > MAX_BYTES:
+        raise ConfigError(
+            f"report: the page would be {size >> 20} MB, more than {MAX_BYTES >> 20} MB: "
+            f"fewer --with-signals designs or fewer files"
+        )
+    from ..io import atomic_file
+
+    with atomic_file(output) as stream:
+        stream.write(html.encode())
+    return Path(output), size, [n for s in studies for n in s.notes]

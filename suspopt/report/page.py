@@ -1,0 +1,305 @@
+"""The report's HTML page: plotly.js, the studies as JSON and the page's own script, inline.
+
+:func:`render` needs plotly (``pip install 'suspopt[report]'``) for its JavaScript only: the
+figures are drawn in the browser by :data:`SCRIPT` from the data, so that the drop-downs can
+redraw them. The data are JSON in a ``<script type="application/json">`` element with every
+``<``, ``>`` and ``&`` escaped, and every name from a file is shown with ``textContent``,
+never as markup.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+from typing import Any
+
+from ..config import ConfigError
+
+__all__ = ["render", "SCRIPT", "STYLE"]
+
+STYLE = """
+body { font-family: system-ui, sans-serif; margin: 1.2em; color: #222; }
+h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.6em; }
+.controls label { margin-right: 1em; font-size: 0.9em; }
+.row { display: flex; flex-wrap: wrap; gap: 1em; }
+.plot { width: 720px; height: 480px; } .wide { width: 1100px; height: 420px; }
+.design { min-width: 300px; max-width: 380px; font-size: 0.85em; }
+.design table { border-collapse: collapse; } .design td { padding: 1px 6px; }
+.note { color: #666; font-size: 0.85em; }
+pre { background: #f6f6f6; padding: 0.6em; max-height: 24em; overflow: auto; }
+"""
+
+SCRIPT = r"""
+(function () {
+  "use strict";
+  const data = JSON.parse(document.getElementById("suspopt-data").textContent);
+  const api = { studies: [], selected: null, select: null };
+  window.suspoptReport = api;
+
+  function el(tag, text, parent) {
+    const e = document.createElement(tag);
+    if (text !== undefined && text !== null) e.textContent = String(text);
+    if (parent) parent.appendChild(e);
+    return e;
+  }
+  function fmt(v) { return v === null ? "-" : Number(v).toPrecision(5); }
+  function column(study, key) {
+    const d = study.data, [kind, j] = key.split(":");
+    const rows = kind === "F" ? d.F : d.X;
+    return rows.map(r => r[Number(j)]);
+  }
+  function label(study, key) {
+    const d = study.data, [kind, j] = key.split(":");
+    return kind === "F" ? d.objectives[j] + " [" + d.objective_units[j] + "]"
+                        : d.variables[j] + " [" + d.variable_units[j] + "]";
+  }
+  function select(el_, options, value) {
+    for (const [k, text] of options) {
+      const o = el("option", text, el_); o.value = k; if (k === value) o.selected = true;
+    }
+  }
+
+  function showDesign(i, row) {
+    const study = data.studies[i], d = study.data, box = document.getElementById("design-" + i);
+    box.textContent = "";
+    el("h3", "row " + row, box);
+    const picks = Object.entries(d.picks).filter(([, r]) => r === row).map(([n]) => n);
+    if (picks.length) el("div", "pick: " + picks.join(", "), box);
+    const t = el("table", null, box);
+    function add(name, value, unit) {
+      const tr = el("tr", null, t); el("td", name, tr); el("td", fmt(value), tr); el("td", unit, tr);
+    }
+    d.objectives.forEach((n, j) => add(n, d.F[row][j], d.objective_units[j]));
+    d.variables.forEach((n, j) => add(n, d.X[row][j], d.variable_units[j]));
+    if (d.G) d.constraints.forEach((n, j) => add("g: " + n, d.G[row][j], d.constraint_units[j]));
+    if (d.k_eps) add("k-ε level", d.k_eps[row], "1");
+    if (d.case) add("case " + d.case[row], null, "");
+    api.selected = { study: i, row: row };
+    box.setAttribute("data-row", String(row));
+  }
+  api.select = showDesign;
+
+  function colours(study) {
+    const d = study.data, out = [];
+    if (d.feasible) out.push(["feasible", "feasibility"]);
+    if (d.k_eps) out.push(["k_eps", "k-ε level"]);
+    if (d.case) out.push(["case", "case"]);
+    d.objectives.forEach((n, j) => out.push(["F:" + j, n]));
+    d.variables.forEach((n, j) => out.push(["X:" + j, n]));
+    return out;
+  }
+  function colourValues(study, key) {
+    const d = study.data;
+    if (key === "feasible") return d.feasible.map(v => (v ? 1 : 0));
+    if (key === "k_eps") return d.k_eps;
+    if (key === "case") { const u = [...new Set(d.case)]; return d.case.map(c => u.indexOf(c)); }
+    return column(study, key);
+  }
+
+  function drawFront(i) {
+    const study = data.studies[i], d = study.data;
+    const x = document.getElementById("x-" + i).value, y = document.getElementById("y-" + i).value;
+    const c = document.getElementById("c-" + i).value;
+    const three = document.getElementById("d3-" + i);
+    const rows = d.F.map((_, r) => r);
+    const hover = rows.map(r => "row " + r + "<br>" + d.objectives.map((n, j) => n + " " + fmt(d.F[r][j])).join("<br>"));
+    const marker = { color: colourValues(study, c), colorscale: "Viridis", showscale: true, size: 7,
+                     colorbar: { title: { text: (colours(study).find(o => o[0] === c) || [c, c])[1] } } };
+    if (c === "feasible") Object.assign(marker, { colorscale: [[0, "#d62728"], [1, "#1f77b4"]], cmin: 0, cmax: 1,
+      colorbar: { title: { text: "feasible" }, tickvals: [0, 1], ticktext: ["no", "yes"] } });
+    const traces = [];
+    const use3d = three && three.checked;
+    if (use3d) {
+      traces.push({ type: "scatter3d", mode: "markers", name: "designs", x: column(study, "F:0"),
+        y: column(study, "F:1"), z: column(study, "F:2"), customdata: rows, text: hover,
+        hoverinfo: "text", marker: Object.assign({}, marker, { size: 4 }) });
+    } else {
+      traces.push({ type: "scatter",
+        mode: "markers", name: "designs", x: column(study, x), y: column(study, y), customdata: rows,
+        text: hover, hoverinfo: "text", marker: marker });
+      const names = Object.keys(d.picks), pr = names.map(n => d.picks[n]);
+      traces.push({ type: "scatter", mode: "markers+text", name: "picks", x: pr.map(r => column(study, x)[r]),
+        y: pr.map(r => column(study, y)[r]), text: names, textposition: "top center", customdata: pr,
+        hoverinfo: "text", marker: { symbol: "x", size: 12, color: "#d62728" } });
+      for (const p of d.pseudo || []) {
+        if (!x.startsWith("F:") || !y.startsWith("F:")) break;
+        const jx = Number(x.slice(2)), jy = Number(y.slice(2)), lx = [], ly = [];
+        p.F.forEach((r, k) => { lx.push(d.F[k][jx], r[jx], null); ly.push(d.F[k][jy], r[jy], null); });
+        traces.push({ type: "scatter", mode: "markers", name: p.label, x: p.F.map(r => r[jx]),
+          y: p.F.map(r => r[jy]), customdata: rows, marker: { size: 6, symbol: "diamond" } });
+        traces.push({ type: "scatter", mode: "lines", name: p.label + " (moves)", x: lx, y: ly,
+          hoverinfo: "skip", line: { width: 0.8, color: "#999" } });
+      }
+    }
+    const layout = use3d ? { scene: { xaxis: { title: { text: label(study, "F:0") } },
+                                      yaxis: { title: { text: label(study, "F:1") } },
+                                      zaxis: { title: { text: label(study, "F:2") } } },
+                             margin: { t: 20 } }
+                         : { xaxis: { title: { text: label(study, x) } }, yaxis: { title: { text: label(study, y) } },
+                             margin: { t: 20 }, legend: { orientation: "h", y: -0.18 } };
+    const div = document.getElementById("front-" + i);
+    return Plotly.react(div, traces, layout, { displaylogo: false });
+  }
+
+  function drawParallel(i) {
+    const study = data.studies[i], d = study.data;
+    const dims = d.objectives.map((n, j) => ({ label: n, values: column(study, "F:" + j) }))
+      .concat(d.variables.map((n, j) => ({ label: n, values: column(study, "X:" + j) })));
+    const colour = d.feasible ? d.feasible.map(v => (v ? 1 : 0)) : column(study, "F:0");
+    return Plotly.newPlot("parallel-" + i, [{ type: "parcoords", dimensions: dims,
+      line: { color: colour, colorscale: "Viridis" } }], { margin: { t: 40 } }, { displaylogo: false });
+  }
+
+  function drawHistory(i) {
+    const h = data.studies[i].data.history;
+    if (!h) return Promise.resolve();
+    const traces = [];
+    (h.best || []).forEach((b, j) => traces.push({ type: "scatter", mode: "lines", name: "best " + h.best_names[j],
+      x: h.generation, y: b }));
+    if (h.hypervolume) traces.push({ type: "scatter", mode: "lines", name: "hypervolume", x: h.generation, y: h.hypervolume, yaxis: "y2" });
+    if (h.feasible) traces.push({ type: "scatter", mode: "lines", name: "feasible share", x: h.generation, y: h.feasible, yaxis: "y2" });
+    return Plotly.newPlot("history-" + i, traces, { xaxis: { title: { text: "generation" } },
+      yaxis2: { overlaying: "y", side: "right", range: [0, 1.05] }, margin: { t: 20 } }, { displaylogo: false });
+  }
+
+  function drawSignals(i) {
+    const s = data.studies[i].data.signals;
+    const names = Object.keys(s.signals);
+    if (!names.length) return Promise.resolve();
+    const pick = document.getElementById("s-" + i).value;
+    const traces = s.rows.map((row, k) => ({ type: "scatter", mode: "lines", name: "row " + row,
+      x: s.time, y: s.signals[pick][k] }));
+    const spectra = s.rows.map((row, k) => ({ type: "scatter", mode: "lines", name: "row " + row,
+      x: s.psd_f, y: s.psd[pick][k] }));
+    const unit = s.units[pick];
+    return Promise.all([
+      Plotly.react("signal-" + i, traces, { xaxis: { title: { text: "time [s]" } },
+        yaxis: { title: { text: pick + " [" + unit + "]" } }, margin: { t: 20 } }, { displaylogo: false }),
+      Plotly.react("psd-" + i, spectra, { xaxis: { title: { text: "frequency [Hz]" }, type: "log" },
+        yaxis: { title: { text: "PSD [(" + unit + ")^2/Hz]" }, type: "log" }, margin: { t: 20 } },
+        { displaylogo: false }),
+    ]);
+  }
+
+  function drawTransmissibility(i) {
+    const t = data.studies[i].data.signals.transmissibility;
+    if (!t) return Promise.resolve();
+    const traces = [];
+    for (const [dof, curves] of Object.entries(t.dofs)) {
+      curves.forEach((y, k) => traces.push({ type: "scatter", mode: "lines", x: t.f, y: y,
+        name: (dof === "head" ? "STHT (head)" : dof) + ", row " + t.rows[k],
+        line: { dash: dof === "head" ? "solid" : "dot" } }));
+    }
+    return Plotly.newPlot("tr-" + i, traces, { xaxis: { title: { text: "frequency [Hz]" }, type: "log" },
+      yaxis: { title: { text: "|transmissibility| [1]" }, type: "log" }, margin: { t: 20 } },
+      { displaylogo: false });
+  }
+
+  const done = [];
+  data.studies.forEach((study, i) => {
+    const d = study.data, keys = d.objectives.map((n, j) => ["F:" + j, n])
+      .concat(d.variables.map((n, j) => ["X:" + j, n]));
+    const xs = document.getElementById("x-" + i), ys = document.getElementById("y-" + i);
+    select(xs, keys, d.objectives.length > 1 ? "F:0" : "X:0");
+    select(ys, keys, d.objectives.length > 1 ? "F:1" : "F:0");
+    const mixed = d.feasible && d.feasible.some(v => !v);
+    select(document.getElementById("c-" + i), colours(study),
+           mixed ? "feasible" : d.k_eps ? "k_eps" : d.variables.length ? "X:0" : "F:0");
+    const sig = document.getElementById("s-" + i);
+    if (sig) select(sig, Object.keys(d.signals.signals).map(n => [n, n]), Object.keys(d.signals.signals)[0]);
+    const front = drawFront(i).then(div => {
+      div.on("plotly_click", ev => { const p = ev.points[0]; if (p && p.customdata !== undefined) showDesign(i, p.customdata); });
+    });
+    for (const id of ["x-", "y-", "c-", "d3-"]) {
+      const e = document.getElementById(id + i); if (e) e.addEventListener("change", () => drawFront(i));
+    }
+    if (sig) sig.addEventListener("change", () => drawSignals(i));
+    api.studies.push({ label: study.label, points: d.rows, front: "front-" + i });
+    done.push(front, drawParallel(i), drawHistory(i), drawSignals(i), drawTransmissibility(i));
+    showDesign(i, Object.values(d.picks)[0] || 0);
+  });
+  Promise.all(done).then(() => { document.body.setAttribute("data-rendered", "1"); });
+})();
+"""
+
+
+def _plotly_js() -> str:
+    try:
+        from plotly.offline import get_plotlyjs
+    except ImportError:
+        raise ConfigError(
+            "report: needs plotly for its page's plots: pip install 'suspopt[report]'"
+        ) from None
+    return get_plotlyjs()
+
+
+def _json(value: Any) -> str:
+    """JSON safe inside a ``<script>`` element: no ``<``, ``>`` or ``&`` left as such."""
+    text = json.dumps(value, allow_nan=False, separators=(",", ":"))
+    return text.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
+
+
+def _section(i: int, study) -> str:
+    d = study.data
+    e = html.escape
+    three = (
+        f'<label><input type="checkbox" id="d3-{i}"> 3D ({", ".join(e(n) for n in d["objectives"])})</label>'
+        if len(d["objectives"]) == 3
+        else ""
+    )
+    parts = [
+        f"<h2>{e(study.label)} <span class='note'>({e(study.kind)}, {d['rows']} designs)</span></h2>",
+        f"<div class='controls'><label>x <select id='x-{i}'></select></label>"
+        f"<label>y <select id='y-{i}'></select></label>"
+        f"<label>colour <select id='c-{i}'></select></label>{three}</div>",
+        f"<div class='row'><div id='front-{i}' class='plot'></div>"
+        f"<div id='design-{i}' class='design'></div></div>",
+        f"<h3>Objectives and variables</h3><div id='parallel-{i}' class='wide'></div>",
+    ]
+    if d["signals"]["signals"]:
+        parts.append(
+            f"<h3>Signals of the picks</h3><div class='controls'><label>signal "
+            f"<select id='s-{i}'></select></label></div><div class='row'>"
+            f"<div id='signal-{i}' class='plot'></div><div id='psd-{i}' class='plot'></div></div>"
+        )
+    if d["signals"].get("transmissibility"):
+        parts.append(
+            f"<h3>Seat transmissibility of the picks (floor to seat; to head: STHT, Eq 2.86;"
+            f" the seat linearised)</h3><div id='tr-{i}' class='wide'></div>"
+        )
+    if "history" in d:
+        parts.append(f"<h3>History</h3><div id='history-{i}' class='wide'></div>")
+    for note in study.notes:
+        parts.append(f"<p class='note'>{e(note)}</p>")
+    prov = d["provenance"]
+    config = prov.get("config", "")
+    rest = "\n".join(f"{k}: {v}" for k, v in prov.items() if k != "config")
+    parts.append(
+        f"<details><summary>Provenance</summary><pre>{e(rest)}</pre>"
+        f"<pre>{e(config)}</pre></details>"
+    )
+    return "\n".join(parts)
+
+
+def render(studies, title: str) -> str:
+    """The whole page of ``studies`` (:class:`suspopt.report.Study`)."""
+    from .. import __version__
+
+    payload = {"studies": [{"label": s.label, "kind": s.kind, "data": s.data} for s in studies]}
+    e = html.escape
+    return "\n".join(
+        [
+            "<!DOCTYPE html>",
+            "<html lang='en'><head><meta charset='utf-8'>",
+            f"<meta name='generator' content='suspopt {e(__version__)}'>",
+            f"<title>{e(title)}</title><style>{STYLE}</style></head><body>",
+            f"<h1>{e(title)}</h1>",
+            "<p class='note'>Click a design to see its row; drag along an axis of the "
+            "parallel coordinates to brush. Written by suspopt report; it needs no network.</p>",
+            *(_section(i, s) for i, s in enumerate(studies)),
+            f"<script type='application/json' id='suspopt-data'>{_json(payload)}</script>",
+            f"<script>{_plotly_js()}</script>",
+            f"<script>{SCRIPT}</script>",
+            "</body></html>",
+        ]
+    )
