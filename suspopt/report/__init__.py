@@ -211,7 +211,9 @@ def _transmissibility(picked, rows: list[int], out: dict) -> None:
     seat = build_seat(cfg, ParamView(cfg, picked.params()))
     with np.errstate(all="ignore"):
         curves = np.abs(base_transmissibility(linearise(seat), LINEAR_FREQUENCIES))
-    tr = out.setdefault("transmissibility", {"f": _list(LINEAR_FREQUENCIES), "rows": [], "dofs": {}})
+    tr = out.setdefault(
+        "transmissibility", {"f": _list(LINEAR_FREQUENCIES), "rows": [], "dofs": {}}
+    )
     tr["rows"] += rows
     for j, name in enumerate(seat.dof_names):
         if name in ("seat", "head"):
