@@ -127,7 +127,7 @@ def test_the_page_holds_every_design_and_nothing_from_a_file_as_markup(files, tm
     assert sorted(tr["rows"]) == sorted(front["signals"]["rows"]) and len(
         tr["dofs"]["seat"]
     ) == len(tr["rows"])
-    assert len(front["signals"]["time"]) <= 2000
+    assert len(front["signals"]["time"]) <= 1000
     assert page.stat().st_size < 10 << 20
 
 

@@ -42,7 +42,7 @@ from ..config import ConfigError
 __all__ = ["build_report", "collect", "Study", "MAX_SAMPLES", "MAX_BYTES"]
 
 #: The most samples a time history or spectrum keeps in the page (others are thinned).
-MAX_SAMPLES = 2000
+MAX_SAMPLES = 1000
 #: The page may not grow beyond this [bytes] (a 1000-design front with 5 picks' signals
 #: stays far below it).
 MAX_BYTES = 10 << 20
