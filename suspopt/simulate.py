@@ -230,8 +230,9 @@ def _setup(
 ) -> tuple[Run, np.ndarray, np.ndarray, np.ndarray]:
     """The integrator's :class:`~suspopt.integrator.Run` of the designs, the roads' inputs
     ``z, zd (n_u, G, 2 n_steps + 1)`` on the half-step grid and that grid [s]. ``roads``
-    (road sections without edges, G of them, each checked against the time grid) drive the
-    designs in G equal blocks of consecutive columns; default: the config's road."""
+    (G road sections, each checked against the time grid, their edges if any at the same
+    instants) drive the designs in G equal blocks of consecutive columns; default: the
+    config's road."""
     sim = cfg.simulation
     n_steps, every = sim.n_steps, sim.output_every
     t_grid = np.arange(2 * n_steps + 1) * (0.5 * sim.dt)

@@ -199,7 +199,8 @@ def reduce(
     :func:`suspopt.specs.spec_signals` gives them) for the designs ``params`` (as
     :func:`suspopt.simulate`), without keeping the run's signals (module docstring): a
     :class:`Reduced`, or the whole :class:`~suspopt.result.Result` for a controlled run.
-    ``roads`` (road sections without edges) drive the designs in equal blocks of
+    ``roads`` (road sections whose edges, if any, fall at the same instants) drive the
+    designs in equal blocks of
     consecutive columns instead of the config's road (robust design, one batch for
     several roads on one time grid)."""
     from . import integrator

@@ -62,8 +62,8 @@ def _law(code, r, p, F, par):
 @_jit
 def _stage(W, F, par, idx, lay, src, o, oi, lr, has_input, scale, out):
     """The accelerations at the state ``W[src] = [q; v]`` with the inputs' part ``o[oi]``
-    (when ``has_input``; ``o (.., G, 2R)``, lane ``b`` on road ``lr[b]`` when G > 1), times the inverse masses' row set ``scale`` (0: 1, 1: dt/2, 2: dt,
-    3: dt/6), into ``W[out, n:]``: ``δ = D_q q + D_u u``, ``F = k δ + c δ̇`` plus the laws,
+    (when ``has_input``; ``o (.., G, 2R)``, lane ``b`` on road ``lr[b]`` when G > 1), times
+    the inverse masses' row set ``scale`` (0: 1, 1: dt/2, 2: dt, 3: dt/6), into ``W[out, n:]``: ``δ = D_q q + D_u u``, ``F = k δ + c δ̇`` plus the laws,
     ``q'' = M^-1 G F``."""
     nD, nG, R, X, n = lay[0], lay[1], lay[2], lay[3], lay[4]
     oD, oG, oK, oC, oL, oM = lay[5], lay[6], lay[7], lay[8], lay[9], lay[10]

@@ -520,9 +520,9 @@ def _controller_hold(
 class Run(NamedTuple):
     """One integration, as every engine takes it: the assembled network (its first
     ``n_vehicle`` DOFs the vehicle's), the inputs' part of the deformations on the half-step
-    grid ``t = j dt/2``, ``offsets`` (2 n_steps + 1, 2R, G, 1) (their right limits at a road
-    edge; G > 1 roads without edges, each under P/G consecutive designs), the step ``dt`` [s], the number of steps, the samples' spacing ``every`` in steps,
-    the semi-active controller and the road's edges (or None)."""
+    grid ``t = j dt/2``, ``offsets`` (2 n_steps + 1, 2R, G, 1) (right limits at an edge; G
+    roads, each under P/G consecutive designs, edges at shared instants), the step ``dt`` [s],
+    the steps, the samples' spacing ``every``, the controller and the edges (or None)."""
 
     asm: Assembled
     n_vehicle: int

@@ -103,10 +103,6 @@ class Group:
         return self.cfg.model_copy(update={"metrics": []})
 
 
-def _dotted(loc: tuple) -> str:
-    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc).lstrip(".")
-
-
 def _one(case, loc: tuple) -> Scenario:
     return Scenario(
         case.name,
@@ -206,7 +202,7 @@ def _load_changes(
 ) -> tuple[dict, dict]:
     """``values`` with the passenger of ``load_mass`` seated (Sec 8.4.3), and the factors on
     design variables that the rule scales; ``({path: value}, {path: factor})``."""
-    from ..seat import build_seat, passenger_mass_change
+    from ..seat import passenger_mass_change
 
     loc = scenario.load_loc or scenario.loc
     if cfg.seat is None:
@@ -216,19 +212,17 @@ def _load_changes(
             raise cfg.error(
                 loc, f"load_mass changes the passenger, and {path} is a design variable"
             )
-    old = float(build_seat(cfg).isolator["load_mass"][0])
     lowest = cfg.seat.mass if cfg.seat.passenger is not None else 0.0
     new = float(scenario.load_mass)  # type: ignore[arg-type]
     if not new > lowest:
         raise cfg.error(loc, f"the load must be above the seat's own {lowest:g} kg, got {new:g} kg")
     changed = {path: float(v[0]) for path, v in passenger_mass_change(cfg, new).items()}
-    scales = {}
+    nominal, scales = numeric_paths(cfg), {}
     for path in list(changed):
         if path in values:
             raise cfg.error(scenario.locs[path], f"{path} is set by load_mass too")
-        if path in designed:  # seat.stiffness_ratio: each design's own takes the factor
-            del changed[path]
-            scales[path] = old / new
+        if path in designed:  # seat.stiffness_ratio: each design's own takes the rule's factor
+            scales[path] = changed.pop(path) / nominal[path]
     return {**values, **changed}, scales
 
 
@@ -295,11 +289,6 @@ class ScenarioSet:
             group.scales.append(scales)
             group.configs.append(group_cfg)
         return cls(scenarios, list(groups.values()))
-
-    @property
-    def widest(self) -> int:
-        """The most scenarios of one group (the columns a design takes in one batch)."""
-        return max(len(g.members) for g in self.groups)
 
     def columns(self, group: Group, params: dict[str, np.ndarray], P: int) -> dict[str, np.ndarray]:
         """``params`` of P designs under every scenario of ``group``: each path ``(P S_g,)``,
