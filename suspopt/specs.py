@@ -35,7 +35,9 @@ class MetricDef:
     how a run that keeps no (P, T) signal (:mod:`suspopt.streaming`) gets it: ``moments``
     (from the signal's count, mean and squared deviations), ``extremes`` (its maximum and
     minimum), ``window_max`` (the largest of ``compute`` over the windows of time: a maximum
-    over time of a value per sample) or ``keep`` (``compute`` on the signal kept whole).
+    over time of a value per sample), ``weighted`` (an ISO 2631 weighted metric, from the
+    weighting's filter run on window by window) or ``keep`` (``compute`` on the signal kept
+    whole).
     Adding a metric is adding one entry to :data:`METRICS`."""
 
     kind: str
@@ -130,12 +132,14 @@ METRICS: dict[str, MetricDef] = {
         _same,
         "ISO 2631-1 weighted r.m.s., RC (Eq 2.78)",
         _weighted(iso2631.weighted_rms),
+        stream="weighted",
     ),
     "vdv": MetricDef(
         "iso2631",
         lambda u: f"{u} s^0.25" if u != "m/s^2" else "m/s^1.75",
         "vibration dose value (Eq 2.82)",
         _weighted(iso2631.vdv),
+        stream="weighted",
     ),
     "mtvv": MetricDef(
         "iso2631",
@@ -144,9 +148,14 @@ METRICS: dict[str, MetricDef] = {
         lambda spec, r, signal: iso2631.mtvv(
             r.signals[signal], _rate(r), spec.weighting, tau=spec.tau
         ),
+        stream="weighted",
     ),
     "crest_factor": MetricDef(
-        "iso2631", _fixed("1"), "crest factor (Eq 2.83)", _weighted(iso2631.crest_factor)
+        "iso2631",
+        _fixed("1"),
+        "crest factor (Eq 2.83)",
+        _weighted(iso2631.crest_factor),
+        stream="weighted",
     ),
     "peak": MetricDef("transient", _same, "transient peak M_p (Sec 2.4.1)", _transient("peak")),
     "peak_time": MetricDef(

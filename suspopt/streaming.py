@@ -16,17 +16,22 @@ from them, as its :class:`suspopt.specs.MetricDef` says (``stream``):
 - ``extremes`` (maximum, minimum, largest magnitude, range) and ``window_max`` (a maximum over
   time of a value per sample, such as the spring usage of Eq 5.3): the largest (smallest) of
   the windows' values, exactly the whole signal's;
-- ``keep`` (the ISO 2631 weighted metrics, the transient metrics, the dissipated power, the
-  dynamic tyre load, the switch count): the signals they read are kept whole and the metric is
-  computed once at the end, exactly as on a whole run.
+- ``weighted`` (the ISO 2631 weighted r.m.s., VDV, MTVV and crest factor, Eq 2.78-2.83): the
+  weighting's recursive filter (:func:`suspopt.metrics.iso2631.weighting_filter`) runs on
+  from window to window with its state, which gives the whole signal's weighted samples bit
+  for bit; the sums of ``a_w²`` and ``a_w⁴`` are taken per :data:`BLOCK` and added in time
+  order (so they do not depend on the window; they agree with the whole signal's to rounding),
+  the largest ``|a_w|`` and the MTVV (the running r.m.s. from the running sum of ``a_w²`` and
+  its last ``τ fs`` values) exactly;
+- ``keep`` (the transient metrics, the dissipated power, the dynamic tyre load, the switch
+  count): the signals they read are kept whole and the metric is computed once at the end,
+  exactly as on a whole run.
 
-Memory therefore holds one window of every signal and state plus the kept signals; the
-weighting's transforms run over blocks of :data:`WEIGHTED_ROWS` designs.
-A run with a semi-active controller is simulated whole (its hold keeps records over the run):
-:func:`reduce` then returns the :class:`~suspopt.result.Result` of :func:`suspopt.simulate`.
-Deviation from a recursive filter: the ISO 2631 weightings are applied to the kept signal by
-their analogue response (the one method of :mod:`suspopt.metrics.iso2631`), not run as
-filter states during the integration.
+Memory therefore holds one window of every signal and state, the MTVV's last ``τ fs``
+values, and the kept signals; with no ``keep`` metric it grows with the designs, not with the
+run's length. A run with a semi-active controller is simulated whole (its hold keeps records
+over the run): :func:`reduce` then returns the :class:`~suspopt.result.Result` of
+:func:`suspopt.simulate`.
 """
 
 from __future__ import annotations
@@ -47,9 +52,6 @@ BLOCK = 256
 #: Memory of one window's states and signals [bytes]: a window is as many whole blocks as
 #: fit (a few designs: the whole run at once), at least one.
 WINDOW_BYTES = 64 << 20
-#: Designs whose ISO 2631 weighting is transformed at a time (each row's arithmetic the
-#: same whatever the block).
-WEIGHTED_ROWS = 128
 
 
 class _Moments:
@@ -121,6 +123,81 @@ class _Extremes:
         return self.high - self.low  # peak_to_peak
 
 
+def _block_sums(x: np.ndarray) -> list[np.ndarray]:
+    """The sums over each :data:`BLOCK` of samples of ``x (P, T)`` in time order (the last
+    one shorter at the run's end)."""
+    P, T = x.shape
+    whole = T - T % BLOCK
+    sums = list(np.sum(x[:, :whole].reshape(P, -1, BLOCK), axis=-1).T) if whole else []
+    return sums + ([np.sum(x[:, whole:], axis=-1)] if whole < T else [])
+
+
+class _Weighted:
+    """One signal under one ISO 2631 weighting as the windows arrive (module docstring):
+    the filter's state, the count, the sums of ``a_w²`` and ``a_w⁴`` and the largest
+    ``|a_w|`` (P,) each, and for each MTVV window ``τ`` [s] the running sum of ``a_w²``, its
+    last ``τ fs`` values and the largest running r.m.s. so far."""
+
+    def __init__(self, weighting: str | None) -> None:
+        self.weighting = weighting
+        self.taus: set[float] = set()
+        self.fs = 0.0
+        self.n = 0
+        self.squares: Any = 0.0
+        self.fourth: Any = 0.0
+        self.peak: Any = None
+        self.filter: Any = None
+        self.state: Any = None
+        self.running: dict[float, list[Any]] = {}
+
+    def add(self, x: np.ndarray, time: np.ndarray) -> None:
+        from .metrics.iso2631 import weighting_filter
+
+        if self.n == 0:
+            self.fs = 1.0 / (time[1] - time[0])  # the output rate, as the whole run's metric
+            self.filter = weighting_filter(self.weighting, self.fs)
+        aw = np.array(x, dtype=float)
+        if self.filter is not None:
+            aw, self.state = self.filter.apply(aw, self.state)
+        self.n += aw.shape[-1]
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverging design: inf, NaN
+            squared = np.square(aw)
+            for block in _block_sums(squared):
+                self.squares = self.squares + block
+            for block in _block_sums(np.square(squared)):
+                self.fourth = self.fourth + block
+            for tau in self.taus:
+                self._running(tau, squared)
+        peak = np.max(np.abs(aw), axis=-1)
+        self.peak = peak if self.peak is None else np.maximum(self.peak, peak)
+
+    def _running(self, tau: float, squared: np.ndarray) -> None:
+        """Eq 2.80 over this window, from the running sum: the arithmetic of
+        :func:`suspopt.metrics.iso2631.running_rms` on the whole signal."""
+        width = max(1, round(tau * self.fs))
+        P = squared.shape[0]
+        total, history, largest = self.running.get(tau, (np.zeros(P), np.zeros((P, width)), None))
+        summed = np.cumsum(np.concatenate([total[:, None], squared], axis=-1), axis=-1)[:, 1:]
+        energy = summed / self.fs
+        joined = np.concatenate([history, energy], axis=-1)
+        lagged = joined[:, : energy.shape[-1]]
+        rms = np.sqrt(np.maximum(energy - lagged, 0.0) / (width / self.fs))
+        top = np.max(rms, axis=-1)
+        largest = top if largest is None else np.maximum(largest, top)
+        self.running[tau] = [summed[:, -1], joined[:, joined.shape[-1] - width :], largest]
+
+    def value(self, spec) -> np.ndarray:
+        rms = np.sqrt(self.squares / self.n)
+        if spec.metric == "rms_weighted":
+            return rms
+        if spec.metric == "vdv":
+            return (self.fourth / self.fs) ** 0.25
+        if spec.metric == "mtvv":
+            return self.running[spec.tau][2]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return self.peak / rms  # crest factor
+
+
 class _Kept:
     """What a ``keep`` metric reads of a Result: the kept signals whole, the run's time, its
     config and model."""
@@ -174,19 +251,18 @@ def _kept_names(spec, name: str) -> list[str]:
     return [name] + ([f"{also}.{name.rsplit('.', 1)[1]}"] if also else [])
 
 
-def _kept_metric(spec, whole: _Kept, name: str) -> np.ndarray:
-    """A ``keep`` metric of the kept signal ``name``; an ISO 2631 one over blocks of
-    :data:`WEIGHTED_ROWS` designs (its transforms padded to several times the record: the
-    memory of a whole batch's would exceed the rest of the run's)."""
-    compute = METRICS[spec.metric].compute
-    if METRICS[spec.metric].kind != "iso2631":
-        return compute(spec, whole, name)
-    signal = whole.signals[name]
-    blocks = [
-        _Kept({name: signal[start : start + WEIGHTED_ROWS]}, whole.time, whole.config, whole.model)
-        for start in range(0, signal.shape[0], WEIGHTED_ROWS)
-    ]
-    return np.concatenate([compute(spec, block, name) for block in blocks])
+def _weighted(requests) -> dict[tuple[str, Any], _Weighted]:
+    """One :class:`_Weighted` per (signal, weighting) the ``weighted`` metrics of
+    ``requests`` read, with the MTVV windows asked of it."""
+    found: dict[tuple[str, Any], _Weighted] = {}
+    for spec, names in requests:
+        if METRICS[spec.metric].stream != "weighted":
+            continue
+        for name in names:
+            accumulator = found.setdefault((name, spec.weighting), _Weighted(spec.weighting))
+            if spec.metric == "mtvv":
+                accumulator.taus.add(spec.tau)
+    return found
 
 
 def reduce(
@@ -225,6 +301,7 @@ def reduce(
 
     moments = {name: _Moments() for name in streamed("moments")}
     extremes = {name: _Extremes() for name in streamed("extremes")}
+    weighted = _weighted(requests)
     maxima = [(spec, n) for spec, names in requests if METRICS[spec.metric].stream == "window_max"
               for n in names]  # fmt: skip
     window_max: dict[tuple[int, str], Any] = {}
@@ -238,6 +315,8 @@ def reduce(
             moment.add(signals[name])
         for name, extreme in extremes.items():
             extreme.add(signals[name])
+        for (name, _), accumulator in weighted.items():
+            accumulator.add(signals[name], window.time)
         for spec, name in maxima:
             value, key = window.metric(spec, name), (id(spec), name)
             window_max[key] = np.maximum(window_max.get(key, value), value)
@@ -254,12 +333,15 @@ def reduce(
     for spec, names in requests:
         stream = METRICS[spec.metric].stream
         for name in names:
+            key = (id(spec), name)
             if stream == "moments":
-                values[(id(spec), name)] = moments[name].value(spec.metric)
+                values[key] = moments[name].value(spec.metric)
             elif stream == "extremes":
-                values[(id(spec), name)] = extremes[name].value(spec.metric)
+                values[key] = extremes[name].value(spec.metric)
+            elif stream == "weighted":
+                values[key] = weighted[(name, spec.weighting)].value(spec)
             elif stream == "window_max":
-                values[(id(spec), name)] = window_max[(id(spec), name)]
+                values[key] = window_max[key]
             else:
-                values[(id(spec), name)] = _kept_metric(spec, whole, name)
+                values[key] = METRICS[spec.metric].compute(spec, whole, name)
     return Reduced(model, table, values, traj.diverged_at, traj.engine)

@@ -5,8 +5,9 @@ whole integration.
 - The windows of either engine joined are the whole run bit for bit (a bump's edges, a random
   road, a seat with its passenger).
 - Every metric of :data:`suspopt.specs.METRICS` that a passive run has, reduced in windows,
-  equals the whole run's: to 1e-13 relative for the moments (a merge of blocks, not one sum),
-  exactly for the extremes, the windows' maxima and the kept signals.
+  equals the whole run's: to 1e-13 relative for the moments and the weighted sums (a merge of
+  blocks, not one sum), exactly for the extremes, the windows' maxima, the MTVV and the kept
+  signals.
 - The moments do not depend on the batch and match the whole signal's for any windows; a
   diverged design comes out NaN as in the whole run.
 """
@@ -86,15 +87,19 @@ def _every_metric(cfg):
     return requests
 
 
+#: The weighted metrics whose streamed value is a sum in blocks (MTVV is a maximum: exact).
+_SUMMED = ("rms_weighted", "vdv", "crest_factor")
+
+
 @pytest.mark.parametrize("engine", ENGINES)
 def test_every_metric_reduced_in_windows_is_the_whole_runs(engine, monkeypatch):
-    monkeypatch.setattr(streaming, "WEIGHTED_ROWS", 4)  # the weighting in blocks of 4 and 2
+    monkeypatch.setattr(streaming, "WINDOW_BYTES", 1)  # windows of one block each
     cfg = _short("ch5/case1_s1.yaml", 2.0)
     cfg.simulation.engine = engine
     params = _designs(cfg, 6)
     requests = _every_metric(cfg)
     assert {METRICS[s.metric].stream for s, _ in requests} == {
-        "moments", "extremes", "window_max", "keep"
+        "moments", "extremes", "window_max", "weighted", "keep"
     }  # fmt: skip
     reduced = streaming.reduce(cfg, params, requests)
     whole = simulate(cfg, params)
@@ -102,7 +107,7 @@ def test_every_metric_reduced_in_windows_is_the_whole_runs(engine, monkeypatch):
     for spec, names in requests:
         for name in names:
             got, want = reduced.metric(spec, name), whole.metric(spec, name)
-            if METRICS[spec.metric].stream == "moments":
+            if METRICS[spec.metric].stream == "moments" or spec.metric in _SUMMED:
                 np.testing.assert_allclose(got, want, rtol=1e-13, err_msg=spec.metric)
             else:
                 assert np.array_equal(got, want, equal_nan=True), spec.metric
