@@ -1783,6 +1783,7 @@ def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: boo
     os.dup2(devnull, 1)  # anything written to fd 1 by C code is dropped
     sys.setrecursionlimit(max(sys.getrecursionlimit(), 1000))
     import h5py
+    from conftest import build_commands_once
     from typer.testing import CliRunner
 
     import suspopt.analyse
@@ -1792,6 +1793,7 @@ def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: boo
     from suspopt.cli import app
 
     suspopt.analyse.analysis_kinds()
+    build_commands_once()
 
     if memory > 0:
         soft, hard = resource.getrlimit(resource.RLIMIT_AS)
