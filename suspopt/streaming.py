@@ -19,10 +19,12 @@ from them, as its :class:`suspopt.specs.MetricDef` says (``stream``):
 - ``weighted`` (the ISO 2631 weighted r.m.s., VDV, MTVV and crest factor, Eq 2.78-2.83): the
   weighting's recursive filter (:func:`suspopt.metrics.iso2631.weighting_filter`) runs on
   from window to window with its state, which gives the whole signal's weighted samples bit
-  for bit; the sums of ``a_w²`` and ``a_w⁴`` are taken per :data:`BLOCK` and added in time
-  order (so they do not depend on the window; they agree with the whole signal's to rounding),
+  for bit; the sums of ``a_w²`` and ``a_w⁴`` are the blocks of
+  :func:`~suspopt.metrics.iso2631.block_sums` added in time order, as the whole-signal metrics
+  add them (a window holds whole blocks: :data:`BLOCK` is a multiple of ``SUM_BLOCK``), and
   the largest ``|a_w|`` and the MTVV (the running r.m.s. from the running sum of ``a_w²`` and
-  its last ``τ fs`` values) exactly;
+  its last ``τ fs`` values) follow the whole signal's arithmetic: every weighted metric is the
+  whole run's, bit for bit;
 - ``keep`` (the transient metrics, the dissipated power, the dynamic tyre load, the switch
   count): the signals they read are kept whole and the metric is computed once at the end,
   exactly as on a whole run.
@@ -123,15 +125,6 @@ class _Extremes:
         return self.high - self.low  # peak_to_peak
 
 
-def _block_sums(x: np.ndarray) -> list[np.ndarray]:
-    """The sums over each :data:`BLOCK` of samples of ``x (P, T)`` in time order (the last
-    one shorter at the run's end)."""
-    P, T = x.shape
-    whole = T - T % BLOCK
-    sums = list(np.sum(x[:, :whole].reshape(P, -1, BLOCK), axis=-1).T) if whole else []
-    return sums + ([np.sum(x[:, whole:], axis=-1)] if whole < T else [])
-
-
 class _Weighted:
     """One signal under one ISO 2631 weighting as the windows arrive (module docstring):
     the filter's state, the count, the sums of ``a_w²`` and ``a_w⁴`` and the largest
@@ -151,7 +144,7 @@ class _Weighted:
         self.running: dict[float, list[Any]] = {}
 
     def add(self, x: np.ndarray, time: np.ndarray) -> None:
-        from .metrics.iso2631 import weighting_filter
+        from .metrics.iso2631 import block_sums, weighting_filter
 
         if self.n == 0:
             self.fs = 1.0 / (time[1] - time[0])  # the output rate, as the whole run's metric
@@ -162,9 +155,10 @@ class _Weighted:
         self.n += aw.shape[-1]
         with np.errstate(over="ignore", invalid="ignore"):  # a diverging design: inf, NaN
             squared = np.square(aw)
-            for block in _block_sums(squared):
+            # the blocks added in time order: the whole signal's sums, bit for bit
+            for block in block_sums(squared).T:
                 self.squares = self.squares + block
-            for block in _block_sums(np.square(squared)):
+            for block in block_sums(np.square(squared)).T:
                 self.fourth = self.fourth + block
             for tau in self.taus:
                 self._running(tau, squared)

@@ -369,7 +369,8 @@ def test_roads_of_one_time_grid_are_columns_of_one_batch(engine, wide, monkeypat
 
     if not wide:
         monkeypatch.setattr(rk4, "_WIDE_OFFSETS", 0)
-    text = ISO.replace("output_dt: 2.0e-3}", f"output_dt: 2.0e-3, engine: {engine}}}")
+    assert "output_dt: 2.0e-3, engine: auto}" in ISO
+    text = ISO.replace("engine: auto}", f"engine: {engine}}}")
     assert text != ISO
     calls = _counted_calls(monkeypatch, columns=False)
     problem = _problem(ROADS, base=text)

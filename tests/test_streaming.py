@@ -5,8 +5,8 @@ whole integration.
 - The windows of either engine joined are the whole run bit for bit (a bump's edges, a random
   road, a seat with its passenger).
 - Every metric of :data:`suspopt.specs.METRICS` that a passive run has, reduced in windows,
-  equals the whole run's: to 1e-13 relative for the moments and the weighted sums (a merge of
-  blocks, not one sum), exactly for the extremes, the windows' maxima, the MTVV and the kept
+  equals the whole run's: to 1e-13 relative for the moments (a merge of blocks, not one sum),
+  exactly for the extremes, the windows' maxima, the ISO 2631 weighted metrics and the kept
   signals.
 - The moments do not depend on the batch and match the whole signal's for any windows; a
   diverged design comes out NaN as in the whole run.
@@ -22,6 +22,7 @@ from suspopt import integrator, streaming
 from suspopt.config import load_config
 from suspopt.config.metrics import MetricSpec
 from suspopt.integrator import compiled_available
+from suspopt.metrics.iso2631 import SUM_BLOCK
 from suspopt.simulate import _setup, prepare, simulate
 from suspopt.specs import METRICS, spec_signals
 
@@ -87,10 +88,6 @@ def _every_metric(cfg):
     return requests
 
 
-#: The weighted metrics whose streamed value is a sum in blocks (MTVV is a maximum: exact).
-_SUMMED = ("rms_weighted", "vdv", "crest_factor")
-
-
 @pytest.mark.parametrize("engine", ENGINES)
 def test_every_metric_reduced_in_windows_is_the_whole_runs(engine, monkeypatch):
     monkeypatch.setattr(streaming, "WINDOW_BYTES", 1)  # windows of one block each
@@ -107,11 +104,15 @@ def test_every_metric_reduced_in_windows_is_the_whole_runs(engine, monkeypatch):
     for spec, names in requests:
         for name in names:
             got, want = reduced.metric(spec, name), whole.metric(spec, name)
-            if METRICS[spec.metric].stream == "moments" or spec.metric in _SUMMED:
+            if METRICS[spec.metric].stream == "moments":
                 np.testing.assert_allclose(got, want, rtol=1e-13, err_msg=spec.metric)
             else:
                 assert np.array_equal(got, want, equal_nan=True), spec.metric
     assert np.array_equal(reduced.diverged_at, whole.diverged_at, equal_nan=True)
+
+
+def test_windows_hold_whole_blocks_of_the_weighted_sums():
+    assert streaming.BLOCK % SUM_BLOCK == 0
 
 
 def test_moments_do_not_depend_on_the_batch_and_match_the_whole_signal():

@@ -20,7 +20,7 @@ from .._lazy import lazy_names
 _MODULES = {
     "iso2631": (
         "WEIGHTINGS", "MTVV_RATIO_LIMIT", "VDV_RATIO_LIMIT", "COMFORT_REACTIONS",
-        "weighting_response", "weighting_filter", "weight", "weighted_rms", "running_rms", "mtvv", "vdv",
+        "weighting_response", "weighting_filter", "SUM_BLOCK", "block_sums", "weight", "weighted_rms", "running_rms", "mtvv", "vdv",
         "crest_factor", "ratio_tests", "comfort_reaction"
     ),
     "stats": (

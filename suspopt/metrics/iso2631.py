@@ -30,6 +30,8 @@ __all__ = [
     "COMFORT_REACTIONS",
     "weighting_response",
     "weighting_filter",
+    "SUM_BLOCK",
+    "block_sums",
     "weight",
     "weighted_rms",
     "running_rms",
@@ -203,8 +205,32 @@ def weight(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
     return a.copy() if found is None else found.apply(a)[0]
 
 
+SUM_BLOCK = 256
+"""Samples per block of the weighted metrics' sums (r.m.s., VDV, crest factor): each block is
+summed on its own and the blocks are added in time order, so that a signal which arrives in
+windows of whole blocks (:mod:`suspopt.streaming`) gives the whole signal's bits."""
+
+
+def block_sums(x: np.ndarray) -> np.ndarray:
+    """Sums of ``x (..., T)`` over each :data:`SUM_BLOCK` samples, in time order:
+    ``(..., ceil(T / SUM_BLOCK))``, the last block shorter when ``T`` is not a multiple."""
+    T = x.shape[-1]
+    whole = T - T % SUM_BLOCK
+    parts = []
+    if whole:
+        parts.append(np.sum(x[..., :whole].reshape(*x.shape[:-1], -1, SUM_BLOCK), axis=-1))
+    if whole < T:
+        parts.append(np.sum(x[..., whole:], axis=-1, keepdims=True))
+    return np.concatenate(parts, axis=-1)
+
+
+def _total(x: np.ndarray) -> np.ndarray:
+    """The sum over time of ``x``: its :func:`block_sums` added in time order."""
+    return np.cumsum(block_sums(x), axis=-1)[..., -1]
+
+
 def _rms(aw: np.ndarray) -> np.ndarray:
-    return np.sqrt(np.mean(aw**2, axis=-1))
+    return np.sqrt(_total(np.square(aw)) / aw.shape[-1])
 
 
 def _running_rms(aw: np.ndarray, fs: float, tau: float) -> np.ndarray:
@@ -216,7 +242,7 @@ def _running_rms(aw: np.ndarray, fs: float, tau: float) -> np.ndarray:
 
 
 def _vdv(aw: np.ndarray, fs: float) -> np.ndarray:
-    return (np.sum(aw**4, axis=-1) / fs) ** 0.25
+    return (_total(np.square(np.square(aw))) / fs) ** 0.25
 
 
 def weighted_rms(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
