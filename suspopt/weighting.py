@@ -7,7 +7,7 @@ is realised here as ``H_d(z) = C(z) · Π_k S_k(z)``:
 - ``S_k(z)``: each Annex A stage (band-limiting high-pass and low-pass, acceleration-velocity
   transition, upward step) by the matched z-transform: its poles and finite zeros mapped
   exactly, ``z = exp(s/fs)`` (the high-pass's double zero at 0 Hz to ``(1 - z⁻¹)²``), and its
-  gain at 0 Hz kept (at high frequency for the high-pass). A stage's zeros sit beside its poles,
+  gain at 0 Hz kept (at the Nyquist frequency for the high-pass). A stage's zeros sit beside its poles,
   so no section amplifies the rounding of the one before it; the filter is stable because the
   analogue one is.
 - ``C(z)``: a short FIR correction of degree ``M``, fitted by weighted linear least squares so
@@ -28,8 +28,8 @@ The output is the response of the filter starting at rest (the signal taken as z
 record), like the causal analogue weighting. Rows of a batch are filtered independently, so a
 design's weighted signal has the same bits alone and in a batch; the fit takes its sums in
 numpy's own loops, not the threaded BLAS, so that the coefficients have the same bits in every
-process (an executor's workers included). Deviation from the thesis: Eq 2.79 applies the weighting to the spectrum of the record;
-this is its causal time-domain equivalent.
+process (an executor's workers included). Deviation from the thesis: Eq 2.79 applies the
+weighting to the spectrum of the record; this is its causal time-domain equivalent.
 """
 
 from __future__ import annotations
@@ -106,8 +106,8 @@ class WeightingFilter:
 
 
 def _quadratic(row: np.ndarray, zi: np.ndarray) -> np.ndarray:
-    """``c0 + c1 z⁻¹ + c2 z⁻²`` at ``zi = z⁻¹`` as a product of its root factors, which keeps
-    its relative accuracy where a root is close to ``z = 1`` (no cancellation)."""
+    """``c0 + c1 z⁻¹ + c2 z⁻²`` at ``zi = z⁻¹`` as a product of its root factors, which
+    keeps its relative accuracy where a root is close to ``z = 1`` (no cancellation)."""
     c0, c1, c2 = row
     if c2 == 0.0:
         return c0 + c1 * zi
@@ -140,6 +140,12 @@ def _mapped(roots, fs: float) -> list[float]:
     return [1.0, -float((z[0] + z[1]).real), float((z[0] * z[1]).real)]
 
 
+def _at_dc(roots, fs: float) -> float:
+    """``Π (1 - exp(r/fs))`` over the roots [1/s]: a mapped factor's value at 0 Hz, by
+    ``expm1`` (the coefficients' sum cancels where a root maps close to ``z = 1``)."""
+    return float(np.prod([-np.expm1(r / fs) for r in roots]).real) if roots else 1.0
+
+
 def _sections(params, fs: float) -> np.ndarray:
     """The matched stages as ``sos`` rows, each with its analogue gain at 0 Hz (the
     high-pass: its gain 1 at the Nyquist frequency, ``(1 - z⁻¹)²`` over its poles)."""
@@ -155,33 +161,37 @@ def _sections(params, fs: float) -> np.ndarray:
     for zeros, poles, gain in stages:
         top = _mapped(zeros, fs) if zeros else [1.0, 0.0, 0.0]
         bottom = _mapped(poles, fs)
-        scale = gain * sum(bottom) / sum(top)
+        scale = gain * _at_dc(poles, fs) / _at_dc(zeros, fs)
         rows.append([c * scale for c in top] + bottom)
     return np.array(rows)
 
 
-def _grids(params, fs: float, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Frequencies [Hz] of the fitted band (log and linear spacing) and of the rest to fs/2."""
+def _grids(name: str, fs: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Frequencies [Hz] of the fitted band (log and linear spacing from a thousandth of the
+    high-pass corner) and of the rest to fs/2."""
+    from .metrics.iso2631 import WEIGHTINGS
+
     top = BAND * fs
-    inside = np.union1d(np.geomspace(1e-3 * params.f1, top, n), np.linspace(0.0, top, n)[1:])
+    low = 1e-3 * WEIGHTINGS[name].f1
+    inside = np.union1d(np.geomspace(low, top, n), np.linspace(0.0, top, n)[1:])
     return inside, np.linspace(top, 0.5 * fs, n // 2)[1:]
 
 
 def _basis(sections: np.ndarray, f: np.ndarray, fs: float, degree: int) -> np.ndarray:
     """``z⁻ᵐ Π_k S_k`` at ``f`` for m = 0..degree: columns of the fit."""
     zi = np.exp(-2j * math.pi * f / fs)
-    return (_stages(sections, zi) * np.ones(1))[:, None] * zi[:, None] ** np.arange(degree + 1)
+    return _stages(sections, zi)[:, None] * zi[:, None] ** np.arange(degree + 1)
 
 
-def _fit(params, fs: float, sections: np.ndarray, degree: int, weight_out: float) -> np.ndarray:
+def _fit(name: str, fs: float, sections: np.ndarray, degree: int, weight_out: float) -> np.ndarray:
     """``C``'s coefficients: relative least squares below fs/4, Lawson-re-weighted, plus the
     absolute error above it weighted by ``weight_out``."""
-    from .metrics.iso2631 import _response
+    from .metrics.iso2631 import weighting_response
 
-    inside, outside = _grids(params, fs, 600)
-    a_in = _basis(sections, inside, fs, degree) / _response(inside, params)[:, None]
+    inside, outside = _grids(name, fs, 600)
+    a_in = _basis(sections, inside, fs, degree) / weighting_response(inside, name)[:, None]
     a_out = weight_out * _basis(sections, outside, fs, degree)
-    b_out = weight_out * _response(outside, params)
+    b_out = weight_out * weighting_response(outside, name)
     lawson = np.ones(len(inside))
     for _ in range(_LAWSON_STEPS):
         root = np.sqrt(lawson)[:, None]
@@ -206,14 +216,16 @@ def _least_squares(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     return np.linalg.solve(gram, np.einsum("ij,i->j", stacked, target)) / norms
 
 
-def _errors(params, fs: float, numerator: np.ndarray, sections: np.ndarray) -> tuple[float, float]:
+def _errors(
+    name: str, fs: float, numerator: np.ndarray, sections: np.ndarray
+) -> tuple[float, float]:
     """(largest relative error up to fs/4, largest absolute error above) on a fine grid."""
-    from .metrics.iso2631 import _response
+    from .metrics.iso2631 import weighting_response
 
-    candidate = WeightingFilter("", fs, numerator, sections, 0.0, 0.0)
-    inside, outside = _grids(params, fs, 4000)
-    relative = np.abs(candidate.response(inside) / _response(inside, params) - 1.0)
-    absolute = np.abs(candidate.response(outside) - _response(outside, params))
+    candidate = WeightingFilter(name, fs, numerator, sections, 0.0, 0.0)
+    inside, outside = _grids(name, fs, 4000)
+    relative = np.abs(candidate.response(inside) / weighting_response(inside, name) - 1.0)
+    absolute = np.abs(candidate.response(outside) - weighting_response(outside, name))
     return float(relative.max()), float(absolute.max())
 
 
@@ -229,8 +241,8 @@ def design(weighting: str, fs: float) -> WeightingFilter:
     best: WeightingFilter | None = None
     for weight_out in _OUT_WEIGHTS:
         for degree in _DEGREES:
-            numerator = _fit(params, fs, sections, degree, weight_out)
-            error, out_of_band = _errors(params, fs, numerator, sections)
+            numerator = _fit(weighting, fs, sections, degree, weight_out)
+            error, out_of_band = _errors(weighting, fs, numerator, sections)
             found = WeightingFilter(weighting, fs, numerator, sections, error, out_of_band)
             if best is None or error < best.error:
                 best = found

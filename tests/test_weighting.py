@@ -93,3 +93,9 @@ def test_design_is_cached_and_does_not_depend_on_what_came_before():
     again = design("Wk", 800.0)
     np.testing.assert_array_equal(again.numerator, first.numerator)
     np.testing.assert_array_equal(again.sections, first.sections)
+
+
+@pytest.mark.parametrize("fs", [float("inf"), float("nan"), 99.0])
+def test_a_sample_rate_that_is_not_a_finite_100_hz_or_more_is_refused(fs):
+    with pytest.raises(ValueError, match="fs = "):
+        weight(np.zeros(10), fs, "Wk")

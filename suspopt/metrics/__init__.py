@@ -19,9 +19,9 @@ from .._lazy import lazy_names
 # fmt: off
 _MODULES = {
     "iso2631": (
-        "WEIGHTINGS", "MTVV_RATIO_LIMIT", "VDV_RATIO_LIMIT", "COMFORT_REACTIONS",
-        "weighting_response", "weighting_filter", "SUM_BLOCK", "block_sums", "weight", "weighted_rms", "running_rms", "mtvv", "vdv",
-        "crest_factor", "ratio_tests", "comfort_reaction"
+        "WEIGHTINGS", "MTVV_RATIO_LIMIT", "VDV_RATIO_LIMIT", "COMFORT_REACTIONS", "SUM_BLOCK",
+        "weighting_response", "weighting_filter", "block_sums", "weight", "weighted_rms",
+        "running_rms", "mtvv", "vdv", "crest_factor", "ratio_tests", "comfort_reaction"
     ),
     "stats": (
         "STATISTICS", "var", "std", "rms", "maximum", "minimum", "max_abs", "mean",
