@@ -1782,7 +1782,10 @@ def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: boo
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)  # anything written to fd 1 by C code is dropped
     sys.setrecursionlimit(max(sys.getrecursionlimit(), 1000))
+    # scipy.signal (the weightings' sosfilt) now: an import cut short by a case's alarm
+    # would leave a half-made module behind for every later case
     import h5py
+    import scipy.signal  # noqa: F401
     from conftest import build_commands_once
     from typer.testing import CliRunner
 
