@@ -149,7 +149,7 @@ class _Weighted:
         if self.n == 0:
             self.fs = 1.0 / (time[1] - time[0])  # the output rate, as the whole run's metric
             self.filter = weighting_filter(self.weighting, self.fs)
-        aw = np.array(x, dtype=float)
+        aw = np.asarray(x, dtype=float)  # read only: the filter's output is a new array
         if self.filter is not None:
             aw, self.state = self.filter.apply(aw, self.state)
         self.n += aw.shape[-1]

@@ -177,22 +177,43 @@ def _grids(name: str, fs: float, n: int) -> tuple[np.ndarray, np.ndarray]:
     return inside, np.linspace(top, 0.5 * fs, n // 2)[1:]
 
 
-def _basis(sections: np.ndarray, f: np.ndarray, fs: float, degree: int) -> np.ndarray:
-    """``z⁻ᵐ Π_k S_k`` at ``f`` for m = 0..degree: columns of the fit."""
-    zi = np.exp(-2j * math.pi * f / fs)
-    return _stages(sections, zi)[:, None] * zi[:, None] ** np.arange(degree + 1)
+@dataclass(frozen=True)
+class _Grid:
+    """One frequency grid of a design, evaluated once: ``z⁻¹``, the matched stages ``Π S_k``
+    and the analogue response, below fs/4 (``*_in``) and above it (``*_out``)."""
+
+    zi_in: np.ndarray
+    stages_in: np.ndarray
+    h_in: np.ndarray
+    zi_out: np.ndarray
+    stages_out: np.ndarray
+    h_out: np.ndarray
 
 
-def _fit(name: str, fs: float, sections: np.ndarray, degree: int, weight_out: float) -> np.ndarray:
-    """``C``'s coefficients: relative least squares below fs/4, Lawson-re-weighted, plus the
-    absolute error above it weighted by ``weight_out``."""
+def _grid(name: str, fs: float, sections: np.ndarray, n: int) -> _Grid:
     from .metrics.iso2631 import weighting_response
 
-    inside, outside = _grids(name, fs, 600)
-    a_in = _basis(sections, inside, fs, degree) / weighting_response(inside, name)[:, None]
-    a_out = weight_out * _basis(sections, outside, fs, degree)
-    b_out = weight_out * weighting_response(outside, name)
-    lawson = np.ones(len(inside))
+    inside, outside = _grids(name, fs, n)
+    zi_in, zi_out = np.exp(-2j * math.pi * inside / fs), np.exp(-2j * math.pi * outside / fs)
+    return _Grid(
+        zi_in,
+        _stages(sections, zi_in),
+        weighting_response(inside, name),
+        zi_out,
+        _stages(sections, zi_out),
+        weighting_response(outside, name),
+    )
+
+
+def _fit(grid: _Grid, degree: int, weight_out: float) -> np.ndarray:
+    """``C``'s coefficients: relative least squares below fs/4, Lawson-re-weighted, plus the
+    absolute error above it weighted by ``weight_out``. The columns are ``z⁻ᵐ Π_k S_k``,
+    m = 0..degree."""
+    powers = np.arange(degree + 1)
+    a_in = (grid.stages_in[:, None] * grid.zi_in[:, None] ** powers) / grid.h_in[:, None]
+    a_out = weight_out * (grid.stages_out[:, None] * grid.zi_out[:, None] ** powers)
+    b_out = weight_out * grid.h_out
+    lawson = np.ones(len(grid.zi_in))
     for _ in range(_LAWSON_STEPS):
         root = np.sqrt(lawson)[:, None]
         coefficients = _least_squares(
@@ -216,17 +237,13 @@ def _least_squares(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     return np.linalg.solve(gram, np.einsum("ij,i->j", stacked, target)) / norms
 
 
-def _errors(
-    name: str, fs: float, numerator: np.ndarray, sections: np.ndarray
-) -> tuple[float, float]:
-    """(largest relative error up to fs/4, largest absolute error above) on a fine grid."""
-    from .metrics.iso2631 import weighting_response
-
-    candidate = WeightingFilter(name, fs, numerator, sections, 0.0, 0.0)
-    inside, outside = _grids(name, fs, 4000)
-    relative = np.abs(candidate.response(inside) / weighting_response(inside, name) - 1.0)
-    absolute = np.abs(candidate.response(outside) - weighting_response(outside, name))
-    return float(relative.max()), float(absolute.max())
+def _errors(grid: _Grid, numerator: np.ndarray) -> tuple[float, float]:
+    """(largest relative error up to fs/4, largest absolute error above) on ``grid``: the
+    response of :meth:`WeightingFilter.response`, with the stages evaluated once."""
+    inside = np.polyval(numerator[::-1], grid.zi_in) * grid.stages_in
+    outside = np.polyval(numerator[::-1], grid.zi_out) * grid.stages_out
+    relative = np.abs(inside / grid.h_in - 1.0)
+    return float(relative.max()), float(np.abs(outside - grid.h_out).max())
 
 
 @functools.lru_cache(maxsize=64)
@@ -238,11 +255,12 @@ def design(weighting: str, fs: float) -> WeightingFilter:
 
     params = WEIGHTINGS[weighting]
     sections = _sections(params, fs)
+    fitted, checked = _grid(weighting, fs, sections, 600), _grid(weighting, fs, sections, 4000)
     best: WeightingFilter | None = None
     for weight_out in _OUT_WEIGHTS:
         for degree in _DEGREES:
-            numerator = _fit(weighting, fs, sections, degree, weight_out)
-            error, out_of_band = _errors(weighting, fs, numerator, sections)
+            numerator = _fit(fitted, degree, weight_out)
+            error, out_of_band = _errors(checked, numerator)
             found = WeightingFilter(weighting, fs, numerator, sections, error, out_of_band)
             if best is None or error < best.error:
                 best = found
