@@ -44,6 +44,9 @@ __all__ = [
 
 _Q_BAND = 1.0 / math.sqrt(2.0)
 MIN_SAMPLE_RATE = 100.0
+#: Highest sample rate a weighting is designed for [Hz]: a config's shortest output step
+#: (0.1 µs); above it the poles crowd z = 1 past what the filter's coefficients resolve.
+MAX_SAMPLE_RATE = 1.0e7
 _UNWEIGHTED = "none"
 
 MTVV_RATIO_LIMIT = 1.5
@@ -173,8 +176,10 @@ def _check_rate(fs: float) -> float:
         raise ValueError(
             f"sampling rate fs = {fs} Hz is below the supported {MIN_SAMPLE_RATE:g} Hz"
         )
-    if not math.isfinite(fs):
-        raise ValueError(f"sampling rate fs = {fs} Hz must be finite")
+    if not fs <= MAX_SAMPLE_RATE * (1.0 + 1e-9):  # (a rate from a sample grid's rounding)
+        raise ValueError(
+            f"sampling rate fs = {fs} Hz is above the supported {MAX_SAMPLE_RATE:g} Hz"
+        )
     return float(fs)
 
 
