@@ -99,6 +99,7 @@ def test_models_natural_frequencies_are_the_quarter_cars_closed_form(tmp_path):
         assert value["natural_frequency.body.roll"][1] > 0
 
 
+@pytest.mark.slow
 def test_models_on_a_random_road_compare_ride_metrics_per_corner(tmp_path):
     qc, fc = short(tmp_path, "part1a_qc_class_b", 4.0), short(tmp_path, "part1a_fc_class_b", 4.0)
     out, fig = tmp_path / "ride.h5", tmp_path / "ride.png"

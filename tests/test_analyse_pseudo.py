@@ -68,6 +68,7 @@ def datasets(h5):
     return found
 
 
+@pytest.mark.slow
 def test_roads_on_the_original_road_reproduce_the_stored_objectives_exactly(tmp_path, ps_front):
     config, pareto = ps_front
     out, fig = tmp_path / "roads.h5", tmp_path / "roads.png"
@@ -173,6 +174,7 @@ def test_masses_keep_x_st_and_k_h_of_nss1_designs(tmp_path):
         assert np.array_equal(values.F[:, 1], pareto.F[:, 1])  # X_ST kept
 
 
+@pytest.mark.slow
 def test_controllers_with_the_stored_control_reproduce_the_front(tmp_path, sh2_front):
     config, pareto = sh2_front
     same = tmp_path / "same.yaml"

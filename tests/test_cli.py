@@ -64,6 +64,7 @@ def test_missing_config_file_exits_2(tmp_path):
     assert proc.returncode == 2 and "no such config file" in proc.stderr
 
 
+@pytest.mark.slow
 def test_validate_and_schema():
     proc = run("validate", CONFIGS / "quickstart.yaml")
     assert proc.returncode == 0 and "valid" in proc.stdout
@@ -72,6 +73,7 @@ def test_validate_and_schema():
     assert {"vehicle", "road", "simulation"} <= set(schema["properties"])
 
 
+@pytest.mark.slow
 def test_simulate_writes_the_design_md_layout(tmp_path):
     out = tmp_path / "run.h5"
     proc = run("simulate", CONFIGS / "quickstart.yaml", "-o", out)

@@ -264,6 +264,7 @@ def test_each_corner_uses_its_own_velocities_with_roll_and_pitch():
     assert res.signal_unit("damper_state.F1") == "1"
 
 
+@pytest.mark.slow
 def test_groundhook_holds_the_road_and_skyhook_the_body():
     """Sign check of the laws: on the Ch. 3 car (Table 3.1, c 400-1200 N s/m) groundhook gives
     the smaller tyre deflection and SH-2 the smaller weighted body acceleration."""
@@ -434,6 +435,7 @@ def test_threshold_leaves_the_share_on_the_stiff_side():
         ("sh_add_2", "empirical", [0.27, 0.45]),
     ],
 )
+@pytest.mark.slow
 def test_adaptive_threshold_reaches_the_requested_share(law, distribution, shares):
     """On 40 s of class C road the C_max share after the first fit lies within 6 points of
     the request (so the C_min share N % does too). Measured over road seeds 1-8: SH-2 within
@@ -622,6 +624,7 @@ SENSITIVITY = {
 }
 
 
+@pytest.mark.slow
 def test_cdf_sensitivity_writes_hdf5_and_plot(tmp_path):
     import yaml
 

@@ -161,6 +161,7 @@ def errors(preset: str, kind: str, start: float, length: float) -> np.ndarray:
 
 @pytest.mark.parametrize("kind", ["bump_step", "bump_half_sine"])
 @pytest.mark.parametrize("name, preset, start, length", CASES, ids=[c[0] for c in CASES])
+@pytest.mark.slow
 def test_error_falls_at_rk4_order_across_bump_edges(name, preset, start, length, kind):
     err = errors(preset, kind, start, length)
     ratios = err[:-1] / err[1:]

@@ -35,6 +35,7 @@ def kesort_file(tmp_path_factory):
     return front, out
 
 
+@pytest.mark.slow
 def test_a_kesort_knee_re_simulated_gives_its_stored_objectives(kesort_file, tmp_path, capsys):
     _, ke = kesort_file
     out = tmp_path / "knee.h5"
@@ -194,6 +195,7 @@ def test_the_command_follows_the_conventions(capsys):
     assert code == 0
 
 
+@pytest.mark.slow
 def test_tables_fit_80_columns_without_cutting_a_cell(kesort_file, monkeypatch, capsys):
     import sys
 
@@ -249,6 +251,7 @@ def test_startup_does_not_import_the_heavy_modules():
     assert proc.stdout.strip() == "[]", proc.stdout + proc.stderr
 
 
+@pytest.mark.slow
 def test_simulate_of_a_config_writes_its_plot(tmp_path, capsys):
     fig = tmp_path / "run.png"
     code, out, err = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "--plot", fig)

@@ -524,6 +524,7 @@ def test_a_crafted_checkpoint_runs_no_code(front, capsys, tmp_path):
         ),
     ],
 )
+@pytest.mark.slow
 def test_a_damaged_checkpoint_is_a_clear_error(front, capsys, damage, needle):
     config, out = front
     with h5py.File(out, "a") as h5:

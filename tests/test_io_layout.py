@@ -100,6 +100,7 @@ def datasets(path) -> list[tuple[str, tuple, dict]]:
 
 
 @pytest.mark.parametrize("kind", ["sim", "front", "ke", "roads", "stht", "models"])
+@pytest.mark.slow
 def test_every_group_opens_in_xarray_with_named_dimensions(files, kind):
     """No phony_dim anywhere; the whole file is one DataTree (one length per name)."""
     path = files[kind]
@@ -113,6 +114,7 @@ def test_every_group_opens_in_xarray_with_named_dimensions(files, kind):
         assert None not in dims, name  # every axis has its scale
 
 
+@pytest.mark.slow
 def test_simulate_file_has_time_and_design(files):
     path = files["sim"]
     with h5py.File(path) as h5:

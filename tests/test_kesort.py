@@ -223,6 +223,7 @@ def test_another_config_gives_a_pseudo_front_and_pooling_keeps_the_case(pareto, 
     np.testing.assert_array_equal(sel.row, np.tile(np.arange(N), 2))
 
 
+@pytest.mark.slow
 def test_cli_kesort_writes_the_layout(pareto, tmp_path):
     out, fig = tmp_path / "ke.h5", tmp_path / "ke.png"
     result = CliRunner().invoke(

@@ -103,6 +103,7 @@ def test_gradient_and_hybrid_hold_a_constraint():
     assert np.all(hi - lo <= 0.2 * 4.0 + 1e-12)
 
 
+@pytest.mark.slow
 def test_nsga2_approaches_the_zdt1_front():
     zdt1 = get_problem("zdt1")
     front = minimize(
@@ -332,6 +333,7 @@ def test_bad_optimisation_input_names_key_and_line(case):
 
 
 @pytest.mark.parametrize("variant", ["nsga2", "hybrid_weighted"])
+@pytest.mark.slow
 def test_resume_equals_an_uninterrupted_run(tmp_path, variant):
     cfg = (
         tiny()
@@ -366,6 +368,7 @@ def test_resume_equals_an_uninterrupted_run(tmp_path, variant):
         optimise(tiny(**{"seed: 1}": "seed: 2}"}), tmp_path / "part.h5", resume=True)
 
 
+@pytest.mark.slow
 def test_cli_optimise_writes_the_design_md_layout(tmp_path):
     config = tmp_path / "case.yaml"
     config.write_text(TINY.replace("generations: 4", "generations: 2"))

@@ -179,6 +179,7 @@ def test_bad_signals_and_designs_are_value_errors_before_anything_is_written(swe
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_more_designs_than_fit_are_thinned_evenly_and_the_title_says_so(tmp_path):
     cfg = suspopt.load_config(CONFIGS / "quickstart.yaml")
     res = suspopt.simulate(
@@ -267,6 +268,7 @@ def test_two_objectives_draw_the_front_and_the_history(tmp_path):
     assert overlapping_texts(fig) == []
 
 
+@pytest.mark.slow
 def test_three_objectives_draw_every_pair():
     F = np.random.default_rng(1).random((12, 3))
     fig = plots.optimisation_figure(
@@ -305,6 +307,7 @@ def test_one_objective_or_a_weighted_sum_draws_the_best_value():
     assert overlapping_texts(weighted) == []
 
 
+@pytest.mark.slow
 def test_plot_optimisation_draws_a_run(tmp_path):
     from suspopt.optimise import optimise
 
@@ -368,6 +371,7 @@ def test_coinciding_model_curves_all_show_their_colour():
     assert min(shown) >= 150, shown
 
 
+@pytest.mark.slow
 def test_analyse_models_figure_uses_the_styles(tmp_path):
     from suspopt.analyse.models import compare_models, plot_models
 

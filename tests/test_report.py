@@ -104,6 +104,7 @@ def _payload(page: str) -> dict:
     return json.loads(found.group(1))
 
 
+@pytest.mark.slow
 def test_the_page_holds_every_design_and_nothing_from_a_file_as_markup(files, tmp_path):
     page = tmp_path / "study.html"
     res = _invoke("report", files["front"], files["kesort"], files["roads"], "-o", page,

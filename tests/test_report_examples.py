@@ -231,6 +231,7 @@ def test_spread_and_bounds_text():
     assert text == "C_F1, C_R1 at the lower bound; K_nlF1 at the upper bound"
 
 
+@pytest.mark.slow
 def test_a_partial_output_names_what_is_missing(tmp_path):
     """report.py on the outputs of a run that stopped early: each chapter it cannot build
     says which file is missing, and the rest is written."""

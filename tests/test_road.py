@@ -199,6 +199,7 @@ REALISED_SPREAD = {100.0: 3.3e-2, 1000.0: 6.1e-5, 4000.0: 1.7e-5}
 
 
 @pytest.mark.parametrize("length", [100.0, 1000.0, 4000.0])
+@pytest.mark.slow
 def test_iso8608_realised_variance_over_the_road_is_the_integral_of_the_psd(length):
     # the inclusive grid of Eq 2.100 overshoots by 58 %, 4.7 % and 1.1 % here
     s = np.linspace(0.0, length, round(length / 0.05) + 1)

@@ -275,6 +275,7 @@ def test_the_pareto_file_holds_every_scenario(tmp_path):
 
 
 @pytest.mark.cli
+@pytest.mark.slow
 def test_simulate_a_pick_under_one_scenario(tmp_path):
     from typer.testing import CliRunner
 

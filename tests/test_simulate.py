@@ -151,6 +151,7 @@ def test_batch_equals_single_runs(load):
 
 
 @pytest.mark.parametrize("rel", ["ch3/part1a_qc_bump.yaml", "quickstart.yaml"])
+@pytest.mark.slow
 def test_halving_dt_changes_peak_acceleration_little(load, rel):
     cfg = load(rel)
     peak = []

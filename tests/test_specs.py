@@ -59,6 +59,7 @@ def test_batched_metrics_have_one_value_per_design(load):
         ("  - {metric: spring_usage, signal: travel}\n", "takes no signal"),
     ],
 )
+@pytest.mark.slow
 def test_bad_specs_are_config_errors_with_line(tmp_path, entry, needle):
     cfg = write(tmp_path, GOOD + "metrics:\n" + entry)
     proc = run("validate", cfg)
@@ -67,6 +68,7 @@ def test_bad_specs_are_config_errors_with_line(tmp_path, entry, needle):
     assert len(proc.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_quarter_car_class_b_comfort_matches_table_3_6(load):
     """Table 3.6: QC on class B at 86.4 km/h, RC = 0.19 m/s² (thesis convention). RC averages
     over the whole run, so the realisation moves it by a few per cent only: 10 % tolerance."""
