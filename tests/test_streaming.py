@@ -176,3 +176,27 @@ def test_a_designs_objectives_are_the_same_bits_alone_and_in_a_batch():
     alone = problem.evaluate(X[7:8], return_values_of=["F", "G"])
     for whole, one in zip(batch, alone):
         assert np.array_equal(whole[7:8], one)
+
+
+@pytest.mark.skipif(not compiled_available(), reason="needs numba")
+def test_blas_has_one_thread_while_the_compiled_windows_run_and_its_own_after():
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+
+    def blas_threads():
+        info = threadpoolctl.threadpool_info()
+        return {i["filepath"]: i["num_threads"] for i in info if i["user_api"] == "blas"}
+
+    cfg = _short("ch5/case1_s1.yaml", 1.0)
+    pv, model, controller, attachments = prepare(cfg, _designs(cfg, 3))
+    run = _setup(cfg, pv, model, controller, attachments)[0]
+    with threadpoolctl.threadpool_limits(2, user_api="blas"):  # as a 2-core machine starts
+        before = blas_threads()
+        during = [blas_threads() for _ in integrator.windows(run, "compiled", 32)]
+        after = blas_threads()
+        first = integrator.windows(run, "compiled", 32)
+        next(first)
+        first.close()  # a caller that stops early gives the threads back too
+        closed = blas_threads()
+    # (the first compiled call in a process may load one more BLAS library: scipy's)
+    assert len(during) > 1 and all(set(d.values()) == {1} for d in during)
+    assert all(after[k] == n and closed[k] == n for k, n in before.items())

@@ -86,5 +86,30 @@ def windows(
         from . import compiled
 
         if compiled.unsupported(run.asm, run.controller) is None:
-            return compiled.windows(run, width)
+            return _one_blas_thread(compiled.windows(run, width))
     return windows_numpy(run, width)
+
+
+def _one_blas_thread(windows: Iterator[tuple[int, Trajectory]]):
+    """``windows`` with the BLAS libraries held to one thread from the first window until the
+    last has been used (the caller reduces each window between two of them). The kernel runs
+    its blocks on every core; a BLAS product of the caller's (a deformation of a window, a
+    few rows by P x T) spread over the cores as well leaves threads spinning that the
+    kernel's next stretch then waits for: 1000 designs of the Ch. 5 problem took 0.33 s per
+    evaluation with OpenBLAS's two threads and 0.19 s with one (``Problem.evaluate``; the
+    command line sets one thread at start-up anyway, :data:`suspopt._entry.
+    BLAS_THREAD_VARIABLES`). With threadpoolctl missing (it comes with the ``fast`` extra)
+    the threads are left as they are."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        yield from windows
+        return
+    with threadpool_limits(1, user_api="blas"):
+        first = next(windows, None)
+        if first is None:
+            return
+        # numba's first call in a process loads scipy's BLAS (numba.np.linalg), held here too
+        with threadpool_limits(1, user_api="blas"):
+            yield first
+            yield from windows

@@ -221,9 +221,13 @@ MAX_LANES = 64
 
 
 def block_width(P: int, threads: int) -> int:
-    """Designs per block: as many as fill the threads evenly, at most :data:`MAX_LANES`. A
-    design's arithmetic does not depend on it."""
-    return max(1, min(MAX_LANES, -(-P // max(threads, 1))))
+    """Designs per block: the fewest blocks, a multiple of the threads, of at most
+    :data:`MAX_LANES` each, shared out evenly (200 designs on 2 threads: 4 blocks of 50, not
+    4 of 64 with 56 lanes of padding; 150: 4 of 38, not 3 of 64 of which one thread runs
+    two). A design's arithmetic does not depend on it."""
+    threads = max(threads, 1)
+    blocks = threads * -(-P // (threads * MAX_LANES))
+    return max(1, -(-P // blocks))
 
 
 def integrate(run: Run) -> Trajectory:
