@@ -20,6 +20,7 @@ divergence rule; see :mod:`.rk4` for what those are.
 from __future__ import annotations
 
 import functools
+import importlib.util
 from collections.abc import Iterator
 
 from .rk4 import (
@@ -59,8 +60,6 @@ INSTALL_FAST = 'pip install "suspopt[fast]"'
 def compiled_available() -> bool:
     """Whether numba can be imported (the compiled engine's one dependency); looked up once
     per process, not at every simulation."""
-    import importlib.util
-
     return importlib.util.find_spec("numba") is not None
 
 
@@ -99,17 +98,24 @@ def _one_blas_thread(windows: Iterator[tuple[int, Trajectory]]):
     evaluation with OpenBLAS's two threads and 0.19 s with one (``Problem.evaluate``; the
     command line sets one thread at start-up anyway, :data:`suspopt._entry.
     BLAS_THREAD_VARIABLES`). With threadpoolctl missing (it comes with the ``fast`` extra)
-    the threads are left as they are."""
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
+    the threads are left as they are. The first window comes before the hold: numba's first
+    call in a process loads scipy's BLAS (``numba.np.linalg``), and the libraries are listed
+    once per process (:func:`_blas_pools`), after that."""
+    if importlib.util.find_spec("threadpoolctl") is None:
         yield from windows
         return
-    with threadpool_limits(1, user_api="blas"):
-        first = next(windows, None)
-        if first is None:
-            return
-        # numba's first call in a process loads scipy's BLAS (numba.np.linalg), held here too
-        with threadpool_limits(1, user_api="blas"):
-            yield first
-            yield from windows
+    first = next(windows, None)
+    if first is None:
+        return
+    with _blas_pools().limit(limits=1):
+        yield first
+        yield from windows
+
+
+@functools.cache
+def _blas_pools():
+    """The BLAS libraries loaded in this process (threadpoolctl; listing them reads the
+    process's memory map, about 4 ms, so it is done once)."""
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController().select(user_api="blas")
