@@ -23,6 +23,7 @@ def test_a_figure_that_fails_to_write_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []  # no figure, no temporary file, no lock
 
 
+@pytest.mark.slow
 def test_the_suffix_chooses_the_format(tmp_path):
     f = np.linspace(0.1, 30, 50)
     png = plots.transmissibilities(tmp_path / "t.png", "T", [("seat", f, 1 / f)])

@@ -128,6 +128,7 @@ def test_roads_from_a_config_take_its_road_and_simulation(tmp_path, ps_front):
         assert np.all(g["F"][:, 0] > stored(pareto)["F"][:, 0])
 
 
+@pytest.mark.slow
 def test_masses_follow_the_k_v_rule_of_sec_8_4_3(tmp_path, ps_front):
     """PS keeps K_v, so X_ST = m g / K_v follows the load exactly."""
     _, pareto = ps_front

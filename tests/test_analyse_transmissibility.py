@@ -41,6 +41,7 @@ def ps_front(tmp_path_factory):
     return SimpleNamespace(path=path, F=F, X=X, picks=picks, rows=rows)
 
 
+@pytest.mark.slow
 def test_front_picks_as_stored_reproduce_their_objectives(tmp_path, ps_front):
     """Without a passenger the seat is the stored one: the picks' Wk r.m.s. of seat.acc and
     X_ST are their stored objectives RC_se and X_ST (Eq 8.1-8.2), bit for bit."""

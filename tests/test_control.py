@@ -312,6 +312,7 @@ def _t_maximum_likelihood(x: np.ndarray) -> tuple[float, float, float]:
     return float(np.exp(opt.x[0])), float(opt.x[1]), float(np.exp(opt.x[2]))
 
 
+@pytest.mark.slow
 def test_student_t_fit_is_the_maximum_likelihood_fit():
     """The vectorised Newton fit against a direct maximisation, one column at a time, also for
     near-normal data (ν = 30), where the likelihood is flat in ν."""

@@ -669,6 +669,7 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
 
 
 @pytest.mark.cli
+@pytest.mark.slow
 def test_a_reader_that_goes_away_is_not_an_error(tmp_path):
     """``suspopt simulate ... | head -1``: the file is written, nothing on stderr, exit 0 (the
     command's own code), not rich's SystemExit(1)."""
@@ -689,6 +690,7 @@ def test_a_reader_that_goes_away_is_not_an_error(tmp_path):
 
 
 @pytest.mark.cli
+@pytest.mark.slow
 def test_printed_lines_drop_control_characters(tmp_path):
     """A config whose name holds an escape sequence: the line that names it does not colour
     or move the terminal."""

@@ -246,6 +246,7 @@ HISTORY = {
 }
 
 
+@pytest.mark.slow
 def test_two_objectives_draw_the_front_and_the_history(tmp_path):
     F = np.array([[1.0, 4.0], [2.0, 2.0], [3.0, 1.0], [1.5, 5.0], [1e10, 1e10]])
     G = np.array([[-1.0], [-0.5], [0.0], [0.3], [1.0]])

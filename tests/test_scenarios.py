@@ -436,6 +436,7 @@ def test_a_scenario_road_too_large_for_memory_is_bad_input(monkeypatch):
         memory.set_limit(None)
 
 
+@pytest.mark.slow
 def test_resume_continues_a_robust_run_bit_for_bit(tmp_path):
     from suspopt.optimise import optimise
 
