@@ -332,6 +332,42 @@ def test_bad_optimisation_input_names_key_and_line(case):
 # --- runs: reproducible, resumable, written as docs/architecture.md#public-contract says --------
 
 
+@pytest.mark.parametrize("seconds, writes", [(0.0, [1, 2, 3, 4, 4]), (1e9, [1, 4])])
+def test_the_output_is_rewritten_at_most_every_few_seconds_and_at_the_end(
+    tmp_path, monkeypatch, seconds, writes
+):
+    from suspopt.optimise import run as run_module
+
+    monkeypatch.setattr(run_module, "REWRITE_SECONDS", seconds)
+    real, generations = run_module._write, []
+
+    def counted(output, cfg, problem, snap, *args):
+        generations.append(snap.generation)
+        return real(output, cfg, problem, snap, *args)
+
+    monkeypatch.setattr(run_module, "_write", counted)
+    result = optimise(tiny(), tmp_path / "out.h5")
+    assert generations == writes and result.status == "finished"  # the first, then the last
+
+
+def test_an_error_that_stops_a_run_leaves_the_last_completed_generation(tmp_path, monkeypatch):
+    from suspopt.optimise import run as run_module
+
+    monkeypatch.setattr(run_module, "REWRITE_SECONDS", 1e9)  # nothing but the first written
+
+    def fail_at_3(progress):
+        if progress.generation == 3:
+            raise RuntimeError("the scheduler went away")
+
+    with pytest.raises(RuntimeError, match="went away"):
+        optimise(tiny(), tmp_path / "out.h5", callback=fail_at_3)
+    with h5py.File(tmp_path / "out.h5") as h5:
+        assert h5.attrs["status"] == "running" and h5.attrs["generations"] == 3
+    resumed = optimise(tiny(), tmp_path / "out.h5", resume=True)
+    whole = optimise(tiny(), tmp_path / "whole.h5")
+    np.testing.assert_array_equal(resumed.F, whole.F)
+
+
 @pytest.mark.parametrize("variant", ["nsga2", "hybrid_weighted"])
 @pytest.mark.slow
 def test_resume_equals_an_uninterrupted_run(tmp_path, variant):

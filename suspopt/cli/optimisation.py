@@ -70,7 +70,7 @@ def optimise(
         "-o",
         "--output",
         help="HDF5 file (default CONFIG's name with .h5 in "
-        "the current folder), rewritten every generation",
+        "the current folder), rewritten after the first generation and then at most every 2 s",
     ),
     resume: bool = typer.Option(False, "--resume", help="continue from the checkpoint in OUT.h5"),
     plot: Path | None = base.plot_option(

@@ -1,11 +1,14 @@
 """``optimise(cfg, output)``: the run behind ``suspopt optimise``, checkpointed to HDF5.
 
 The run builds :class:`~suspopt.optimise.problem.Problem` and the optimiser of the config,
-then advances one generation at a time. After every generation it rewrites ``output``
+then advances one generation at a time. After the first generation, and then after a
+generation at least :data:`REWRITE_SECONDS` after the last rewrite, it rewrites ``output``
 (atomically, :func:`suspopt.io.atomic_h5`) with the optimum so far, the history and a
 checkpoint; ``resume=True`` continues from that checkpoint to the same result as an
 uninterrupted run. Ctrl-C (KeyboardInterrupt) stops the run and rewrites the file from the
-last completed generation with ``status = "interrupted"``. Nothing here prints: progress goes
+last completed generation with ``status = "interrupted"``; an error that stops the run (a
+lost Dask scheduler) first rewrites it from the last completed generation, ``status =
+"running"``. Nothing here prints: progress goes
 to ``callback(Progress)``.
 
 HDF5 layout (the public contract, docs/architecture.md#public-contract), every dataset with a
@@ -40,6 +43,7 @@ HDF5 layout (the public contract, docs/architecture.md#public-contract), every d
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections import deque
 from collections.abc import Callable
@@ -61,6 +65,14 @@ from .problem import PENALTY, Problem
 __all__ = ["optimise", "build_optimiser", "Progress", "OptimisationResult"]
 
 _HV_REFERENCE = 1.1
+
+#: Seconds between two rewrites of the output during a run: a generation that ends sooner
+#: after the last rewrite waits for the next one. The last completed generation is written at
+#: the end, on Ctrl-C and when an error stops the run, so only a kill -9 (or a power cut) loses
+#: work, at most this much. Rewriting the file costs about 35 ms (23 datasets, the
+#: checkpoint's batches, two fsyncs): after every generation it took 4.6 s of the 16.6 s of
+#: a Ch. 5 case 1 S1 run, 137 generations of 200 designs.
+REWRITE_SECONDS = 2.0
 
 
 @dataclass
@@ -192,20 +204,29 @@ def optimise(
     )
     snapshot = None
     status = "finished"
+    written, last_write = True, -np.inf
     try:
         start = time.perf_counter() - run.elapsed
         while run.optimiser.has_next():
             run.optimiser.next()
             run.elapsed = time.perf_counter() - start
             progress = _record(run, cfg)
-            snapshot = _snapshot(run, problem)
-            _write(output, cfg, problem, snapshot, run, "running", command)
+            snapshot, written = _snapshot(run, problem), False
+            if time.perf_counter() - last_write >= REWRITE_SECONDS:
+                _write(output, cfg, problem, snapshot, run, "running", command)
+                written, last_write = True, time.perf_counter()
             if callback is not None:
                 callback(progress)
     except KeyboardInterrupt:
         if snapshot is None:
             raise
         status = "interrupted"
+    except BaseException:  # an error: the file first gets the last completed generation
+        if not written:
+            assert snapshot is not None  # (written is True until the first snapshot)
+            with contextlib.suppress(Exception):  # (the error raised is the first one)
+                _write(output, cfg, problem, snapshot, run, "running", command)
+        raise
     if snapshot is None:  # resumed a finished run, or nothing to do
         snapshot = _snapshot(run, problem)
     if status == "finished" and (snapshot.optimum.F >= PENALTY).all():
