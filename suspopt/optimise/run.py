@@ -8,8 +8,7 @@ checkpoint; ``resume=True`` continues from that checkpoint to the same result as
 uninterrupted run. Ctrl-C (KeyboardInterrupt) stops the run and rewrites the file from the
 last completed generation with ``status = "interrupted"``; an error that stops the run (a
 lost Dask scheduler) first rewrites it from the last completed generation, ``status =
-"running"``. Nothing here prints: progress goes
-to ``callback(Progress)``.
+"running"``. Nothing here prints: progress goes to ``callback(Progress)``.
 
 HDF5 layout (the public contract, docs/architecture.md#public-contract), every dataset with a
 ``units`` attribute (one per column for X, F, G and best):
