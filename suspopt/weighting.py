@@ -74,7 +74,7 @@ class WeightingFilter:
     def response(self, f: np.ndarray | float) -> np.ndarray:
         """Complex response ``H_d(exp(j2πf/fs))`` at frequencies ``f`` [Hz]."""
         zi = np.exp(-2j * math.pi * np.asarray(f, dtype=float) / self.fs)
-        return np.polyval(self.numerator[::-1], zi) * _stages(self.sections, zi)
+        return _cascade(self.numerator, zi, _stages(self.sections, zi))
 
     def initial_state(self, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
         """The filter at rest for signals of leading shape ``shape`` (for :meth:`apply`): the
@@ -103,6 +103,11 @@ class WeightingFilter:
             out = out + c * x[..., m - k : m - k + n]
         out, poles = sosfilt(self.sections, out, axis=-1, zi=poles)
         return out, (x[..., x.shape[-1] - m :], poles)
+
+
+def _cascade(numerator: np.ndarray, zi: np.ndarray, stages: np.ndarray) -> np.ndarray:
+    """``C(z) · Π S_k(z)`` at ``zi = z⁻¹`` from the stages' product ``stages`` there."""
+    return np.polyval(numerator[::-1], zi) * stages
 
 
 def _quadratic(row: np.ndarray, zi: np.ndarray) -> np.ndarray:
@@ -238,10 +243,10 @@ def _least_squares(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
 
 
 def _errors(grid: _Grid, numerator: np.ndarray) -> tuple[float, float]:
-    """(largest relative error up to fs/4, largest absolute error above) on ``grid``: the
-    response of :meth:`WeightingFilter.response`, with the stages evaluated once."""
-    inside = np.polyval(numerator[::-1], grid.zi_in) * grid.stages_in
-    outside = np.polyval(numerator[::-1], grid.zi_out) * grid.stages_out
+    """(largest relative error up to fs/4, largest absolute error above) on ``grid``, the
+    stages evaluated once."""
+    inside = _cascade(numerator, grid.zi_in, grid.stages_in)
+    outside = _cascade(numerator, grid.zi_out, grid.stages_out)
     relative = np.abs(inside / grid.h_in - 1.0)
     return float(relative.max()), float(np.abs(outside - grid.h_out).max())
 

@@ -200,3 +200,15 @@ def test_blas_has_one_thread_while_the_compiled_windows_run_and_its_own_after():
     # (the first compiled call in a process may load one more BLAS library: scipy's)
     assert len(during) > 1 and all(set(d.values()) == {1} for d in during)
     assert all(after[k] == n and closed[k] == n for k, n in before.items())
+
+
+@pytest.mark.skipif(not compiled_available(), reason="needs numba")
+def test_without_threadpoolctl_the_compiled_windows_are_the_same(monkeypatch):
+    cfg = _short("ch5/case1_s1.yaml", 1.0)
+    pv, model, controller, attachments = prepare(cfg, _designs(cfg, 3))
+    run = _setup(cfg, pv, model, controller, attachments)[0]
+    held = [t.states for _, t in integrator.windows(run, "compiled", 256)]
+    monkeypatch.setattr(integrator, "_blas_pools", lambda: None)  # (what a missing import gives)
+    free = [t.states for _, t in integrator.windows(run, "compiled", 256)]
+    assert len(held) == len(free) > 1
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(held, free))

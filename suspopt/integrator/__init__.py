@@ -20,7 +20,6 @@ divergence rule; see :mod:`.rk4` for what those are.
 from __future__ import annotations
 
 import functools
-import importlib.util
 from collections.abc import Iterator
 
 from .rk4 import (
@@ -60,6 +59,8 @@ INSTALL_FAST = 'pip install "suspopt[fast]"'
 def compiled_available() -> bool:
     """Whether numba can be imported (the compiled engine's one dependency); looked up once
     per process, not at every simulation."""
+    import importlib.util
+
     return importlib.util.find_spec("numba") is not None
 
 
@@ -101,21 +102,25 @@ def _one_blas_thread(windows: Iterator[tuple[int, Trajectory]]):
     the threads are left as they are. The first window comes before the hold: numba's first
     call in a process loads scipy's BLAS (``numba.np.linalg``), and the libraries are listed
     once per process (:func:`_blas_pools`), after that."""
-    if importlib.util.find_spec("threadpoolctl") is None:
-        yield from windows
-        return
     first = next(windows, None)
     if first is None:
         return
-    with _blas_pools().limit(limits=1):
+    pools = _blas_pools()
+    if pools is None:
+        yield first
+        yield from windows
+        return
+    with pools.limit(limits=1):
         yield first
         yield from windows
 
 
 @functools.cache
 def _blas_pools():
-    """The BLAS libraries loaded in this process (threadpoolctl; listing them reads the
-    process's memory map, about 4 ms, so it is done once)."""
-    from threadpoolctl import ThreadpoolController
-
+    """The BLAS libraries loaded in this process, or None without threadpoolctl (listing
+    them reads the process's memory map, about 4 ms, so it is done once)."""
+    try:
+        from threadpoolctl import ThreadpoolController
+    except ImportError:
+        return None
     return ThreadpoolController().select(user_api="blas")
