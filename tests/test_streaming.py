@@ -10,9 +10,14 @@ whole integration.
   signals.
 - The moments do not depend on the batch and match the whole signal's for any windows; a
   diverged design comes out NaN as in the whole run.
+- Every signal of the table reads only the rows of the states and accelerations the probe
+  (:func:`suspopt.streaming.recorded_rows`) finds for it: with the others NaN or garbage it is
+  the same bits; a signal that is not a function of its instant's sample makes every row read.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -23,7 +28,7 @@ from suspopt.config import load_config
 from suspopt.config.metrics import MetricSpec
 from suspopt.integrator import compiled_available
 from suspopt.metrics.iso2631 import SUM_BLOCK
-from suspopt.simulate import _setup, prepare, simulate
+from suspopt.simulate import _result, _setup, prepare, simulate
 from suspopt.specs import METRICS, spec_signals
 
 ENGINES = ["numpy"] + (["compiled"] if compiled_available() else [])
@@ -212,3 +217,76 @@ def test_without_threadpoolctl_the_compiled_windows_are_the_same(monkeypatch):
     free = [t.states for _, t in integrator.windows(run, "compiled", 256)]
     assert len(held) == len(free) > 1
     assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(held, free))
+
+
+def _lift_off(cfg):
+    cfg.vehicle.tyre_lift_off = True
+    return cfg
+
+
+def _two_way(cfg):
+    cfg.seat.coupling = "two_way"
+    return cfg
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name, change",
+    [
+        ("ch3/part2a_fc_arb_bump.yaml", None),  # full car, anti-roll bars
+        ("ch3/part1a_qc_bump.yaml", _lift_off),  # a tyre that may lift off
+        ("ch6/part_b.yaml", None),  # half car, PS seat and passenger, one way
+        ("ch6/part_b.yaml", _two_way),
+        ("ch8/nss4_class_a_passenger.yaml", None),  # Taylor mechanism, passenger
+        ("ch8/nss1_class_a.yaml", None),  # the exact NSS1 mechanism
+    ],
+)
+def test_every_signal_reads_only_the_rows_recorded_for_it(name, change):
+    """Each signal of the table, computed from a run whose rows the probe did not find for it
+    hold NaN or garbage instead, is the same bits as from the whole run."""
+    cfg = load_config(CONFIGS / name)
+    cfg.simulation.duration = getattr(cfg.road, "start", 0.0) + 0.8
+    cfg = change(cfg) if change else cfg
+    cfg.simulation.engine = "auto"
+    pv, model, controller, attachments = prepare(cfg, _designs(cfg, 3) or None)
+    run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments)
+    traj = integrator.integrate(run, "numpy")
+    whole = _result(cfg, pv, model, None, attachments, run, (z, zd, t_grid), traj)
+    n, garbage = run.asm.n, np.random.default_rng(7)
+    rows_seen = set()
+    for signal in whole._table:
+        rows = streaming._recorded(cfg, (pv, model, attachments, run, z), [signal])
+        assert rows is not None and rows.shape == (3 * n,)
+        rows_seen.add(int(rows.sum()))
+        for filler in (np.nan, 1e3):
+            states, acc = traj.states.copy(), traj.accelerations.copy()
+            states[~rows[: 2 * n]] = filler * garbage.standard_normal(states[~rows[: 2 * n]].shape)
+            acc[~rows[2 * n :]] = filler * garbage.standard_normal(acc[~rows[2 * n :]].shape)
+            part = replace(traj, states=states, accelerations=acc)
+            window = _result(cfg, pv, model, None, attachments, run, (z, zd, t_grid), part)
+            same = np.array_equal(window.signals[signal], whole.signals[signal], equal_nan=True)
+            assert same, signal
+    assert max(rows_seen) < 3 * n  # (every signal leaves some row out)
+
+
+class _Probe:
+    """A stand-in Result whose one signal is ``compute(states, accelerations)``."""
+
+    def __init__(self, compute, states, accelerations):
+        self.signals = {"s": compute(states, accelerations)}
+
+
+@pytest.mark.parametrize(
+    "compute, read",
+    [
+        (lambda q, a: q[1] + 0.0 * q[0], [0, 1]),  # a zero coefficient still reads its row
+        (lambda q, a: np.where(q[2] > 0.1, 1.0, 0.0), [2]),  # a threshold
+        (lambda q, a: a[0] * 2.0, [4]),  # the first acceleration (n = 2: rows 4, 5)
+        (lambda q, a: np.cumsum(q[3], axis=-1), [0, 1, 2, 3, 4, 5]),  # not pointwise: all
+        (lambda q, a: q[0] / 0.0, [0, 1, 2, 3, 4, 5]),  # not finite on the probe: all
+    ],
+)
+def test_the_probe_finds_the_rows_a_signal_reads(compute, read):
+    with np.errstate(all="ignore"):
+        rows = streaming.recorded_rows(lambda q, a: _Probe(compute, q, a), 2, 3, ["s"])
+    assert list(np.flatnonzero(rows)) == read

@@ -22,6 +22,8 @@ from __future__ import annotations
 import functools
 from collections.abc import Iterator
 
+import numpy as np
+
 from .rk4 import (
     DIVERGENCE_LIMIT,
     Controller,
@@ -72,12 +74,18 @@ def integrate(run: Run, engine: str = "numpy") -> Trajectory:
 
 
 def windows(
-    run: Run, engine: str = "numpy", width: int | None = None
+    run: Run,
+    engine: str = "numpy",
+    width: int | None = None,
+    recorded: np.ndarray | None = None,
 ) -> Iterator[tuple[int, Trajectory]]:
     """The integration of :func:`integrate` as consecutive windows of at most ``width``
     output samples, a multiple of :data:`WINDOW_MULTIPLE` (all of them when None):
     ``(first sample, trajectory of the window)``; the windows joined are the whole run bit
-    for bit, on either engine (:func:`.rk4.windows`). A controlled run comes whole."""
+    for bit, on either engine (:func:`.rk4.windows`). A controlled run comes whole.
+    ``recorded (3n,)``: the rows of the states ``[q; q']`` and then of the accelerations the
+    caller reads; the compiled engine may leave the others NaN (:func:`.compiled.windows`),
+    the numpy engine computes them all anyway."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, not {engine!r}")
     if engine == "compiled" and not compiled_available():
@@ -86,7 +94,7 @@ def windows(
         from . import compiled
 
         if compiled.unsupported(run.asm, run.controller) is None:
-            return _one_blas_thread(compiled.windows(run, width))
+            return _one_blas_thread(compiled.windows(run, width, recorded))
     return windows_numpy(run, width)
 
 

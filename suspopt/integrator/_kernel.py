@@ -206,37 +206,41 @@ def _check(W, at, limit, time):
 
 
 @_jit
-def _keep(W, rec, t, n, pb, idx, lay):
-    """Sample into row ``t`` of the time-major buffer ``rec``: the state, the accelerations
-    and the lagged damping coefficients."""
-    for i in range(2 * n):
-        for b in range(W.shape[2]):
-            rec[t, i, b] = W[Y, i, b]
-    for i in range(n):
-        for b in range(W.shape[2]):
-            rec[t, 2 * n + i, b] = W[S1, n + i, b]
+def _keep(W, rec, t, n, pb, idx, lay, kept):
+    """Sample into row ``t`` of the time-major buffer ``rec``: the rows ``kept`` of the
+    record (the state ``0 .. 2n``, the accelerations ``2n .. 3n``, the lagged damping
+    coefficients from ``3n`` on), in that order."""
     base = 2 * lay[0] + 2 * lay[1] + 2 * lay[3]
-    for m in range(lay[11]):
-        for b in range(W.shape[2]):
-            rec[t, 3 * n + m, b] = pb[lay[8] + idx[base + m], b]
+    for m in range(kept.shape[0]):
+        i = kept[m]
+        if i < 2 * n:
+            for b in range(W.shape[2]):
+                rec[t, m, b] = W[Y, i, b]
+        elif i < 3 * n:
+            for b in range(W.shape[2]):
+                rec[t, m, b] = W[S1, i - n, b]
+        else:
+            for b in range(W.shape[2]):
+                rec[t, m, b] = pb[lay[8] + idx[base + i - 3 * n], b]
 
 
 @_jit
-def _flush(rec, j0, count, p0, n, out):
-    """The buffer's first ``count`` samples to samples ``j0 ..`` of the records: a transposed
-    copy that writes each design's row as a contiguous run (writing every sample straight to
-    the ``(rows, P, T)`` records touches a new cache line per value and took two thirds of
-    the run)."""
+def _flush(rec, j0, count, p0, n, out, kept):
+    """The buffer's first ``count`` samples to samples ``j0 ..`` of the records (its row
+    ``m`` is record row ``kept[m]``): a transposed copy that writes each design's row as a
+    contiguous run (writing every sample straight to the ``(rows, P, T)`` records touches a
+    new cache line per value and took two thirds of the run)."""
     states, accelerations, lagged = out[0], out[1], out[3]
-    for i in range(rec.shape[1]):
+    for m in range(kept.shape[0]):
+        i = kept[m]
         for b in range(rec.shape[2]):
             for t in range(count):
                 if i < 2 * n:
-                    states[i, p0 + b, j0 + t] = rec[t, i, b]
+                    states[i, p0 + b, j0 + t] = rec[t, m, b]
                 elif i < 3 * n:
-                    accelerations[i - 2 * n, p0 + b, j0 + t] = rec[t, i, b]
+                    accelerations[i - 2 * n, p0 + b, j0 + t] = rec[t, m, b]
                 else:
-                    lagged[i - 3 * n, p0 + b, j0 + t] = rec[t, i, b]
+                    lagged[i - 3 * n, p0 + b, j0 + t] = rec[t, m, b]
 
 
 @_jit
@@ -260,12 +264,12 @@ def _advance(
     final sample alone): the sample's first stage, the sample when one is due (sample ``j``
     written at ``j - origin`` of the records, ``origin`` a multiple of :data:`SAMPLES`), the
     step, the divergence check."""
-    W_all, F_all, rec_all, at_all = state
+    W_all, F_all, rec_all, at_all = state[0], state[1], state[2], state[3]
     states, diverged_at = out[0], out[2]
     W, F, rec, at, pb = W_all[blk], F_all[blk], rec_all[blk], at_all[blk], par[blk]
     n, B = lay[4], W.shape[2]
     off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
-    lr = road[12][blk]
+    lr, kept = road[12][blk], state[4]
     if k0 == 0:
         for u in range(start_jumps.shape[0]):
             _impulse(start_jumps, u, no_pull, W, F, pb, idx, lay, lr)
@@ -274,9 +278,9 @@ def _advance(
         _stage(W, F, pb, idx, lay, Y, off, 2 * step, lr, active[2 * step], 0, S1)
         if step % every == 0:  # the sample: the state and the first stage's accelerations
             j = step // every
-            _keep(W, rec, j % SAMPLES, n, pb, idx, lay)
+            _keep(W, rec, j % SAMPLES, n, pb, idx, lay, kept)
             if j % SAMPLES == SAMPLES - 1 or j - origin == states.shape[2] - 1:
-                _flush(rec, j - j % SAMPLES - origin, j % SAMPLES + 1, blk * B, n, out)
+                _flush(rec, j - j % SAMPLES - origin, j % SAMPLES + 1, blk * B, n, out, kept)
         if step == n_steps:
             break
         if split_of[step] < 0:
@@ -291,7 +295,8 @@ def _advance(
 @numba.njit(cache=True, parallel=True, nogil=True)
 def run(k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out):
     """Steps ``k0 .. k1 - 1`` of every block (in parallel over the cores) from the kept
-    ``state = (W, F, rec, at)`` of each, ``par (blocks, rows, B)`` (the arrays:
+    ``state = (W, F, rec, at, kept)`` of each (``kept``: the record's rows the samples
+    keep, :func:`_keep`), ``par (blocks, rows, B)`` (the arrays:
     :func:`.compiled._packed`), samples from ``origin`` on in ``out``."""
     for blk in numba.prange(par.shape[0]):
         _advance(

@@ -237,10 +237,18 @@ def integrate(run: Run) -> Trajectory:
     return next(windows(run))[1]
 
 
-def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajectory]]:
+def windows(
+    run: Run, width: int | None = None, recorded: np.ndarray | None = None
+) -> Iterator[tuple[int, Trajectory]]:
     """The compiled engine's :func:`.rk4.windows`: the run in windows of ``width`` output
     samples (a multiple of :data:`._kernel.SAMPLES`; all of them when None), a controlled run
-    whole."""
+    whole. ``recorded (3n,)`` says which rows of the states ``[q; q']`` and then of the
+    accelerations the samples keep (all when None); the others are not written (they hold
+    whatever the memory held: the caller reads none of them, as
+    :func:`suspopt.streaming.recorded_rows` makes sure). Writing the samples is about a
+    third of the kernel's time when every row is kept (the Ch. 5 problem's objectives read
+    5 of its 12 rows, Part B's of Ch. 6 5 of 36), and filling the rest with NaN would cost
+    about as much as writing them."""
     asm, n_vehicle, offsets, dt, n_steps, every, controller, edges = run
     import numba
 
@@ -270,11 +278,14 @@ def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajector
     lane_road = np.minimum(np.arange(P) // (P0 // G), G - 1).reshape(blocks, B)
     road = (off, off.any(axis=(1, 2))) + _edge_arrays(asm, edges, dt, n_steps, off)
     road += (lane_road,)
+    recorded = np.ones(3 * n, np.bool_) if recorded is None else recorded
+    kept = np.concatenate([np.flatnonzero(recorded), 3 * n + np.arange(Nl)])
     state = (
         np.zeros((blocks, 11, 2 * n, B)),
         np.empty((blocks, 3, R, B)),
-        np.empty((blocks, _kernel.SAMPLES, 3 * n + Nl, B)),
+        np.empty((blocks, _kernel.SAMPLES, kept.size, B)),
         np.full((blocks, B), np.nan),
+        kept.astype(np.int64),
     )
     diverged_at = np.full(P, np.nan)
     for j0 in range(0, n_out, width):
