@@ -36,9 +36,8 @@ row. The numpy engine computes every row anyway.
 
 Memory therefore holds one window of every signal and state, the MTVV's last ``τ fs``
 values, and the kept signals; with no ``keep`` metric it grows with the designs, not with the
-run's length. A run with a semi-active controller is simulated whole (its hold keeps records
-over the run): :func:`reduce` then returns the :class:`~suspopt.result.Result` of
-:func:`suspopt.simulate`.
+run's length. A run with a semi-active controller is one window, the whole run (its hold
+keeps records over the run), reduced the same way.
 """
 
 from __future__ import annotations
@@ -290,7 +289,8 @@ def recorded_rows(result_of, n: int, P: int, names: Sequence[str]) -> np.ndarray
     for x in probes:
         x = np.broadcast_to(x, (rows, P, T))  # the same samples for every design
         signals = result_of(x[: 2 * n], x[2 * n :]).signals
-        seen.append([np.asarray(signals[name]) for name in names])
+        # (a controller's records are not in a probe without one: they read no state)
+        seen.append([np.asarray(signals[name]) for name in names if name in signals])
     read = np.zeros(rows, np.bool_)
     for base, *moved in zip(*seen):
         if base.shape[-1] != T or not np.isfinite(base).all():
@@ -327,85 +327,102 @@ def _recorded(cfg: Config, setup, names: Sequence[str]) -> np.ndarray | None:
     return recorded_rows(result_of, run.asm.n, pv.P, names)
 
 
+class _Streams:
+    """The accumulators of one :func:`reduce`: per signal its moments, extremes, weighted
+    sums, the windows' maxima of the ``window_max`` metrics and the pieces of the kept
+    signals (:class:`suspopt.specs.MetricDef`'s ``stream``)."""
+
+    def __init__(self, requests) -> None:
+        def streamed(kind: str) -> list[str]:
+            return sorted({n for spec, names in requests if METRICS[spec.metric].stream == kind
+                           for n in names})  # fmt: skip
+
+        self.requests = requests
+        self.moments = {name: _Moments() for name in streamed("moments")}
+        self.extremes = {name: _Extremes() for name in streamed("extremes")}
+        self.weighted = _weighted(requests)
+        self.maxima = [(spec, n) for spec, names in requests
+                       if METRICS[spec.metric].stream == "window_max" for n in names]  # fmt: skip
+        self.window_max: dict[tuple[int, str], Any] = {}
+        kept = {k for spec, names in requests if METRICS[spec.metric].stream == "keep"
+                for n in names for k in _kept_names(spec, n)}  # fmt: skip
+        self.pieces: dict[str, list[np.ndarray]] = {name: [] for name in sorted(kept)}
+        self.times: list[np.ndarray] = []
+
+    def add(self, window) -> None:
+        """One window's Result."""
+        signals = window.signals
+        self.times.append(window.time)
+        for name, moment in self.moments.items():
+            moment.add(signals[name])
+        for name, extreme in self.extremes.items():
+            extreme.add(signals[name])
+        for (name, _), accumulator in self.weighted.items():
+            accumulator.add(signals[name], window.time)
+        for spec, name in self.maxima:
+            value, key = window.metric(spec, name), (id(spec), name)
+            self.window_max[key] = np.maximum(self.window_max.get(key, value), value)
+        for name, pieces in self.pieces.items():
+            pieces.append(np.array(signals[name]))
+
+    def values(self, cfg: Config, model) -> dict[tuple[int, str], np.ndarray]:
+        """Every requested metric's (P,) values, by ``(id(spec), signal name)``."""
+        whole = _Kept(
+            {name: np.concatenate(p, axis=-1) for name, p in self.pieces.items()},
+            np.concatenate(self.times),
+            cfg,
+            model,
+        )
+        values: dict[tuple[int, str], np.ndarray] = {}
+        for spec, names in self.requests:
+            stream = METRICS[spec.metric].stream
+            for name in names:
+                key = (id(spec), name)
+                if stream == "moments":
+                    values[key] = self.moments[name].value(spec.metric)
+                elif stream == "extremes":
+                    values[key] = self.extremes[name].value(spec.metric)
+                elif stream == "weighted":
+                    values[key] = self.weighted[(name, spec.weighting)].value(spec)
+                elif stream == "window_max":
+                    values[key] = self.window_max[key]
+                else:
+                    values[key] = METRICS[spec.metric].compute(spec, whole, name)
+        return values
+
+
 def reduce(
     cfg: Config,
     params: Mapping[str, Any] | None,
     requests: Sequence[tuple[Any, Sequence[str]]],
     roads: Sequence[Any] | None = None,
-):
+) -> Reduced:
     """The metric specs of ``requests`` (``(spec, its signal names)``, names as
     :func:`suspopt.specs.spec_signals` gives them) for the designs ``params`` (as
-    :func:`suspopt.simulate`), without keeping the run's signals (module docstring): a
-    :class:`Reduced`, or the whole :class:`~suspopt.result.Result` for a controlled run.
-    ``roads`` (road sections whose edges, if any, fall at the same instants) drive the
-    designs in equal blocks of
-    consecutive columns instead of the config's road (robust design, one batch for
-    several roads on one time grid)."""
+    :func:`suspopt.simulate`), without keeping the run's signals (module docstring), as a
+    :class:`Reduced`. ``roads`` (road sections whose edges, if any, fall at the same
+    instants) drive the designs in equal blocks of consecutive columns instead of the
+    config's road (robust design, one batch for several roads on one time grid). A run with
+    a controller is one window (its hold keeps records over the run)."""
     from . import integrator
-    from .simulate import _result, _run, _setup, check_memory, prepare
+    from .simulate import _result, _setup, check_memory, prepare
 
     pv, model, controller, attachments = prepare(cfg, params)
-    if controller is not None:  # the whole run (what simulate does, once prepared)
+    streams = _Streams(requests)
+    if controller is not None:
+        width = None
         check_memory(cfg, model, attachments, pv.P, signals=len(requests))
-        return _run(cfg, pv, model, controller, attachments, roads)
-    kept = sorted(
-        {k for spec, names in requests if METRICS[spec.metric].stream == "keep"
-         for n in names for k in _kept_names(spec, n)}
-    )  # fmt: skip
-    width = window_width(cfg, model, attachments, pv.P, len(requests))
-    check_memory(cfg, model, attachments, pv.P, signals=len(requests), window=width, kept=len(kept))
+    else:
+        width = window_width(cfg, model, attachments, pv.P, len(requests))
+        check_memory(cfg, model, attachments, pv.P, signals=len(requests), window=width,
+                     kept=len(streams.pieces))  # fmt: skip
     run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments, roads)
-
-    def streamed(kind: str) -> list[str]:
-        return sorted(
-            {n for spec, names in requests if METRICS[spec.metric].stream == kind for n in names}
-        )
-
-    moments = {name: _Moments() for name in streamed("moments")}
-    extremes = {name: _Extremes() for name in streamed("extremes")}
-    weighted = _weighted(requests)
-    maxima = [(spec, n) for spec, names in requests if METRICS[spec.metric].stream == "window_max"
-              for n in names]  # fmt: skip
-    window_max: dict[tuple[int, str], Any] = {}
-    pieces: dict[str, list[np.ndarray]] = {name: [] for name in kept}
-    times, table, traj = [], None, None
     read = sorted({k for spec, names in requests for n in names for k in _kept_names(spec, n)})
     recorded = _recorded(cfg, (pv, model, attachments, run, z), read)
+    table, traj = None, None
     for first, traj in integrator.windows(run, cfg.simulation.engine, width, recorded):
         window = _result(cfg, pv, model, controller, attachments, run, (z, zd, t_grid), traj, first)
-        table, signals = window._table, window.signals
-        times.append(window.time)
-        for name, moment in moments.items():
-            moment.add(signals[name])
-        for name, extreme in extremes.items():
-            extreme.add(signals[name])
-        for (name, _), accumulator in weighted.items():
-            accumulator.add(signals[name], window.time)
-        for spec, name in maxima:
-            value, key = window.metric(spec, name), (id(spec), name)
-            window_max[key] = np.maximum(window_max.get(key, value), value)
-        for name in kept:
-            pieces[name].append(np.array(signals[name]))
+        table = window._table
+        streams.add(window)
     assert traj is not None and table is not None  # (a run has at least one sample)
-    whole = _Kept(
-        {name: np.concatenate(p, axis=-1) for name, p in pieces.items()},
-        np.concatenate(times),
-        cfg,
-        model,
-    )
-    values: dict[tuple[int, str], np.ndarray] = {}
-    for spec, names in requests:
-        stream = METRICS[spec.metric].stream
-        for name in names:
-            key = (id(spec), name)
-            if stream == "moments":
-                values[key] = moments[name].value(spec.metric)
-            elif stream == "extremes":
-                values[key] = extremes[name].value(spec.metric)
-            elif stream == "weighted":
-                values[key] = weighted[(name, spec.weighting)].value(spec)
-            elif stream == "window_max":
-                values[key] = window_max[key]
-            else:
-                values[key] = METRICS[spec.metric].compute(spec, whole, name)
-    return Reduced(model, table, values, traj.diverged_at, traj.engine)
+    return Reduced(model, table, streams.values(cfg, model), traj.diverged_at, traj.engine)

@@ -11,11 +11,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import CONFIGS
+import yaml
+from conftest import CONFIGS, make_config
 
 import suspopt
+from suspopt.control import LAWS, PARAMETERS
 from suspopt.errors import ConfigError
-from suspopt.simulate import simulate
+from suspopt.simulate import prepare, simulate
 
 numba = pytest.importorskip("numba")
 
@@ -155,3 +157,53 @@ def test_the_compiled_engine_without_numba_is_bad_input(monkeypatch, tmp_path):
         suspopt.load_config(path)
     path.write_text(text.replace("engine: compiled", "engine: auto"))
     assert suspopt.load_config(path).simulation.engine == "auto"
+
+
+@pytest.mark.parametrize(
+    "laws, threshold",
+    [
+        (("sh_l", "hybrid"), 1e-4),  # the continuous laws, a fixed threshold [m^2/s^2]
+        (("add", "sh_add_1"), None),  # the laws that read the body's acceleration
+        (("groundhook", "sh_add_2"), None),
+        (("sh_2", None), 0.0),  # a passive rear corner
+    ],
+)
+def test_the_kernel_takes_every_laws_samples_as_the_controller_does(laws, threshold):
+    """The compiled engine takes a fixed-threshold controller's samples inside the kernel, with
+    the laws' own rules: mixed laws, their parameters per design, a passive corner, a design
+    whose C_min = C_max (the records then say when the law asked for the stiff state), with
+    and without the actuator's lag; states to 1e-12 and records to 1e-9 of the numpy engine."""
+    data = yaml.safe_load((CONFIGS / "ch7" / "sh_2.yaml").read_text())
+    data["simulation"]["duration"] = 0.8
+    data.pop("design_variables"), data.pop("objectives"), data.pop("constraints", None)
+    data["vehicle"]["corner_defaults"].pop("damper")
+    for corner, law in zip(("F1", "R1"), laws):
+        damper = {"kind": "semi_active", "c_min": 1500, "c_max": 3500, "law": law}
+        damper.update(
+            {name: PARAMETERS[name].default for name in LAWS[law].parameters} if law else {}
+        )
+        passive = {"kind": "passive", "c": 2500}
+        data["vehicle"]["corners"][corner] = {"damper": damper if law else passive}
+    if threshold is not None:
+        data["control"]["threshold"] = {"mode": "fixed", "value": threshold}
+    base = make_config(data)
+    params = {"control.actuator_lag": np.array([0.0, 0.0, 0.01])}
+    params["vehicle.corners.F1.damper.c_min"] = np.array([1500.0, 3500.0, 1000.0])
+    for corner, law in zip(("F1", "R1"), laws):
+        for name in LAWS[law].parameters if law else ():
+            path = f"vehicle.corners.{corner}.damper.{name}"
+            params[path] = {"linear_weight": [0.0, 0.4, 1.0], "skyhook_weight": [0.0, 0.6, 1.0],
+                            "crossover_frequency": [20.0, 39.0, 60.0]}[name]  # fmt: skip
+    numpy_run, compiled_run = _run(base, "numpy", params), _run(base, "compiled", params)
+    assert compiled_run.engine == "compiled"
+    from suspopt.integrator import compiled
+
+    pv, model, controller, attachments = prepare(base, params)
+    assert compiled._sample_rules(controller) is not None  # (the kernel took the samples)
+    _agree(numpy_run, compiled_run)
+    for key, held in numpy_run.controller_records.items():
+        x, y = held.full(), compiled_run.controller_records[key].full()
+        scale = np.nanmax(np.abs(x)) if np.isfinite(x).any() else 1.0
+        np.testing.assert_allclose(y, x, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
+    state = compiled_run.signals["damper_state.F1"]
+    assert np.isin(state[1], (0.0, 1.0)).all() and (state[1] == 1.0).any()  # C_min = C_max

@@ -116,6 +116,30 @@ def test_every_metric_reduced_in_windows_is_the_whole_runs(engine, monkeypatch):
     assert np.array_equal(reduced.diverged_at, whole.diverged_at, equal_nan=True)
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_every_metric_of_a_controlled_run_reduced_is_the_whole_runs(engine):
+    """A run with a controller is one window: its metrics (the switch count of the damper
+    state among them) equal the whole run's, the rows it records chosen by the probe."""
+    cfg = _short("ch7/sh_add_2.yaml", 1.5)
+    cfg.simulation.engine = engine
+    params = _designs(cfg, 4)
+    requests = _every_metric(cfg)
+    spec = MetricSpec(metric="switches", signal="damper_state")
+    requests.append((spec, ["damper_state.F1", "damper_state.R1"]))
+    reduced = streaming.reduce(cfg, params, requests)
+    whole = simulate(cfg, params)
+    assert reduced.engine == whole.engine
+    for spec, names in requests:
+        for name in names:
+            got, want = reduced.metric(spec, name), whole.metric(spec, name)
+            if METRICS[spec.metric].stream == "moments":  # (a mean near 0: to its signal's size)
+                size = np.abs(whole.signals[name]).max() ** (2 if spec.metric == "var" else 1)
+                np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13 * size)
+            else:
+                assert np.array_equal(got, want, equal_nan=True), spec.metric
+
+
 def test_windows_hold_whole_blocks_of_the_weighted_sums():
     assert streaming.BLOCK % SUM_BLOCK == 0
 

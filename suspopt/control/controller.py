@@ -20,6 +20,8 @@ a refit costs the same however long the history.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from ..config import Config, ConfigError
@@ -30,7 +32,7 @@ from .laws import LAWS, PARAMETERS, Motion
 from .stats import distribution_quantile, t_quantile
 from .summary import StudentTSummary
 
-__all__ = ["SemiActiveController", "build_controller"]
+__all__ = ["SemiActiveController", "SampleRules", "build_controller"]
 
 
 def _per_design(
@@ -59,6 +61,28 @@ def _by_rows(matrix: np.ndarray, rows: np.ndarray) -> np.ndarray:
     layout (P, 1, r) of the laws (a view)."""
     out = np.dot(matrix, rows) if matrix.ndim == 2 else np.einsum("prc,cp->rp", matrix, rows)
     return out.T[:, None, :]
+
+
+class SampleRules(NamedTuple):
+    """What an engine needs to take a fixed-threshold controller's samples itself
+    (:meth:`SemiActiveController.sample_rules`), with the controller's arithmetic: the law of
+    each corner (None: passive), the map ``rates`` ``(3N, n)`` or ``(P, 3N, n)`` of the
+    vehicle's velocities to ``[ṠT; ż_s; ż_u]`` at the corners (its rows ``N .. 2N`` also map
+    the accelerations to ``z̈_s``), ``C_min``, ``C_max`` [N s/m] and the threshold ``(P, N)``,
+    the law parameters ``(len(PARAMETERS), P, N)`` in the order of
+    :data:`~suspopt.control.laws.PARAMETERS`, where a corner is stiff below the threshold
+    ``(N,)``, whether a law reads ``z̈_s`` and whether the records carry ``stiff``
+    (:meth:`SemiActiveController.record`)."""
+
+    laws: tuple[str | None, ...]
+    rates: np.ndarray
+    c_min: np.ndarray
+    c_max: np.ndarray
+    threshold: np.ndarray
+    parameters: np.ndarray
+    below: np.ndarray
+    needs_acceleration: bool
+    stiff_records: bool
 
 
 class SemiActiveController:
@@ -91,6 +115,7 @@ class SemiActiveController:
         distribution: str = "student_t",
     ):
         N = len(model.corners)
+        self._laws = tuple(laws)
         self._passive = np.array([law is None for law in laws])
         present = sorted({law for law in laws if law is not None}, key=list(LAWS).index)
         self._groups = [
@@ -169,6 +194,25 @@ class SemiActiveController:
         lag; None when no design has one."""
         return self._decay if self._lagged else None
 
+    def sample_rules(self) -> SampleRules | None:
+        """The samples' rules for an engine that takes them itself; None with an adaptive
+        threshold (its refits stay here)."""
+        if self._adaptive:
+            return None
+        below = np.array([law is not None and LAWS[law].stiff_below for law in self._laws])
+        values = np.stack([self._parameters[name][:, 0] for name in PARAMETERS])
+        return SampleRules(
+            self._laws,
+            self._rates,
+            self._c_min[:, 0],
+            self._c_max[:, 0],
+            np.broadcast_to(self._threshold[:, 0], self._c_min[:, 0].shape),
+            values,
+            below,
+            self._needs_acc,
+            self._fixed,
+        )
+
     def sample(self, k: int, t: float, state) -> np.ndarray:
         """The command (P, 1, N) [N s/m] from the sample at step ``k`` (``t = k dt``), held
         until the next sample (see the protocol in simulate.py)."""
@@ -199,6 +243,7 @@ class SemiActiveController:
             stiff = condition > self._threshold
         else:
             stiff = np.where(self._below, condition < self._threshold, condition > self._threshold)
+        assert condition is not None  # (a controller has at least one law)
         c_stiff = self._c_max
         for law, mask in self._groups:
             if LAWS[law].continuous:

@@ -54,7 +54,9 @@ take the ratio ``ż_s / ṠT`` (or ``X / ṠT²``) as 0.
 **Adding a law** is adding one :class:`Law` to :data:`LAWS` (with any new :class:`Parameter`
 in :data:`PARAMETERS`): the config (``vehicle...damper.law`` and its parameter fields,
 :mod:`suspopt.config.vehicle`) and the controller (:mod:`suspopt.control.controller`) read
-them from here. This module imports nothing of the config.
+them from here. The compiled engine takes the samples of the laws it lists
+(:data:`suspopt.integrator._kernel.CONTROL_LAWS`, with these same rules) and hands any other
+law's back to the controller at each sample. This module imports nothing of the config.
 """
 
 from __future__ import annotations
@@ -97,25 +99,44 @@ class Motion:
 
 @dataclass(frozen=True)
 class Law:
-    """A control law (module docstring): ``condition(motion)`` gives X in ``unit``;
-    ``stiff_below``: stiff when X < T (else X > T); ``needs_acceleration``: reads z̈_s;
-    ``parameters``: the names of the :data:`PARAMETERS` it takes; ``stiff(c_min, c_max,
-    motion, X)`` the coefficient of its stiff state [N s/m], None for ``C_max`` (an on-off
-    law); ``equation`` where the thesis states it."""
+    """A control law (module docstring). ``rule(st, zs, zu, za, linear_weight,
+    crossover_frequency, skyhook_weight)`` gives X in ``unit`` from the travel rate ṠT, the
+    body's velocity ż_s and acceleration z̈_s at the corner and the wheel's velocity ż_u
+    (arrays of one shape; ``za`` is None or unused for a law that does not read it) and the
+    :data:`PARAMETERS` in their order; ``stiff_below``: stiff when X < T (else X > T);
+    ``needs_acceleration``: reads z̈_s; ``parameters``: the names of the parameters it takes;
+    ``stiff_rule(c_min, c_max, st, zs, x, linear_weight, crossover_frequency,
+    skyhook_weight)`` the coefficient of its stiff state [N s/m], None for ``C_max`` (an on-off
+    law); ``equation`` where the thesis states it. The rules use only arithmetic,
+    ``np.where`` and ``np.clip`` on arrays, so the compiled engine runs the same functions
+    (:mod:`suspopt.integrator.compiled`)."""
 
     name: str
-    condition: Callable[[Motion], np.ndarray]
+    rule: Callable[..., np.ndarray]
     unit: str
     equation: str
     stiff_below: bool = False
     needs_acceleration: bool = False
     parameters: tuple[str, ...] = ()
-    stiff: Callable[..., np.ndarray] | None = None
+    stiff_rule: Callable[..., np.ndarray] | None = None
 
     @property
     def continuous(self) -> bool:
         """Whether the stiff coefficient varies inside ``[C_min, C_max]``."""
-        return self.stiff is not None
+        return self.stiff_rule is not None
+
+    def condition(self, m: Motion) -> np.ndarray:
+        """X at the sample ``m``."""
+        values = [m.parameters[name] for name in PARAMETERS]
+        return self.rule(m.travel_vel, m.body_vel, m.wheel_vel, m.body_acc, *values)
+
+    def stiff(self, c_min, c_max, m: Motion, condition: np.ndarray) -> np.ndarray:
+        """The stiff coefficient at the sample ``m`` with condition X (``C_max`` for an
+        on-off law)."""
+        if self.stiff_rule is None:
+            return c_max
+        values = [m.parameters[name] for name in PARAMETERS]
+        return self.stiff_rule(c_min, c_max, m.travel_vel, m.body_vel, condition, *values)
 
 
 PARAMETERS: dict[str, Parameter] = {
@@ -154,53 +175,48 @@ PARAMETERS: dict[str, Parameter] = {
 }
 
 
-def _ratio(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
-    """``numerator / denominator``, 0 where the denominator is 0."""
-    return np.divide(
-        numerator,
-        denominator,
-        out=np.zeros(np.broadcast_shapes(numerator.shape, denominator.shape)),
-        where=denominator != 0,
-    )
+def _skyhook(st, zs, zu, za, linear_weight, crossover, skyhook_weight):
+    return st * zs
 
 
-def _selector(m: Motion) -> np.ndarray:
+def _add(st, zs, zu, za, linear_weight, crossover, skyhook_weight):
+    return st * za
+
+
+def _selector(st, zs, zu, za, linear_weight, crossover, skyhook_weight):
     """``S = z̈_s² - α_c² ż_s²`` (Eq 2.37-2.39; slip: docs/thesis-slips.md#eq-237) [m²/s⁴]."""
-    crossover = m.parameters["crossover_frequency"]
-    return m.body_acc * m.body_acc - crossover * crossover * (m.body_vel * m.body_vel)
+    return za * za - crossover * crossover * (zs * zs)
 
 
-def _skyhook(m: Motion) -> np.ndarray:
-    return m.travel_vel * m.body_vel
+def _sh_add_1(st, zs, zu, za, linear_weight, crossover, skyhook_weight):
+    low = za * za - crossover * crossover * (zs * zs) <= 0  # (the selector S)
+    return np.where(low, st * zs, st * za / crossover)
 
 
-def _sh_add_1(m: Motion) -> np.ndarray:
-    low = _selector(m) <= 0
-    return np.where(
-        low,
-        m.travel_vel * m.body_vel,
-        m.travel_vel * m.body_acc / m.parameters["crossover_frequency"],
-    )
+def _groundhook(st, zs, zu, za, linear_weight, crossover, skyhook_weight):
+    return -(st * zu)
 
 
-def _hybrid(m: Motion) -> np.ndarray:
+def _hybrid(st, zs, zu, za, linear_weight, crossover, skyhook_weight):
     """``ṠT (β σ_sky + (1 - β) σ_gnd)``."""
-    beta = m.parameters["skyhook_weight"]
-    sky = np.where(m.travel_vel * m.body_vel > 0, m.body_vel, 0.0)
-    ground = np.where(m.travel_vel * m.wheel_vel < 0, -m.wheel_vel, 0.0)
-    return m.travel_vel * (beta * sky + (1.0 - beta) * ground)
+    sky = np.where(st * zs > 0, zs, 0.0)
+    ground = np.where(st * zu < 0, -zu, 0.0)
+    return st * (skyhook_weight * sky + (1.0 - skyhook_weight) * ground)
 
 
-def _sh_l_coefficient(c_min, c_max, m: Motion, condition) -> np.ndarray:
-    """The clipped SH-L coefficient (Eq 2.35)."""
-    alpha = m.parameters["linear_weight"]
-    c = alpha * c_max + (1.0 - alpha) * c_max * _ratio(m.body_vel, m.travel_vel)
-    return np.clip(c, c_min, c_max)
+def _sh_l_coefficient(c_min, c_max, st, zs, x, linear_weight, crossover, skyhook_weight):
+    """The clipped SH-L coefficient (Eq 2.35); the ratio ż_s / ṠT taken as 0 where ṠT = 0."""
+    moving = st != 0
+    ratio = np.where(moving, zs / np.where(moving, st, 1.0), 0.0)
+    return np.clip(linear_weight * c_max + (1.0 - linear_weight) * c_max * ratio, c_min, c_max)
 
 
-def _hybrid_coefficient(c_min, c_max, m: Motion, condition) -> np.ndarray:
-    """``clip(C_max X / ṠT²)``: the coefficient that realises the hybrid force."""
-    return np.clip(c_max * _ratio(condition, m.travel_vel * m.travel_vel), c_min, c_max)
+def _hybrid_coefficient(c_min, c_max, st, zs, x, linear_weight, crossover, skyhook_weight):
+    """``clip(C_max X / ṠT²)``: the coefficient that realises the hybrid force (X / ṠT² taken
+    as 0 where ṠT = 0)."""
+    square = st * st
+    moving = square != 0
+    return np.clip(c_max * np.where(moving, x / np.where(moving, square, 1.0), 0.0), c_min, c_max)
 
 
 LAWS: dict[str, Law] = {
@@ -213,15 +229,9 @@ LAWS: dict[str, Law] = {
             "m^2/s^2",
             "Eq 2.35",
             parameters=("linear_weight",),
-            stiff=_sh_l_coefficient,
+            stiff_rule=_sh_l_coefficient,
         ),
-        Law(
-            "add",
-            lambda m: m.travel_vel * m.body_acc,
-            "m^2/s^3",
-            "Eq 2.36",
-            needs_acceleration=True,
-        ),
+        Law("add", _add, "m^2/s^3", "Eq 2.36", needs_acceleration=True),
         Law(
             "sh_add_1",
             _sh_add_1,
@@ -239,14 +249,14 @@ LAWS: dict[str, Law] = {
             needs_acceleration=True,
             parameters=("crossover_frequency",),
         ),
-        Law("groundhook", lambda m: -(m.travel_vel * m.wheel_vel), "m^2/s^2", "Sec 4.4"),
+        Law("groundhook", _groundhook, "m^2/s^2", "Sec 4.4"),
         Law(
             "hybrid",
             _hybrid,
             "m^2/s^2",
             "Sec 4.4",
             parameters=("skyhook_weight",),
-            stiff=_hybrid_coefficient,
+            stiff_rule=_hybrid_coefficient,
         ),
     )
 }
@@ -292,9 +302,5 @@ def stiff_coefficient(
 ) -> np.ndarray:
     """Coefficient [N s/m] of ``law`` in its stiff state: ``C_max`` for the on-off laws, the
     clipped SH-L (Eq 2.35) or hybrid coefficient for the continuous ones."""
-    stiff = LAWS[law].stiff
-    if stiff is None:
-        return c_max
-    return stiff(
-        c_min, c_max, _motion(travel_vel, body_vel, np.zeros(1), None, **parameters), condition
-    )
+    motion = _motion(travel_vel, body_vel, np.zeros(1), None, **parameters)
+    return LAWS[law].stiff(c_min, c_max, motion, condition)

@@ -16,6 +16,10 @@ starts (:func:`.compiled._packed`):
 - ``idx``: D_q's rows and columns, G's rows (DOFs) and columns (elements), the laws' codes
   (:data:`.compiled.LAWS`) and element rows, the lagged dampers' element rows.
 
+A fixed-threshold controller's samples are taken in the kernel (:func:`_control`, with
+``ctl = (cp, ci, records)``: its values per block, its indices and each sample's records;
+empty when the kernel takes none).
+
 The lane is every loop's innermost index (a loop the compiler vectorises, with a run-time
 check that its arrays do not overlap).
 """
@@ -24,6 +28,8 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+
+from ..control.laws import LAWS
 
 _jit = numba.njit(cache=True, nogil=True)
 
@@ -256,10 +262,102 @@ def _lag(pb, idx, lay):
             pb[oC + r, b] = pb[oC + r, b] + pb[oPulled + m, b]
 
 
+#: The control laws the kernel takes samples of, by code (their index here); their rules are
+#: the controller's own functions (:class:`suspopt.control.laws.Law`), compiled.
+CONTROL_LAWS = ("sh_2", "sh_l", "add", "sh_add_1", "sh_add_2", "groundhook", "hybrid")
+_x0, _x1, _x2, _x3, _x4, _x5, _x6 = (_jit(LAWS[name].rule) for name in CONTROL_LAWS)
+
+
+def _stiff_rule(name: str):
+    rule = LAWS[name].stiff_rule
+    assert rule is not None  # (a continuous law)
+    return _jit(rule)
+
+
+#: The continuous laws' codes and stiff coefficients (the other laws' is C_max).
+_SH_L, _HYBRID = CONTROL_LAWS.index("sh_l"), CONTROL_LAWS.index("hybrid")
+_stiff_sh_l, _stiff_hybrid = _stiff_rule("sh_l"), _stiff_rule("hybrid")
+
+
+@_jit
+def _condition(code, st, zs, zu, za, lw, cf, sw):
+    """X of law ``code`` (:data:`CONTROL_LAWS`; -1, a passive corner: 0)."""
+    if code == 0:
+        return _x0(st, zs, zu, za, lw, cf, sw)
+    if code == 1:
+        return _x1(st, zs, zu, za, lw, cf, sw)
+    if code == 2:
+        return _x2(st, zs, zu, za, lw, cf, sw)
+    if code == 3:
+        return _x3(st, zs, zu, za, lw, cf, sw)
+    if code == 4:
+        return _x4(st, zs, zu, za, lw, cf, sw)
+    if code == 5:
+        return _x5(st, zs, zu, za, lw, cf, sw)
+    if code == 6:
+        return _x6(st, zs, zu, za, lw, cf, sw)
+    return np.zeros_like(st)
+
+
+@_jit
+def _stiff(code, c_min, c_max, st, zs, x, lw, cf, sw):
+    """The stiff coefficient of law ``code`` (``C_max`` for an on-off law)."""
+    if code == _SH_L:
+        return _stiff_sh_l(c_min, c_max, st, zs, x, lw, cf, sw)
+    if code == _HYBRID:
+        return _stiff_hybrid(c_min, c_max, st, zs, x, lw, cf, sw)
+    return c_max.copy()
+
+
+@_jit
+def _control(step, W, F, pb, idx, lay, road, lr, cp, ci, records):
+    """The controller's sample at ``step`` (:class:`suspopt.control.controller.
+    SemiActiveController`'s arithmetic): the rates ``[ṠT; ż_s; ż_u]`` of the velocities (and
+    ``z̈_s`` of the accelerations with the coefficients in force), each corner's condition,
+    threshold and command, the command into the damper's coefficient (or its share of the
+    lag) and the sample's records ``(command, condition, threshold, stiff)``. ``ci = (N,
+    entries, steps per sample, whether the final instant is one, reads z̈_s, lagged, law
+    codes (N), stiff below (N), damper elements (N), the rates map's rows and columns)``,
+    ``cp``: the map's values, then ``C_min, C_max, T`` and the law parameters (N rows each)."""
+    N, nnz, B, n = ci[0], ci[1], W.shape[2], lay[4]
+    codes, below, elements, rows, cols = 6, 6 + N, 6 + 2 * N, 6 + 3 * N, 6 + 3 * N + nnz
+    rates = np.zeros((3 * N, B))
+    acc = np.zeros((N, B))
+    for z in range(nnz):
+        for b in range(B):
+            rates[ci[rows + z], b] += cp[z, b] * W[Y, n + ci[cols + z], b]
+    if ci[4]:
+        _stage(W, F, pb, idx, lay, Y, road[0], 2 * step, lr, road[1][2 * step], 0, TMP)
+        for z in range(nnz):
+            r = ci[rows + z]
+            if N <= r < 2 * N:
+                for b in range(B):
+                    acc[r - N, b] += cp[z, b] * W[TMP, n + ci[cols + z], b]
+    s, o = step // ci[2], nnz
+    for c in range(N):
+        st, zs, zu = rates[c], rates[N + c], rates[2 * N + c]
+        lw, cf, sw = cp[o + 3 * N + c], cp[o + 4 * N + c], cp[o + 5 * N + c]
+        c_min, c_max, threshold = cp[o + c], cp[o + N + c], cp[o + 2 * N + c]
+        x = _condition(ci[codes + c], st, zs, zu, acc[c], lw, cf, sw)
+        stiff = x < threshold if ci[below + c] else x > threshold
+        command = np.where(stiff, _stiff(ci[codes + c], c_min, c_max, st, zs, x, lw, cf, sw), c_min)
+        r = ci[elements + c]
+        for b in range(B):
+            if ci[5]:  # the command's share of the lag: c_cmd (1 - e)
+                pb[lay[13] + c, b] = command[b] * (1.0 - pb[lay[12] + c, b])
+            else:
+                pb[lay[8] + r, b] = command[b]
+            records[0, s, b, c] = command[b]
+            records[1, s, b, c] = x[b]
+            records[2, s, b, c] = threshold[b]
+            records[3, s, b, c] = 1.0 if stiff[b] else 0.0
+
+
 @_jit
 def _advance(
-    blk, k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out
-):
+    blk, k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out,
+    ctl,
+):  # fmt: skip
     """Block ``blk``'s steps ``k0 .. k1 - 1`` from its kept state (step ``n_steps`` is the
     final sample alone): the sample's first stage, the sample when one is due (sample ``j``
     written at ``j - origin`` of the records, ``origin`` a multiple of :data:`SAMPLES`), the
@@ -270,10 +368,13 @@ def _advance(
     n, B = lay[4], W.shape[2]
     off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
     lr, kept = road[12][blk], state[4]
+    cp, ci, records = ctl[0][blk], ctl[1], ctl[2][:, :, blk * B : blk * B + B]
     if k0 == 0:
         for u in range(start_jumps.shape[0]):
             _impulse(start_jumps, u, no_pull, W, F, pb, idx, lay, lr)
     for step in range(k0, k1):
+        if ci[0] and step % ci[2] == 0 and (step < n_steps or ci[3]):
+            _control(step, W, F, pb, idx, lay, road, lr, cp, ci, records)
         _lag(pb, idx, lay)
         _stage(W, F, pb, idx, lay, Y, off, 2 * step, lr, active[2 * step], 0, S1)
         if step % every == 0:  # the sample: the state and the first stage's accelerations
@@ -293,7 +394,9 @@ def _advance(
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)
-def run(k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out):
+def run(
+    k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out, ctl
+):
     """Steps ``k0 .. k1 - 1`` of every block (in parallel over the cores) from the kept
     ``state = (W, F, rec, at, kept)`` of each (``kept``: the record's rows the samples
     keep, :func:`_keep`), ``par (blocks, rows, B)`` (the arrays:
@@ -301,7 +404,7 @@ def run(k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, r
     for blk in numba.prange(par.shape[0]):
         _advance(
             blk, k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road,
-            state, out,
+            state, out, ctl,
         )  # fmt: skip
 
 

@@ -23,13 +23,20 @@ scaled by their step, ``y += (s1 + 2 s2 + s3)/3 + s4``). The two agree to roundi
 taken in another order (and BLAS may fuse multiply-adds), about 1e-15 relative per step
 (``tests/test_compiled.py`` checks 1e-12 on the bundled configs).
 
-A semi-active controller stays the one in :mod:`suspopt.control` (numpy, every law and
-threshold): the kernel runs the steps between its samples, and at each sample the
-controller reads the vehicle's velocities (and, for the laws that need them, the
-accelerations, computed by the kernel with the coefficients in force) and its command goes
-into the blocks' damper coefficients (with an actuator lag, the command's share, the kernel
-applying the lag at every step), as the numpy engine's hold does it. Not covered (the numpy
-engine runs it, :func:`unsupported` says why): a non-linear part without a compiled law.
+A semi-active controller with a fixed threshold (or none) is sampled by the kernel itself
+(:func:`._kernel._control`): every ``ΔT`` it maps the vehicle's velocities (and, for the
+laws that need it, the accelerations with the coefficients in force) to each corner's
+travel rate, body and wheel velocity, runs the corner's law (the controller's own rule of
+:class:`suspopt.control.laws.Law`, compiled: one definition), compares it with the threshold
+and puts the command into the damper's coefficient (with an actuator lag, into the
+command's share, the kernel applying the lag at every step), keeping each sample's records;
+the whole run is then one call of the kernel. The records the run keeps are chosen from them
+as the numpy engine's hold keeps its own (:func:`_in_kernel`). An adaptive threshold (its
+refits fit distributions to the whole history) stays in :mod:`suspopt.control`: the kernel
+then runs the steps between the samples and the controller takes each sample in numpy
+(:func:`_controlled`); so does a law the kernel does not list (:data:`._kernel.
+CONTROL_LAWS`). Not covered (the numpy engine runs it, :func:`unsupported` says why): a
+non-linear element without a compiled law.
 A new law is a branch of ``_kernel._law`` and an entry of :data:`LAWS`, beside the numpy
 closure that defines it (:attr:`suspopt.network.Elements.extra`).
 
@@ -293,9 +300,9 @@ def windows(
         states, accelerations = np.empty((2 * n, P, T)), np.empty((n, P, T))
         out = (states, accelerations, diverged_at, np.empty((Nl, P, T)))
 
-        def advance(k0: int, k1: int, out=out, j0=j0) -> None:
+        def advance(k0: int, k1: int, ctl=_no_control(blocks, B), out=out, j0=j0) -> None:
             _kernel.run(k0, k1, j0, dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par,
-                        idx, lay, road, state, out)  # fmt: skip
+                        idx, lay, road, state, out, ctl)  # fmt: skip
 
         damping, records = None, {}
         if controller is None:
@@ -356,10 +363,49 @@ class _Lanes:
             target[whole, :, P - whole * B :] = values[:, -1:]
 
 
+def _no_control(blocks: int, B: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The kernel's controller arrays of a run whose kernel takes no controller sample."""
+    return np.zeros((blocks, 0, B)), np.array([0, 0, 1, 0, 0, 0], np.int64), np.zeros((4, 0, B, 0))
+
+
+def _sample_rules(controller):
+    """The controller's :class:`~suspopt.control.controller.SampleRules` when the kernel can
+    take its samples (a fixed threshold, laws of :data:`._kernel.CONTROL_LAWS`), else None
+    (an adaptive threshold refits in numpy between compiled stretches)."""
+    from . import _kernel
+
+    rules = getattr(controller, "sample_rules", lambda: None)()
+    if rules is None or any(law not in _kernel.CONTROL_LAWS for law in rules.laws if law):
+        return None
+    return rules
+
+
+def _control_arrays(
+    asm: Assembled, rules, par: np.ndarray, every_c: int, final: bool, lagged: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel's controller values ``cp (blocks, rows, B)`` and indices ``ci``
+    (:func:`._kernel._control`) for samples every ``every_c`` steps (the run's final instant
+    one of them when ``final``), the command into the lag's share when ``lagged``."""
+    from . import _kernel
+
+    blocks, _, B = par.shape
+    P = blocks * B
+    r_row, r_col, r_val = _entries(rules.rates, P)
+    values = [rules.c_min, rules.c_max, rules.threshold, *rules.parameters]
+    cp = np.concatenate([r_val] + [_padded(np.asarray(v, float).T, P) for v in values])
+    codes = [_kernel.CONTROL_LAWS.index(law) if law else -1 for law in rules.laws]
+    ci = [len(rules.laws), r_row.size, every_c, int(final), int(rules.needs_acceleration)]
+    ci += [int(lagged)] + codes + [int(b) for b in rules.below] + list(_damper_elements(asm))
+    ci += list(r_row) + list(r_col)
+    cp = np.ascontiguousarray(cp.reshape(cp.shape[0], blocks, B).transpose(1, 0, 2))
+    return cp, np.array(ci, np.int64)
+
+
 def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps, every):
-    """The run with ``controller``: compiled stretches of steps between its samples, each
-    sample taken as the numpy engine's :class:`.rk4._ControllerHold` takes it (zero-order
-    hold, the records kept at the first output sample after each change)."""
+    """The run with ``controller``, each sample taken as the numpy engine's
+    :class:`.rk4._ControllerHold` takes it (zero-order hold, the records kept at the first
+    output sample after each change): by the kernel itself when it can
+    (:func:`_sample_rules`), else in compiled stretches of steps between the samples."""
     n_out, lay = n_steps // every + 1, lanes.lay
     elements = _damper_elements(asm)  # contiguous: their rows of c among the parameters
     dampers = slice(int(lay[8]) + elements[0], int(lay[8]) + elements[-1] + 1)
@@ -369,12 +415,15 @@ def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps,
     assert rows is not None
     hold = _ControllerHold(controller, coef, rows, asm.P, n_out, dt, vehicle)
     lanes.set_rows(dampers, hold.damping[:, :, 0])
-    lagged = hold.decay is not None
-    shares = slice(int(lay[13]), int(lay[13]) + int(lay[11]))  # the lagged command's share
     every_c = controller.sample_every
     samples = list(range(0, n_steps, every_c))
     if n_steps % every == 0 and n_steps % every_c == 0:
         samples.append(n_steps)  # the final instant is an output sample
+    rules = _sample_rules(controller)
+    if rules is not None:
+        return _in_kernel(hold, rules, asm, lanes, advance, samples, (n_steps, every))
+    lagged = hold.decay is not None
+    shares = slice(int(lay[13]), int(lay[13]) + int(lay[11]))  # the lagged command's share
     k0, pending = 0, None
     for k in samples:
         advance(k0, k)
@@ -391,4 +440,29 @@ def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps,
     advance(k0, n_steps + 1)
     if pending is not None:
         hold.kept(pending)
+    return hold.held(n_out)
+
+
+def _in_kernel(hold, rules, asm: Assembled, lanes: _Lanes, advance, samples, grid):
+    """The whole run in one call of the kernel, which takes the controller's samples; then
+    the records the hold keeps (those of the last sample before each output sample), as the
+    hold would have kept them."""
+    n_steps, every = grid
+    n_out, P = n_steps // every + 1, asm.P
+    final = bool(samples) and samples[-1] == n_steps
+    cp, ci = _control_arrays(asm, rules, lanes.par, hold.every, final, hold.decay is not None)
+    blocks, _, B = lanes.par.shape
+    records = np.empty((4, len(samples), blocks * B, len(rules.laws)))  # (every one written)
+    advance(0, n_steps + 1, (cp, ci, records))
+    records = records[:, :, :P]
+    first = -(-np.array(samples) // every)  # each sample's first output sample
+    last = np.append(first[1:] != first[:-1], True) & (first < n_out)
+    kept = np.flatnonzero(last)
+    names = ["command", "condition", "threshold"] + (["stiff"] if rules.stiff_records else [])
+    columns = [list(records[0, kept]), list(records[1, kept]), list(records[2, kept])]
+    columns += [list(records[3, kept] > 0.5)] if rules.stiff_records else []
+    hold.held_records.extend(dict(zip(names, values)) for values in zip(*columns))
+    if hold.decay is None:
+        hold.held_damping.extend(columns[0])
+    hold.changes.extend(first[kept].tolist())
     return hold.held(n_out)
