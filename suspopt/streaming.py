@@ -307,8 +307,9 @@ def recorded_rows(result_of, n: int, P: int, names: Sequence[str]) -> np.ndarray
 
 def _recorded(cfg: Config, setup, names: Sequence[str]) -> np.ndarray | None:
     """The rows of the states and accelerations the signals ``names`` read
-    (:func:`recorded_rows`; ``setup = (designs, model, attachments, run, road inputs)`` of a
-    run without a controller), or None on the numpy engine (which computes every row)."""
+    (:func:`recorded_rows`; ``setup = (designs, model, attachments, run, road inputs)``; the
+    probe has no controller, whose records read no state), or None on the numpy engine
+    (which computes every row)."""
     if cfg.simulation.engine == "numpy":
         return None
     from .integrator import Trajectory

@@ -207,3 +207,18 @@ def test_the_kernel_takes_every_laws_samples_as_the_controller_does(laws, thresh
         np.testing.assert_allclose(y, x, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
     state = compiled_run.signals["damper_state.F1"]
     assert np.isin(state[1], (0.0, 1.0)).all() and (state[1] == 1.0).any()  # C_min = C_max
+
+
+def test_every_row_of_a_packed_map_has_an_entry():
+    """The kernel starts a row's sum at its first entry: a row without one gets a zero entry,
+    in row order, the others kept as they were."""
+    from suspopt.integrator.compiled import _every_row
+
+    rows, cols = np.array([0, 0, 2]), np.array([1, 3, 0])
+    vals = np.arange(6.0).reshape(3, 2)
+    r, c, v = _every_row((rows, cols, vals), 4)
+    assert r.tolist() == [0, 0, 1, 2, 3] and c.tolist() == [1, 3, 0, 0, 0]
+    np.testing.assert_array_equal(v, [[0, 1], [2, 3], [0, 0], [4, 5], [0, 0]])
+    assert _every_row((rows, cols, vals), 3)[0].tolist() == [0, 0, 1, 2]
+    full = (np.array([0, 1]), np.array([0, 0]), np.ones((2, 2)))
+    assert _every_row(full, 2)[0] is full[0]  # (nothing missing: the entries as they are)

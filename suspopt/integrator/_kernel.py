@@ -66,56 +66,68 @@ def _law(code, r, p, F, par):
 
 
 @_jit
-def _stage(W, F, par, idx, lay, src, o, oi, lr, has_input, scale, out):
-    """The accelerations at the state ``W[src] = [q; v]`` with the inputs' part ``o[oi]``
+def _stage(W, F, par, idx, lay, src, o, oi, lr, has_input, scale, out, h):
+    """The accelerations at the state ``W[src] = [q; q']`` with the inputs' part ``o[oi]``
     (when ``has_input``; ``o (.., G, 2R)``, lane ``b`` on road ``lr[b]`` when G > 1), times
-    the inverse masses' row set ``scale`` (0: 1, 1: dt/2, 2: dt, 3: dt/6), into ``W[out, n:]``: ``δ = D_q q + D_u u``, ``F = k δ + c δ̇`` plus the laws,
-    ``q'' = M^-1 G F``."""
+    the inverse masses' row set ``scale`` (0: 1, 1: dt/2, 2: dt, 3: dt/6), into
+    ``W[out, n:]``, and the displacement rates ``h q'`` into ``W[out, :n]``: ``δ = D_q q + D_u
+    u``, ``F = k δ + c δ̇`` plus the laws, ``q'' = M^-1 G F``. The entries of D_q (of G) come
+    row by row, every row at least once (:func:`.compiled._packed`): a row's first entry
+    starts its sum (``0 + x``, the arithmetic of a sum started at zero) and its last one
+    scales it, so that each lane loop does one entry's work (the loops' set-up is most of a
+    stage's time at 50 lanes)."""
     nD, nG, R, X, n = lay[0], lay[1], lay[2], lay[3], lay[4]
     oD, oG, oK, oC, oL, oM = lay[5], lay[6], lay[7], lay[8], lay[9], lay[10]
-    for r in range(R):
-        for b in range(W.shape[2]):
-            F[0, r, b] = 0.0
-            F[1, r, b] = 0.0
+    B = W.shape[2]
     for z in range(nD):
         r, j = idx[z], idx[nD + z]
-        for b in range(W.shape[2]):
-            F[0, r, b] += par[oD + z, b] * W[src, j, b]
-            F[1, r, b] += par[oD + z, b] * W[src, n + j, b]
+        if z == 0 or idx[z - 1] != r:
+            for b in range(B):
+                F[0, r, b] = 0.0 + par[oD + z, b] * W[src, j, b]
+                F[1, r, b] = 0.0 + par[oD + z, b] * W[src, n + j, b]
+        else:
+            for b in range(B):
+                F[0, r, b] += par[oD + z, b] * W[src, j, b]
+                F[1, r, b] += par[oD + z, b] * W[src, n + j, b]
     if has_input and o.shape[1] == 1:
         for r in range(R):
-            for b in range(W.shape[2]):
-                F[0, r, b] += o[oi, 0, r]
-                F[1, r, b] += o[oi, 0, R + r]
+            for b in range(B):
+                d = F[0, r, b] + o[oi, 0, r]
+                F[0, r, b] = d
+                F[2, r, b] = par[oK + r, b] * d + par[oC + r, b] * (F[1, r, b] + o[oi, 0, R + r])
     elif has_input:  # a road per lane
         for r in range(R):
-            for b in range(W.shape[2]):
-                F[0, r, b] += o[oi, lr[b], r]
-                F[1, r, b] += o[oi, lr[b], R + r]
-    for r in range(R):
-        for b in range(W.shape[2]):
-            F[2, r, b] = par[oK + r, b] * F[0, r, b] + par[oC + r, b] * F[1, r, b]
+            for b in range(B):
+                d = F[0, r, b] + o[oi, lr[b], r]
+                F[0, r, b] = d
+                v = F[1, r, b] + o[oi, lr[b], R + r]
+                F[2, r, b] = par[oK + r, b] * d + par[oC + r, b] * v
+    else:
+        for r in range(R):
+            for b in range(B):
+                F[2, r, b] = par[oK + r, b] * F[0, r, b] + par[oC + r, b] * F[1, r, b]
     for x in range(X):
         _law(idx[2 * nD + 2 * nG + x], idx[2 * nD + 2 * nG + X + x], oL + 5 * x, F, par)
-    for i in range(n):
-        for b in range(W.shape[2]):
-            W[out, n + i, b] = 0.0
     for z in range(nG):
         i, r = idx[2 * nD + z], idx[2 * nD + nG + z]
-        for b in range(W.shape[2]):
-            W[out, n + i, b] += par[oG + z, b] * F[2, r, b]
-    for i in range(n):
-        for b in range(W.shape[2]):
-            W[out, n + i, b] *= par[oM + scale * n + i, b]
-
-
-@_jit
-def _rates(W, src, h, out, n):
-    """``W[out, :n] = h v`` of the state ``W[src]``: a stage's displacement rates times its
-    step."""
-    for i in range(n):
-        for b in range(W.shape[2]):
-            W[out, i, b] = W[src, n + i, b] * h
+        first = z == 0 or idx[2 * nD + z - 1] != i
+        if z == nG - 1 or idx[2 * nD + z + 1] != i:  # the DOF's last entry
+            m = oM + scale * n + i
+            if first:
+                for b in range(B):
+                    W[out, n + i, b] = (0.0 + par[oG + z, b] * F[2, r, b]) * par[m, b]
+                    W[out, i, b] = W[src, n + i, b] * h
+            else:
+                for b in range(B):
+                    acc = W[out, n + i, b] + par[oG + z, b] * F[2, r, b]
+                    W[out, n + i, b] = acc * par[m, b]
+                    W[out, i, b] = W[src, n + i, b] * h
+        elif first:
+            for b in range(B):
+                W[out, n + i, b] = 0.0 + par[oG + z, b] * F[2, r, b]
+        else:
+            for b in range(B):
+                W[out, n + i, b] += par[oG + z, b] * F[2, r, b]
 
 
 @_jit
@@ -135,13 +147,11 @@ def _regular_step(h0, dt, W, F, par, idx, lay, off, lr, active):
     for i in range(n):
         for b in range(W.shape[2]):
             W[S1, n + i, b] *= half
-    _rates(W, Y, half, S1, n)
     for stage in range(3):  # s2, s3, s4
         h = half if stage == 0 else (dt if stage == 1 else dt / 6.0)
         hi = h0 + 1 if stage < 2 else h0 + 2
         _plus(W, Y, S1 + stage, 1.0, YS, n)
-        _stage(W, F, par, idx, lay, YS, off, hi, lr, active[hi], stage + 1, S2 + stage)
-        _rates(W, YS, h, S2 + stage, n)
+        _stage(W, F, par, idx, lay, YS, off, hi, lr, active[hi], stage + 1, S2 + stage, h)
     third = 1.0 / 3.0
     for i in range(2 * n):
         for b in range(W.shape[2]):
@@ -185,8 +195,7 @@ def _split_step(s, W, F, par, idx, lay, road, lr):
             w = 0.0 if stage == 0 else (hu if stage == 3 else 0.5 * hu)
             inputs = sub_right if stage == 0 else (sub_left if stage == 3 else sub_middle)
             _plus(W, Y, Y if stage == 0 else K1 + stage - 1, w, TMP, n)
-            _stage(W, F, par, idx, lay, TMP, inputs, u, lr, True, 0, K1 + stage)
-            _rates(W, TMP, 1.0, K1 + stage, n)
+            _stage(W, F, par, idx, lay, TMP, inputs, u, lr, True, 0, K1 + stage, 1.0)
         for i in range(2 * n):
             for b in range(W.shape[2]):
                 W[Y, i, b] += (
@@ -327,7 +336,7 @@ def _control(step, W, F, pb, idx, lay, road, lr, cp, ci, records):
         for b in range(B):
             rates[ci[rows + z], b] += cp[z, b] * W[Y, n + ci[cols + z], b]
     if ci[4]:
-        _stage(W, F, pb, idx, lay, Y, road[0], 2 * step, lr, road[1][2 * step], 0, TMP)
+        _stage(W, F, pb, idx, lay, Y, road[0], 2 * step, lr, road[1][2 * step], 0, TMP, 0.0)
         for z in range(nnz):
             r = ci[rows + z]
             if N <= r < 2 * N:
@@ -376,7 +385,7 @@ def _advance(
         if ci[0] and step % ci[2] == 0 and (step < n_steps or ci[3]):
             _control(step, W, F, pb, idx, lay, road, lr, cp, ci, records)
         _lag(pb, idx, lay)
-        _stage(W, F, pb, idx, lay, Y, off, 2 * step, lr, active[2 * step], 0, S1)
+        _stage(W, F, pb, idx, lay, Y, off, 2 * step, lr, active[2 * step], 0, S1, 0.5 * dt)
         if step % every == 0:  # the sample: the state and the first stage's accelerations
             j = step // every
             _keep(W, rec, j % SAMPLES, n, pb, idx, lay, kept)
@@ -417,7 +426,7 @@ def accelerations_now(h, par, idx, lay, road, state, out):
     n = lay[4]
     for blk in numba.prange(par.shape[0]):
         W, F = state[0][blk], state[1][blk]
-        _stage(W, F, par[blk], idx, lay, Y, off, h, road[12][blk], active[h], 0, TMP)
+        _stage(W, F, par[blk], idx, lay, Y, off, h, road[12][blk], active[h], 0, TMP, 0.0)
         for i in range(n):
             for b in range(W.shape[2]):
                 out[blk, i, b] = W[TMP, n + i, b]

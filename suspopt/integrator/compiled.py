@@ -111,6 +111,23 @@ def _entries(matrix: np.ndarray, P: int) -> tuple[np.ndarray, np.ndarray, np.nda
     return rows.astype(np.int64), cols.astype(np.int64), _padded(values, P)
 
 
+def _every_row(
+    entries: tuple[np.ndarray, np.ndarray, np.ndarray], count: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``entries`` (rows, columns, values) with a zero entry in column 0 for each of the
+    ``count`` rows that has none, in row order: the kernel starts a row's sum at its first
+    entry and scales it at its last (:func:`._kernel._stage`), so every row needs one."""
+    rows, cols, vals = entries
+    missing = np.setdiff1d(np.arange(count), rows)
+    if not missing.size:
+        return rows, cols, vals
+    rows = np.concatenate([rows, missing])
+    cols = np.concatenate([cols, np.zeros_like(missing)])
+    vals = np.concatenate([vals, np.zeros((missing.size, vals.shape[1]))])
+    order = np.argsort(rows, kind="stable")
+    return rows[order], cols[order], np.ascontiguousarray(vals[order])
+
+
 def _laws(asm: Assembled, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The non-linear parts element by element: law codes and element rows (X,), parameters
     (:data:`LAW_PARAMETERS`, X, P)."""
@@ -195,8 +212,8 @@ def _packed(
     of dampers with an actuator lag, ``decay (1, P0)`` its decay per step."""
     lagged = np.zeros(0, np.int64) if lagged is None else lagged
     n, R = asm.n, asm.R
-    d_row, d_col, d_val = _entries(asm.D2[..., :R, :n], P)
-    g_row, g_col, g_val = _entries(asm.G2[..., :R], P)
+    d_row, d_col, d_val = _every_row(_entries(asm.D2[..., :R, :n], P), R)
+    g_row, g_col, g_val = _every_row(_entries(asm.G2[..., :R], P), n)
     law_code, law_row, law_par = _laws(asm, P)
     im = _padded(asm.inverse_mass[:, :, 0], P)
     parts = [
