@@ -235,6 +235,7 @@ class SemiActiveController:
             condition = (
                 x if mask is None else np.where(mask, x, 0.0 if condition is None else condition)
             )
+        assert condition is not None  # (a controller has at least one law)
         if self._adaptive:
             self._refit(t, condition)
         if self._below is True:
@@ -243,7 +244,6 @@ class SemiActiveController:
             stiff = condition > self._threshold
         else:
             stiff = np.where(self._below, condition < self._threshold, condition > self._threshold)
-        assert condition is not None  # (a controller has at least one law)
         c_stiff = self._c_max
         for law, mask in self._groups:
             if LAWS[law].continuous:

@@ -291,21 +291,16 @@ _stiff_sh_l, _stiff_hybrid = _stiff_rule("sh_l"), _stiff_rule("hybrid")
 @_jit
 def _condition(code, st, zs, zu, za, lw, cf, sw):
     """X of law ``code`` (:data:`CONTROL_LAWS`; -1, a passive corner: 0)."""
-    if code == 0:
-        return _x0(st, zs, zu, za, lw, cf, sw)
-    if code == 1:
-        return _x1(st, zs, zu, za, lw, cf, sw)
-    if code == 2:
-        return _x2(st, zs, zu, za, lw, cf, sw)
-    if code == 3:
-        return _x3(st, zs, zu, za, lw, cf, sw)
-    if code == 4:
-        return _x4(st, zs, zu, za, lw, cf, sw)
-    if code == 5:
-        return _x5(st, zs, zu, za, lw, cf, sw)
-    if code == 6:
-        return _x6(st, zs, zu, za, lw, cf, sw)
-    return np.zeros_like(st)
+    a = (st, zs, zu, za, lw, cf, sw)
+    if code < 0:
+        return np.zeros_like(st)
+    if code < 4:
+        return (
+            _x0(*a)
+            if code == 0
+            else (_x1(*a) if code == 1 else (_x2(*a) if code == 2 else _x3(*a)))
+        )
+    return _x4(*a) if code == 4 else (_x5(*a) if code == 5 else _x6(*a))
 
 
 @_jit
