@@ -20,7 +20,7 @@
 #   Ch. 6-8    the configs' population 100 and 100 generations (Ch. 6-8 state no budget).
 # SUSPOPT_QUICK=1 runs everything on a tiny budget (population 8, 2 generations, 3 s runs;
 # examples/budget_config.sh) and writes the whole report structure in a few minutes, for CI.
-# About 30 minutes on a 2-core machine (Ch. 8's ten fronts take 8 of them); run it under
+# About 25 minutes on a 2-core machine (Ch. 8's ten fronts take 6 of them); run it under
 # `nice -n 10` on a shared one.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
