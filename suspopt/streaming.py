@@ -272,12 +272,12 @@ def recorded_rows(result_of, n: int, P: int, names: Sequence[str]) -> np.ndarray
 
     Sample ``2k`` of a probe moves row ``k`` alone, sample ``2k + 1`` none; there are three
     probes, moving it up, down (by 0.5 from values of about 0.01, so that a sign or a
-    threshold flips) and to NaN. A row is read when a signal's sample ``2k`` changes or turns
-    NaN in any of them, so a row that is not recorded (:func:`suspopt.integrator.compiled.
-    windows`, whatever its memory holds) reaches no signal, not even through a zero
-    coefficient. A signal is a function of the sample at its instant; one that is not (a
-    move reaching a sample that did not move), or that is not finite on the probe, makes
-    every row read."""
+    threshold flips) and to NaN, read one after the other from one Result. A row is read when
+    a signal's sample ``2k`` changes or turns NaN in any of them, so a row that is not
+    recorded (:func:`suspopt.integrator.compiled.windows`, whatever its memory holds) reaches
+    no signal, not even through a zero coefficient. A signal is a function of the sample at
+    its instant; one that is not (a move reaching a sample that did not move), or that is
+    not finite on the probe, makes every row read."""
     rows, T = 3 * n, 6 * n
     pattern = 0.01 * np.sin(1.0 + np.arange(rows * T, dtype=float)).reshape(rows, 1, T)
     probes = [pattern]
@@ -285,20 +285,22 @@ def recorded_rows(result_of, n: int, P: int, names: Sequence[str]) -> np.ndarray
         moved = pattern.copy()
         moved[np.arange(rows), 0, 2 * np.arange(rows)] += value
         probes.append(moved)
-    seen = []
-    for x in probes:
-        x = np.broadcast_to(x, (rows, P, T))  # the same samples for every design
-        signals = result_of(x[: 2 * n], x[2 * n :]).signals
-        # (a controller's records are not in a probe without one: they read no state)
-        seen.append([np.asarray(signals[name]) for name in names if name in signals])
+    # the four probes one after the other in time, read in one Result (a signal that is not
+    # a function of its instant's sample shows where a later block's samples did not move)
+    x = np.broadcast_to(np.concatenate(probes, axis=-1), (rows, P, 4 * T))
+    signals = result_of(x[: 2 * n], x[2 * n :]).signals
     read = np.zeros(rows, np.bool_)
-    for base, *moved in zip(*seen):
-        if base.shape[-1] != T or not np.isfinite(base).all():
+    for name in names:
+        if name not in signals:  # a controller's records (no controller in the probe): no state
+            continue
+        values = np.asarray(signals[name])
+        base = values[..., :T]
+        if values.shape[-1] != 4 * T or not np.isfinite(base).all():
             return np.ones(rows, np.bool_)
         axes = tuple(range(base.ndim - 1))
         differs = np.zeros(T, np.bool_)
-        for m in moved:
-            differs |= (m != base).any(axis=axes)  # (NaN differs from everything)
+        for k in (1, 2, 3):
+            differs |= (values[..., k * T : (k + 1) * T] != base).any(axis=axes)  # (NaN differs)
         if differs[1::2].any():  # a signal that is not a function of its instant's sample
             return np.ones(rows, np.bool_)
         read |= differs[0::2]
@@ -308,11 +310,12 @@ def recorded_rows(result_of, n: int, P: int, names: Sequence[str]) -> np.ndarray
 def _recorded(cfg: Config, setup, names: Sequence[str]) -> np.ndarray | None:
     """The rows of the states and accelerations the signals ``names`` read
     (:func:`recorded_rows`; ``setup = (designs, model, attachments, run, road inputs)``; the
-    probe has no controller, whose records read no state), or None on the numpy engine
-    (which computes every row)."""
-    if cfg.simulation.engine == "numpy":
+    probe has no controller, whose records read no state), or None on the numpy engine or
+    without numba (which computes every row)."""
+    from .integrator import Trajectory, compiled_available
+
+    if cfg.simulation.engine == "numpy" or not compiled_available():
         return None
-    from .integrator import Trajectory
     from .simulate import _result
 
     pv, model, attachments, run, z = setup
