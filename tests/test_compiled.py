@@ -209,6 +209,62 @@ def test_the_kernel_takes_every_laws_samples_as_the_controller_does(laws, thresh
     assert np.isin(state[1], (0.0, 1.0)).all() and (state[1] == 1.0).any()  # C_min = C_max
 
 
+@pytest.mark.parametrize(
+    "distribution, laws, lag",
+    [
+        ("student_t", ("sh_2", "sh_add_2"), 0.0),
+        ("normal", ("sh_l", None), 0.01),
+        ("empirical", ("add", "groundhook"), 0.0),
+    ],
+)
+def test_an_adaptive_threshold_refits_between_the_kernels_samples(
+    monkeypatch, distribution, laws, lag
+):
+    """With an adaptive CDF threshold the kernel takes every sample but the refits (each
+    design's own instants: learn times of 0.2, 0.25 and 0.33 s, refitted every 0.4, 0.5 and
+    0.66 s), which the controller takes from the history of the kernel's conditions: the
+    records and the states agree with the numpy engine (1e-9, 1e-12), and the controller is
+    asked at the refits only."""
+    from suspopt.control.controller import SemiActiveController
+
+    data = yaml.safe_load((CONFIGS / "ch7" / "sh_add_2_cdf.yaml").read_text())
+    data["simulation"]["duration"] = 1.5
+    data.pop("design_variables"), data.pop("objectives"), data.pop("constraints", None)
+    data["vehicle"]["corner_defaults"].pop("damper")
+    for corner, law in zip(("F1", "R1"), laws):
+        damper = {"kind": "semi_active", "c_min": 1000, "c_max": 3500, "law": law}
+        damper.update(
+            {name: PARAMETERS[name].default for name in LAWS[law].parameters} if law else {}
+        )
+        data["vehicle"]["corners"][corner] = {
+            "damper": damper if law else {"kind": "passive", "c": 2500}
+        }
+    data["control"]["actuator_lag"] = lag
+    data["control"]["threshold"].update({"distribution": distribution, "refit_factor": 2.0})
+    base = make_config(data)
+    params = {"control.threshold.learn_time": np.array([0.2, 0.25, 0.33])}
+    numpy_run = _run(base, "numpy", params)
+    asked = []
+    sample = SemiActiveController.sample
+    monkeypatch.setattr(
+        SemiActiveController, "sample", lambda c, k, t, s: asked.append(k) or sample(c, k, t, s)
+    )
+    compiled_run = _run(base, "compiled", params)
+    assert compiled_run.engine == "compiled"
+    every = round(base.control.sample_time / base.simulation.dt)
+    instants = [learn * (1 + 2 * i) for learn in (0.2, 0.25, 0.33) for i in range(4)]
+    steps = np.ceil((np.array(instants) / base.simulation.dt - 0.5) / every - 1e-9) * every
+    refits = sorted({int(k) for k in steps if k <= base.simulation.n_steps})  # (at or after)
+    assert asked == refits
+    _agree(numpy_run, compiled_run)
+    for key, held in numpy_run.controller_records.items():
+        x, y = held.full(), compiled_run.controller_records[key].full()
+        scale = np.nanmax(np.abs(x)) if np.isfinite(x).any() else 1.0
+        np.testing.assert_allclose(y, x, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
+    threshold = compiled_run.signals["control_threshold.F1"]
+    assert len({tuple(row) for row in np.unique(threshold, axis=1).T}) > 3  # it was refitted
+
+
 def test_every_row_of_a_packed_map_has_an_entry():
     """The kernel starts a row's sum at its first entry: a row without one gets a zero entry,
     in row order, the others kept as they were."""

@@ -72,7 +72,9 @@ class SampleRules(NamedTuple):
     the law parameters ``(len(PARAMETERS), P, N)`` in the order of
     :data:`~suspopt.control.laws.PARAMETERS`, where a corner is stiff below the threshold
     ``(N,)``, whether a law reads ``z̈_s`` and whether the records carry ``stiff``
-    (:meth:`SemiActiveController.record`)."""
+    (:meth:`SemiActiveController.record`); ``adaptive``: the threshold is the one in force
+    until the next refit (:meth:`SemiActiveController.refit_step`), whose sample the
+    controller takes itself."""
 
     laws: tuple[str | None, ...]
     rates: np.ndarray
@@ -83,6 +85,7 @@ class SampleRules(NamedTuple):
     below: np.ndarray
     needs_acceleration: bool
     stiff_records: bool
+    adaptive: bool = False
 
 
 class SemiActiveController:
@@ -194,11 +197,11 @@ class SemiActiveController:
         lag; None when no design has one."""
         return self._decay if self._lagged else None
 
-    def sample_rules(self) -> SampleRules | None:
-        """The samples' rules for an engine that takes them itself; None with an adaptive
-        threshold (its refits stay here)."""
-        if self._adaptive:
-            return None
+    def sample_rules(self) -> SampleRules:
+        """The samples' rules for an engine that takes them itself. With an adaptive
+        threshold they hold until the next refit (:meth:`refit_step`): the engine hands that
+        sample back (:meth:`sample`), tells the controller of the samples it took before
+        (:meth:`taken`) and asks for the rules again."""
         below = np.array([law is not None and LAWS[law].stiff_below for law in self._laws])
         values = np.stack([self._parameters[name][:, 0] for name in PARAMETERS])
         return SampleRules(
@@ -211,7 +214,35 @@ class SemiActiveController:
             below,
             self._needs_acc,
             self._fixed,
+            self._adaptive,
         )
+
+    def refit_step(self, k: int) -> int | None:
+        """The first sample step from step ``k`` on at which some design's threshold is
+        refitted (:meth:`_refit`'s test on ``t = k dt``), None with a fixed threshold."""
+        if not self._adaptive:
+            return None
+        every, dt = self._every, 2.0 * self._half_step
+        first = -(-k // every)
+
+        def due(j: int) -> bool:
+            return not (j * every * dt + self._half_step < self._next_due)
+
+        j = max(first, int((self._next_due - self._half_step) / (dt * every)))
+        while j > first and due(j - 1):
+            j -= 1
+        while not due(j):
+            j += 1
+        return j * every
+
+    def taken(self, conditions: np.ndarray) -> None:
+        """Samples an engine took itself with :meth:`sample_rules` (none of them a refit):
+        their conditions ``(S, P, N)``, in time order, join the history the refits fit."""
+        if self._adaptive:
+            end = self._n_history + len(conditions)
+            self._history[self._n_history : end] = conditions
+            self._n_history = end
+        self.samples += len(conditions)
 
     def sample(self, k: int, t: float, state) -> np.ndarray:
         """The command (P, 1, N) [N s/m] from the sample at step ``k`` (``t = k dt``), held

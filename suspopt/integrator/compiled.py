@@ -240,15 +240,18 @@ def _packed(
 
 
 #: The most lanes of a block: enough to amortise each lane loop's set-up, few enough for the
-#: block's buffers to stay in the core's cache (about 80 KB for the Ch. 5 half car).
-MAX_LANES = 64
+#: block's buffers to stay in the core's second-level cache (about 160 KB for the Ch. 5 half
+#: car). 128 lanes took 10-30 % less kernel time than 64 on the Ch. 5 problem at 200 and
+#: 1000 designs on this machine (64 KB of L1 data cache and 1 MB of L2 over its 2 cores);
+#: 256 took about as long as 128.
+MAX_LANES = 128
 
 
 def block_width(P: int, threads: int) -> int:
     """Designs per block: the fewest blocks, a multiple of the threads, of at most
-    :data:`MAX_LANES` each, shared out evenly (200 designs on 2 threads: 4 blocks of 50, not
-    4 of 64 with 56 lanes of padding; 150: 4 of 38, not 3 of 64 of which one thread runs
-    two). A design's arithmetic does not depend on it."""
+    :data:`MAX_LANES` each, shared out evenly (300 designs on 2 threads: 4 blocks of 75, not
+    4 of 128 with 212 lanes of padding; 150 designs: 2 blocks of 75). A design's arithmetic
+    does not depend on it."""
     threads = max(threads, 1)
     blocks = threads * -(-P // (threads * MAX_LANES))
     return max(1, -(-P // blocks))
@@ -387,8 +390,9 @@ def _no_control(blocks: int, B: int) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 def _sample_rules(controller):
     """The controller's :class:`~suspopt.control.controller.SampleRules` when the kernel can
-    take its samples (a fixed threshold, laws of :data:`._kernel.CONTROL_LAWS`), else None
-    (an adaptive threshold refits in numpy between compiled stretches)."""
+    take its samples (laws of :data:`._kernel.CONTROL_LAWS`; an adaptive threshold's refits
+    are the controller's own samples), else None (every sample in numpy, between compiled
+    stretches)."""
     from . import _kernel
 
     rules = getattr(controller, "sample_rules", lambda: None)()
@@ -461,16 +465,30 @@ def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps,
 
 
 def _in_kernel(hold, rules, asm: Assembled, lanes: _Lanes, advance, samples, grid):
-    """The whole run in one call of the kernel, which takes the controller's samples; then
-    the records the hold keeps (those of the last sample before each output sample), as the
-    hold would have kept them."""
+    """The run in calls of the kernel, which takes the controller's samples, but for an
+    adaptive threshold's refits (:func:`_refit`); then the records the hold keeps (those of
+    the last sample before each output sample), as the hold would have kept them."""
     n_steps, every = grid
     n_out, P = n_steps // every + 1, asm.P
     final = bool(samples) and samples[-1] == n_steps
     cp, ci = _control_arrays(asm, rules, lanes.par, hold.every, final, hold.decay is not None)
     blocks, _, B = lanes.par.shape
     records = np.empty((4, len(samples), blocks * B, len(rules.laws)))  # (every one written)
-    advance(0, n_steps + 1, (cp, ci, records))
+    controller, k0, lay = hold.controller, 0, lanes.lay
+    elements = _damper_elements(asm)
+    command_rows = (  # where the controller's own samples write the command
+        slice(int(lay[13]), int(lay[13]) + int(lay[11]))
+        if hold.decay is not None
+        else slice(int(lay[8]) + elements[0], int(lay[8]) + elements[-1] + 1)
+    )
+    refit = controller.refit_step(0)
+    while refit is not None and samples and refit <= samples[-1]:
+        advance(k0, refit, (cp, ci, records))
+        controller.taken(records[1, -(-k0 // hold.every) : refit // hold.every, :P])
+        _refit(hold, rules, refit, lanes, command_rows, cp, records[:, refit // hold.every, :P])
+        advance(refit, refit + 1)  # (the step of the sample the controller took)
+        k0, refit = refit + 1, controller.refit_step(refit + 1)
+    advance(k0, n_steps + 1, (cp, ci, records))
     records = records[:, :, :P]
     first = -(-np.array(samples) // every)  # each sample's first output sample
     last = np.append(first[1:] != first[:-1], True) & (first < n_out)
@@ -483,3 +501,22 @@ def _in_kernel(hold, rules, asm: Assembled, lanes: _Lanes, advance, samples, gri
         hold.held_damping.extend(columns[0])
     hold.changes.extend(first[kept].tolist())
     return hold.held(n_out)
+
+
+def _refit(hold, rules, k: int, lanes: _Lanes, rows: slice, cp, record: np.ndarray) -> None:
+    """The controller's own sample at step ``k``, a refit of its adaptive threshold: its
+    command into the blocks' ``rows`` (the damper coefficients, or the lag's share), its
+    records into ``record (4, P, N)`` as the kernel writes them, and the new threshold into
+    the kernel's controller values ``cp`` (:func:`_control_arrays`)."""
+    N = len(rules.laws)
+    lanes.read_velocity()
+    hold.control(k)
+    lanes.set_rows(rows, (hold.pulled if hold.decay is not None else hold.damping)[:, :, 0])
+    values = hold.controller.record()
+    record[0], record[1], record[2] = values["command"], values["condition"], values["threshold"]
+    if rules.stiff_records:
+        record[3] = values["stiff"]
+    threshold = hold.controller.sample_rules().threshold
+    blocks, _, B = cp.shape
+    o = cp.shape[1] - (3 + len(rules.parameters)) * N + 2 * N  # (the threshold's first row)
+    cp[:, o : o + N] = _padded(threshold.T, blocks * B).reshape(N, blocks, B).transpose(1, 0, 2)
