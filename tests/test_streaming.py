@@ -93,6 +93,36 @@ def _every_metric(cfg):
     return requests
 
 
+def test_the_next_window_is_integrated_ahead_and_errors_come_in_place():
+    """The compiled engine's windows come in order, the next one integrated in another
+    thread while the caller holds this one; an integration error comes where its window
+    would have, and closing early waits for the window under way."""
+    import threading
+
+    from suspopt.integrator import _ahead
+
+    where, started = [], threading.Event()
+
+    def windows():
+        for i in range(3):
+            where.append(threading.current_thread() is threading.main_thread())
+            started.set()
+            yield i
+        raise MemoryError("the fourth window")
+
+    it = _ahead(windows())
+    assert next(it) == 0
+    assert started.wait(5) and where[:1] == [True]
+    assert next(it) == 1 and next(it) == 2
+    assert where == [True, False, False]  # (the first one inline, the next ones ahead)
+    with pytest.raises(MemoryError, match="fourth window"):
+        next(it)
+    it = _ahead(iter(range(5)))
+    assert next(it) == 0
+    it.close()  # (joins the thread that took 1)
+    assert [*_ahead(iter(()))] == []
+
+
 @pytest.mark.parametrize("engine", ENGINES)
 def test_every_metric_reduced_in_windows_is_the_whole_runs(engine, monkeypatch):
     monkeypatch.setattr(streaming, "WINDOW_BYTES", 1)  # windows of one block each

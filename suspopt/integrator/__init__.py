@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 
@@ -85,7 +86,8 @@ def windows(
     for bit, on either engine (:func:`.rk4.windows`). A controlled run comes whole.
     ``recorded (3n,)``: the rows of the states ``[q; q']`` and then of the accelerations the
     caller reads; the compiled engine may leave the others NaN (:func:`.compiled.windows`),
-    the numpy engine computes them all anyway."""
+    the numpy engine computes them all anyway. The compiled engine integrates the next
+    window while the caller has this one (:func:`_ahead`)."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, not {engine!r}")
     if engine == "compiled" and not compiled_available():
@@ -94,8 +96,44 @@ def windows(
         from . import compiled
 
         if compiled.unsupported(run.asm, run.controller) is None:
-            return _one_blas_thread(compiled.windows(run, width, recorded))
+            return _one_blas_thread(_ahead(compiled.windows(run, width, recorded)))
     return windows_numpy(run, width)
+
+
+def _ahead(windows: Iterator[tuple[int, Trajectory]]) -> Iterator[tuple[int, Trajectory]]:
+    """``windows`` with the next window integrated in a thread while the caller reduces the
+    one it has (the kernel holds no GIL; each window has arrays of its own): the kernel and
+    numpy's reductions overlap instead of taking turns. The same windows, in order; an
+    exception of the integration comes out where that window would have. One thread at a
+    time runs the kernel (numba's ``workqueue`` threading layer allows no more)."""
+    import threading
+
+    box: dict[str, Any] = {}
+
+    def fetch() -> None:
+        try:
+            box["item"] = next(windows, None)
+        except BaseException as exc:  # noqa: BLE001 - raised again in the caller's thread
+            box["error"] = exc
+
+    fetch()
+    try:
+        while True:
+            item, error = box.pop("item", None), box.pop("error", None)
+            if error is not None:
+                raise error
+            if item is None:
+                return
+            thread = threading.Thread(target=fetch, daemon=True)
+            thread.start()
+            try:
+                yield item
+            finally:
+                thread.join()
+    finally:  # a caller that stops early closes the windows (and gives BLAS its threads)
+        close = getattr(windows, "close", None)
+        if close is not None:
+            close()
 
 
 def _one_blas_thread(windows: Iterator[tuple[int, Trajectory]]):
