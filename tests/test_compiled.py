@@ -265,6 +265,24 @@ def test_an_adaptive_threshold_refits_between_the_kernels_samples(
     assert len({tuple(row) for row in np.unique(threshold, axis=1).T}) > 3  # it was refitted
 
 
+def test_a_refit_at_the_first_sample_keeps_the_starts_impulse_single():
+    """A threshold refitted at step 0 (learn time under half a step) on a road that steps at
+    t = 0 through a damped tyre: the kernel is asked for no step before the controller's
+    sample, and the start's velocity jump is applied once, as on the numpy engine."""
+    data = yaml.safe_load((CONFIGS / "ch4" / "sh_add_2_bump.yaml").read_text())
+    data["road"]["start"] = 0.0
+    data["simulation"]["duration"] = 0.3
+    data["vehicle"]["corners"]["F1"]["tyre"]["damping"] = 300.0
+    data["control"]["threshold"] = {"mode": "adaptive", "c_max_share": 0.27,
+                                    "learn_time": 1e-4, "distribution": "empirical"}  # fmt: skip
+    for key in ("design_variables", "objectives", "constraints"):
+        data.pop(key, None)
+    base = make_config(data)
+    numpy_run, compiled_run = _run(base, "numpy", {}), _run(base, "compiled", {})
+    assert compiled_run.engine == "compiled"
+    _agree(numpy_run, compiled_run)
+
+
 def test_every_row_of_a_packed_map_has_an_entry():
     """The kernel starts a row's sum at its first entry: a row without one gets a zero entry,
     in row order, the others kept as they were."""

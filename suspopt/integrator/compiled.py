@@ -321,6 +321,8 @@ def windows(
         out = (states, accelerations, diverged_at, np.empty((Nl, P, T)))
 
         def advance(k0: int, k1: int, ctl=_no_control(blocks, B), out=out, j0=j0) -> None:
+            if k1 <= k0:  # (no step: a call from step 0 would apply the start's impulses)
+                return
             _kernel.run(k0, k1, j0, dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par,
                         idx, lay, road, state, out, ctl)  # fmt: skip
 
