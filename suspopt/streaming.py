@@ -56,13 +56,8 @@ __all__ = ["reduce", "Reduced", "BLOCK", "window_width", "recorded_rows"]
 #: :data:`suspopt.integrator.WINDOW_MULTIPLE`).
 BLOCK = 256
 #: Memory of one window's states and signals [bytes]: a window is as many whole blocks as
-#: fit (a few designs: the whole run at once), at least one. The compiled engine integrates
-#: the next window while this one is reduced (:func:`suspopt.integrator.windows`), so more
-#: windows overlap more, and smaller ones hold less memory. With the overlap, an evaluation
-#: of the Ch. 5 problem took about 20 % less time at 1000 designs and 10 % less at 200 (the
-#: medians of 8 rounds, 2026-12-03), with windows of 32 MB or 64 MB alike; Part B of Ch. 6
-#: at 100 designs took as long as before with 32 MB and longer with 16 MB.
-WINDOW_BYTES = 32 << 20
+#: fit (a few designs: the whole run at once), at least one.
+WINDOW_BYTES = 64 << 20
 
 
 class _Moments:

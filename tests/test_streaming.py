@@ -126,6 +126,7 @@ def test_the_next_window_is_integrated_ahead_and_errors_come_in_place():
 @pytest.mark.parametrize("engine", ENGINES)
 def test_every_metric_reduced_in_windows_is_the_whole_runs(engine, monkeypatch):
     monkeypatch.setattr(streaming, "WINDOW_BYTES", 1)  # windows of one block each
+    monkeypatch.setattr(integrator, "AHEAD_DESIGNS", 1)  # (each integrated ahead)
     cfg = _short("ch5/case1_s1.yaml", 2.0)
     cfg.simulation.engine = engine
     params = _designs(cfg, 6)

@@ -87,7 +87,8 @@ def windows(
     ``recorded (3n,)``: the rows of the states ``[q; q']`` and then of the accelerations the
     caller reads; the compiled engine may leave the others NaN (:func:`.compiled.windows`),
     the numpy engine computes them all anyway. The compiled engine integrates the next
-    window while the caller has this one (:func:`_ahead`)."""
+    window while the caller has this one in a batch of :data:`AHEAD_DESIGNS` or more
+    (:func:`_ahead`)."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, not {engine!r}")
     if engine == "compiled" and not compiled_available():
@@ -96,8 +97,20 @@ def windows(
         from . import compiled
 
         if compiled.unsupported(run.asm, run.controller) is None:
-            return _one_blas_thread(_ahead(compiled.windows(run, width, recorded)))
+            stream = compiled.windows(run, width, recorded)
+            if run.asm.P >= AHEAD_DESIGNS:
+                stream = _ahead(stream)
+            return _one_blas_thread(stream)
     return windows_numpy(run, width)
+
+
+#: The fewest designs of a batch whose next window the compiled engine integrates while the
+#: caller reduces this one (:func:`_ahead`). Measured on this 2-core machine (2026-12-03),
+#: interleaved: ``suspopt optimise configs/ch5/case4_s2.yaml`` (1000 designs) 56-62 s
+#: without the overlap and 52-55 s with it; ``configs/ch6/part_b.yaml`` (100 designs)
+#: 11.9-13.4 s without and 14.7-15.5 s with it (the kernel's two threads and the caller's
+#: then share two cores, and the small windows gain less than that costs).
+AHEAD_DESIGNS = 500
 
 
 def _ahead(windows: Iterator[tuple[int, Trajectory]]) -> Iterator[tuple[int, Trajectory]]:
