@@ -270,9 +270,8 @@ def windows(
     """The compiled engine's :func:`.rk4.windows`: the run in windows of ``width`` output
     samples (a multiple of :data:`._kernel.SAMPLES`; all of them when None), a controlled run
     whole. ``recorded (3n,)`` says which rows of the states ``[q; q']`` and then of the
-    accelerations the samples keep (all when None); the others are not written (they hold
-    whatever the memory held: the caller reads none of them, as
-    :func:`suspopt.streaming.recorded_rows` makes sure). Writing the samples is about a
+    accelerations the samples keep (all when None); the others are not written (the caller
+    reads none of them: :func:`suspopt.streaming.recorded_rows`). Writing the samples is a
     third of the kernel's time when every row is kept (the Ch. 5 problem's objectives read
     5 of its 12 rows, Part B's of Ch. 6 5 of 36), and filling the rest with NaN would cost
     about as much as writing them."""
