@@ -159,6 +159,33 @@ def test_the_compiled_engine_without_numba_is_bad_input(monkeypatch, tmp_path):
     assert suspopt.load_config(path).simulation.engine == "auto"
 
 
+def _agree_with_records(numpy_run, compiled_run) -> None:
+    """:func:`_agree`, and every controller record within 1e-9 of the numpy engine's."""
+    _agree(numpy_run, compiled_run)
+    for key, held in numpy_run.controller_records.items():
+        x, y = held.full(), compiled_run.controller_records[key].full()
+        scale = np.nanmax(np.abs(x)) if np.isfinite(x).any() else 1.0
+        np.testing.assert_allclose(y, x, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
+
+
+def _two_laws(name: str, duration: float, laws, c_min: float) -> dict:
+    """configs/ch7/``name`` as data, run for ``duration`` [s] with no optimisation, its
+    corners F1 and R1 on ``laws`` (None: a passive 2500 N s/m damper), C_min ``c_min`` and
+    C_max 3500 N s/m, each law's parameters at their defaults."""
+    data = yaml.safe_load((CONFIGS / "ch7" / name).read_text())
+    data["simulation"]["duration"] = duration
+    data.pop("design_variables"), data.pop("objectives"), data.pop("constraints", None)
+    data["vehicle"]["corner_defaults"].pop("damper")
+    for corner, law in zip(("F1", "R1"), laws):
+        damper = {"kind": "semi_active", "c_min": c_min, "c_max": 3500, "law": law}
+        damper.update(
+            {name: PARAMETERS[name].default for name in LAWS[law].parameters} if law else {}
+        )
+        passive = {"kind": "passive", "c": 2500}
+        data["vehicle"]["corners"][corner] = {"damper": damper if law else passive}
+    return data
+
+
 @pytest.mark.parametrize(
     "laws, threshold",
     [
@@ -173,17 +200,7 @@ def test_the_kernel_takes_every_laws_samples_as_the_controller_does(laws, thresh
     the laws' own rules: mixed laws, their parameters per design, a passive corner, a design
     whose C_min = C_max (the records then say when the law asked for the stiff state), with
     and without the actuator's lag; states to 1e-12 and records to 1e-9 of the numpy engine."""
-    data = yaml.safe_load((CONFIGS / "ch7" / "sh_2.yaml").read_text())
-    data["simulation"]["duration"] = 0.8
-    data.pop("design_variables"), data.pop("objectives"), data.pop("constraints", None)
-    data["vehicle"]["corner_defaults"].pop("damper")
-    for corner, law in zip(("F1", "R1"), laws):
-        damper = {"kind": "semi_active", "c_min": 1500, "c_max": 3500, "law": law}
-        damper.update(
-            {name: PARAMETERS[name].default for name in LAWS[law].parameters} if law else {}
-        )
-        passive = {"kind": "passive", "c": 2500}
-        data["vehicle"]["corners"][corner] = {"damper": damper if law else passive}
+    data = _two_laws("sh_2.yaml", 0.8, laws, 1500)
     if threshold is not None:
         data["control"]["threshold"] = {"mode": "fixed", "value": threshold}
     base = make_config(data)
@@ -200,11 +217,7 @@ def test_the_kernel_takes_every_laws_samples_as_the_controller_does(laws, thresh
 
     pv, model, controller, attachments = prepare(base, params)
     assert compiled._sample_rules(controller) is not None  # (the kernel took the samples)
-    _agree(numpy_run, compiled_run)
-    for key, held in numpy_run.controller_records.items():
-        x, y = held.full(), compiled_run.controller_records[key].full()
-        scale = np.nanmax(np.abs(x)) if np.isfinite(x).any() else 1.0
-        np.testing.assert_allclose(y, x, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
+    _agree_with_records(numpy_run, compiled_run)
     state = compiled_run.signals["damper_state.F1"]
     assert np.isin(state[1], (0.0, 1.0)).all() and (state[1] == 1.0).any()  # C_min = C_max
 
@@ -227,18 +240,7 @@ def test_an_adaptive_threshold_refits_between_the_kernels_samples(
     asked at the refits only."""
     from suspopt.control.controller import SemiActiveController
 
-    data = yaml.safe_load((CONFIGS / "ch7" / "sh_add_2_cdf.yaml").read_text())
-    data["simulation"]["duration"] = 1.5
-    data.pop("design_variables"), data.pop("objectives"), data.pop("constraints", None)
-    data["vehicle"]["corner_defaults"].pop("damper")
-    for corner, law in zip(("F1", "R1"), laws):
-        damper = {"kind": "semi_active", "c_min": 1000, "c_max": 3500, "law": law}
-        damper.update(
-            {name: PARAMETERS[name].default for name in LAWS[law].parameters} if law else {}
-        )
-        data["vehicle"]["corners"][corner] = {
-            "damper": damper if law else {"kind": "passive", "c": 2500}
-        }
+    data = _two_laws("sh_add_2_cdf.yaml", 1.5, laws, 1000)
     data["control"]["actuator_lag"] = lag
     data["control"]["threshold"].update({"distribution": distribution, "refit_factor": 2.0})
     base = make_config(data)
@@ -256,11 +258,7 @@ def test_an_adaptive_threshold_refits_between_the_kernels_samples(
     steps = np.ceil((np.array(instants) / base.simulation.dt - 0.5) / every - 1e-9) * every
     refits = sorted({int(k) for k in steps if k <= base.simulation.n_steps})  # (at or after)
     assert asked == refits
-    _agree(numpy_run, compiled_run)
-    for key, held in numpy_run.controller_records.items():
-        x, y = held.full(), compiled_run.controller_records[key].full()
-        scale = np.nanmax(np.abs(x)) if np.isfinite(x).any() else 1.0
-        np.testing.assert_allclose(y, x, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
+    _agree_with_records(numpy_run, compiled_run)
     threshold = compiled_run.signals["control_threshold.F1"]
     assert len({tuple(row) for row in np.unique(threshold, axis=1).T}) > 3  # it was refitted
 
