@@ -117,6 +117,23 @@ def test_the_controller_decides_the_same_on_both_engines(name, lag):
     np.testing.assert_allclose(damping[1], damping[0], rtol=1e-12)
 
 
+@pytest.mark.parametrize("lag", [0.0, 0.01])
+def test_a_law_the_kernel_does_not_list_is_sampled_in_numpy_between_stretches(monkeypatch, lag):
+    """Every sample in numpy, between compiled stretches of steps (what a law missing from
+    ``_kernel.CONTROL_LAWS`` gets): the same run as on the numpy engine."""
+    from suspopt.integrator import compiled
+
+    cfg = suspopt.load_config(CONFIGS / "ch4" / "sh_add_2_bump.yaml")
+    cfg.control.actuator_lag = lag
+    cfg.simulation.duration = getattr(cfg.road, "start", 0.0) + 0.5
+    params = _designs(cfg)
+    numpy_run = _run(cfg, "numpy", params)
+    monkeypatch.setattr(compiled, "_sample_rules", lambda controller: None)
+    compiled_run = _run(cfg, "compiled", params)
+    assert compiled_run.engine == "compiled"
+    _agree_with_records(numpy_run, compiled_run)
+
+
 def test_a_design_gives_the_same_bits_in_any_batch():
     cfg = suspopt.load_config(CONFIGS / "ch5" / "case1_s1.yaml")
     cfg.simulation.duration = 1.0

@@ -64,7 +64,7 @@ def _by_rows(matrix: np.ndarray, rows: np.ndarray) -> np.ndarray:
 
 
 class SampleRules(NamedTuple):
-    """What an engine needs to take a fixed-threshold controller's samples itself
+    """What an engine needs to take a controller's samples itself
     (:meth:`SemiActiveController.sample_rules`), with the controller's arithmetic: the law of
     each corner (None: passive), the map ``rates`` ``(3N, n)`` or ``(P, 3N, n)`` of the
     vehicle's velocities to ``[ṠT; ż_s; ż_u]`` at the corners (its rows ``N .. 2N`` also map

@@ -32,10 +32,11 @@ and puts the command into the damper's coefficient (with an actuator lag, into t
 command's share, the kernel applying the lag at every step), keeping each sample's records;
 the whole run is then one call of the kernel. The records the run keeps are chosen from them
 as the numpy engine's hold keeps its own (:func:`_in_kernel`). An adaptive threshold (its
-refits fit distributions to the whole history) stays in :mod:`suspopt.control`: the kernel
-then runs the steps between the samples and the controller takes each sample in numpy
-(:func:`_controlled`); so does a law the kernel does not list (:data:`._kernel.
-CONTROL_LAWS`). Not covered (the numpy engine runs it, :func:`unsupported` says why): a
+refits fit distributions to the whole history) is sampled by the kernel too between its
+refits; at each refit the controller in :mod:`suspopt.control` takes the sample itself (the
+fit) and hands the new threshold back. A law the kernel does not list (:data:`._kernel.
+CONTROL_LAWS`) is sampled in numpy at every sample, between compiled stretches of steps
+(:func:`_controlled`). Not covered (the numpy engine runs it, :func:`unsupported` says why): a
 non-linear element without a compiled law.
 A new law is a branch of ``_kernel._law`` and an entry of :data:`LAWS`, beside the numpy
 closure that defines it (:attr:`suspopt.network.Elements.extra`).
@@ -441,23 +442,22 @@ def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps,
     samples = list(range(0, n_steps, every_c))
     if n_steps % every == 0 and n_steps % every_c == 0:
         samples.append(n_steps)  # the final instant is an output sample
+    # where a sample's command goes: the damper rows, or with a lag the command's share
+    command_rows = (
+        slice(int(lay[13]), int(lay[13]) + int(lay[11])) if hold.decay is not None else dampers
+    )
     rules = _sample_rules(controller)
     if rules is not None:
-        return _in_kernel(hold, rules, asm, lanes, advance, samples, (n_steps, every))
-    lagged = hold.decay is not None
-    shares = slice(int(lay[13]), int(lay[13]) + int(lay[11]))  # the lagged command's share
+        return _in_kernel(
+            hold, rules, (asm, lanes, command_rows), advance, samples, (n_steps, every)
+        )
     k0, pending = 0, None
     for k in samples:
         advance(k0, k)
-        lanes.read_velocity()
         first_output = -(-k // every)
         if pending is not None and pending != first_output:
             hold.kept(pending)  # the previous sample's records, at its first output sample
-        hold.control(k)
-        if lagged:  # the kernel applies the lag at every step from here
-            lanes.set_rows(shares, hold.pulled[:, :, 0])
-        else:
-            lanes.set_rows(dampers, hold.damping[:, :, 0])
+        _take_sample(hold, k, lanes, command_rows)
         pending, k0 = (first_output if first_output < n_out else None), k
     advance(k0, n_steps + 1)
     if pending is not None:
@@ -465,28 +465,33 @@ def _controlled(controller, asm: Assembled, lanes: _Lanes, advance, dt, n_steps,
     return hold.held(n_out)
 
 
-def _in_kernel(hold, rules, asm: Assembled, lanes: _Lanes, advance, samples, grid):
+def _take_sample(hold, k: int, lanes: _Lanes, rows: slice) -> None:
+    """The controller's own sample at step ``k`` from the blocks' velocities, its command
+    into the blocks' ``rows`` (the damper coefficients, or with a lag the command's share:
+    the kernel applies the lag at every step)."""
+    lanes.read_velocity()
+    hold.control(k)
+    lanes.set_rows(rows, (hold.pulled if hold.decay is not None else hold.damping)[:, :, 0])
+
+
+def _in_kernel(hold, rules, blocks_of, advance, samples, grid):
     """The run in calls of the kernel, which takes the controller's samples, but for an
-    adaptive threshold's refits (:func:`_refit`); then the records the hold keeps (those of
+    adaptive threshold's refits (:func:`_take_sample`, :func:`_refitted`); then the records the hold keeps (those of
     the last sample before each output sample), as the hold would have kept them."""
     n_steps, every = grid
+    asm, lanes, command_rows = blocks_of  # (command_rows: :func:`_take_sample`)
     n_out, P = n_steps // every + 1, asm.P
     final = bool(samples) and samples[-1] == n_steps
     cp, ci = _control_arrays(asm, rules, lanes.par, hold.every, final, hold.decay is not None)
     blocks, _, B = lanes.par.shape
     records = np.empty((4, len(samples), blocks * B, len(rules.laws)))  # (every one written)
-    controller, k0, lay = hold.controller, 0, lanes.lay
-    elements = _damper_elements(asm)
-    command_rows = (  # where the controller's own samples write the command
-        slice(int(lay[13]), int(lay[13]) + int(lay[11]))
-        if hold.decay is not None
-        else slice(int(lay[8]) + elements[0], int(lay[8]) + elements[-1] + 1)
-    )
+    controller, k0 = hold.controller, 0
     refit = controller.refit_step(0)
     while refit is not None and samples and refit <= samples[-1]:
         advance(k0, refit, (cp, ci, records))
         controller.taken(records[1, -(-k0 // hold.every) : refit // hold.every, :P])
-        _refit(hold, rules, refit, lanes, command_rows, cp, records[:, refit // hold.every, :P])
+        _take_sample(hold, refit, lanes, command_rows)
+        _refitted(controller, rules, ci, cp, records[:, refit // hold.every, :P])
         advance(refit, refit + 1)  # (the step of the sample the controller took)
         k0, refit = refit + 1, controller.refit_step(refit + 1)
     advance(k0, n_steps + 1, (cp, ci, records))
@@ -504,20 +509,16 @@ def _in_kernel(hold, rules, asm: Assembled, lanes: _Lanes, advance, samples, gri
     return hold.held(n_out)
 
 
-def _refit(hold, rules, k: int, lanes: _Lanes, rows: slice, cp, record: np.ndarray) -> None:
-    """The controller's own sample at step ``k``, a refit of its adaptive threshold: its
-    command into the blocks' ``rows`` (the damper coefficients, or the lag's share), its
-    records into ``record (4, P, N)`` as the kernel writes them, and the new threshold into
-    the kernel's controller values ``cp`` (:func:`_control_arrays`)."""
-    N = len(rules.laws)
-    lanes.read_velocity()
-    hold.control(k)
-    lanes.set_rows(rows, (hold.pulled if hold.decay is not None else hold.damping)[:, :, 0])
-    values = hold.controller.record()
+def _refitted(controller, rules, ci: np.ndarray, cp: np.ndarray, record: np.ndarray) -> None:
+    """After the controller's own sample (a refit of its adaptive threshold): its records
+    into ``record (4, P, N)`` as the kernel writes them, and its new threshold into the
+    kernel's controller values ``cp``, whose rows are the rates map's ``ci[1]`` entries, then
+    ``C_min``, ``C_max`` and the threshold (:func:`_control_arrays`)."""
+    values, N = controller.record(), len(rules.laws)
     record[0], record[1], record[2] = values["command"], values["condition"], values["threshold"]
     if rules.stiff_records:
         record[3] = values["stiff"]
-    threshold = hold.controller.sample_rules().threshold
     blocks, _, B = cp.shape
-    o = cp.shape[1] - (3 + len(rules.parameters)) * N + 2 * N  # (the threshold's first row)
-    cp[:, o : o + N] = _padded(threshold.T, blocks * B).reshape(N, blocks, B).transpose(1, 0, 2)
+    o = int(ci[1]) + 2 * N
+    threshold = np.broadcast_to(values["threshold"], rules.c_min.shape).T  # (N, P)
+    cp[:, o : o + N] = _padded(threshold, blocks * B).reshape(N, blocks, B).transpose(1, 0, 2)
