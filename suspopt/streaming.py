@@ -34,6 +34,12 @@ The compiled engine records only the rows of the states and accelerations those 
 read 5 of its 12 rows): writing the samples is about a third of its time when it keeps every
 row. The numpy engine computes every row anyway.
 
+With numba installed, the block moments, the weighting filter and the weighted sums run as
+compiled loops over each window (:func:`suspopt.integrator.compiled_reductions`): the same
+arithmetic in the same order, so the same bits as the numpy code beside them
+(``tests/test_reductions.py``), one pass over each row instead of several whole-array
+passes and their temporaries.
+
 Memory therefore holds one window of every signal and state, the MTVV's last ``τ fs``
 values, and the kept signals; with no ``keep`` metric it grows with the designs, not with the
 run's length. A run with a semi-active controller is one window, the whole run (its hold
@@ -73,19 +79,7 @@ class _Moments:
         mean and squared deviations (two passes), merged into the running ones in time
         order (a window holds whole blocks, but for the run's last)."""
         x = np.ascontiguousarray(x)
-        P, T = x.shape
-        whole = T - T % BLOCK
-        parts = []
-        if whole:
-            blocks = x[:, :whole].reshape(P, -1, BLOCK)
-            means = np.mean(blocks, axis=-1)
-            squares = np.sum(np.square(blocks - means[:, :, None]), axis=-1)
-            parts = [(BLOCK, means[:, b], squares[:, b]) for b in range(means.shape[1])]
-        if whole < T:
-            rest = x[:, whole:]
-            mean = np.mean(rest, axis=-1)
-            parts.append((T - whole, mean, np.sum(np.square(rest - mean[:, None]), axis=-1)))
-        for m, mean, m2 in parts:
+        for m, mean, m2 in _block_moments(x):
             if self.n == 0:
                 self.n, self.mean, self.m2 = m, mean, m2
                 continue
@@ -104,6 +98,35 @@ class _Moments:
         if metric == "mean":
             return self.mean
         return np.sqrt(var + np.square(self.mean))  # rms
+
+
+def _block_moments(x: np.ndarray) -> list[tuple[int, np.ndarray, np.ndarray]]:
+    """``(count, mean (P,), sum of squared deviations (P,))`` of each block of :data:`BLOCK`
+    samples of ``x (P, T)`` (the last one shorter), in time order: numpy's mean and squared
+    deviations of each block, or the compiled loops' (the same bits) when numba is
+    installed."""
+    from .integrator import compiled_reductions
+
+    P, T = x.shape
+    loops = compiled_reductions()
+    if loops is not None and x.dtype == np.float64:
+        nb = -(-T // BLOCK)
+        means, squares = np.empty((P, nb)), np.empty((P, nb))
+        loops.block_moments(x, BLOCK, means, squares)
+        counts = [min(BLOCK, T - b * BLOCK) for b in range(nb)]
+        return [(counts[b], means[:, b], squares[:, b]) for b in range(nb)]
+    whole = T - T % BLOCK
+    parts = []
+    if whole:
+        blocks = x[:, :whole].reshape(P, -1, BLOCK)
+        means = np.mean(blocks, axis=-1)
+        squares = np.sum(np.square(blocks - means[:, :, None]), axis=-1)
+        parts = [(BLOCK, means[:, b], squares[:, b]) for b in range(means.shape[1])]
+    if whole < T:
+        rest = x[:, whole:]
+        mean = np.mean(rest, axis=-1)
+        parts.append((T - whole, mean, np.sum(np.square(rest - mean[:, None]), axis=-1)))
+    return parts
 
 
 class _Extremes:
@@ -148,7 +171,7 @@ class _Weighted:
         self.running: dict[float, list[Any]] = {}
 
     def add(self, x: np.ndarray, time: np.ndarray) -> None:
-        from .metrics.iso2631 import block_sums, weighting_filter
+        from .metrics.iso2631 import weighting_filter
 
         if self.n == 0:
             self.fs = 1.0 / (time[1] - time[0])  # the output rate, as the whole run's metric
@@ -158,15 +181,14 @@ class _Weighted:
             aw, self.state = self.filter.apply(aw, self.state)
         self.n += aw.shape[-1]
         with np.errstate(over="ignore", invalid="ignore"):  # a diverging design: inf, NaN
-            squared = np.square(aw)
+            squares, fourth, peak = _power_sums(aw)
             # the blocks added in time order: the whole signal's sums, bit for bit
-            for block in block_sums(squared).T:
+            for block in squares.T:
                 self.squares = self.squares + block
-            for block in block_sums(np.square(squared)).T:
+            for block in fourth.T:
                 self.fourth = self.fourth + block
             for tau in self.taus:
-                self._running(tau, squared)
-        peak = np.max(np.abs(aw), axis=-1)
+                self._running(tau, np.square(aw))
         self.peak = peak if self.peak is None else np.maximum(self.peak, peak)
 
     def _running(self, tau: float, squared: np.ndarray) -> None:
@@ -194,6 +216,24 @@ class _Weighted:
             return self.running[spec.tau][2]
         with np.errstate(invalid="ignore", divide="ignore"):
             return self.peak / rms  # crest factor
+
+
+def _power_sums(aw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`~suspopt.metrics.iso2631.block_sums` of ``aw²`` and of ``aw⁴`` (P, blocks) and
+    the largest ``|aw|`` (P,) of ``aw (P, T)``: numpy's, or the compiled loops' (the same
+    bits, one pass) when numba is installed."""
+    from .integrator import compiled_reductions
+    from .metrics.iso2631 import SUM_BLOCK, block_sums
+
+    loops = compiled_reductions()
+    if loops is None or aw.dtype != np.float64 or aw.ndim != 2:
+        squared = np.square(aw)
+        return block_sums(squared), block_sums(np.square(squared)), np.max(np.abs(aw), axis=-1)
+    P, T = aw.shape
+    nb = -(-T // SUM_BLOCK)
+    squares, fourth, peak = np.empty((P, nb)), np.empty((P, nb)), np.empty(P)
+    loops.power_sums(np.ascontiguousarray(aw), SUM_BLOCK, squares, fourth, peak)
+    return squares, fourth, peak
 
 
 class _Kept:

@@ -47,6 +47,7 @@ __all__ += [
     "DIVERGENCE_LIMIT",
     "ENGINES",
     "compiled_available",
+    "compiled_reductions",
 ]
 
 #: A window's samples are a multiple of this (the compiled kernel's sample buffer).
@@ -65,6 +66,17 @@ def compiled_available() -> bool:
     import importlib.util
 
     return importlib.util.find_spec("numba") is not None
+
+
+def compiled_reductions() -> Any:
+    """The compiled loops of the reductions and the weighting filter (``._reductions``: the
+    numpy arithmetic, the same bits) when numba is installed, else None; the callers then
+    run their numpy arithmetic."""
+    if not compiled_available():
+        return None
+    from . import _reductions
+
+    return _reductions
 
 
 def integrate(run: Run, engine: str = "numpy") -> Trajectory:

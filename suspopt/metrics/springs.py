@@ -17,10 +17,17 @@ def nonlinear_spring_usage(
     and ``k_nonlinear`` in N/m³, scalars or one per design ``(P,)``. The ratio is evaluated as
     ``k_nl x² / (k_l + k_nl x²)``, equal for ``x ≠ 0``; where the cubic force is zero (``x = 0``,
     the 0/0 of Eq 5.3, or ``k_nl = 0``) it is defined as 0. Chapter 5 constrains it to 10-30 %.
+
+    With ``k_l > 0`` and ``k_nl >= 0`` the ratio grows with ``x²``, so it is evaluated once, at
+    the largest ``x²`` of each record (the same value to the last bit or so: the rounded
+    ratios of two nearly equal ``x²`` may be one unit in the last place out of order), a
+    NaN or infinite travel giving NaN as the ratio of every sample would.
     """
     x2 = np.square(np.asarray(travel, dtype=float))
     k_l = np.asarray(k_linear, dtype=float)[..., None]
     k_nl = np.asarray(k_nonlinear, dtype=float)[..., None]
+    if np.all(k_l > 0.0) and np.all(k_nl >= 0.0):
+        x2 = np.max(x2, axis=-1, keepdims=True)
     cubic = k_nl * x2
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = np.where(cubic != 0.0, cubic / (k_l + cubic), 0.0)
