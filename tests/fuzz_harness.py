@@ -1885,6 +1885,14 @@ def _compile_the_kernel() -> None:
             cfg.road.start = 0.01  # early in the short run
         cfg.simulation.duration = 0.1
         suspopt.simulate(cfg)
+    # the streamed reductions' loops (suspopt.integrator._reductions), as an evaluation calls them
+    from suspopt import streaming
+    from suspopt.metrics.iso2631 import weighting_filter
+
+    x = np.ones((2, 300))
+    weighting_filter("Wk", 1000.0).apply(x)
+    streaming._block_moments(x)
+    streaming._power_sums(x)
 
 
 def _command_name(args: list[str]) -> str:
