@@ -345,3 +345,54 @@ def test_the_probe_finds_the_rows_a_signal_reads(compute, read):
     with np.errstate(all="ignore"):
         rows = streaming.recorded_rows(lambda q, a: _Probe(compute, q, a), 2, 3, ["s"])
     assert list(np.flatnonzero(rows)) == read
+
+
+def _reaches(monkeypatch) -> list:
+    """What :func:`suspopt.integrator.compiled.reached` returns in each run, recorded."""
+    from suspopt.integrator import compiled
+
+    found, reached = [], compiled.reached
+    monkeypatch.setattr(compiled, "reached", lambda *a: found.append(reached(*a)) or found[-1])
+    return found
+
+
+@pytest.mark.skipif(not compiled_available(), reason="the compiled engine needs numba")
+@pytest.mark.parametrize("road", ["bump_half_sine", "bump_step"])
+def test_an_evaluation_integrates_only_the_part_its_signals_depend_on(road, monkeypatch):
+    """Part B of Ch. 6 (a one-way seat and passenger) on the compiled engine: objectives and
+    constraints of the vehicle alone reach its 4 DOFs and 4 elements (a rectangular bump with
+    tyres that may lift off: the edges' impulses and the rows that cannot pull, taken apart
+    too), with the values of the whole network's run bit for bit; a seat signal, or the seat
+    mounted two ways, reaches every DOF."""
+    from suspopt import Problem
+    from suspopt.config.road import BumpStep
+    from suspopt.integrator import compiled
+
+    cfg = _short("ch6/part_b.yaml", 1.2)
+    cfg.simulation.engine = "compiled"
+    if road == "bump_step":
+        cfg.road = BumpStep(kind="bump_step", height=0.08, length=0.5, start=0.3, speed=11.111)
+        cfg.vehicle.tyre_lift_off = True
+    X = np.random.default_rng(3).random((7, len(cfg.design_variables)))
+
+    def evaluated(cfg):
+        problem = Problem.from_config(cfg)
+        return problem.evaluate(problem.xl + X * (problem.xu - problem.xl),
+                                return_values_of=["F", "G"])  # fmt: skip
+
+    found = _reaches(monkeypatch)
+    reached = evaluated(cfg)
+    dofs, elements = found[-1]
+    model_dofs = prepare(cfg, None)[1].n_dof
+    assert list(dofs) == list(range(model_dofs)) and elements.size == 4
+    monkeypatch.setattr(compiled, "reached", lambda *a: None)
+    whole = evaluated(cfg)
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(reached, whole))
+    assert np.isfinite(whole[0]).all()  # (a real run, not NaN against NaN)
+
+    found = _reaches(monkeypatch)
+    seated = cfg.model_copy(deep=True)
+    seated.objectives.main.append(seated.objectives.supplementary[0])  # VDV of the head
+    evaluated(seated)
+    evaluated(_two_way(cfg.model_copy(deep=True)))
+    assert found == [None, None]

@@ -240,14 +240,17 @@ def _keep(W, rec, t, n, pb, idx, lay, kept):
 
 
 @_jit
-def _flush(rec, j0, count, p0, n, out, kept):
+def _flush(rec, j0, count, p0, out, dest):
     """The buffer's first ``count`` samples to samples ``j0 ..`` of the records (its row
-    ``m`` is record row ``kept[m]``): a transposed copy that writes each design's row as a
-    contiguous run (writing every sample straight to the ``(rows, P, T)`` records touches a
-    new cache line per value and took two thirds of the run)."""
+    ``m`` is record row ``dest[m]`` of the whole network's ``n`` DOFs: the states ``0 ..
+    2n``, the accelerations ``2n .. 3n``, the lagged coefficients from ``3n`` on): a
+    transposed copy that writes each design's row as a contiguous run (writing every sample
+    straight to the ``(rows, P, T)`` records touches a new cache line per value and took two
+    thirds of the run)."""
     states, accelerations, lagged = out[0], out[1], out[3]
-    for m in range(kept.shape[0]):
-        i = kept[m]
+    n = states.shape[0] // 2
+    for m in range(dest.shape[0]):
+        i = dest[m]
         for b in range(rec.shape[2]):
             for t in range(count):
                 if i < 2 * n:
@@ -371,7 +374,7 @@ def _advance(
     W, F, rec, at, pb = W_all[blk], F_all[blk], rec_all[blk], at_all[blk], par[blk]
     n, B = lay[4], W.shape[2]
     off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
-    lr, kept = road[12][blk], state[4]
+    lr, kept, dest = road[12][blk], state[4], state[5]
     cp, ci, records = ctl[0][blk], ctl[1], ctl[2][:, :, blk * B : blk * B + B]
     if k0 == 0:
         for u in range(start_jumps.shape[0]):
@@ -385,7 +388,7 @@ def _advance(
             j = step // every
             _keep(W, rec, j % SAMPLES, n, pb, idx, lay, kept)
             if j % SAMPLES == SAMPLES - 1 or j - origin == states.shape[2] - 1:
-                _flush(rec, j - j % SAMPLES - origin, j % SAMPLES + 1, blk * B, n, out, kept)
+                _flush(rec, j - j % SAMPLES - origin, j % SAMPLES + 1, blk * B, out, dest)
         if step == n_steps:
             break
         if split_of[step] < 0:
@@ -402,9 +405,10 @@ def run(
     k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out, ctl
 ):
     """Steps ``k0 .. k1 - 1`` of every block (in parallel over the cores) from the kept
-    ``state = (W, F, rec, at, kept)`` of each (``kept``: the record's rows the samples
-    keep, :func:`_keep`), ``par (blocks, rows, B)`` (the arrays:
-    :func:`.compiled._packed`), samples from ``origin`` on in ``out``."""
+    ``state = (W, F, rec, at, kept, dest)`` of each (``kept``: the rows the samples keep,
+    :func:`_keep`; ``dest``: the records' rows they go to, :func:`_flush`), ``par (blocks,
+    rows, B)`` (the arrays: :func:`.compiled._packed`), samples from ``origin`` on in
+    ``out``."""
     for blk in numba.prange(par.shape[0]):
         _advance(
             blk, k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road,
