@@ -52,6 +52,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from ..network import Assembled
+from .reach import reached, reached_road, renumbered
 from .rk4 import (
     _CHECK_EVERY,
     DIVERGENCE_LIMIT,
@@ -205,29 +206,6 @@ def _edge_arrays(asm: Assembled, edges: Edges | None, dt: float, n_steps: int, o
     )
 
 
-def reached(asm: Assembled, recorded: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """The DOFs and the elements (sorted indices) that the rows ``recorded (3n,)`` of the
-    states ``[q; q']`` and accelerations depend on, or None when that is every DOF: a DOF's
-    acceleration on the elements whose forces reach it (``G``), an element's force on the
-    DOFs its deformation reads (``D_q``), closed. A one-way seat's DOFs are not reached from
-    the vehicle's: an evaluation whose signals read only the vehicle does not integrate the
-    seat (Part B of Ch. 6: 4 of 12 DOFs, 4 of 13 elements)."""
-    n, R = asm.n, asm.R
-    reads, pushes = asm.D2[..., :R, :n] != 0, asm.G2[..., :R] != 0
-    reads = reads.any(axis=0) if reads.ndim == 3 else reads  # (R, n)
-    pushes = pushes.any(axis=0) if pushes.ndim == 3 else pushes  # (n, R)
-    dofs = recorded[:n] | recorded[n : 2 * n] | recorded[2 * n : 3 * n]
-    while True:
-        elements = pushes[dofs].any(axis=0)
-        wider = dofs | reads[elements].any(axis=0)
-        if np.array_equal(wider, dofs):
-            break
-        dofs = wider
-    if dofs.all():
-        return None
-    return np.flatnonzero(dofs), np.flatnonzero(elements)
-
-
 def _packed(
     asm: Assembled,
     dt: float,
@@ -239,7 +217,7 @@ def _packed(
     """The network for the kernel (:mod:`._kernel`): every per-design number ``par (rows,
     P)``, every index ``idx`` and where each part starts, ``lay``; ``lagged`` the element rows
     of dampers with an actuator lag, ``decay (1, P0)`` its decay per step; ``reach`` (the
-    DOFs, the elements: :func:`reached`) keeps only those, renumbered in their order (each
+    DOFs, the elements: :func:`.reach.reached`) keeps only those, renumbered in their order (each
     kept row's entries are the same, in the same order: the same arithmetic)."""
     lagged = np.zeros(0, np.int64) if lagged is None else lagged
     n, R = asm.n, asm.R
@@ -316,7 +294,7 @@ def windows(
     third of the kernel's time when every row is kept (the Ch. 5 problem's objectives read
     5 of its 12 rows, Part B's of Ch. 6 5 of 36), and filling the rest with NaN would cost
     about as much as writing them. Without a controller, only the DOFs and elements those rows
-    depend on are integrated (:func:`reached`): the same arithmetic for them, and a part
+    depend on are integrated (:func:`.reach.reached`): the same arithmetic for them, and a part
     that no recorded row depends on neither costs time nor, by diverging, fails a design."""
     asm, n_vehicle, offsets, dt, n_steps, every, controller, edges = run
     import numba
@@ -347,19 +325,8 @@ def windows(
     G = off.shape[1]
     lane_road = np.minimum(np.arange(P) // (P0 // G), G - 1).reshape(blocks, B)
     road = (off, off.any(axis=(1, 2))) + _edge_arrays(asm, edges, dt, n_steps, off)
-    road = (road if reach is None else _reached_road(road, reach[1], R)) + (lane_road,)
-    recorded = np.ones(3 * n, np.bool_) if recorded is None else recorded
-    wanted = np.flatnonzero(recorded)  # rows of the records, and below where the kernel has them
-    rows = wanted if reach is None else _renumbered(wanted, n, reach[0])
-    n_kernel, R = int(lay[4]), int(lay[2])  # the reached DOFs and elements
-    state = (
-        np.zeros((blocks, 11, 2 * n_kernel, B)),
-        np.empty((blocks, 3, R, B)),
-        np.empty((blocks, _kernel.SAMPLES, rows.size + Nl, B)),
-        np.full((blocks, B), np.nan),
-        np.concatenate([rows, 3 * n_kernel + np.arange(Nl)]).astype(np.int64),
-        np.concatenate([wanted, 3 * n + np.arange(Nl)]).astype(np.int64),
-    )
+    road = (road if reach is None else reached_road(road, reach[1], R)) + (lane_road,)
+    state = _kernel_state(blocks, B, lay, n, recorded, reach)
     diverged_at = np.full(P, np.nan)
     for j0 in range(0, n_out, width):
         T = min(width, n_out - j0)
@@ -393,25 +360,25 @@ def windows(
         )
 
 
-def _reached_road(road: tuple, elements: np.ndarray, R: int) -> tuple:
-    """The road's arrays (:func:`_edge_arrays` after the inputs' part and whether each half
-    step has one, both kept whole) of the ``elements`` alone."""
-    both = np.concatenate([elements, R + elements])
-    off, active, split_of, first, h, rights, middles, lefts, jumps, kicks, start, no_pull = road
+def _kernel_state(blocks: int, B: int, lay: np.ndarray, n: int, recorded, reach) -> tuple:
+    """The kernel's ``state = (W, F, rec, at, kept, dest)`` (:func:`._kernel.run`) of a
+    network of ``n`` DOFs packed as ``lay`` (its ``reach`` of them, :func:`.reach.reached`), its
+    samples keeping the rows ``recorded (3n,)`` (all when None) and the lagged
+    coefficients."""
+    from . import _kernel
 
-    def part(a, cols):
-        return np.ascontiguousarray(a[..., cols])
-
+    Nl, n_kernel, R = int(lay[11]), int(lay[4]), int(lay[2])  # (the reached DOFs, elements)
+    recorded = np.ones(3 * n, np.bool_) if recorded is None else recorded
+    wanted = np.flatnonzero(recorded)  # rows of the records, and where the kernel has them
+    rows = wanted if reach is None else renumbered(wanted, n, reach[0])
     return (
-        part(off, both), active, split_of, first, h, part(rights, both), part(middles, both),
-        part(lefts, both), part(jumps, elements), kicks, part(start, elements), no_pull[elements],
-    )  # fmt: skip
-
-
-def _renumbered(wanted: np.ndarray, n: int, dofs: np.ndarray) -> np.ndarray:
-    """Rows ``wanted`` of ``[q; q'; q'']`` (3n) as rows of the kept ``dofs``' own."""
-    kind, dof = np.divmod(wanted, n)
-    return kind * dofs.size + np.searchsorted(dofs, dof)
+        np.zeros((blocks, 11, 2 * n_kernel, B)),
+        np.empty((blocks, 3, R, B)),
+        np.empty((blocks, _kernel.SAMPLES, rows.size + Nl, B)),
+        np.full((blocks, B), np.nan),
+        np.concatenate([rows, 3 * n_kernel + np.arange(Nl)]).astype(np.int64),
+        np.concatenate([wanted, 3 * n + np.arange(Nl)]).astype(np.int64),
+    )
 
 
 class _Lanes:
