@@ -356,6 +356,7 @@ def _reaches(monkeypatch) -> list:
     return found
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not compiled_available(), reason="the compiled engine needs numba")
 @pytest.mark.parametrize("road", ["bump_half_sine", "bump_step"])
 def test_an_evaluation_integrates_only_the_part_its_signals_depend_on(road, monkeypatch):
