@@ -281,6 +281,38 @@ def test_tracks_identical_independent_and_one_sided():
     assert not z[0::2].any() and not zdot[0::2].any() and z[1::2].all()
 
 
+def test_an_iso_road_asked_again_is_the_same_bits_and_the_callers_own(monkeypatch):
+    """The inputs of an ISO 8608 road asked again (an optimisation's every generation) come
+    from the kept ones: the same bits as computed afresh, a copy the caller may change; a
+    change of seed, speed, wheels or times is another road; the kept ones stay few and
+    bounded in size."""
+    from suspopt import road as road_module
+
+    monkeypatch.setattr(road_module, "_RANDOM_ROADS", type(road_module._RANDOM_ROADS)())
+    t = np.linspace(0.0, 3.0, 3001)
+    first = road_inputs(iso(seed=4), *FOUR_WHEELS, t)
+    assert len(road_module._RANDOM_ROADS) == 1
+    first[0][:] = 7.0  # (the caller's copy)
+    again = road_inputs(iso(seed=4), *FOUR_WHEELS, t)
+    monkeypatch.setattr(road_module, "RANDOM_ROAD_CACHE_BYTES", 0)  # nothing kept from here on
+    fresh = road_inputs(iso(seed=4), *FOUR_WHEELS, t.copy())
+    assert np.array_equal(again[0], fresh[0]) and np.array_equal(again[1], fresh[1])
+    assert not np.array_equal(again[0], first[0])
+    for other in (
+        road_inputs(iso(seed=5), *FOUR_WHEELS, t),
+        road_inputs(iso(seed=4, speed=21.0), *FOUR_WHEELS, t),
+        road_inputs(iso(seed=4), np.zeros(4), FOUR_WHEELS[1], t),
+    ):
+        assert not np.array_equal(other[0], fresh[0])
+    shorter = road_inputs(iso(seed=4), *FOUR_WHEELS, t[:-1])[0]
+    assert shorter.shape == (4, t.size - 1)
+    assert len(road_module._RANDOM_ROADS) == 1  # (none of those kept: no room)
+    monkeypatch.setattr(road_module, "RANDOM_ROAD_CACHE_BYTES", 2**30)
+    for seed in range(10):
+        road_inputs(iso(seed=seed), *FOUR_WHEELS, t)
+    assert len(road_module._RANDOM_ROADS) == road_module.RANDOM_ROAD_CACHE_ENTRIES
+
+
 # --- CSV profiles ----------------------------------------------------------------------------
 
 
