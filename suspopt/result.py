@@ -230,6 +230,7 @@ class Result:
         self._signal_cache: dict[str, np.ndarray] = {}
         self._table = signal_table(self.model, self.controller_units, self.attachments)
         self._deformation: dict[tuple[str, bool], np.ndarray] = {}
+        self._bases: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._forces: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._damping_full: np.ndarray | None = None
 
@@ -328,7 +329,9 @@ class Result:
         sl = slice(start, start + len(self.attachments[j].dof_names))
         n = self.n
         q, v, acc = self.states[:n], self.states[n:], self.acceleration()
-        return compute(q[sl], v[sl], acc[sl], self.base(j, q), self.base(j, v), self.base(j, acc))
+        if j not in self._bases:  # (computed once for every signal of the attachment)
+            self._bases[j] = (self.base(j, q), self.base(j, v), self.base(j, acc))
+        return compute(q[sl], v[sl], acc[sl], *self._bases[j])
 
     def channel(self, deriv: str, j: int) -> np.ndarray:
         """DOF ``j`` displacement (''), velocity ('vel') or acceleration ('acc'), (P, T)."""
