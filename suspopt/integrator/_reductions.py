@@ -15,11 +15,11 @@ the same bits (``tests/test_reductions.py`` checks it against numpy on hostile s
 
 :data:`_pairwise` is numpy's pairwise summation (its ``pairwise_sum`` of a contiguous run:
 eight partial sums up to 128 values, halves above that, a start at zero), so a block summed
-here has the bits of ``np.sum`` of that block (numpy 2.x; the test compares them). One pass over each row instead of numpy's
-several whole-array passes and temporaries (``benchmarks/bench_reductions.py`` times both in
-one run). Single-threaded (no ``prange``): they run in
-the caller's thread while the kernel may integrate the next window on every core
-(:func:`suspopt.integrator._ahead`).
+here has the bits of ``np.sum`` of that block (numpy 2.x; the test compares them). One pass
+over each row instead of numpy's several whole-array passes and temporaries
+(``benchmarks/bench_reductions.py`` times both in one run). Single-threaded (no
+``prange``): they run in the caller's thread while the kernel may integrate the next window
+on every core (:func:`suspopt.integrator._ahead`).
 """
 
 from __future__ import annotations
