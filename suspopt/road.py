@@ -101,11 +101,12 @@ def road_inputs(
     """
     offsets, t = _check_wheels(offsets, sides, t)
     key = _random_road_key(road, offsets, sides, t)
-    with _RANDOM_ROADS_LOCK:
-        found = _RANDOM_ROADS.get(key) if key is not None else None
-        if found is not None:
-            _RANDOM_ROADS.move_to_end(key)
-            return found[0].copy(), found[1].copy()
+    if key is not None:
+        with _RANDOM_ROADS_LOCK:
+            found = _RANDOM_ROADS.get(key)
+            if found is not None:
+                _RANDOM_ROADS.move_to_end(key)
+                return found[0].copy(), found[1].copy()
     if isinstance(road, (BumpStep, BumpHalfSine)):
         z, zdot = _bump_inputs(road, offsets, t, left)
     else:
