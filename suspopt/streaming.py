@@ -187,8 +187,10 @@ class _Weighted:
                 self.squares = self.squares + block
             for block in fourth.T:
                 self.fourth = self.fourth + block
-            for tau in self.taus:
-                self._running(tau, np.square(aw))
+            if self.taus:
+                squared = np.square(aw)  # (once for every MTVV window)
+                for tau in self.taus:
+                    self._running(tau, squared)
         self.peak = peak if self.peak is None else np.maximum(self.peak, peak)
 
     def _running(self, tau: float, squared: np.ndarray) -> None:
