@@ -32,6 +32,8 @@ import numpy as np
 from ..control.laws import LAWS
 
 _jit = numba.njit(cache=True, nogil=True)
+#: A helper compiled into its one caller (no call, no reference counts).
+_inline = numba.njit(cache=True, nogil=True, inline="always")
 
 #: Samples a block buffers before writing them to the records.
 SAMPLES = 32
@@ -39,30 +41,163 @@ SAMPLES = 32
 Y, YS, S1, S2, S3, S4, K1, K2, K3, K4, TMP = range(11)
 
 
+@_inline
+def _law_force(code, d, f, par, p, b):
+    """Lane ``b``'s force ``f`` at ``δ = d`` with the non-linear part of law ``code``
+    (:data:`.compiled.LAWS`) added, its parameters in rows ``p ..`` of ``par`` (the numpy
+    closures' arithmetic)."""
+    if code == 0:  # poly3: ((c3 δ + c2) δ + c1) δ
+        return f + ((par[p + 2, b] * d + par[p + 1, b]) * d + par[p, b]) * d
+    if code == 1:  # cap: the force no larger than the limit (NaN stays NaN)
+        return par[p, b] if f > par[p, b] else f
+    w = par[p + 3, b] + d
+    if code == 2:  # link: (a + b / sqrt(l^2 - w^2)) w + F0, w = w0 + δ
+        x = (par[p, b] + par[p + 1, b] / np.sqrt(par[p + 2, b] - w * w)) * w
+    else:  # carrella: (b / sqrt(w^2 + l^2) + a) w + F0
+        x = (par[p + 1, b] / np.sqrt(w * w + par[p + 2, b]) + par[p, b]) * w
+    return (f + x) + par[p + 4, b]
+
+
 @_jit
 def _law(code, r, p, F, par):
-    """Element ``r``'s non-linear part, law ``code`` (:data:`.compiled.LAWS`) with its
-    parameters in rows ``p ..`` of ``par``, added to its force ``F[2, r]`` at ``δ = F[0, r]``
-    (the numpy closures' arithmetic); the law chosen once, outside the lane loops."""
+    """Element ``r``'s non-linear part (:func:`_law_force`) added to its force ``F[2, r]`` at
+    ``δ = F[0, r]``, the law chosen once, outside the lane loops."""
     B = F.shape[2]
-    if code == 0:  # poly3: ((c3 δ + c2) δ + c1) δ
+    if code == 0:
         for b in range(B):
-            d = F[0, r, b]
-            F[2, r, b] += ((par[p + 2, b] * d + par[p + 1, b]) * d + par[p, b]) * d
-    elif code == 1:  # cap: the force no larger than the limit (NaN stays NaN)
+            F[2, r, b] = _law_force(0, F[0, r, b], F[2, r, b], par, p, b)
+    elif code == 1:
         for b in range(B):
-            if F[2, r, b] > par[p, b]:
-                F[2, r, b] = par[p, b]
-    elif code == 2:  # link: (a + b / sqrt(l^2 - w^2)) w + F0, w = w0 + δ
+            F[2, r, b] = _law_force(1, F[0, r, b], F[2, r, b], par, p, b)
+    elif code == 2:
         for b in range(B):
-            w = par[p + 3, b] + F[0, r, b]
-            F[2, r, b] += (par[p, b] + par[p + 1, b] / np.sqrt(par[p + 2, b] - w * w)) * w
-            F[2, r, b] += par[p + 4, b]
-    else:  # carrella: (b / sqrt(w^2 + l^2) + a) w + F0
+            F[2, r, b] = _law_force(2, F[0, r, b], F[2, r, b], par, p, b)
+    else:
         for b in range(B):
-            w = par[p + 3, b] + F[0, r, b]
-            F[2, r, b] += (par[p + 1, b] / np.sqrt(w * w + par[p + 2, b]) + par[p, b]) * w
-            F[2, r, b] += par[p + 4, b]
+            F[2, r, b] = _law_force(3, F[0, r, b], F[2, r, b], par, p, b)
+
+
+@_inline
+def _deformations(W, F, par, idx, nD, n, oD, src):
+    """``δ = D_q q`` and ``δ̇ = D_q q̇`` at ``W[src]`` into ``F[0], F[1]``: the entries of a
+    row in pairs (one lane loop does two entries' work, the same operations in the same
+    order as one at a time), a row's first entry starting its sum at zero."""
+    B = W.shape[2]
+    z = 0
+    while z < nD:
+        r, j = idx[z], idx[nD + z]
+        first = z == 0 or idx[z - 1] != r
+        p = oD + z
+        if z + 1 < nD and idx[z + 1] == r:
+            k = idx[nD + z + 1]
+            if first:
+                for b in range(B):
+                    F[0, r, b] = (0.0 + par[p, b] * W[src, j, b]) + par[p + 1, b] * W[src, k, b]
+                    d = 0.0 + par[p, b] * W[src, n + j, b]
+                    F[1, r, b] = d + par[p + 1, b] * W[src, n + k, b]
+            else:
+                for b in range(B):
+                    d = F[0, r, b] + par[p, b] * W[src, j, b]
+                    F[0, r, b] = d + par[p + 1, b] * W[src, k, b]
+                    d = F[1, r, b] + par[p, b] * W[src, n + j, b]
+                    F[1, r, b] = d + par[p + 1, b] * W[src, n + k, b]
+            z += 2
+        else:
+            if first:
+                for b in range(B):
+                    F[0, r, b] = 0.0 + par[p, b] * W[src, j, b]
+                    F[1, r, b] = 0.0 + par[p, b] * W[src, n + j, b]
+            else:
+                for b in range(B):
+                    F[0, r, b] += par[p, b] * W[src, j, b]
+                    F[1, r, b] += par[p, b] * W[src, n + j, b]
+            z += 1
+
+
+@_inline
+def _accelerations(W, F, par, idx, nD, nG, n, oG, oM, src, out, h):
+    """``q'' = M^-1 G F`` into ``W[out, n:]`` (the inverse masses' rows from ``oM``) and
+    ``h q'`` into ``W[out, :n]``: the entries of a DOF in pairs, as :func:`_deformations`
+    does, a DOF's last entry scaling its sum."""
+    B = W.shape[2]
+    z = 0
+    while z < nG:
+        i, r = idx[2 * nD + z], idx[2 * nD + nG + z]
+        g, m = oG + z, oM + i
+        first = z == 0 or idx[2 * nD + z - 1] != i
+        e = z + 2 if z + 1 < nG and idx[2 * nD + z + 1] == i else z + 1  # the next entry
+        last = e == nG or idx[2 * nD + e] != i
+        s = idx[2 * nD + nG + z + 1] if e == z + 2 else r
+        if e == z + 1 and first and last:
+            for b in range(B):
+                W[out, n + i, b] = (0.0 + par[g, b] * F[2, r, b]) * par[m, b]
+                W[out, i, b] = W[src, n + i, b] * h
+        elif e == z + 1 and first:
+            for b in range(B):
+                W[out, n + i, b] = 0.0 + par[g, b] * F[2, r, b]
+        elif e == z + 1 and last:
+            for b in range(B):
+                W[out, n + i, b] = (W[out, n + i, b] + par[g, b] * F[2, r, b]) * par[m, b]
+                W[out, i, b] = W[src, n + i, b] * h
+        elif e == z + 1:
+            for b in range(B):
+                W[out, n + i, b] += par[g, b] * F[2, r, b]
+        elif first and last:
+            for b in range(B):
+                a = (0.0 + par[g, b] * F[2, r, b]) + par[g + 1, b] * F[2, s, b]
+                W[out, n + i, b] = a * par[m, b]
+                W[out, i, b] = W[src, n + i, b] * h
+        elif first:
+            for b in range(B):
+                a = 0.0 + par[g, b] * F[2, r, b]
+                W[out, n + i, b] = a + par[g + 1, b] * F[2, s, b]
+        elif last:
+            for b in range(B):
+                a = W[out, n + i, b] + par[g, b] * F[2, r, b]
+                W[out, n + i, b] = (a + par[g + 1, b] * F[2, s, b]) * par[m, b]
+                W[out, i, b] = W[src, n + i, b] * h
+        else:
+            for b in range(B):
+                a = W[out, n + i, b] + par[g, b] * F[2, r, b]
+                W[out, n + i, b] = a + par[g + 1, b] * F[2, s, b]
+        z = e
+
+
+@_inline
+def _stage_by_lane(W, F, par, idx, lay, src, o, oi, lr, has_input, scale, out, h):
+    """:func:`_stage` lane by lane, for a block of one design: each lane's operations in the
+    same order as the lane loops do them, without a loop per entry (whose set-up, for one
+    lane, costs more than the entry: a run of the Ch. 8 seat takes about a fifth less time
+    this way; with two lanes or more the lane loops are as fast or faster)."""
+    nD, nG, R, X, n = lay[0], lay[1], lay[2], lay[3], lay[4]
+    oD, oG, oK, oC, oL, oM = lay[5], lay[6], lay[7], lay[8], lay[9], lay[10]
+    for b in range(W.shape[2]):
+        g = lr[b] if o.shape[1] > 1 else 0
+        for z in range(nD):
+            r, j = idx[z], idx[nD + z]
+            d = 0.0 if z == 0 or idx[z - 1] != r else F[0, r, b]
+            v = 0.0 if z == 0 or idx[z - 1] != r else F[1, r, b]
+            F[0, r, b] = d + par[oD + z, b] * W[src, j, b]
+            F[1, r, b] = v + par[oD + z, b] * W[src, n + j, b]
+        for r in range(R):
+            d, v = F[0, r, b], F[1, r, b]
+            if has_input:
+                d = d + o[oi, g, r]
+                v = v + o[oi, g, R + r]
+                F[0, r, b] = d
+            F[2, r, b] = par[oK + r, b] * d + par[oC + r, b] * v
+        for x in range(X):
+            r = idx[2 * nD + 2 * nG + X + x]
+            code, p = idx[2 * nD + 2 * nG + x], oL + 5 * x
+            F[2, r, b] = _law_force(code, F[0, r, b], F[2, r, b], par, p, b)
+        for z in range(nG):
+            i, r = idx[2 * nD + z], idx[2 * nD + nG + z]
+            a = 0.0 if z == 0 or idx[2 * nD + z - 1] != i else W[out, n + i, b]
+            a = a + par[oG + z, b] * F[2, r, b]
+            if z == nG - 1 or idx[2 * nD + z + 1] != i:  # the DOF's last entry
+                a = a * par[oM + scale * n + i, b]
+                W[out, i, b] = W[src, n + i, b] * h
+            W[out, n + i, b] = a
 
 
 @_jit
@@ -74,21 +209,17 @@ def _stage(W, F, par, idx, lay, src, o, oi, lr, has_input, scale, out, h):
     u``, ``F = k δ + c δ̇`` plus the laws, ``q'' = M^-1 G F``. The entries of D_q (of G) come
     row by row, every row at least once (:func:`.compiled._packed`): a row's first entry
     starts its sum (``0 + x``, the arithmetic of a sum started at zero) and its last one
-    scales it, so that each lane loop does one entry's work (the loops' set-up is most of a
-    stage's time at 50 lanes)."""
+    scales it; a lane loop does two entries' work where a row has two or more
+    (:func:`_deformations`, :func:`_accelerations`: the loops' set-up is much of a stage's
+    time at 50 lanes), and a block of one design runs lane by lane
+    (:func:`_stage_by_lane`)."""
     nD, nG, R, X, n = lay[0], lay[1], lay[2], lay[3], lay[4]
     oD, oG, oK, oC, oL, oM = lay[5], lay[6], lay[7], lay[8], lay[9], lay[10]
     B = W.shape[2]
-    for z in range(nD):
-        r, j = idx[z], idx[nD + z]
-        if z == 0 or idx[z - 1] != r:
-            for b in range(B):
-                F[0, r, b] = 0.0 + par[oD + z, b] * W[src, j, b]
-                F[1, r, b] = 0.0 + par[oD + z, b] * W[src, n + j, b]
-        else:
-            for b in range(B):
-                F[0, r, b] += par[oD + z, b] * W[src, j, b]
-                F[1, r, b] += par[oD + z, b] * W[src, n + j, b]
+    if B == 1:  # (two or three lanes are faster in lane loops)
+        _stage_by_lane(W, F, par, idx, lay, src, o, oi, lr, has_input, scale, out, h)
+        return
+    _deformations(W, F, par, idx, nD, n, oD, src)
     if has_input and o.shape[1] == 1:
         for r in range(R):
             for b in range(B):
@@ -108,26 +239,7 @@ def _stage(W, F, par, idx, lay, src, o, oi, lr, has_input, scale, out, h):
                 F[2, r, b] = par[oK + r, b] * F[0, r, b] + par[oC + r, b] * F[1, r, b]
     for x in range(X):
         _law(idx[2 * nD + 2 * nG + x], idx[2 * nD + 2 * nG + X + x], oL + 5 * x, F, par)
-    for z in range(nG):
-        i, r = idx[2 * nD + z], idx[2 * nD + nG + z]
-        first = z == 0 or idx[2 * nD + z - 1] != i
-        if z == nG - 1 or idx[2 * nD + z + 1] != i:  # the DOF's last entry
-            m = oM + scale * n + i
-            if first:
-                for b in range(B):
-                    W[out, n + i, b] = (0.0 + par[oG + z, b] * F[2, r, b]) * par[m, b]
-                    W[out, i, b] = W[src, n + i, b] * h
-            else:
-                for b in range(B):
-                    acc = W[out, n + i, b] + par[oG + z, b] * F[2, r, b]
-                    W[out, n + i, b] = acc * par[m, b]
-                    W[out, i, b] = W[src, n + i, b] * h
-        elif first:
-            for b in range(B):
-                W[out, n + i, b] = 0.0 + par[oG + z, b] * F[2, r, b]
-        else:
-            for b in range(B):
-                W[out, n + i, b] += par[oG + z, b] * F[2, r, b]
+    _accelerations(W, F, par, idx, nD, nG, n, oG, oM + scale * n, src, out, h)
 
 
 @_jit
