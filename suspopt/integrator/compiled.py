@@ -20,10 +20,11 @@ compiler vectorises (a block of one design runs its stages lane by lane instead,
 spread over the cores (``numba.prange``). A lane's arithmetic never involves another lane,
 so a design gives the same bits whatever its batch, its block or the number of threads.
 Every step, sample, road edge (a split step's sub-steps and its exact impulse, planned by
-:class:`.rk4.EdgePlan`) and the divergence rule are the numpy engine's; the regular step uses its arithmetic (stages
-scaled by their step, ``y += (s1 + 2 s2 + s3)/3 + s4``). The two agree to rounding: sums are
-taken in another order (and BLAS may fuse multiply-adds), about 1e-15 relative per step
-(``tests/test_compiled.py`` checks 1e-12 on the bundled configs).
+:class:`.rk4.EdgePlan`) and the divergence rule are the numpy engine's; the regular step
+uses its arithmetic (stages scaled by their step, ``y += (s1 + 2 s2 + s3)/3 + s4``). The
+two agree to rounding: sums are taken in another order (and BLAS may fuse multiply-adds),
+about 1e-15 relative per step (``tests/test_compiled.py`` checks 1e-12 on the bundled
+configs).
 
 A semi-active controller with a fixed threshold (or none) is sampled by the kernel itself
 (:func:`._kernel._control`): every ``ΔT`` it maps the vehicle's velocities (and, for the
