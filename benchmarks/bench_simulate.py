@@ -181,13 +181,20 @@ def flops_per_design_step(cfg) -> int:
 
 
 def peak_flops() -> tuple[float, str]:
-    """The machine's double-precision peak [flop/s]: cores x clock x flops per cycle (two FMA
-    units: 32 with AVX-512, 16 with AVX2), from /proc/cpuinfo."""
+    """The machine's double-precision peak [flop/s]: cores x clock x flops per cycle, from
+    /proc/cpuinfo. Two FMA units of 4 doubles (AVX2) make 16 flops per cycle; 32 only where
+    AVX-512 runs on 512-bit units: Intel's, and AMD's from family 26 (Zen 5). AMD's family 25
+    (Zen 4) reports ``avx512f`` but runs each 512-bit operation as two 256-bit halves, so
+    16. (An Intel part with one 512-bit FMA unit would be counted at twice its peak.)"""
     import os
 
     info = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
     mhz = [float(line.split(":")[1]) for line in info.splitlines() if line.startswith("cpu MHz")]
-    per_cycle = 32 if "avx512f" in info else 16
+    family = [
+        int(line.split(":")[1]) for line in info.splitlines() if line.startswith("cpu family")
+    ]
+    wide = "GenuineIntel" in info or (bool(family) and family[0] >= 26)
+    per_cycle = 32 if "avx512f" in info and wide else 16
     cores = os.cpu_count() or 1
     clock = (mhz[0] if mhz else 2000.0) * 1e6
     return cores * clock * per_cycle, f"{cores} cores x {clock / 1e9:.2f} GHz x {per_cycle}"
