@@ -419,6 +419,36 @@ def test_quantiles_are_vectorised_over_columns():
             )
 
 
+@pytest.mark.parametrize("level", [0.0, 0.27, 0.5, 0.73, 1.0])
+def test_the_empirical_quantile_is_the_sorted_samples_linear_interpolation(level):
+    """One level for every column (selected, not sorted) or one per column: the 'linear'
+    quantile of the sorted samples, NaN sorted last, on columns with ties, signed zeros,
+    infinities, NaN and a single sample, bit for bit."""
+    rng = np.random.default_rng(12)
+    x = np.round(rng.normal(size=(37, 60)) * 2.0)  # ties and -0.0
+    x[rng.random(x.shape) < 0.15] = np.nan
+    x[rng.random(x.shape) < 0.05] = np.inf
+    x[rng.random(x.shape) < 0.05] = -np.inf
+    x[:, 0] = np.nan
+    x[:30, 1] = np.nan
+
+    def by_sorting(column, q):
+        s = np.sort(column)  # NaN last
+        position = q * (s.size - 1)
+        lo = int(np.floor(position))
+        a, b = s[lo], s[min(lo + 1, s.size - 1)]
+        return a + (b - a) * (position - lo)
+
+    per_column = np.linspace(0.0, 1.0, x.shape[1])
+    with np.errstate(invalid="ignore"):
+        for samples in (x, x[:1]):
+            for levels in (np.full(x.shape[1], level), per_column):
+                got = distribution_quantile(samples, levels, "empirical")
+                want = [by_sorting(samples[:, j], levels[j]) for j in range(x.shape[1])]
+                np.testing.assert_array_equal(got, want)
+                assert np.array_equal(np.signbit(got), np.signbit(want))
+
+
 def test_threshold_leaves_the_share_on_the_stiff_side():
     """SH-2 stiffens above T (level 1 - share, Eq 4.6), SH-ADD-2 below it (Eq 4.4)."""
     x = np.random.default_rng(6).normal(size=(2, 10001))
