@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
-import ctypes.util
 
 __all__ = [
     "reuse_memory",
@@ -46,14 +45,13 @@ def reuse_memory() -> bool:
     bool
         Whether the setting took effect.
     """
-    name = ctypes.util.find_library("c")
-    if name is None:
-        return False
     try:
-        libc = ctypes.CDLL(name)
+        # the process's own symbols, the C library's among them (``find_library`` would run
+        # ``ldconfig``, or a compiler where that is missing, at every command)
+        libc = ctypes.CDLL(None)
         _ = libc.gnu_get_libc_version  # glibc only
         mallopt = libc.mallopt
-    except (OSError, AttributeError):
+    except (OSError, AttributeError, TypeError):  # (TypeError: Windows takes no None)
         return False
     mallopt.argtypes, mallopt.restype = (ctypes.c_int, ctypes.c_int), ctypes.c_int
     return bool(mallopt(_M_MMAP_MAX, 0)) and bool(mallopt(_M_TRIM_THRESHOLD, _KEEP))

@@ -830,3 +830,33 @@ def test_the_stability_radius_in_chunks_is_the_radius_in_one_pass(monkeypatch):
     whole = checks._rk4_radius(direction)
     monkeypatch.setattr(checks, "_RADIUS_CHUNK", 64)
     np.testing.assert_array_equal(checks._rk4_radius(direction), whole)
+
+
+@pytest.mark.skipif(
+    not sys.platform.startswith("linux") or os.confstr("CS_GNU_LIBC_VERSION") is None,
+    reason="glibc only",
+)
+def test_reuse_memory_keeps_freed_arrays_mapped():
+    """After :func:`suspopt.reuse_memory` a freed 256 MB array stays in the process (the next
+    one of that size finds its pages mapped); without it glibc gives it back at once."""
+    script = """
+import os
+import sys
+import numpy as np
+import suspopt
+if sys.argv[1] == "1":
+    assert suspopt.reuse_memory() is True
+def resident():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+before = resident()
+a = np.ones(1 << 25)  # 256 MB, touched
+del a
+print(resident() - before)
+"""
+    kept = {}
+    for flag in ("0", "1"):
+        proc = subprocess.run([sys.executable, "-c", script, flag], capture_output=True, text=True)
+        assert proc.returncode == 0, proc.stderr
+        kept[flag] = int(proc.stdout)
+    assert kept["1"] > 200e6 and kept["0"] < 50e6, kept
