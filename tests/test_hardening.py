@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import pickle
+import platform
 import shlex
 import signal
 import subprocess
@@ -833,7 +834,7 @@ def test_the_stability_radius_in_chunks_is_the_radius_in_one_pass(monkeypatch):
 
 
 @pytest.mark.skipif(
-    not sys.platform.startswith("linux") or os.confstr("CS_GNU_LIBC_VERSION") is None,
+    not sys.platform.startswith("linux") or platform.libc_ver()[0] != "glibc",
     reason="glibc only",
 )
 def test_reuse_memory_keeps_freed_arrays_mapped():
