@@ -333,7 +333,6 @@ def _empirical_quantile(x: np.ndarray, level: np.ndarray) -> np.ndarray:
     n = x.shape[0]
     position = level * (n - 1)
     lo = np.floor(position).astype(int)
-    hi = np.minimum(lo + 1, n - 1)
     if lo.size and n > 1 and np.all(lo == lo.flat[0]):
         k = int(lo.flat[0])
         part = np.partition(x, k, axis=0)
@@ -342,7 +341,7 @@ def _empirical_quantile(x: np.ndarray, level: np.ndarray) -> np.ndarray:
     else:
         s = np.sort(x, axis=0)
         a = np.take_along_axis(s, lo[None], axis=0)[0]
-        b = np.take_along_axis(s, hi[None], axis=0)[0]
+        b = np.take_along_axis(s, np.minimum(lo + 1, n - 1)[None], axis=0)[0]
     return a + (b - a) * (position - lo)
 
 
