@@ -326,3 +326,90 @@ def test_every_row_of_a_packed_map_has_an_entry():
     assert _every_row((rows, cols, vals), 3)[0].tolist() == [0, 0, 1, 2]
     full = (np.array([0, 1]), np.array([0, 0]), np.ones((2, 2)))
     assert _every_row(full, 2)[0] is full[0]  # (nothing missing: the entries as they are)
+
+
+def _walked(monkeypatch) -> None:
+    """Every run from here on walks the network (no fused step, :mod:`._fused`)."""
+    from suspopt.integrator import _fused
+
+    monkeypatch.setattr(_fused, "MIN_DESIGNS", 10**9)
+
+
+@pytest.mark.parametrize(
+    "name, lift_off",
+    [
+        ("ch5/case1_s1.yaml", True),
+        ("ch3/part2a_fc_arb_bump.yaml", False),
+        ("ch8/nss4_class_a_passenger.yaml", False),
+        ("ch8/nss1_class_a.yaml", False),
+    ],
+)
+def test_the_fused_step_gives_the_bits_of_the_walked_network(monkeypatch, name, lift_off):
+    """A run of enough designs takes the network's fused functions; the same designs give the
+    same bits when the kernel walks the network: Duffing springs and tyres that lift off over
+    a bump (split steps and their impulses), a full car with anti-roll bars, the exact NSS4
+    mechanism with its passenger and NSS1 over an ISO 8608 road."""
+    from suspopt.integrator import _fused
+
+    cfg = suspopt.load_config(CONFIGS / name)
+    cfg.simulation.duration = min(cfg.simulation.duration, getattr(cfg.road, "start", 0.0) + 1.0)
+    cfg.simulation.engine = "compiled"
+    if lift_off:
+        cfg.vehicle.tyre_lift_off = True
+        cfg.road.height = 0.15
+    P = _fused.MIN_DESIGNS + 3  # (a padded last block)
+    path = "seat.damping" if cfg.seat is not None else "vehicle.anti_roll_bars.front"
+    params = _designs(cfg, P) or {path: np.linspace(200.0, 2000.0, P)}
+    made = []
+    monkeypatch.setattr(_fused, "steps", lambda *a, f=_fused.steps: made.append(1) or f(*a))
+    fused = simulate(cfg, params)
+    assert made and fused.engine == "compiled" and np.isfinite(fused.states).all()
+    _walked(monkeypatch)
+    walked = simulate(cfg, params)
+    assert len(made) == 1
+    assert fused.states.tobytes() == walked.states.tobytes()
+    assert fused.accelerations.tobytes() == walked.accelerations.tobytes()
+
+
+def test_an_evaluation_on_the_fused_step_gives_the_walked_networks_objectives(monkeypatch):
+    """``Problem.evaluate`` (streamed, only the DOFs its signals reach integrated) gives the
+    same objectives and constraints, bit for bit, on either path."""
+    cfg = suspopt.load_config(CONFIGS / "ch5" / "case4_s1.yaml")
+    cfg.simulation.engine = "compiled"
+    problem = suspopt.Problem.from_config(cfg)
+    X = np.random.default_rng(5).uniform(problem.xl, problem.xu, (80, problem.n_var))
+    F, G = problem.evaluate(X, return_values_of=["F", "G"])
+    _walked(monkeypatch)
+    F0, G0 = problem.evaluate(X, return_values_of=["F", "G"])
+    assert F.tobytes() == F0.tobytes() and G.tobytes() == G0.tobytes()
+
+
+def test_the_fused_modules_cache_is_rewritten_when_changed_and_skipped_when_unwritable(
+    monkeypatch, tmp_path
+):
+    """The generated module is kept whole under its hash; a file changed since is written
+    again (what runs is the text generated in the process, never the file), and where the
+    cache cannot be written the kernel walks the network (``steps`` is None)."""
+    from suspopt.integrator import _fused
+
+    cfg = suspopt.load_config(CONFIGS / "ch5" / "case4_s1.yaml")
+    pv, model, controller, attachments = prepare(cfg, _designs(cfg, 2))
+    from suspopt.integrator.compiled import _packed
+    from suspopt.network import Assembled
+    from suspopt.simulate import full_network
+
+    _, idx, lay = _packed(Assembled(full_network(model, attachments), pv.P), 1e-3, _fused.LANES)
+    monkeypatch.setenv("SUSPOPT_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(_fused, "_LOADED", {})
+    first, regular = _fused.steps(idx, lay)
+    (path,) = (tmp_path / "fused").glob("fused_*.py")
+    assert path.read_text() == _fused.source(idx, lay)
+    path.write_text("raise SystemExit('not run')\n")
+    monkeypatch.setattr(_fused, "_LOADED", {})
+    assert _fused.steps(idx, lay) is not None
+    assert path.read_text() == _fused.source(idx, lay)
+    blocked = tmp_path / "a file"
+    blocked.write_text("")
+    monkeypatch.setenv("SUSPOPT_CACHE_DIR", str(blocked))
+    monkeypatch.setattr(_fused, "_LOADED", {})
+    assert _fused.steps(idx, lay) is None

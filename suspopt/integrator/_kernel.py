@@ -26,15 +26,45 @@ check that its arrays do not overlap).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numba
 import numpy as np
+from numba import types
+from numba.extending import intrinsic
 
 from ..control.laws import LAWS
+from . import _fused
 
 _jit = numba.njit(cache=True, nogil=True)
 #: A helper compiled into its one caller (no call, no reference counts).
 _inline = numba.njit(cache=True, nogil=True, inline="always")
 
+
+def _address_of(typingctx, array):
+    """The address of ``array``'s first element, for a fused step (:mod:`._fused`)."""
+
+    def codegen(context, builder, signature, args):
+        return context.make_array(array)(context, builder, args[0]).data
+
+    return types.CPointer(array.dtype)(array), codegen
+
+
+_address: Any = intrinsic(_address_of)
+
+
+@numba.cfunc(_fused.FIRST, cache=True)
+def _no_first(W, par, u, has, h):  # pragma: no cover - never called
+    """The fused first stage's stand-in where the kernel walks the network."""
+
+
+@numba.cfunc(_fused.REGULAR, cache=True)
+def _no_regular(W, par, u, w, mid, end, dt):  # pragma: no cover - never called
+    """The fused regular step's stand-in where the kernel walks the network."""
+
+
+#: The kernel's ``fused`` argument where it walks the network (:func:`run`).
+NOT_FUSED = (0, _no_first, _no_regular)
 #: Samples a block buffers before writing them to the records.
 SAMPLES = 32
 #: The blocks of W.
@@ -475,12 +505,13 @@ def _control(step, W, F, pb, idx, lay, road, lr, cp, ci, records):
 @_jit
 def _advance(
     blk, k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out,
-    ctl,
+    ctl, fused,
 ):  # fmt: skip
     """Block ``blk``'s steps ``k0 .. k1 - 1`` from its kept state (step ``n_steps`` is the
     final sample alone): the sample's first stage, the sample when one is due (sample ``j``
     written at ``j - origin`` of the records, ``origin`` a multiple of :data:`SAMPLES`), the
-    step, the divergence check."""
+    step, the divergence check. ``fused = (on, first, regular)``: when ``on``, the first
+    stage and the regular steps are the network's fused functions (:mod:`._fused`)."""
     W_all, F_all, rec_all, at_all = state[0], state[1], state[2], state[3]
     states, diverged_at = out[0], out[2]
     W, F, rec, at, pb = W_all[blk], F_all[blk], rec_all[blk], at_all[blk], par[blk]
@@ -488,6 +519,8 @@ def _advance(
     off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
     lr, kept, dest = road[12][blk], state[4], state[5]
     cp, ci, records = ctl[0][blk], ctl[1], ctl[2][:, :, blk * B : blk * B + B]
+    on, first, regular = fused
+    Wp, pp = _address(W), _address(pb)
     if k0 == 0:
         for u in range(start_jumps.shape[0]):
             _impulse(start_jumps, u, no_pull, W, F, pb, idx, lay, lr)
@@ -495,7 +528,11 @@ def _advance(
         if ci[0] and step % ci[2] == 0 and (step < n_steps or ci[3]):
             _control(step, W, F, pb, idx, lay, road, lr, cp, ci, records)
         _lag(pb, idx, lay)
-        _stage(W, F, pb, idx, lay, Y, off, 2 * step, lr, active[2 * step], 0, S1, 0.5 * dt)
+        h = 2 * step
+        if on:
+            first(Wp, pp, _address(off[h, 0]), 1 if active[h] else 0, 0.5 * dt)
+        else:
+            _stage(W, F, pb, idx, lay, Y, off, h, lr, active[h], 0, S1, 0.5 * dt)
         if step % every == 0:  # the sample: the state and the first stage's accelerations
             j = step // every
             _keep(W, rec, j % SAMPLES, n, pb, idx, lay, kept)
@@ -503,8 +540,11 @@ def _advance(
                 _flush(rec, j - j % SAMPLES - origin, j % SAMPLES + 1, blk * B, out, dest)
         if step == n_steps:
             break
-        if split_of[step] < 0:
-            _regular_step(2 * step, dt, W, F, pb, idx, lay, off, lr, active)
+        if split_of[step] < 0 and on:
+            mid, end = 1 if active[h + 1] else 0, 1 if active[h + 2] else 0
+            regular(Wp, pp, _address(off[h + 1, 0]), _address(off[h + 2, 0]), mid, end, dt)
+        elif split_of[step] < 0:
+            _regular_step(h, dt, W, F, pb, idx, lay, off, lr, active)
         else:
             _split_step(split_of[step], W, F, pb, idx, lay, road, lr)
         if (step + 1) % check_every == 0 or step + 1 == n_steps:
@@ -514,17 +554,18 @@ def _advance(
 
 @numba.njit(cache=True, parallel=True, nogil=True)
 def run(
-    k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out, ctl
-):
+    k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road, state, out, ctl,
+    fused,
+):  # fmt: skip
     """Steps ``k0 .. k1 - 1`` of every block (in parallel over the cores) from the kept
     ``state = (W, F, rec, at, kept, dest)`` of each (``kept``: the rows the samples keep,
     :func:`_keep`; ``dest``: the records' rows they go to, :func:`_flush`), ``par (blocks,
     rows, B)`` (the arrays: :func:`.compiled._packed`), samples from ``origin`` on in
-    ``out``."""
+    ``out``; ``fused``: :func:`_advance`, :data:`NOT_FUSED` to walk the network."""
     for blk in numba.prange(par.shape[0]):
         _advance(
             blk, k0, k1, origin, dt, n_steps, every, limit, check_every, par, idx, lay, road,
-            state, out, ctl,
+            state, out, ctl, fused,
         )  # fmt: skip
 
 

@@ -44,6 +44,11 @@ non-linear element without a compiled law.
 A new law is a branch of ``_kernel._law`` and an entry of :data:`LAWS`, beside the numpy
 closure that defines it (:attr:`suspopt.network.Elements.extra`).
 
+A run of :data:`._fused.MIN_DESIGNS` designs or more without a controller and on one road
+(:func:`_fusable`) takes its first stages and regular steps from functions generated and
+compiled for its network (:mod:`._fused`), on blocks of :data:`._fused.LANES` designs: the
+same arithmetic in one vectorised lane loop per call, the same bits.
+
 The first call on a machine compiles the kernel (``cache=True`` keeps it in the package's
 ``__pycache__`` for later processes; ``benchmarks/bench_simulate.py`` reports the time).
 """
@@ -302,7 +307,7 @@ def windows(
     asm, n_vehicle, offsets, dt, n_steps, every, controller, edges = run
     import numba
 
-    from . import _kernel
+    from . import _fused, _kernel
 
     n, R, P0 = asm.n, asm.R, asm.P
     n_out = n_steps // every + 1
@@ -311,15 +316,18 @@ def windows(
         raise ValueError("a controlled run is integrated whole (width >= its samples)")
     if width < n_out and width % _kernel.SAMPLES:
         raise ValueError(f"a window is a multiple of {_kernel.SAMPLES} samples")
-    B = block_width(P0, numba.get_num_threads())
-    blocks = -(-P0 // B)
-    P = blocks * B  # whole blocks: the last design repeated
     lagged = decay = None
     if controller is not None and controller.lag_decay is not None:
         lagged = _damper_elements(asm)
         decay = controller.lag_decay.reshape(1, -1)
     reach = None if recorded is None or controller is not None else reached(asm, recorded)
+    fusable = _fusable(offsets, controller, P0)
+    B = _fused.LANES if fusable else block_width(P0, numba.get_num_threads())
+    blocks = -(-P0 // B)
+    P = blocks * B  # whole blocks: the last design repeated
     flat, idx, lay = _packed(asm, dt, P, lagged, decay, reach)
+    steps = _fused.steps(idx, lay) if fusable else None
+    fused = _kernel.NOT_FUSED if steps is None else (1, *steps)
     Nl = int(lay[11])
     par = np.ascontiguousarray(flat.reshape(flat.shape[0], blocks, B).transpose(1, 0, 2))
     # the inputs' part (T, G, 2R) of G roads, each under P0/G consecutive designs, and the road
@@ -340,7 +348,7 @@ def windows(
             if k1 <= k0:  # (no step: a call from step 0 would apply the start's impulses)
                 return
             _kernel.run(k0, k1, j0, dt, n_steps, every, DIVERGENCE_LIMIT, _CHECK_EVERY, par,
-                        idx, lay, road, state, out, ctl)  # fmt: skip
+                        idx, lay, road, state, out, ctl, fused)  # fmt: skip
 
         damping, records = None, {}
         if controller is None:
@@ -361,6 +369,16 @@ def windows(
                 engine="compiled",
             ),
         )
+
+
+def _fusable(offsets: np.ndarray, controller, P: int) -> bool:
+    """Whether a run's regular steps take the network's fused functions (:mod:`._fused`):
+    no controller, one road for every design (``offsets (T, 2R, G, 1)``) and at least
+    :data:`._fused.MIN_DESIGNS` designs (fewer would pay for the padding of whole blocks of
+    :data:`._fused.LANES`, and a simulation of a few designs for the compilation)."""
+    from . import _fused
+
+    return controller is None and offsets.shape[2] == 1 and P >= _fused.MIN_DESIGNS
 
 
 def _kernel_state(blocks: int, B: int, lay: np.ndarray, n: int, recorded, reach) -> tuple:
