@@ -39,7 +39,11 @@ import numpy as np
 #: Ch. 5 problem at 200 designs, 32 4.8 ms, 64 5.3 ms and 8 10.7 ms (the step's other work,
 #: samples and checks, per block), against 7.4 ms for the general kernel (2026-12-05).
 LANES = 16
-#: The fewest designs a run takes the fused path with (:func:`.compiled._fusable`).
+#: The fewest designs a run takes the fused path with (:func:`.compiled._fusable`). Once
+#: compiled, the fused path was as fast or faster at every size (``Problem.evaluate`` of the
+#: Ch. 5 problem, 2026-12-05: 3.3-3.6 against 3.8-4.0 ms at 1 design, 3.5-3.8 against
+#: 4.5-4.6 ms at 8, 8.7-10.1 against 11.2-11.7 ms at 64); the bound spares a run of a few
+#: designs, which takes milliseconds, the first compilation of its network (about 1.5 s).
 MIN_DESIGNS = 64
 #: The fused functions' C signatures: ``first(W, par, u, has_input, h)`` and
 #: ``regular(W, par, u_mid, u_end, mid_has_input, end_has_input, dt)``, the arrays as
