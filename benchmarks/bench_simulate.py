@@ -11,8 +11,10 @@ the k_nl range of docs/thesis-slips.md#table-52). Each size is timed as the best
 (the first call of a size also pays the operating system for memory the process has not touched
 before). Run:
 ``python benchmarks/bench_simulate.py [--sizes 1,100,1000,10000]``. Prints a table; asserts
-nothing. The compiled engine's first call (compiling, or loading numba's cache) is printed
-first.
+nothing. The compiled engine's first call (compiling, or loading numba's cache) and its first
+call of 64 designs (this network's fused step, :mod:`suspopt.integrator._fused`) are printed
+first; last, the kernel's share of the machine's peak, from whole ``simulate`` calls and from
+the kernel's own calls at P = 1000 (:func:`kernel_rate`).
 Like the command line, it first makes the allocator reuse freed memory
 (:func:`suspopt.reuse_memory`); ``--default-allocator`` leaves it as it is.
 """
