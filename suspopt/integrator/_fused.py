@@ -15,7 +15,8 @@ step, the laws' closures), so a design gives the same bits on either path
 rule, which the divergence check then reports) where :mod:`._kernel` would raise.
 
 Only numbers from the packing reach the source: integers (rows, columns, offsets, law
-codes) and the literals written here. The source goes to a file named by its hash in the
+codes) and the literals written here; the laws are the kernel's own function
+(:func:`._kernel._law_value`), inlined. The source goes to a file named by its hash in the
 user's cache (``$SUSPOPT_CACHE_DIR/fused``, else ``$XDG_CACHE_HOME/suspopt/fused`` or
 ``~/.cache/suspopt/fused``), written whole (a temporary file, then renamed), so that numba's
 ``cache=True`` keeps the compiled functions for later processes: about 2 s of compilation per
@@ -81,18 +82,9 @@ def _par(p: int) -> str:
 
 
 def _law(code: int, d: str, f: str, p: int) -> str:
-    """The force ``f`` with law ``code``'s part at ``δ = d`` (:func:`._kernel._law_force`)."""
-    a, b_, c, w0, f0 = (_par(p + k) for k in range(5))
-    if code == 0:  # poly3
-        return f"{f} + (({c} * {d} + {b_}) * {d} + {a}) * {d}"
-    if code == 1:  # cap
-        return f"{a} if {f} > {a} else {f}"
-    w = f"({w0} + {d})"
-    if code == 2:  # link
-        x = f"({a} + {b_} / np.sqrt({c} - {w} * {w})) * {w}"
-    else:  # carrella
-        x = f"({b_} / np.sqrt({w} * {w} + {c}) + {a}) * {w}"
-    return f"({f} + {x}) + {f0}"
+    """The force ``f`` with law ``code``'s part at ``δ = d``: the kernel's own
+    :func:`._kernel._law_value`, its parameters the law's five rows of ``par``."""
+    return f"_law_value({code}, {d}, {f}, " + ", ".join(_par(p + k) for k in range(5)) + ")"
 
 
 def _stage(s: dict, q: list[str], v: list[str], inputs: tuple[str, str], scale: int, h: str,
@@ -136,7 +128,7 @@ def source(idx: np.ndarray, lay: np.ndarray) -> str:
     """The module of the two fused functions for the network packed as ``idx, lay``."""
     s = _structure(idx, lay)
     n, R = s["n"], s["R"]
-    head = ["import numpy as np", "import numba", ""]
+    head = ["import numba", "", "from suspopt.integrator._kernel import _law_value", ""]
     loads = [f"    {name}{r} = {name}[{r}]" for name in ("u", "w") for r in range(2 * R)]
     first = _stage(s, [_w(_Y, j, n) for j in range(n)], [_w(_Y, n + j, n) for j in range(n)],
                    ("u", "has"), 0, "h", "")  # fmt: skip

@@ -72,20 +72,28 @@ Y, YS, S1, S2, S3, S4, K1, K2, K3, K4, TMP = range(11)
 
 
 @_inline
-def _law_force(code, d, f, par, p, b):
-    """Lane ``b``'s force ``f`` at ``δ = d`` with the non-linear part of law ``code``
-    (:data:`.compiled.LAWS`) added, its parameters in rows ``p ..`` of ``par`` (the numpy
-    closures' arithmetic)."""
-    if code == 0:  # poly3: ((c3 δ + c2) δ + c1) δ
-        return f + ((par[p + 2, b] * d + par[p + 1, b]) * d + par[p, b]) * d
-    if code == 1:  # cap: the force no larger than the limit (NaN stays NaN)
-        return par[p, b] if f > par[p, b] else f
-    w = par[p + 3, b] + d
+def _law_value(code, d, f, a, b, c, w0, f0):
+    """The force ``f`` at ``δ = d`` with the non-linear part of law ``code``
+    (:data:`.compiled.LAWS`) added, its parameters ``a, b, c, w0, f0`` (as many as it takes;
+    the numpy closures' arithmetic). The walked kernel (:func:`_law_force`) and the fused
+    step (:mod:`._fused`, the code a literal) both call it."""
+    if code == 0:  # poly3 (c1, c2, c3): ((c3 δ + c2) δ + c1) δ
+        return f + ((c * d + b) * d + a) * d
+    if code == 1:  # cap (limit,): the force no larger than the limit (NaN stays NaN)
+        return a if f > a else f
+    w = w0 + d
     if code == 2:  # link: (a + b / sqrt(l^2 - w^2)) w + F0, w = w0 + δ
-        x = (par[p, b] + par[p + 1, b] / np.sqrt(par[p + 2, b] - w * w)) * w
+        x = (a + b / np.sqrt(c - w * w)) * w
     else:  # carrella: (b / sqrt(w^2 + l^2) + a) w + F0
-        x = (par[p + 1, b] / np.sqrt(w * w + par[p + 2, b]) + par[p, b]) * w
-    return (f + x) + par[p + 4, b]
+        x = (b / np.sqrt(w * w + c) + a) * w
+    return (f + x) + f0
+
+
+@_inline
+def _law_force(code, d, f, par, p, b):
+    """Lane ``b``'s :func:`_law_value`, its parameters in rows ``p .. p + 4`` of ``par``."""
+    a, b_, c, w0, f0 = par[p, b], par[p + 1, b], par[p + 2, b], par[p + 3, b], par[p + 4, b]
+    return _law_value(code, d, f, a, b_, c, w0, f0)
 
 
 @_jit
