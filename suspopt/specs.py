@@ -37,7 +37,10 @@ class MetricDef:
     minimum), ``window_max`` (the largest of ``compute`` over the windows of time: a maximum
     over time of a value per sample), ``weighted`` (an ISO 2631 weighted metric, from the
     weighting's filter run on window by window) or ``keep`` (``compute`` on the signal kept
-    whole).
+    whole). ``extremes(spec, model, signal)``, for a ``window_max`` metric, says whether its
+    value over a record is its value over the record's largest and smallest sample alone
+    (for the designs of ``model``); then the compiled kernel may keep those two instead of
+    the signal (:mod:`suspopt.integrator.accumulators`).
     Adding a metric is adding one entry to :data:`METRICS`."""
 
     kind: str
@@ -47,6 +50,7 @@ class MetricDef:
     family: str | None = None
     also: str | None = None
     stream: str = "keep"
+    extremes: Callable[[Any, Any, str], bool] | None = None
 
 
 def _same(u: str) -> str:
@@ -118,6 +122,15 @@ def _spring_usage(spec, r, signal):
     return springs.nonlinear_spring_usage(
         r.signals[signal], r.model.spring_linear[:, 0, c], r.model.spring_cubic[:, 0, c]
     )
+
+
+def _spring_usage_extremes(spec, model, signal: str) -> bool:
+    """Eq 5.3's ratio grows with the travel's square when ``k_l > 0`` and ``k_nl >= 0``
+    (:func:`suspopt.metrics.springs.nonlinear_spring_usage`), so its largest value is at the
+    record's largest or smallest travel."""
+    c = model.corners.index(signal.rsplit(".", 1)[1])
+    k_l, k_nl = model.spring_linear[:, 0, c], model.spring_cubic[:, 0, c]
+    return bool(np.all(k_l > 0.0) and np.all(k_nl >= 0.0))
 
 
 def _dynamic_tyre_load(spec, r, signal):
@@ -194,6 +207,7 @@ METRICS: dict[str, MetricDef] = {
         _spring_usage,
         family="travel",
         stream="window_max",
+        extremes=_spring_usage_extremes,
     ),
     "dynamic_tyre_load": MetricDef(
         "derived",

@@ -34,6 +34,17 @@ The compiled engine records only the rows of the states and accelerations those 
 read 5 of its 12 rows): writing the samples is about a third of its time when it keeps every
 row. The numpy engine computes every row anyway.
 
+On the compiled engine (without a controller) the kernel itself forms every signal that is
+affine in a sample (:func:`suspopt.affine.affine_signals` probes the signal table: travel,
+tyre deflection, accelerations...) and reduces it as it integrates: moments by Welford's
+update, extremes, the weighting filter and its sums, and a ``window_max`` metric that its
+extremes give (:class:`suspopt.specs.MetricDef`'s ``extremes``: the spring usage of Eq 5.3);
+those rows are neither recorded nor passed through numpy
+(:mod:`suspopt.integrator.accumulators`). Its values agree with the whole run's metrics to
+rounding (about 1e-15 relative), not to the bit, and a design's values still do not depend
+on its batch, block, window or thread. The MTVV, the ``keep`` metrics and signals that are
+not affine are reduced from the windows as below.
+
 With numba installed, the block moments, the weighting filter and the weighted sums run as
 compiled loops over each window (:func:`suspopt.integrator.compiled_reductions`): the same
 arithmetic in the same order, so the same bits as the numpy code beside them
@@ -361,6 +372,8 @@ def _recorded(cfg: Config, setup, names: Sequence[str]) -> np.ndarray | None:
     from .simulate import _result
 
     pv, model, attachments, run, z = setup
+    if not names:  # (every signal formed in the kernel: no row to record)
+        return np.zeros(3 * run.asm.n, np.bool_)
     step = 2 * cfg.simulation.output_every
 
     def result_of(states, accelerations):
@@ -371,6 +384,43 @@ def _recorded(cfg: Config, setup, names: Sequence[str]) -> np.ndarray | None:
         return _result(cfg, pv, model, None, attachments, run, grid, traj)
 
     return recorded_rows(result_of, run.asm.n, pv.P, names)
+
+
+def _kernel_streams(cfg: Config, setup, streams: _Streams):
+    """The signals of ``streams`` the compiled kernel forms and reduces itself
+    (:func:`suspopt.affine.kernel_accumulators`; ``setup = (designs, model, attachments,
+    run, (z, zd, t_grid))``), or None: on the numpy engine, without numba, with a
+    controller, or where the compiled engine does not run the network."""
+    from .integrator import compiled_runs
+
+    pv, model, attachments, run, road = setup
+    if run.controller is not None or not compiled_runs(run, cfg.simulation.engine):
+        return None
+    from .affine import kernel_accumulators
+    from .integrator import Trajectory
+    from .simulate import _result
+
+    step = 2 * cfg.simulation.output_every
+    n_u, G = road[0].shape[:2]
+
+    def result_of(states, accelerations, z, zd):
+        T = states.shape[-1]
+        grid = [np.zeros((n_u, G, T * step)) for _ in range(2)]
+        grid[0][:, :, ::step], grid[1][:, :, ::step] = z[:, None], zd[:, None]
+        traj = Trajectory(states, accelerations, None, {}, np.full(pv.P, np.nan))
+        times = np.arange(T * step) * (0.5 * cfg.simulation.dt)
+        return _result(
+            cfg, pv, model, None, attachments, run, (grid[0], grid[1], times), traj
+        ).signals
+
+    shape = (run.asm.n, n_u, pv.P)
+    return kernel_accumulators(result_of, shape, streams.kernel_candidates(model), road, step)
+
+
+def _by_extremes(spec, model, name: str) -> bool:
+    """Whether a ``window_max`` metric's value is that of the signal's extremes alone."""
+    extremes = METRICS[spec.metric].extremes
+    return extremes is not None and extremes(spec, model, name)
 
 
 class _Streams:
@@ -394,6 +444,64 @@ class _Streams:
                 for n in names for k in _kept_names(spec, n)}  # fmt: skip
         self.pieces: dict[str, list[np.ndarray]] = {name: [] for name in sorted(kept)}
         self.times: list[np.ndarray] = []
+        self.kernel: Any = None  # (:meth:`hand_over`)
+        self.handed: list[tuple[dict, str]] = []
+        self.by_extremes: list[tuple[Any, str]] = []
+
+    def kernel_candidates(self, model) -> tuple[list[str], list[tuple[str, Any]]]:
+        """The signals whose moments or extremes are asked (or a ``window_max`` metric that
+        its extremes give, :class:`suspopt.specs.MetricDef`, for the designs of ``model``),
+        and the (signal, weighting) pairs asked without an MTVV: what the compiled kernel
+        may reduce itself."""
+        self.by_extremes = [(spec, name) for spec, name in self.maxima
+                            if _by_extremes(spec, model, name)]  # fmt: skip
+        names = set(self.moments) | set(self.extremes) | {n for _, n in self.by_extremes}
+        return sorted(names), [key for key, w in self.weighted.items() if not w.taus]
+
+    def hand_over(self, kernel) -> None:
+        """Leave the signals of ``kernel`` (:class:`suspopt.integrator.accumulators.
+        Accumulators`) to it: the windows do not reduce them (:meth:`take` fills them in
+        from the kernel's accumulators after the run)."""
+        self.kernel = kernel
+        names = {s.name for s in kernel.signals}
+        for s in kernel.signals:
+            for streams in (self.moments, self.extremes):
+                if streams.pop(s.name, None) is not None:
+                    self.handed.append((streams, s.name))
+        for key in kernel.pair_keys:
+            del self.weighted[key]
+        self.by_extremes = [(spec, n) for spec, n in self.by_extremes if n in names]
+        self.maxima = [m for m in self.maxima if m not in self.by_extremes]
+
+    def numpy_reads(self) -> list[str]:
+        """The signals the windows' reductions read (those not handed to the kernel)."""
+        return sorted(
+            set(self.moments) | set(self.extremes) | {name for name, _ in self.weighted}
+            | {name for _, name in self.maxima} | set(self.pieces)
+        )  # fmt: skip
+
+    def take(self, samples: int, cfg: Config, model, P: int) -> None:
+        """The handed signals' moments, extremes, weighted sums and the ``window_max``
+        metrics their extremes give, from the kernel's accumulators over ``samples`` samples
+        of the P designs of ``model``."""
+        kernel = self.kernel
+        index = {s.name: i for i, s in enumerate(kernel.signals)}
+        for spec, name in self.by_extremes:  # (the metric of the largest and smallest sample)
+            two = np.stack(kernel.moments(index[name], P)[2:], axis=-1)
+            record = _Kept({name: two}, np.zeros(2), cfg, model)
+            self.window_max[(id(spec), name)] = METRICS[spec.metric].compute(spec, record, name)
+        for streams, name in self.handed:
+            mean, m2, high, low = kernel.moments(index[name], P)
+            if streams is self.moments:
+                moment = streams[name] = _Moments()
+                moment.n, moment.mean, moment.m2 = samples, mean, m2
+            else:
+                extreme = streams[name] = _Extremes()
+                extreme.high, extreme.low = high, low
+        for p, key in enumerate(kernel.pair_keys):
+            weighted = self.weighted[key] = _Weighted(key[1])
+            weighted.n, weighted.fs = samples, kernel.fs
+            weighted.squares, weighted.fourth, weighted.peak = kernel.weighted(p, P)
 
     def add(self, window) -> None:
         """One window's Result."""
@@ -463,14 +571,20 @@ def reduce(
         check_memory(cfg, model, attachments, pv.P, signals=len(requests), window=width,
                      kept=len(streams.pieces))  # fmt: skip
     run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments, roads)
-    read = sorted({k for spec, names in requests for n in names for k in _kept_names(spec, n)})
-    recorded = _recorded(cfg, (pv, model, attachments, run, z), read)
+    kernel = _kernel_streams(cfg, (pv, model, attachments, run, (z, zd, t_grid)), streams)
+    if kernel is not None:
+        streams.hand_over(kernel)
+    recorded = _recorded(cfg, (pv, model, attachments, run, z), streams.numpy_reads())
+    if kernel is not None and recorded is not None and not recorded.any():
+        width = None  # (nothing recorded, nothing held per sample: one call of the kernel)
     table = diverged = engine = None
-    for first, traj in integrator.windows(run, cfg.simulation.engine, width, recorded):
+    for first, traj in integrator.windows(run, cfg.simulation.engine, width, recorded, kernel):
         window = _result(cfg, pv, model, controller, attachments, run, (z, zd, t_grid), traj, first)
         table, diverged, engine = window._table, traj.diverged_at, traj.engine
         streams.add(window)
         del window, traj  # (the next window is being integrated meanwhile: hold two at most)
     # (a run has at least one sample)
     assert table is not None and diverged is not None and engine is not None
+    if kernel is not None:
+        streams.take(kernel.zs.shape[0], cfg, model, pv.P)
     return Reduced(model, table, streams.values(cfg, model), diverged, engine)

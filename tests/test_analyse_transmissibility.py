@@ -44,7 +44,8 @@ def ps_front(tmp_path_factory):
 @pytest.mark.slow
 def test_front_picks_as_stored_reproduce_their_objectives(tmp_path, ps_front):
     """Without a passenger the seat is the stored one: the picks' Wk r.m.s. of seat.acc and
-    X_ST are their stored objectives RC_se and X_ST (Eq 8.1-8.2), bit for bit."""
+    X_ST are their stored objectives RC_se and X_ST (Eq 8.1-8.2): X_ST bit for bit, RC_se to
+    rounding (the evaluation forms and sums the weighted signal in the compiled kernel)."""
     out, fig = tmp_path / "stht.h5", tmp_path / "stht.svg"
     proc = run("analyse", "transmissibility", ps_front.path, "-o", out, "--plot", fig)
     assert proc.returncode == 0, proc.stderr
@@ -63,7 +64,8 @@ def test_front_picks_as_stored_reproduce_their_objectives(tmp_path, ps_front):
         for key, row in ps_front.picks.items():
             assert key in labels[ps_front.rows.index(row)]
         assert h5["linear/seat"].shape == (P, 500) and "head" not in h5["linear"]
-        assert np.array_equal(h5["weighted_rms/seat.acc"][()], ps_front.F[ps_front.rows, 0])
+        got, stored = h5["weighted_rms/seat.acc"][()], ps_front.F[ps_front.rows, 0]
+        np.testing.assert_allclose(got, stored, rtol=1e-13)  # (the kernel's sums: to rounding)
         assert np.array_equal(h5["statics/static_deflection"][()], ps_front.F[ps_front.rows, 1])
 
 

@@ -179,7 +179,9 @@ def test_load_mass_follows_the_rule_of_analyse_masses():
     result = suspopt.simulate(
         plain._sim_cfg.model_copy(update={"metrics": [plain.cfg.objectives.main[0]]}), params
     )
-    assert np.array_equal(FS[:, 1, 0], result.metrics["RC_se"])
+    # (to rounding: the compiled engine's evaluation forms and sums the weighted signal in its
+    # kernel, suspopt/integrator/accumulators.py)
+    np.testing.assert_allclose(FS[:, 1, 0], result.metrics["RC_se"], rtol=1e-13)
     # X_ST follows the load: K_v stays, m grows
     assert np.allclose(FS[:, 1, 1], FS[:, 0, 1] * 115 / 95)
 

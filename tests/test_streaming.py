@@ -138,10 +138,16 @@ def test_every_metric_reduced_in_windows_is_the_whole_runs(engine, monkeypatch):
     whole = simulate(cfg, params)
     assert isinstance(reduced, streaming.Reduced)
     for spec, names in requests:
+        stream = METRICS[spec.metric].stream
         for name in names:
             got, want = reduced.metric(spec, name), whole.metric(spec, name)
-            if METRICS[spec.metric].stream == "moments":
-                np.testing.assert_allclose(got, want, rtol=1e-13, err_msg=spec.metric)
+            # the signals the compiled kernel forms and reduces itself (to rounding:
+            # suspopt/integrator/accumulators.py), an MTVV or a kept signal in numpy
+            kernel = engine == "compiled" and stream != "keep" and spec.metric != "mtvv"
+            if stream == "moments" or kernel:
+                size = np.abs(whole.signals[name]).max() ** (2 if spec.metric == "var" else 1)
+                np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-14 * size,
+                                           err_msg=spec.metric)  # fmt: skip
             else:
                 assert np.array_equal(got, want, equal_nan=True), spec.metric
     assert np.array_equal(reduced.diverged_at, whole.diverged_at, equal_nan=True)

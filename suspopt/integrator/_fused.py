@@ -179,16 +179,22 @@ def cache_dir() -> Path:
 
 
 #: The functions loaded in this process, by packed structure.
-_LOADED: dict[bytes, tuple] = {}
+_LOADED: dict[bytes, tuple | None] = {}
 
 
 def steps(idx: np.ndarray, lay: np.ndarray) -> tuple | None:
     """The compiled ``(first, regular)`` of the network packed as ``idx, lay``, or None
     when the generated module cannot be kept (the cache not writable)."""
-    key = idx.tobytes() + b"|" + lay.tobytes()
-    if key in _LOADED:
-        return _LOADED[key]
-    text = source(idx, lay)
+    key = b"steps|" + idx.tobytes() + b"|" + lay.tobytes()
+    if key not in _LOADED:
+        _LOADED[key] = load(source(idx, lay), ("first", "regular"))
+    return _LOADED[key]
+
+
+def load(text: str, names: tuple[str, ...]) -> tuple | None:
+    """The functions ``names`` of the generated module ``text``, compiled (module
+    docstring: the file kept under its hash, the text of this process run), or None when the
+    cache cannot be written."""
     digest = hashlib.sha256(text.encode()).hexdigest()[:24]
     try:
         folder = cache_dir()
@@ -208,5 +214,4 @@ def steps(idx: np.ndarray, lay: np.ndarray) -> tuple | None:
     module.__file__ = str(path)
     sys.modules[module.__name__] = module  # (numba's cache finds the module by its name)
     exec(compile(text, str(path), "exec"), module.__dict__)
-    _LOADED[key] = (module.first, module.regular)
-    return _LOADED[key]
+    return tuple(getattr(module, name) for name in names)

@@ -34,7 +34,7 @@ from numba import types
 from numba.extending import intrinsic
 
 from ..control.laws import LAWS
-from . import _fused
+from ._accumulate import accumulate, no_accumulate, no_first, no_regular
 
 _jit = numba.njit(cache=True, nogil=True)
 #: A helper compiled into its one caller (no call, no reference counts).
@@ -53,18 +53,8 @@ def _address_of(typingctx, array):
 _address: Any = intrinsic(_address_of)
 
 
-@numba.cfunc(_fused.FIRST, cache=True)
-def _no_first(W, par, u, has, h):  # pragma: no cover - never called
-    """The fused first stage's stand-in where the kernel walks the network."""
-
-
-@numba.cfunc(_fused.REGULAR, cache=True)
-def _no_regular(W, par, u, w, mid, end, dt):  # pragma: no cover - never called
-    """The fused regular step's stand-in where the kernel walks the network."""
-
-
 #: The kernel's ``fused`` argument where it walks the network (:func:`run`).
-NOT_FUSED = (0, _no_first, _no_regular)
+NOT_FUSED = (0, no_first, no_regular, 0, no_accumulate)
 #: Samples a block buffers before writing them to the records.
 SAMPLES = 32
 #: The blocks of W.
@@ -393,7 +383,8 @@ def _keep(W, rec, t, n, pb, idx, lay, kept):
 def _flush(rec, j0, count, p0, out, dest):
     """The buffer's first ``count`` samples to samples ``j0 ..`` of the records (its row
     ``m`` is record row ``dest[m]`` of the whole network's ``n`` DOFs: the states ``0 ..
-    2n``, the accelerations ``2n .. 3n``, the lagged coefficients from ``3n`` on): a
+    2n``, the accelerations ``2n .. 3n``, the lagged coefficients from ``3n`` on; -1 for a
+    row only the kernel's own reductions read): a
     transposed copy that writes each design's row as a contiguous run (writing every sample
     straight to the ``(rows, P, T)`` records touches a new cache line per value and took two
     thirds of the run)."""
@@ -401,7 +392,7 @@ def _flush(rec, j0, count, p0, out, dest):
     n = states.shape[0] // 2
     for m in range(dest.shape[0]):
         i = dest[m]
-        for b in range(rec.shape[2]):
+        for b in range(rec.shape[2] if i >= 0 else 0):
             for t in range(count):
                 if i < 2 * n:
                     states[i, p0 + b, j0 + t] = rec[t, m, b]
@@ -518,8 +509,9 @@ def _advance(
     """Block ``blk``'s steps ``k0 .. k1 - 1`` from its kept state (step ``n_steps`` is the
     final sample alone): the sample's first stage, the sample when one is due (sample ``j``
     written at ``j - origin`` of the records, ``origin`` a multiple of :data:`SAMPLES`), the
-    step, the divergence check. ``fused = (on, first, regular)``: when ``on``, the first
-    stage and the regular steps are the network's fused functions (:mod:`._fused`)."""
+    step, the divergence check. ``fused = (on, first, regular, summing, summed)``: when ``on``, the first
+    stage and the regular steps are the network's fused functions (:mod:`._fused`), and
+    when ``summing`` the samples' reductions the generated ``summed``."""
     W_all, F_all, rec_all, at_all = state[0], state[1], state[2], state[3]
     states, diverged_at = out[0], out[2]
     W, F, rec, at, pb = W_all[blk], F_all[blk], rec_all[blk], at_all[blk], par[blk]
@@ -527,7 +519,7 @@ def _advance(
     off, active, split_of, start_jumps, no_pull = road[0], road[1], road[2], road[10], road[11]
     lr, kept, dest = road[12][blk], state[4], state[5]
     cp, ci, records = ctl[0][blk], ctl[1], ctl[2][:, :, blk * B : blk * B + B]
-    on, first, regular = fused
+    on, first, regular, summing, summed = fused
     Wp, pp = _address(W), _address(pb)
     if k0 == 0:
         for u in range(start_jumps.shape[0]):
@@ -546,6 +538,12 @@ def _advance(
             _keep(W, rec, j % SAMPLES, n, pb, idx, lay, kept)
             if j % SAMPLES == SAMPLES - 1 or j - origin == states.shape[2] - 1:
                 _flush(rec, j - j % SAMPLES - origin, j % SAMPLES + 1, blk * B, out, dest)
+                if summing:  # (the generated reductions, :mod:`._accumulate`)
+                    summed(_address(rec), _address(state[8][blk]), _address(state[7][blk]),
+                           _address(state[9]), _address(state[10]), j - j % SAMPLES,
+                           j % SAMPLES + 1)  # fmt: skip
+                else:
+                    accumulate(rec, j - j % SAMPLES, j % SAMPLES + 1, lr, blk, state)
         if step == n_steps:
             break
         if split_of[step] < 0 and on:
@@ -566,8 +564,9 @@ def run(
     fused,
 ):  # fmt: skip
     """Steps ``k0 .. k1 - 1`` of every block (in parallel over the cores) from the kept
-    ``state = (W, F, rec, at, kept, dest)`` of each (``kept``: the rows the samples keep,
-    :func:`_keep`; ``dest``: the records' rows they go to, :func:`_flush`), ``par (blocks,
+    ``state = (W, F, rec, at, kept, dest, *red)`` of each (``kept``: the rows the samples
+    keep, :func:`_keep`; ``dest``: the records' rows they go to, :func:`_flush`; ``red``: the
+    signals the kernel reduces, :mod:`._accumulate`), ``par (blocks,
     rows, B)`` (the arrays: :func:`.compiled._packed`), samples from ``origin`` on in
     ``out``; ``fused``: :func:`_advance`, :data:`NOT_FUSED` to walk the network."""
     for blk in numba.prange(par.shape[0]):

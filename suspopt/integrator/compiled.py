@@ -267,10 +267,8 @@ def _packed(
 
 
 #: The most lanes of a block: enough to amortise each lane loop's set-up, few enough for the
-#: block's buffers to stay in the core's second-level cache (about 160 KB for the Ch. 5 half
-#: car). 128 lanes took 10-30 % less kernel time than 64 on the Ch. 5 problem at 200 and
-#: 1000 designs on this machine (64 KB of L1 data cache and 1 MB of L2 over its 2 cores);
-#: 256 took about as long as 128.
+#: block's buffers to stay in the second-level cache (about 160 KB for the Ch. 5 half car):
+#: 128 took 10-30 % less kernel time than 64 at 200 and 1000 designs here, 256 about as long.
 MAX_LANES = 128
 
 
@@ -292,24 +290,25 @@ def integrate(run: Run) -> Trajectory:
 
 
 def windows(
-    run: Run, width: int | None = None, recorded: np.ndarray | None = None
+    run: Run, width: int | None = None, recorded: np.ndarray | None = None, accumulators=None
 ) -> Iterator[tuple[int, Trajectory]]:
     """The compiled engine's :func:`.rk4.windows`: the run in windows of ``width`` output
     samples (a multiple of :data:`._kernel.SAMPLES`; all of them when None), a controlled run
     whole. ``recorded (3n,)`` says which rows of the states ``[q; q']`` and then of the
     accelerations the samples keep (all when None); the others are not written (the caller
-    reads none of them: :func:`suspopt.streaming.recorded_rows`). Writing the samples is a
-    third of the kernel's time when every row is kept (the Ch. 5 problem's objectives read
-    5 of its 12 rows, Part B's of Ch. 6 5 of 36), and filling the rest with NaN would cost
-    about as much as writing them. Without a controller, only the DOFs and elements those rows
-    depend on are integrated (:func:`.reach.reached`): the same arithmetic for them, and a part
-    that no recorded row depends on neither costs time nor, by diverging, fails a design."""
+    reads none of them: :func:`suspopt.streaming.recorded_rows`; writing every row is a third
+    of the kernel's time, filling the rest with NaN would cost about as much). ``accumulators``
+    (:class:`.accumulators.Accumulators`, with ``recorded``, no controller): signals the
+    kernel forms and reduces itself, their rows read but not recorded. Without a controller,
+    only the DOFs and elements those rows depend on are integrated (:func:`.reach.reached`):
+    the same arithmetic for them, and a part that no row read depends on neither costs time
+    nor, by diverging, fails a design."""
     asm, n_vehicle, offsets, dt, n_steps, every, controller, edges = run
     import numba
 
-    from . import _fused, _kernel
+    from . import _accumulate, _fused, _kernel
 
-    n, R, P0 = asm.n, asm.R, asm.P
+    n, P0 = asm.n, asm.P
     n_out = n_steps // every + 1
     width = n_out if width is None else width
     if controller is not None and width < n_out:
@@ -320,28 +319,26 @@ def windows(
     if controller is not None and controller.lag_decay is not None:
         lagged = _damper_elements(asm)
         decay = controller.lag_decay.reshape(1, -1)
-    reach = None if recorded is None or controller is not None else reached(asm, recorded)
+    reach = None
+    if recorded is not None and controller is None:
+        reach = reached(asm, recorded if accumulators is None else recorded | accumulators.rows(n))
     fusable = _fusable(offsets, controller, P0)
     B = _fused.LANES if fusable else block_width(P0, numba.get_num_threads())
     blocks = -(-P0 // B)
     P = blocks * B  # whole blocks: the last design repeated
     flat, idx, lay = _packed(asm, dt, P, lagged, decay, reach)
     steps = _fused.steps(idx, lay) if fusable else None
-    fused = _kernel.NOT_FUSED if steps is None else (1, *steps)
     Nl = int(lay[11])
     par = np.ascontiguousarray(flat.reshape(flat.shape[0], blocks, B).transpose(1, 0, 2))
-    # the inputs' part (T, G, 2R) of G roads, each under P0/G consecutive designs, and the road
-    # of each lane (the padding's the last design's)
-    off = np.ascontiguousarray(offsets[:, :, :, 0].transpose(0, 2, 1))
-    G = off.shape[1]
-    lane_road = np.minimum(np.arange(P) // (P0 // G), G - 1).reshape(blocks, B)
-    road = (off, off.any(axis=(1, 2))) + _edge_arrays(asm, edges, dt, n_steps, off)
-    road = (road if reach is None else reached_road(road, reach[1], R)) + (lane_road,)
-    state = _kernel_state(blocks, B, lay, n, recorded, reach)
+    road = _road_arrays(run, reach, (blocks, B))
+    state = _kernel_state(blocks, B, lay, n, (recorded, accumulators), reach)
+    fused = _kernel.NOT_FUSED if steps is None else (1, *steps, *_accumulate.summed(state, B))
     diverged_at = np.full(P, np.nan)
+    formed = accumulators is not None and recorded is not None and not recorded.any()
+    rows = 0 if formed else n  # (every signal formed in the kernel: no records)
     for j0 in range(0, n_out, width):
         T = min(width, n_out - j0)
-        states, accelerations = np.empty((2 * n, P, T)), np.empty((n, P, T))
+        states, accelerations = np.empty((2 * rows, P, T)), np.empty((rows, P, T))
         out = (states, accelerations, diverged_at, np.empty((Nl, P, T)))
 
         def advance(k0: int, k1: int, ctl=_no_control(blocks, B), out=out, j0=j0) -> None:
@@ -371,6 +368,19 @@ def windows(
         )
 
 
+def _road_arrays(run: Run, reach, lanes: tuple[int, int]) -> tuple:
+    """The kernel's ``road``: the inputs' part ``(T, G, 2R)`` of G roads (each under P0/G
+    consecutive designs) and whether each half step has one, the edges' arrays
+    (:func:`_edge_arrays`), of the ``reach`` elements alone, and the road of each lane of
+    ``lanes = (blocks, B)`` (the padding's the last design's)."""
+    asm, offsets, P0 = run.asm, run.offsets, run.asm.P
+    off = np.ascontiguousarray(offsets[:, :, :, 0].transpose(0, 2, 1))
+    G, (blocks, B) = off.shape[1], lanes
+    lane_road = np.minimum(np.arange(blocks * B) // (P0 // G), G - 1).reshape(blocks, B)
+    road = (off, off.any(axis=(1, 2))) + _edge_arrays(asm, run.edges, run.dt, run.n_steps, off)
+    return (road if reach is None else reached_road(road, reach[1], asm.R)) + (lane_road,)
+
+
 def _fusable(offsets: np.ndarray, controller, P: int) -> bool:
     """Whether a run's regular steps take the network's fused functions (:mod:`._fused`):
     no controller, one road for every design (``offsets (T, 2R, G, 1)``) and at least
@@ -383,24 +393,33 @@ def _fusable(offsets: np.ndarray, controller, P: int) -> bool:
     return controller is None and offsets.shape[2] == 1 and P >= _fused.MIN_DESIGNS
 
 
-def _kernel_state(blocks: int, B: int, lay: np.ndarray, n: int, recorded, reach) -> tuple:
-    """The kernel's ``state = (W, F, rec, at, kept, dest)`` (:func:`._kernel.run`) of a
-    network of ``n`` DOFs packed as ``lay`` (its ``reach`` of them, :func:`.reach.reached`), its
-    samples keeping the rows ``recorded (3n,)`` (all when None) and the lagged
-    coefficients."""
+def _kernel_state(blocks: int, B: int, lay: np.ndarray, n: int, kept, reach) -> tuple:
+    """The kernel's ``state = (W, F, rec, at, kept, dest, *red)`` (:func:`._kernel.run`) of
+    a network of ``n`` DOFs packed as ``lay`` (its ``reach`` of them, :func:`.reach.reached`),
+    ``kept = (recorded, accumulators)``: its samples recording the rows ``recorded (3n,)``
+    (all when None) and the lagged coefficients, and buffering the rows the
+    ``accumulators`` read (or None) for the kernel's own reductions."""
     from . import _kernel
+    from .accumulators import no_accumulators
 
     Nl, n_kernel, R = int(lay[11]), int(lay[4]), int(lay[2])  # (the reached DOFs, elements)
+    recorded, accumulators = kept
     recorded = np.ones(3 * n, np.bool_) if recorded is None else recorded
-    wanted = np.flatnonzero(recorded)  # rows of the records, and where the kernel has them
+    reads = recorded if accumulators is None else recorded | accumulators.rows(n)
+    wanted = np.flatnonzero(reads)  # rows of the buffer, and where the kernel has them
     rows = wanted if reach is None else renumbered(wanted, n, reach[0])
+    red = no_accumulators(blocks, B) if accumulators is None else accumulators.arrays(
+        blocks, B, wanted)  # fmt: skip
     return (
         np.zeros((blocks, 11, 2 * n_kernel, B)),
         np.empty((blocks, 3, R, B)),
         np.empty((blocks, _kernel.SAMPLES, rows.size + Nl, B)),
         np.full((blocks, B), np.nan),
         np.concatenate([rows, 3 * n_kernel + np.arange(Nl)]).astype(np.int64),
-        np.concatenate([wanted, 3 * n + np.arange(Nl)]).astype(np.int64),
+        np.concatenate([np.where(recorded[wanted], wanted, -1), 3 * n + np.arange(Nl)]).astype(
+            np.int64
+        ),
+        *red,
     )
 
 
