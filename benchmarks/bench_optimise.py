@@ -11,7 +11,8 @@ and tyre coefficients) and the bump from the road section, integrates it with RK
 (``rtol = 1e-4``, ``max_step`` a quarter of the bump's duration), samples it on the same 1 ms
 grid and computes the same objectives and constraints with the public metric functions. It runs
 on the first ``--per-design`` designs (default 40) and its rate is per design. The batched
-path is timed as the best of ``REPEATS`` calls on the whole population, on the numpy engine
+path is timed as the best of ``REPEATS`` calls on the whole population, each engine's after a
+pause of ``QUIET`` (OpenBLAS's spinning threads), on the numpy engine
 and (when numba is installed) the compiled engine (``simulation.engine: compiled``), whose
 objectives are also compared with the numpy engine's.
 
@@ -43,6 +44,12 @@ RTOL, ATOL = 1.0e-4, 1.0e-7
 #: population after another, and the first call of a size also pays the operating system for
 #: memory the process has not touched before.
 REPEATS = 3
+#: Pause before an engine's timed calls [s]. OpenBLAS's threads keep spinning for about 0.1 s
+#: after its last product (its thread time-out, 2**28 cycles), so calls right after the numpy
+#: engine's share the cores with them: the compiled engine's evaluation of 200 designs took
+#: 7.5-18.9 ms in the first five calls after the numpy engine's and 7.3-8.7 ms after a 0.3 s
+#: pause (2026-12-05). An optimiser runs one engine and never pays this.
+QUIET = 0.3
 
 
 def bump(road, offsets: np.ndarray, t) -> tuple[np.ndarray, np.ndarray]:
@@ -152,6 +159,7 @@ def main() -> None:
         X = problem.xl + rng.random((P, problem.n_var)) * (problem.xu - problem.xl)
         results = {}
         for engine, p in problems.items():
+            time.sleep(QUIET)
             batched = np.inf
             for _ in range(REPEATS):  # the optimiser's steady state, one generation
                 start = time.perf_counter()

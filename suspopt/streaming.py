@@ -575,8 +575,8 @@ def reduce(
     if kernel is not None:
         streams.hand_over(kernel)
     recorded = _recorded(cfg, (pv, model, attachments, run, z), streams.numpy_reads())
-    if kernel is not None and recorded is not None and not recorded.any():
-        width = None  # (nothing recorded, nothing held per sample: one call of the kernel)
+    if kernel is not None and not streams.numpy_reads():
+        kernel.alone, width = True, None  # (no record, nothing held per sample: one call)
     table = diverged = engine = None
     for first, traj in integrator.windows(run, cfg.simulation.engine, width, recorded, kernel):
         window = _result(cfg, pv, model, controller, attachments, run, (z, zd, t_grid), traj, first)

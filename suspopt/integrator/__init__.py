@@ -102,9 +102,9 @@ def windows(
     caller reads; the compiled engine may leave the others NaN (:func:`.compiled.windows`),
     the numpy engine computes them all anyway. The compiled engine integrates the next
     window while the caller has this one in a batch of :data:`AHEAD_DESIGNS` or more
-    (:func:`_ahead`), when the caller reads any recorded row. ``accumulators`` (:class:`.accumulators.Accumulators`, compiled engine
-    only): signals the kernel forms and reduces itself as it integrates, found in it after
-    the last window."""
+    (:func:`_ahead`), when the caller reads any recorded row. ``accumulators``
+    (:class:`.accumulators.Accumulators`, compiled engine only): signals the kernel forms
+    and reduces itself as it integrates, found in it after the last window."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, not {engine!r}")
     if engine == "compiled" and not compiled_available():

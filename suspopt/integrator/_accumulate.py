@@ -17,10 +17,11 @@ road's inputs at that instant), then
 ``red = (ri, coef, acc, filt, zs)``: ``ri`` the indices (``[S, K, Wn, SUM_BLOCK]``, then
 ``(signal, source)`` of each of the K terms, then ``(signal, filter offset, M, sections,
 first row)`` of each of the Wn pairs); ``coef (blocks, K + S, B)`` the terms' coefficients
-then the signals' constants; ``acc (blocks, rows, B)`` each signal's value, mean, M2, largest
-and smallest value (5 rows), then each pair's FIR history (M, the latest first), sections' states (2 per
-section) and the :data:`PER_PAIR` rows; ``filt`` every pair's numerator then sections (6 per section); ``zs (J, 2
-n_u, G)`` the road's inputs (heights, then rates) at every sample under each of the G roads.
+then the signals' constants; ``acc (blocks, rows, B)`` each signal's value, mean, M2,
+largest and smallest value (5 rows), then each pair's FIR history (M, the latest first), its
+sections' states (2 per section) and the :data:`PER_PAIR` rows; ``filt`` every pair's
+numerator then sections (6 per section); ``zs (J, 2 n_u, G)`` the road's inputs (heights,
+then rates) at every sample under each of the G roads.
 A term's source ``m >= 0`` is row ``m`` of the buffer (:func:`._kernel._keep`), ``m < 0``
 the road input ``-m - 1`` under the lane's road. With ``S = 0`` nothing is done.
 

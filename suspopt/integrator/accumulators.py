@@ -8,7 +8,7 @@ kernel forms it at each sample from its own buffer and accumulates its moments, 
 and its weighted sums as the integration runs, so its rows are neither written to the
 ``(rows, P, T)`` records nor read back, and no numpy pass runs over it. Which signals are
 affine, and their coefficients, comes from the signal table itself
-(:func:`suspopt.streaming.affine_signals` probes it), not from a second description.
+(:func:`suspopt.affine.affine_signals` probes it), not from a second description.
 
 The kernel's arithmetic is its own (the terms in turn, Welford's update, sums in blocks of
 ``SUM_BLOCK``): each value agrees with the whole run's metric to rounding (about 1e-15
@@ -44,7 +44,8 @@ class Accumulators:
     """The signals ``signals`` the kernel forms and reduces, the weighted pairs ``pairs``
     (index into ``signals``, filter or None for the signal itself), the road inputs ``zs (J,
     2 n_u, G)`` at the J samples, their rate ``fs`` [Hz], each pair's (signal name,
-    weighting) ``pair_keys``, and after the run the accumulators (:meth:`moments`,
+    weighting) ``pair_keys``, whether they are ``alone`` (no signal read from records: the
+    engine then writes none), and after the run the accumulators (:meth:`moments`,
     :meth:`weighted`)."""
 
     signals: list[Affine]
@@ -52,6 +53,7 @@ class Accumulators:
     zs: np.ndarray
     fs: float
     pair_keys: list[tuple[str, str | None]]
+    alone: bool = False
     acc: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 1)))
     _pair_rows: list[int] = field(default_factory=list)
 

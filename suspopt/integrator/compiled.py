@@ -334,8 +334,7 @@ def windows(
     state = _kernel_state(blocks, B, lay, n, (recorded, accumulators), reach)
     fused = _kernel.NOT_FUSED if steps is None else (1, *steps, *_accumulate.summed(state, B))
     diverged_at = np.full(P, np.nan)
-    formed = accumulators is not None and recorded is not None and not recorded.any()
-    rows = 0 if formed else n  # (every signal formed in the kernel: no records)
+    rows = 0 if getattr(accumulators, "alone", False) else n  # (every signal in the kernel)
     for j0 in range(0, n_out, width):
         T = min(width, n_out - j0)
         states, accelerations = np.empty((2 * rows, P, T)), np.empty((rows, P, T))
