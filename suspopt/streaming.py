@@ -360,28 +360,41 @@ def recorded_rows(result_of, n: int, P: int, names: Sequence[str]) -> np.ndarray
     return read
 
 
+def _probe_result(cfg: Config, setup, states, accelerations, z=None, zd=None):
+    """The Result of the probe samples ``states (2n, P, T)``, ``accelerations (n, P, T)``
+    of the designs of ``setup = (designs, model, attachments, run, road inputs (n_u, G, ..))``,
+    without a controller (whose records read no state), under road heights and rates ``z,
+    zd (n_u, T)`` at those samples (zero when None), for :func:`recorded_rows` and
+    :func:`suspopt.affine.affine_signals`."""
+    from .integrator import Trajectory
+    from .simulate import _result
+
+    pv, model, attachments, run, road = setup
+    T, step = states.shape[-1], 2 * cfg.simulation.output_every
+    grid = [np.zeros(road.shape[:2] + (T * step,)) for _ in range(2)]
+    for inputs, given in zip(grid, (z, zd)):
+        if given is not None:
+            inputs[:, :, ::step] = given[:, None]
+    times = np.arange(T * step) * (0.5 * cfg.simulation.dt)
+    traj = Trajectory(states, accelerations, None, {}, np.full(pv.P, np.nan))
+    return _result(cfg, pv, model, None, attachments, run, (grid[0], grid[1], times), traj)
+
+
 def _recorded(cfg: Config, setup, names: Sequence[str]) -> np.ndarray | None:
     """The rows of the states and accelerations the signals ``names`` read
-    (:func:`recorded_rows`; ``setup = (designs, model, attachments, run, road inputs)``; the
-    probe has no controller, whose records read no state), or None on the numpy engine or
-    without numba (which computes every row)."""
-    from .integrator import Trajectory, compiled_available
+    (:func:`recorded_rows` on :func:`_probe_result`; ``setup = (designs, model,
+    attachments, run, road inputs)``), or None on the numpy engine or without numba (which
+    computes every row)."""
+    from .integrator import compiled_available
 
     if cfg.simulation.engine == "numpy" or not compiled_available():
         return None
-    from .simulate import _result
-
-    pv, model, attachments, run, z = setup
+    pv, run = setup[0], setup[3]
     if not names:  # (every signal formed in the kernel: no row to record)
         return np.zeros(3 * run.asm.n, np.bool_)
-    step = 2 * cfg.simulation.output_every
 
-    def result_of(states, accelerations):
-        T = states.shape[-1]
-        zeros = np.zeros(z.shape[:2] + (T * step,))  # no road: its signals read no state
-        grid = (zeros, zeros, np.arange(T * step) * (0.5 * cfg.simulation.dt))
-        traj = Trajectory(states, accelerations, None, {}, np.full(pv.P, np.nan))
-        return _result(cfg, pv, model, None, attachments, run, grid, traj)
+    def result_of(states, accelerations):  # (no road: its signals read no state)
+        return _probe_result(cfg, setup, states, accelerations)
 
     return recorded_rows(result_of, run.asm.n, pv.P, names)
 
@@ -397,23 +410,14 @@ def _kernel_streams(cfg: Config, setup, streams: _Streams):
     if run.controller is not None or not compiled_runs(run, cfg.simulation.engine):
         return None
     from .affine import kernel_accumulators
-    from .integrator import Trajectory
-    from .simulate import _result
 
-    step = 2 * cfg.simulation.output_every
-    n_u, G = road[0].shape[:2]
+    probed = (pv, model, attachments, run, road[0])
 
     def result_of(states, accelerations, z, zd):
-        T = states.shape[-1]
-        grid = [np.zeros((n_u, G, T * step)) for _ in range(2)]
-        grid[0][:, :, ::step], grid[1][:, :, ::step] = z[:, None], zd[:, None]
-        traj = Trajectory(states, accelerations, None, {}, np.full(pv.P, np.nan))
-        times = np.arange(T * step) * (0.5 * cfg.simulation.dt)
-        return _result(
-            cfg, pv, model, None, attachments, run, (grid[0], grid[1], times), traj
-        ).signals
+        return _probe_result(cfg, probed, states, accelerations, z, zd).signals
 
-    shape = (run.asm.n, n_u, pv.P)
+    shape = (run.asm.n, road[0].shape[0], pv.P)
+    step = 2 * cfg.simulation.output_every
     return kernel_accumulators(result_of, shape, streams.kernel_candidates(model), road, step)
 
 

@@ -69,6 +69,7 @@ class Accumulators:
         buffer's rows being the whole network's rows ``wanted`` (sorted), in order."""
         from ..metrics.iso2631 import SUM_BLOCK
         from ._accumulate import PER_PAIR, PER_SIGNAL
+        from .compiled import padded
 
         P = blocks * B
         S = len(self.signals)
@@ -92,7 +93,8 @@ class Accumulators:
             self._pair_rows.append(row)
             row += PER_PAIR
         ri = np.array([S, len(terms) // 2, len(self.pairs), SUM_BLOCK] + terms + pairs, np.int64)
-        coef = np.stack([_lanes(c, P) for c in coefficients]) if coefficients else np.zeros((0, P))
+        # the coefficients (P0,) each over the lanes, the last design repeated
+        coef = padded(np.stack(coefficients), P) if coefficients else np.zeros((0, P))
         acc = np.zeros((row, P))
         for s in range(S):
             acc[PER_SIGNAL * s + 3], acc[PER_SIGNAL * s + 4] = -np.inf, np.inf
@@ -119,14 +121,6 @@ class Accumulators:
         """Pair ``p``'s sums of ``a_w²`` and ``a_w⁴`` and its largest ``|a_w|``, (P,) each."""
         part, total, part4, total4, peak = self._rows(self._pair_rows[p] + 1, 5, P)
         return total + part, total4 + part4, peak
-
-
-def _lanes(values: np.ndarray, P: int) -> np.ndarray:
-    """``values`` (P0,) or (1,) over P >= P0 lanes, the last design repeated."""
-    values = np.asarray(values, float).reshape(-1)
-    if values.size == 1:
-        return np.full(P, values[0])
-    return np.concatenate([values, np.repeat(values[-1:], P - values.size)])
 
 
 def no_accumulators(blocks: int, B: int) -> tuple:

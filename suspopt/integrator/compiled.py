@@ -103,7 +103,7 @@ def unsupported(asm: Assembled, controller: Controller | None) -> str | None:
     return None
 
 
-def _padded(a: np.ndarray, P: int) -> np.ndarray:
+def padded(a: np.ndarray, P: int) -> np.ndarray:
     """``a (..., 1 | P0)`` over ``P >= P0`` designs, the last one repeated, contiguous."""
     if a.shape[-1] == 1:
         return np.ascontiguousarray(np.broadcast_to(a, a.shape[:-1] + (P,)))
@@ -118,7 +118,7 @@ def _entries(matrix: np.ndarray, P: int) -> tuple[np.ndarray, np.ndarray, np.nda
     rows, cols = np.nonzero(mask)
     values = matrix[..., rows, cols]  # (nnz,) or (P0, nnz)
     values = values.T if matrix.ndim == 3 else values[:, None]
-    return rows.astype(np.int64), cols.astype(np.int64), _padded(values, P)
+    return rows.astype(np.int64), cols.astype(np.int64), padded(values, P)
 
 
 def _every_row(
@@ -152,7 +152,7 @@ def _laws(asm: Assembled, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
                 rows.append(start + i)
                 row = np.zeros((LAW_PARAMETERS, P))
                 for j in range(count):
-                    row[j] = _padded(values[j][i, :, 0], P)
+                    row[j] = padded(values[j][i, :, 0], P)
                 params.append(row)
         start += g.size
     stacked = np.stack(params, axis=1) if params else np.zeros((LAW_PARAMETERS, 0, P))
@@ -242,18 +242,18 @@ def _packed(
         n, R = dofs.size, elements.size
     d_row, d_col, d_val = _every_row(_entries(D, P), R)
     g_row, g_col, g_val = _every_row(_entries(G, P), n)
-    im = _padded(im, P)
+    im = padded(im, P)
     parts = [
         d_val,
         g_val,
-        _padded(k, P),
-        _padded(c, P),
+        padded(k, P),
+        padded(c, P),
         law_par.transpose(1, 0, 2).reshape(-1, P),  # (5 X, P): the laws' parameters in turn
         im,
         im * (0.5 * dt),
         im * dt,
         im * (dt / 6.0),
-        _padded(np.broadcast_to(decay, (lagged.size, decay.shape[-1])), P)
+        padded(np.broadcast_to(decay, (lagged.size, decay.shape[-1])), P)
         if lagged.size
         else np.zeros((0, P)),
         np.zeros((lagged.size, P)),  # the command's share, set at each controller sample
@@ -490,7 +490,7 @@ def _control_arrays(
     P = blocks * B
     r_row, r_col, r_val = _entries(rules.rates, P)
     values = [rules.c_min, rules.c_max, rules.threshold, *rules.parameters]
-    cp = np.concatenate([r_val] + [_padded(np.asarray(v, float).T, P) for v in values])
+    cp = np.concatenate([r_val] + [padded(np.asarray(v, float).T, P) for v in values])
     codes = [_kernel.CONTROL_LAWS.index(law) if law else -1 for law in rules.laws]
     ci = [len(rules.laws), r_row.size, every_c, int(final), int(rules.needs_acceleration)]
     ci += [int(lagged)] + codes + [int(b) for b in rules.below] + list(_damper_elements(asm))
@@ -596,4 +596,4 @@ def _refitted(controller, rules, ci: np.ndarray, cp: np.ndarray, record: np.ndar
     blocks, _, B = cp.shape
     o = int(ci[1]) + 2 * N
     threshold = np.broadcast_to(values["threshold"], rules.c_min.shape).T  # (N, P)
-    cp[:, o : o + N] = _padded(threshold, blocks * B).reshape(N, blocks, B).transpose(1, 0, 2)
+    cp[:, o : o + N] = padded(threshold, blocks * B).reshape(N, blocks, B).transpose(1, 0, 2)
