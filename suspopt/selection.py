@@ -391,12 +391,8 @@ def select(
                 f"{files}: no design of case {label} to sort (every one failed "
                 f"or is infeasible){hint}"
             )
-    F = np.vstack([s.F[k][:, [s.names.index(n) for n in names]] for s, k in zip(sets, keep)])
-    X = np.vstack([_columns(s.X[k], s.var_names, var_names) for s, k in zip(sets, keep)])
-    case = np.concatenate([np.full(k.sum(), s.label, dtype=object) for s, k in zip(sets, keep)])
-    source = np.concatenate([np.full(k.sum(), i) for i, k in enumerate(keep)])
-    row = np.concatenate([np.flatnonzero(k) for k in keep])
-    feasible = np.concatenate([s.feasible[k] for s, k in zip(sets, keep)])
+    pooled = _pooled(sets, keep, names, var_names)
+    F, case = pooled["F"], pooled["case"]
     options = dict(eps=eps, P=P, normalise=normalise, names=names, P_range=P_range, P_step=P_step)
     try:
         pool = kesort(F, **options)
@@ -409,23 +405,35 @@ def select(
     except ValueError as exc:
         raise ConfigError(f"{', '.join(str(s.source) for s in sets)}: {exc}") from None
     return Selection(
-        F=F,
+        **pooled,
         names=names,
         units=units,
-        X=X,
         var_names=var_names,
         var_units=var_units,
-        case=case,
-        cases=cases,
-        source=source,
-        row=row,
-        feasible=feasible,
-        sets=sets,
         sort=pool,
         picks=pareto_picks(F, names),
+        cases=cases,
         case_sorts=case_sorts,
+        sets=sets,
         notes=notes,
     )
+
+
+def _pooled(
+    sets: list[DesignSet], keep: list[np.ndarray], names: list[str], var_names: list[str]
+) -> dict[str, np.ndarray]:
+    """The kept designs of ``sets`` in one pool (:class:`Selection`'s ``F``, ``X``, ``case``,
+    ``source``, ``row`` and ``feasible``): the objectives ``names`` and the variables
+    ``var_names`` in that order."""
+    pairs = list(zip(sets, keep))
+    return {
+        "F": np.vstack([s.F[k][:, [s.names.index(n) for n in names]] for s, k in pairs]),
+        "X": np.vstack([_columns(s.X[k], s.var_names, var_names) for s, k in pairs]),
+        "case": np.concatenate([np.full(k.sum(), s.label, dtype=object) for s, k in pairs]),
+        "source": np.concatenate([np.full(k.sum(), i) for i, k in enumerate(keep)]),
+        "row": np.concatenate([np.flatnonzero(k) for k in keep]),
+        "feasible": np.concatenate([s.feasible[k] for s, k in pairs]),
+    }
 
 
 def _columns(X: np.ndarray, have: list[str], want: list[str]) -> np.ndarray:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -44,7 +44,17 @@ __all__ = [
 ]
 
 
-def prepare(cfg: Config, params: Mapping[str, Any] | None = None):
+class Prepared(NamedTuple):
+    """What :func:`prepare` makes of a config: the designs, the model, the controller (None
+    for a passive run) and the attachments (seat, passenger)."""
+
+    pv: ParamView
+    model: VehicleModel
+    controller: Controller | None
+    attachments: list[Attachment]
+
+
+def prepare(cfg: Config, params: Mapping[str, Any] | None = None) -> Prepared:
     """Designs, model, controller and attachments of a run, after the checks that need no
     integration (so that bad input fails before any): the time grid and the road against
     ``dt`` (:func:`suspopt.checks.check_steps`), and the metric specs and ``output.signals``
@@ -69,7 +79,7 @@ def prepare(cfg: Config, params: Mapping[str, Any] | None = None):
                     f"unknown signal {name!r}"
                     + (f"; did you mean {', '.join(close)}?" if close else ""),
                 )
-    return pv, model, controller, attachments
+    return Prepared(pv, model, controller, attachments)
 
 
 def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:
@@ -93,9 +103,10 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:
         Signals ``(P, T)`` with their SI units (``Result.signal_unit``), the metrics ``(P,)``
         and the time ``(T,)`` [s].
     """
-    pv, model, controller, attachments = prepare(cfg, params)
+    prepared = prepare(cfg, params)
+    pv, model, _, attachments = prepared
     check_memory(cfg, model, attachments, pv.P, signals=len(cfg.metrics))
-    result = _run(cfg, pv, model, controller, attachments)
+    result = _run(cfg, prepared)
     for spec in cfg.metrics:
         for name, values, unit in evaluate_spec(spec, result, result.signal_unit):
             result.metrics[name] = values
@@ -153,20 +164,14 @@ def check_memory(
     )
 
 
-def _run(
-    cfg: Config,
-    pv: ParamView,
-    model: VehicleModel,
-    controller: Controller | None,
-    attachments: Sequence[Attachment],
-    roads: Sequence[Any] | None = None,
-) -> Result:
-    """The integration and its :class:`Result` (``roads``: :func:`_setup`); a batch of
-    several designs on one road goes to the executor in force (:mod:`suspopt.execution`) in
-    chunks when that is not ``local``."""
+def _run(cfg: Config, prepared: Prepared, roads: Sequence[Any] | None = None) -> Result:
+    """The integration of a run (:func:`prepare`) and its :class:`Result` (``roads``:
+    :func:`_setup`); a batch of several designs on one road goes to the executor in force
+    (:mod:`suspopt.execution`) in chunks when that is not ``local``."""
     from . import execution
 
     sim = cfg.simulation
+    pv, model, controller, attachments = prepared
     run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments, roads)
     chunked = pv.P > 1 and pv.params and not roads and not execution.is_local(cfg.execution)
     if chunked:

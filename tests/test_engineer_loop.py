@@ -102,7 +102,9 @@ def test_a_sweep_of_3_by_4_values_is_one_batch_of_12_named_designs(tmp_path, cap
     batches = []
     real = simulate_module._run
     monkeypatch.setattr(
-        simulate_module, "_run", lambda cfg, pv, *a: batches.append(pv.P) or real(cfg, pv, *a)
+        simulate_module,
+        "_run",
+        lambda cfg, prepared, *a: batches.append(prepared.pv.P) or real(cfg, prepared, *a),
     )
     out = tmp_path / "sweep.h5"
     code, _, err = cli(

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from contextlib import ExitStack
 from pathlib import Path
 
 import typer
@@ -52,6 +51,7 @@ def _checked(kind: str, sources: list[Path], given: dict):
 
 
 @app.command()
+@base.run_options
 def analyse(
     kind: str = typer.Argument(..., help=_analysis_help(), autocompletion=_analysis_kinds),
     sources: list[Path] = typer.Argument(
@@ -81,11 +81,8 @@ def analyse(
         "--mass-change",
         help="masses: change of the load on the seat, in kg; repeatable (default -20 and +20)",
     ),
-    force: bool = base.force_option(),
-    max_memory: str | None = base.max_memory_option(),
-    executor: str | None = base.executor_option(),
-    scheduler: str | None = base.scheduler_option(),
-    workers: int | None = base.workers_option(),
+    *,
+    run: base.RunOptions,
 ) -> None:
     """Run an analysis of configs or of a Pareto file and print its table: models, roads,
     masses, controllers, transmissibility or cdf-sensitivity (see KIND below)."""
@@ -98,15 +95,12 @@ def analyse(
         "mass_change": mass_change or None,
     }
     spec, options = _checked(kind, sources, given)
-    base.set_memory_limit(max_memory)
-    with ExitStack() as stack, base.executing(executor, scheduler, workers):
-        try:
-            if plot is not None:
-                check_path(plot)
-        except ValueError as exc:
-            base.fail(str(exc))
-        base.claim_output(stack, output, force)
-        base.claim_output(stack, plot, force, "--plot")
+    try:
+        if plot is not None:
+            check_path(plot)
+    except ValueError as exc:
+        base.fail(str(exc))
+    with run.outputs(output, plot):
         try:
             report = spec.run(sources if spec.many else sources[0], output, plot, **options)
         except (ConfigError, FileNotFoundError, ValueError) as exc:

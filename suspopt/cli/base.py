@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import inspect
 import os
 import shlex
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import ExitStack, contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -152,6 +154,68 @@ def workers_option():
         help="worker processes that processes, or dask without --scheduler, starts "
         "(default: the machine's cores)",
     )
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """The options of every command that runs a study (``simulate``, ``optimise``, ``kesort``,
+    ``analyse``): ``--force``, ``--max-memory``, ``--executor``, ``--scheduler`` and
+    ``--workers``, declared once (:func:`run_options`)."""
+
+    force: bool = False
+    max_memory: str | None = None
+    executor: str | None = None
+    scheduler: str | None = None
+    workers: int | None = None
+
+    def executing(self, progress=None, lost_hint: str = ""):
+        """:func:`executing` with the command's ``--executor``, ``--scheduler``, ``--workers``."""
+        return executing(self.executor, self.scheduler, self.workers, progress, lost_hint)
+
+    @contextmanager
+    def outputs(
+        self, output: Path | None, plot: Path | None, execute: bool = True
+    ) -> Iterator[None]:
+        """``--max-memory`` applied; then, for the block, the executor options in force (unless
+        ``execute`` is False: the command puts them in force itself) and ``output`` and
+        ``plot`` claimed (:func:`claim_output`, ``--force``)."""
+        set_memory_limit(self.max_memory)
+        with ExitStack() as stack:
+            if execute:
+                stack.enter_context(self.executing())
+            claim_output(stack, output, self.force)
+            claim_output(stack, plot, self.force, "--plot")
+            yield
+
+
+#: The :class:`RunOptions` as the command line declares them: (name, type, option).
+_RUN_OPTIONS = (
+    ("force", bool, force_option),
+    ("max_memory", str | None, max_memory_option),
+    ("executor", str | None, executor_option),
+    ("scheduler", str | None, scheduler_option),
+    ("workers", int | None, workers_option),
+)
+
+
+def run_options(command: Callable[..., None]) -> Callable[..., None]:
+    """``command``, whose last parameter is the keyword-only ``run: RunOptions``, as a typer
+    command that takes the :class:`RunOptions` after its own options and hands them over as
+    that one ``run``."""
+    own = [p for p in inspect.signature(command).parameters.values() if p.name != "run"]
+    shared = [
+        inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=option(), annotation=kind)
+        for name, kind, option in _RUN_OPTIONS
+    ]
+
+    @functools.wraps(command)
+    def wrapper(**kwargs: Any) -> None:
+        run = RunOptions(**{p.name: kwargs.pop(p.name) for p in shared})
+        command(**kwargs, run=run)
+
+    wrapper.__signature__ = inspect.Signature(own + shared)  # type: ignore[attr-defined]
+    wrapper.__annotations__ = {p.name: p.annotation for p in own + shared}
+    return wrapper
 
 
 @contextmanager

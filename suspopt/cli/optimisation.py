@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -63,6 +62,7 @@ def _optimum_table(result, rows: int = 12) -> Table:
 
 
 @app.command()
+@base.run_options
 def optimise(
     config: Path = typer.Argument(..., help="YAML config file"),
     output: Path | None = typer.Option(
@@ -76,30 +76,24 @@ def optimise(
     plot: Path | None = base.plot_option(
         "the front (or the best value) and the history per generation"
     ),
-    force: bool = base.force_option(),
-    max_memory: str | None = base.max_memory_option(),
-    executor: str | None = base.executor_option(),
-    scheduler: str | None = base.scheduler_option(),
-    workers: int | None = base.workers_option(),
+    *,
+    run: base.RunOptions,
 ) -> None:
     """Optimise the config's design variables; write the optimum or Pareto set to HDF5.
 
     The progress line's HV is the hypervolume of every feasible non-dominated design found so
     far, objectives scaled by the first feasible generation's range (reference point 1.1):
     it never falls."""
-    with ExitStack() as stack:
-        output = output if output is not None else Path(config.stem + ".h5")
-        base.set_memory_limit(max_memory)
-        if plot is not None:
-            from ..plots import check_path
+    output = output if output is not None else Path(config.stem + ".h5")
+    if plot is not None:
+        from ..plots import check_path
 
-            try:
-                check_path(plot)
-            except ValueError as exc:
-                base.fail(str(exc))
-        base.claim_output(stack, output, force)
-        base.claim_output(stack, plot, force, "--plot")
-        _optimise(config, output, resume, plot, (executor, scheduler, workers))
+        try:
+            check_path(plot)
+        except ValueError as exc:
+            base.fail(str(exc))
+    with run.outputs(output, plot, execute=False):
+        _optimise(config, output, resume, plot, run)
 
 
 def _scenarios_line(cfg, output: Path) -> None:
@@ -121,7 +115,7 @@ def _optimise(
     output: Path,
     resume: bool,
     plot: Path | None,
-    executing: tuple[str | None, str | None, int | None],
+    options: base.RunOptions,
 ) -> None:
     from rich.progress import BarColumn, Progress, TextColumn
 
@@ -158,7 +152,7 @@ def _optimise(
             f"; {output} keeps the last generation's checkpoint: continue with suspopt "
             f"optimise {config} -o {output} --resume (on any executor)"
         )
-        with bar, base.executing(*executing, progress=chunk_done, lost_hint=lost):
+        with bar, options.executing(progress=chunk_done, lost_hint=lost):
             result = run(cfg, output, resume=resume, callback=report, command=base.command_line())
     except ConfigError as exc:
         base.fail(str(exc))

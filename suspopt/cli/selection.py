@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -86,7 +85,14 @@ def _threshold_line(sort, label: str) -> str:
     return f"{label}: {how}, normalised by {sort.normalisation}{tied}"
 
 
+_EPS_HELP = (
+    "absolute thresholds in the objectives' SI units: one value, or one per objective "
+    "separated by commas"
+)
+
+
 @app.command()
+@base.run_options
 def kesort(
     pareto: list[Path] = typer.Argument(
         ..., help="Pareto HDF5 file(s) written by suspopt optimise"
@@ -105,12 +111,7 @@ def kesort(
         help="case label, once per file; files with the same "
         "label form one case (default: the config's or the file's name)",
     ),
-    eps: str | None = typer.Option(
-        None,
-        "--eps",
-        help="absolute thresholds in the objectives' SI units: one "
-        "value, or one per objective separated by commas",
-    ),
+    eps: str | None = typer.Option(None, "--eps", help=_EPS_HELP),
     P: str | None = typer.Option(
         None,
         "--P",
@@ -128,18 +129,12 @@ def kesort(
     plot: Path | None = typer.Option(
         None, "--plot", help="figure of the k-ε levels over the front (.png or .svg)"
     ),
-    force: bool = base.force_option(),
-    max_memory: str | None = base.max_memory_option(),
-    executor: str | None = base.executor_option(),
-    scheduler: str | None = base.scheduler_option(),
-    workers: int | None = base.workers_option(),
+    *,
+    run: base.RunOptions,
 ) -> None:
     """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12); supplementary
     objectives are re-simulated in one batch."""
-    base.set_memory_limit(max_memory)
-    with ExitStack() as stack, base.executing(executor, scheduler, workers):
-        base.claim_output(stack, output, force)
-        base.claim_output(stack, plot, force, "--plot")
+    with run.outputs(output, plot):
         _kesort(
             pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot
         )

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import time
-from contextlib import ExitStack
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -87,6 +86,7 @@ _PICK_HELP = (
 
 
 @app.command()
+@base.run_options
 def simulate(
     source: Path = typer.Argument(
         ..., help="YAML config, or a result file of optimise, kesort or analyse with --pick"
@@ -116,17 +116,11 @@ def simulate(
     plot: Path | None = base.plot_option(
         "the signals over time, their PSD and the ISO 2631 comfort levels"
     ),
-    force: bool = base.force_option(),
-    max_memory: str | None = base.max_memory_option(),
-    executor: str | None = base.executor_option(),
-    scheduler: str | None = base.scheduler_option(),
-    workers: int | None = base.workers_option(),
+    *,
+    run: base.RunOptions,
 ) -> None:
     """Simulate a config (or designs picked from a result file) and write signals to HDF5."""
-    base.set_memory_limit(max_memory)
-    with ExitStack() as stack, base.executing(executor, scheduler, workers):
-        base.claim_output(stack, output, force)
-        base.claim_output(stack, plot, force, "--plot")
+    with run.outputs(output, plot):
         try:
             _simulate(source, output, pick, set_, sweep_, zipped, plot, scenario)
         except (ConfigError, ValueError) as exc:

@@ -2,14 +2,31 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import AfterValidator, Field, model_validator
 
 from ..execution import DEFAULT_CHUNK
 from .base import Duration, Section, Step
 
 __all__ = ["Simulation", "Output", "Execution"]
+
+
+def _installed(choice: str) -> str:
+    """``choice`` (an engine or an executor), or a ValueError that names the extra to install
+    when what it needs is missing: numba for the ``compiled`` engine, dask.distributed for
+    the ``dask`` executor (looked for here, not when suspopt starts)."""
+    if choice == "compiled":
+        from ..integrator import INSTALL_FAST, compiled_available
+
+        if not compiled_available():
+            raise ValueError(f"the compiled engine needs numba: {INSTALL_FAST}")
+    if choice == "dask":
+        from ..execution import INSTALL_DASK, dask_available
+
+        if not dask_available():
+            raise ValueError(f"the dask executor needs dask.distributed: {INSTALL_DASK}")
+    return choice
 
 
 class Simulation(Section):
@@ -20,7 +37,7 @@ class Simulation(Section):
     output_dt: Step | None = Field(
         None, description="output sample interval [s], a whole multiple of dt (default dt)"
     )
-    engine: Literal["numpy", "compiled", "auto"] = Field(
+    engine: Annotated[Literal["numpy", "compiled", "auto"], AfterValidator(_installed)] = Field(
         "numpy",
         description="the integrator: numpy (the reference), compiled (numba, pip install "
         '"suspopt[fast]": every vehicle, seat, road and controller; a non-linear element '
@@ -34,16 +51,6 @@ class Simulation(Section):
         "road's band; a linear model on an iso8608 road; var, std, rms, mean, rms_weighted, "
         "dissipated_power and dynamic_tyre_load only); simulate always integrates in time",
     )
-
-    @field_validator("engine")
-    @classmethod
-    def _engine_installed(cls, engine: str) -> str:
-        if engine == "compiled":
-            from ..integrator import INSTALL_FAST, compiled_available
-
-            if not compiled_available():
-                raise ValueError(f"the compiled engine needs numba: {INSTALL_FAST}")
-        return engine
 
     @model_validator(mode="after")
     def _check_steps(self) -> Simulation:
@@ -98,7 +105,7 @@ class Execution(Section):
     pool of processes or a Dask cluster. Every executor gives the same bits; the command
     line's ``--executor``, ``--scheduler`` and ``--workers`` win over this section."""
 
-    executor: Literal["local", "processes", "dask"] = Field(
+    executor: Annotated[Literal["local", "processes", "dask"], AfterValidator(_installed)] = Field(
         "local",
         description="local (this process), processes (a local pool of workers) or dask (a "
         'Dask scheduler, or a local Dask cluster; pip install "suspopt[dask]")',
@@ -124,16 +131,6 @@ class Execution(Section):
         description="designs per chunk sent to a worker: the same whatever the number of "
         "workers, so every design meets the same arithmetic",
     )
-
-    @field_validator("executor")
-    @classmethod
-    def _executor_installed(cls, executor: str) -> str:
-        if executor == "dask":
-            from ..execution import INSTALL_DASK, dask_available
-
-            if not dask_available():
-                raise ValueError(f"the dask executor needs dask.distributed: {INSTALL_DASK}")
-        return executor
 
     @model_validator(mode="after")
     def _check(self) -> Execution:

@@ -309,10 +309,7 @@ def windows(
     from . import _accumulate, _fused, _kernel
 
     n, P0 = asm.n, asm.P
-    n_out = n_steps // every + 1
-    width = n_out if width is None else width
-    if controller is not None and width < n_out:
-        raise ValueError("a controlled run is integrated whole (width >= its samples)")
+    n_out, width = run.window(width)
     if width < n_out and width % _kernel.SAMPLES:
         raise ValueError(f"a window is a multiple of {_kernel.SAMPLES} samples")
     lagged = decay = None

@@ -11,17 +11,16 @@ preallocated buffers, with no Python loop over designs. Its parts are separate: 
 (:class:`_Divergence`). The road is sampled on the half-step grid the stages need.
 
 Road edges (``edges``; the bumps' jumps in z or its rate, Eq 2.101-2.104) are seen at their
-instants. A step whose interior holds edges is split at them into RK4 sub-steps; each
-sub-step's last stage takes the road's left limit at its end and the next one's first stage
-the right limit, so a step ending on an edge uses the left limit in its last stage and one
-starting on it (the grid) the right limit. Where the inputs jump by ``Δu`` their rate
-holds a Dirac ``Δu δ(t - t_e)``, integrated exactly: an impulse ``c D_u Δu`` [N s] of the
-viscous elements that see the road (the tyre damping c_T, Eq 2.29), so the velocities
-jump by ``M^-1 (-D_qᵀ) (c D_u Δu)`` at the edge (the elastic forces stay bounded and give
-no impulse). A tyre that may lift off cannot pull (its force capped at the static load):
-its impulse at an edge where it would pull is not applied. A split step still makes one
-output sample (the accelerations of its first stage), its controller sample (at its start)
-and one actuator-lag update. Only the few split steps allocate and call the road again.
+instants. A step whose interior holds edges is split at them into RK4 sub-steps; each sub-step's
+last stage takes the road's left limit at its end and the next one's first stage the right limit,
+so a step ending on an edge uses the left limit in its last stage and one starting on it (the grid)
+the right limit. Where the inputs jump by ``Δu`` their rate holds a Dirac ``Δu δ(t - t_e)``,
+integrated exactly: an impulse ``c D_u Δu`` [N s] of the viscous elements that see the road (the
+tyre damping c_T, Eq 2.29), so the velocities jump by ``M^-1 (-D_qᵀ) (c D_u Δu)`` at the edge (the
+elastic forces stay bounded and give no impulse). A tyre that may lift off cannot pull (its force
+capped at the static load): its impulse at an edge where it would pull is not applied. A split step
+still makes one output sample (the accelerations of its first stage), its controller sample (at its
+start) and one actuator-lag update. Only the few split steps allocate and call the road again.
 
 A sample at ``t_k`` holds the state, the accelerations ``f(y_k)`` - the first stage of
 step k, so they cost nothing more - and the controller's coefficients and records in force
@@ -315,8 +314,7 @@ class _Divergence:
     then on."""
 
     def __init__(self, y2: np.ndarray, P: int, dt: float):
-        self.y2, self.P, self.dt = y2, P, dt
-        self.at = np.full(P, np.nan)
+        self.y2, self.P, self.dt, self.at = y2, P, dt, np.full(P, np.nan)
 
     def check(self, k: int, y: np.ndarray, n_steps: int) -> None:
         """After step ``k``."""
@@ -533,12 +531,18 @@ class Run(NamedTuple):
     controller: Controller | None = None
     edges: Edges | None = None
 
+    def window(self, width: int | None) -> tuple[int, int]:
+        """``(output samples, window width)``: width None for all, a controlled run whole."""
+        n_out = self.n_steps // self.every + 1
+        if self.controller is not None and width is not None and width < n_out:
+            raise ValueError("a controlled run is integrated whole (width >= its samples)")
+        return n_out, n_out if width is None else width
+
 
 def integrate(run: Run) -> Trajectory:
     """Classical RK4 of ``run`` (:class:`Run`) over its steps, samples kept every ``every``-th
     step. Road edges, the samples, the controller's hold and the batch width: see the module
-    docstring.
-    """
+    docstring."""
     return next(windows(run))[1]
 
 
@@ -546,14 +550,10 @@ def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajector
     """The integration of ``run`` as consecutive windows of at most ``width`` output samples
     (all when None): ``(j0, trajectory of samples j0 ..)``, the steps those of
     :func:`integrate` (the windows joined are its trajectory, bit for bit), ``diverged_at``
-    as known at the window's end. A controlled run comes whole (a smaller ``width`` is a
-    ValueError): its hold keeps records over the run."""
+    as known at the window's end. A controlled run comes whole (:meth:`Run.window`)."""
     asm, n_vehicle, offsets, dt, n_steps, every, controller, edges = run
     n, P = asm.n, asm.P
-    n_out = n_steps // every + 1
-    width = n_out if width is None else width
-    if controller is not None and width < n_out:
-        raise ValueError("a controlled run is integrated whole (width >= its samples)")
+    n_out, width = run.window(width)
     columns = max(P, 2)  # (a single design as two identical columns)
     active, roads = offsets.any(axis=(1, 2, 3)), offsets.shape[2]
     if offsets.size // roads * columns <= _WIDE_OFFSETS:  # small batches: no broadcasting

@@ -493,16 +493,16 @@ def _write(
         write_checkpoint(h5, problem, run_batches[: snap.batches], snap.generation)
     o = snap.optimum
     return OptimisationResult(
-        X=o.X,
-        F=o.F,
-        G=o.G,
-        var_names=problem.var_names,
-        var_units=problem.var_units,
-        obj_names=problem.obj_names,
-        obj_units=problem.obj_units,
-        constraint_names=problem.constraint_names,
-        history=snap.history,
         status=status,
         path=output,
+        X=o.X,
+        var_names=problem.var_names,
+        var_units=problem.var_units,
+        F=o.F,
+        obj_names=problem.obj_names,
+        obj_units=problem.obj_units,
         weights=weights,
+        G=o.G,
+        constraint_names=problem.constraint_names,
+        history=snap.history,
     )
