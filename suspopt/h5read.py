@@ -34,6 +34,13 @@ MAX_DATASET_BYTES = 1 << 30
 #: milliseconds (a 1000-design front: about 5 ms).
 PROBE_SECONDS = 1.0
 PROBE_BYTES_PER_SECOND = 50e6
+#: Memory a probe's walk may take beyond what the process held when it forked [bytes]: this
+#: much, and :data:`PROBE_MEMORY_PER_BYTE` more per byte of file. A sound file's metadata
+#: decodes to a few times its size; a damaged global heap behind a text attribute can declare
+#: a gigabyte in a 12 kB file, which the HDF5 library allocates and reads before it finds the
+#: heap's size wrong.
+PROBE_MEMORY = 64 << 20
+PROBE_MEMORY_PER_BYTE = 8
 #: Files this process has probed: (device, inode, size, modification time).
 _PROBED: set[tuple[int, int, int, int]] = set()
 #: Largest attribute read from an input file [bytes]: a damaged attribute may declare a shape
@@ -50,16 +57,19 @@ def _declared_bytes(obj, key: str) -> int:
     return math.prod(declared.shape) * max(declared.dtype.itemsize, 1)
 
 
-def _walk(path: Path) -> None:
-    """Read every attribute and every text dataset of ``path`` (within the size limits)."""
+def _walk(path: Path, reading: list[str]) -> None:
+    """Read every attribute and every text dataset of ``path`` (within the size limits);
+    ``reading[0]`` names what is being read."""
     import h5py
 
     def visit(obj) -> None:
         for key in obj.attrs:
             if _declared_bytes(obj, key) <= MAX_ATTRIBUTE_BYTES:
+                reading[0] = f"{obj.name}: attribute {key!r}"
                 obj.attrs[key]
         if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "OSU":
             if obj.size * max(obj.dtype.itemsize, 16) <= MAX_DATASET_BYTES:
+                reading[0] = obj.name
                 obj[()]
 
     with h5py.File(path, "r") as f:
@@ -67,12 +77,29 @@ def _walk(path: Path) -> None:
         f.visititems(lambda name, obj: visit(obj))
 
 
+def _cap_memory(allowance: int) -> None:
+    """Limit this process's address space to what it holds now plus ``allowance`` bytes
+    (Linux; elsewhere nothing is limited)."""
+    import resource
+
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/self/statm") as statm:
+            held = int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+        soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+        cap = held + allowance
+        if soft != resource.RLIM_INFINITY:
+            cap = min(cap, soft)
+        resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
+
+
 def _probe(path: Path, where: str) -> None:
     """Walk the file's metadata in a forked child first: a damaged file can send the HDF5
-    library into an endless loop or a crash, in C, where no Python timer reaches (a
-    corrupted global heap behind a text attribute does). The child's own errors are left to
-    the reader's checks; a child that does not finish in time (:data:`PROBE_SECONDS`) or dies by a
-    signal makes the file bad input. Where there is no ``fork`` the probe is skipped."""
+    library into an endless loop or a crash, in C, where no Python timer reaches, or into
+    allocating far more than the file holds (a corrupted global heap behind a text attribute
+    does each). The child's other errors are left to the reader's checks; a child that does
+    not finish in time (:data:`PROBE_SECONDS`), dies by a signal or runs out of its memory
+    (:data:`PROBE_MEMORY`) makes the file bad input. Where there is no ``fork`` the probe is
+    skipped."""
     if not hasattr(os, "fork"):
         return
     info = path.stat()
@@ -80,9 +107,10 @@ def _probe(path: Path, where: str) -> None:
     if key in _PROBED:  # this file, unchanged, walked already by this process
         return
     budget = PROBE_SECONDS + info.st_size / PROBE_BYTES_PER_SECOND
+    allowance = PROBE_MEMORY + PROBE_MEMORY_PER_BYTE * info.st_size
+    said, say = os.pipe()  # what the child ran out of memory reading, if it did
     pid = os.fork()
     if pid == 0:  # the child: walk, and leave without running any of the parent's exit code
-        # errors it meets are the reader's to report, by its own checks
         with contextlib.suppress(BaseException):
             # the kernel ends the child even in a loop in C, and even if the parent is gone
             signal.signal(signal.SIGALRM, signal.SIG_DFL)
@@ -91,8 +119,30 @@ def _probe(path: Path, where: str) -> None:
 
             faulthandler.disable()  # its crash is the parent's to report, in one line
             os.dup2(os.open(os.devnull, os.O_WRONLY), 2)
-            _walk(path)
+            _cap_memory(allowance)
+            reading = ["its metadata"]
+            try:
+                _walk(path, reading)
+            except BaseException as exc:  # the others are the reader's to report
+                if isinstance(exc, MemoryError) or "allocat" in str(exc).lower():
+                    os.write(say, reading[0].encode("utf-8", "replace")[:300])
         os._exit(0)
+    os.close(say)
+    try:
+        _wait_for_probe(pid, where, budget)
+        with os.fdopen(said, "rb", closefd=False) as pipe:
+            short = pipe.read().decode("utf-8", "replace")
+    finally:
+        os.close(said)
+    if short:
+        raise ConfigError(
+            f"{where}: damaged: {short} would take more than {allowance >> 20} MB to read"
+        )
+    _PROBED.add(key)
+
+
+def _wait_for_probe(pid: int, where: str, budget: float) -> None:
+    """Wait for the probe ``pid``; ConfigError when it crashed or ran past ``budget`` s."""
     deadline = time.monotonic() + budget
     while True:
         done, status = os.waitpid(pid, os.WNOHANG)
@@ -101,7 +151,6 @@ def _probe(path: Path, where: str) -> None:
                 raise ConfigError(
                     f"{where}: damaged: reading its metadata crashed the HDF5 library"
                 )
-            _PROBED.add(key)
             return
         if time.monotonic() > deadline:
             os.kill(pid, signal.SIGKILL)
