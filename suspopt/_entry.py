@@ -50,11 +50,13 @@ class _Interrupts:
         raise KeyboardInterrupt
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, leaving: bool = False) -> int:
     """Run ``suspopt`` with ``argv`` (default the process's arguments); return its exit
-    code."""
+    code. Ctrl-C's handling is put back as it was on return, unless the process is
+    ``leaving`` (the command line's, which ignores a second Ctrl-C until it exits)."""
     _Interrupts.seen = False
-    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+    found = signal.getsignal(signal.SIGINT)
+    if found is signal.default_int_handler:
         signal.signal(signal.SIGINT, _Interrupts.handler)
     try:
         warnings.showwarning = _one_line_warning
@@ -86,6 +88,12 @@ def main(argv: list[str] | None = None) -> int:
         from .memory import set_limit
 
         set_limit(None)  # --max-memory holds for one command
+        if (
+            not leaving
+            and found is not None
+            and threading.current_thread() is threading.main_thread()
+        ):
+            signal.signal(signal.SIGINT, found)
 
 
 #: BLAS thread pools the command line sizes to one thread, unless the user set them: the
@@ -106,7 +114,7 @@ def run() -> None:
     # the start-up creates some 10^5 long-lived objects (the config's schema, the commands):
     # CPython's default first-generation threshold of 700 scans them over and over (0.04 s)
     gc.set_threshold(10_000, 10, 10)
-    code = main()
+    code = main(leaving=True)
     if code == EXIT_INTERRUPTED:
         # CPython may remember an interrupt it saw inside C code even though it was caught,
         # and then end the process by SIGINT (status -2) instead of the code given: leave at

@@ -638,6 +638,22 @@ def test_usage_errors_are_one_line(capsys):
 
 
 @pytest.mark.cli
+def test_an_interrupted_command_in_process_leaves_ctrl_c_as_it_found_it(capsys, monkeypatch):
+    """``main`` called from Python (a notebook, these tests): after an interrupted command the
+    process still answers Ctrl-C. (The command line's own process ignores a second one until
+    it exits.)"""
+    import suspopt.cli.configs
+
+    def interrupt(_):  # Ctrl-C pressed as the command starts
+        signal.raise_signal(signal.SIGINT)
+
+    monkeypatch.setattr(suspopt.cli.configs, "set_memory_limit", interrupt)
+    found = signal.getsignal(signal.SIGINT)
+    assert cli(capsys, "validate", CONFIGS / "quickstart.yaml") == (130, "", "interrupted\n")
+    assert signal.getsignal(signal.SIGINT) is found
+
+
+@pytest.mark.cli
 @pytest.mark.slow
 @pytest.mark.parametrize("delay", [0.0, 1.5])
 def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
@@ -650,13 +666,19 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
             "simulation: {duration: 3.0, dt: 1.0e-3}", "simulation: {duration: 300.0, dt: 1.0e-3}"
         ),
     )
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "suspopt", "simulate", str(long), "-o", str(tmp_path / "out.h5")],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=ROOT,
-    )
+    # the command starts with Ctrl-C at its default, as a shell's foreground job does,
+    # whatever this test process does with it
+    found = signal.signal(signal.SIGINT, signal.SIG_DFL)
+    try:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "suspopt", "simulate", str(long), "-o", str(tmp_path / "o.h5")],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=ROOT,
+        )
+    finally:
+        signal.signal(signal.SIGINT, found)
     maps = Path(f"/proc/{proc.pid}/maps")
     deadline = time.monotonic() + 30
     while "numpy" not in maps.read_text() and time.monotonic() < deadline:
@@ -712,7 +734,7 @@ def test_the_command_sizes_blas_to_one_thread_unless_told():
     code = (
         "import os, sys\n"
         "import suspopt._entry as e\n"
-        "e.main = lambda: print(os.environ.get('OPENBLAS_NUM_THREADS')) or 0\n"
+        "e.main = lambda **_: print(os.environ.get('OPENBLAS_NUM_THREADS')) or 0\n"
         "e.run()\n"
     )
     env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
@@ -778,7 +800,7 @@ def test_a_file_that_hangs_or_crashes_hdf5_is_bad_input(tmp_path, monkeypatch, f
     with h5py.File(path, "w") as h5:
         h5.attrs["x"] = 1
 
-    def walk(_path):  # stands for a damaged global heap: an endless loop, or a crash, in C
+    def walk(_path, _reading):  # stands for a damaged global heap: an endless loop or a crash
         if failure == "hang":
             time.sleep(60)
         os.kill(os.getpid(), signal.SIGSEGV)
@@ -789,6 +811,30 @@ def test_a_file_that_hangs_or_crashes_hdf5_is_bad_input(tmp_path, monkeypatch, f
     with pytest.raises(suspopt.ConfigError, match="damaged: reading its metadata"):
         h5read.H5Reader(path)
     assert time.monotonic() - started < 5
+
+
+def test_a_text_attribute_that_declares_a_gigabyte_is_bad_input_before_it_is_read(tmp_path):
+    """A byte flipped in a text attribute's stored length (found by fuzzing): the HDF5 library
+    would allocate the length it says, about 1 GB for a 5 kB file, and then fail. The probe
+    runs out of its own memory first, and this process never tries."""
+    import struct
+
+    from suspopt import h5read
+
+    path = tmp_path / "front.h5"
+    with h5py.File(path, "w") as h5:
+        h5.create_dataset("F", data=np.zeros((3, 2))).attrs["names"] = ["f1", "f2"]
+    data = bytearray(path.read_bytes())
+    # a variable-length string is stored as (length, global heap address, index)
+    at = data.find(struct.pack("<IQ", 2, data.find(b"GCOL")))
+    data[at + 3] = 0x3C  # the length's high byte: 2 + 0x3C << 24 bytes
+    path.write_bytes(data)
+    with pytest.raises(suspopt.ConfigError) as caught:
+        h5read.H5Reader(path)
+    assert str(caught.value) == (
+        f"{path}: damaged: /F: attribute 'names' would take more than "
+        f"{(h5read.PROBE_MEMORY + h5read.PROBE_MEMORY_PER_BYTE * len(data)) >> 20} MB to read"
+    )
 
 
 def test_an_intact_file_passes_the_probe(tmp_path):
