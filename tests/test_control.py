@@ -498,6 +498,29 @@ def test_adaptive_threshold_reaches_the_requested_share(law, distribution, share
     assert np.allclose(np.sort(res.time[refits])[1:], 5.0 * np.arange(1, 9))
 
 
+@pytest.mark.parametrize("engine", ["numpy", "compiled"])
+def test_a_refit_period_far_below_a_sample_refits_at_every_sample(engine):
+    """T_learn = 5e-324 s (found by fuzzing: the count of periods to the next fit overflowed):
+    the same run as T_learn = 1e-9 s, a fit at every controller sample."""
+    if engine == "compiled":
+        pytest.importorskip("numba")
+    runs = []
+    for learn_time in (5e-324, 1e-9):
+        data = quarter_car(
+            semi_active("sh_2"),
+            duration=0.2,
+            control={
+                "threshold": {"mode": "adaptive", "c_max_share": 0.3, "learn_time": learn_time}
+            },
+        )
+        data["simulation"]["engine"] = engine
+        runs.append(suspopt.simulate(make_config(data)))
+    threshold = runs[0].signals["control_threshold.F1"]
+    assert len(np.unique(threshold)) > 50  # refitted again and again
+    for name in ("control_threshold.F1", "body.heave_acc"):
+        np.testing.assert_array_equal(runs[0].signals[name], runs[1].signals[name])
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("law", ["sh_2", "sh_add_2"])
 def test_adaptive_student_t_threshold_follows_the_exact_fit(law):

@@ -124,6 +124,26 @@ def test_values_are_strict_finite_and_in_range(tmp_path, capsys, old, new, needl
     assert needle in message and f"case.yaml:{line}:" in message, message
 
 
+@pytest.mark.parametrize(
+    "vehicle, needle",
+    [  # found by fuzzing: the corner defaults were applied before the types were checked
+        (
+            "{preset: quarter, body: {mass: 300}, corner_defaults: {unsprung_mass: 40}, corners: true}",
+            "corners",
+        ),
+        ("{preset: quarter, body: {mass: 300}, corners: [F1]}", "corners"),
+        (
+            "{preset: {a: 1}, body: {mass: 300}, corner_defaults: {unsprung_mass: 40}, corners: {}}",
+            "preset",
+        ),
+    ],
+)
+def test_corner_defaults_meet_wrong_types_as_bad_input(vehicle, needle):
+    text = edited(GOOD.split("vehicle:")[1].split("\nroad:")[0], " " + vehicle)
+    with pytest.raises(suspopt.ConfigError, match=rf"<config>:\d+: vehicle\.{needle}: "):
+        load_config_text(text)
+
+
 def test_yaml_1_2_numbers():
     cfg = load_config_text(edited("stiffness: 4.0e5}", "stiffness: 4e5}"))
     assert cfg.vehicle.corners["F1"].tyre.stiffness == 4e5

@@ -295,12 +295,17 @@ class Vehicle(Section):
     @model_validator(mode="before")
     @classmethod
     def _apply_corner_defaults(cls, data: Any) -> Any:
-        if not isinstance(data, dict):
-            return data
+        if not isinstance(data, dict) or not isinstance(data.get("corners", {}), dict | None):
+            return data  # (the field's own type error names it)
+        corners = dict(data.get("corners") or {})
         defaults = data.get("corner_defaults") or {}
         preset = data.get("preset")
-        corners = dict(data.get("corners") or {})
-        if defaults and preset in PRESET_CORNERS and isinstance(defaults, dict):
+        if (
+            defaults
+            and isinstance(defaults, dict)
+            and isinstance(preset, str)
+            and preset in PRESET_CORNERS
+        ):
             for name in PRESET_CORNERS[preset]:
                 own = corners.get(name) or {}
                 corners[name] = _deep_merge(defaults, own) if isinstance(own, dict) else own

@@ -311,8 +311,11 @@ class SemiActiveController:
             threshold = distribution_quantile(history, self._level[idx], self._distribution)
         self._threshold = self._threshold.copy()
         self._threshold[idx, 0] = threshold
-        late = t + self._half_step - self._next_fit[idx]
-        self._next_fit[idx] += self._period[idx] * (np.floor(late / self._period[idx]) + 1.0)
+        late, period = t + self._half_step - self._next_fit[idx], self._period[idx]
+        with np.errstate(over="ignore"):  # a period far below a sample's (5e-324 s) ...
+            following = self._next_fit[idx] + period * (np.floor(late / period) + 1.0)
+        # ... refits at every sample: its next fit is due at the next one
+        self._next_fit[idx] = np.where(np.isfinite(following), following, t + self._half_step)
         self._next_due = float(np.min(self._next_fit))
 
     def record(self) -> dict[str, np.ndarray]:
