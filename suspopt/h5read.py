@@ -58,23 +58,43 @@ def _declared_bytes(obj, key: str) -> int:
 
 
 def _walk(path: Path, reading: list[str]) -> None:
-    """Read every attribute and every text dataset of ``path`` (within the size limits);
-    ``reading[0]`` names what is being read."""
+    """Read every attribute and every text dataset of ``path`` (within the size limits),
+    ``reading[0]`` naming what is being read. What fails to read is the reader's to report:
+    the walk goes on past it, so that a crash or a hang further on is still met; running
+    out of memory ends it (MemoryError)."""
     import h5py
 
+    def attempt(label: str, read) -> None:
+        reading[0] = label
+        try:
+            read()
+        except Exception as exc:  # the reader's to report, by its own checks
+            if isinstance(exc, MemoryError) or "allocat" in str(exc).lower():
+                raise MemoryError(label) from None
+
     def visit(obj) -> None:
-        for key in obj.attrs:
-            if _declared_bytes(obj, key) <= MAX_ATTRIBUTE_BYTES:
-                reading[0] = f"{obj.name}: attribute {key!r}"
-                obj.attrs[key]
-        if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "OSU":
-            if obj.size * max(obj.dtype.itemsize, 16) <= MAX_DATASET_BYTES:
-                reading[0] = obj.name
-                obj[()]
+        keys: list[str] = []
+        attempt(f"{obj.name}: its attributes", lambda: keys.extend(obj.attrs))
+        for key in keys:
+            attempt(f"{obj.name}: attribute {key!r}", lambda key=key: _read_attribute(obj, key))
+        if isinstance(obj, h5py.Dataset):
+            attempt(obj.name, lambda: _read_text(obj))
 
     with h5py.File(path, "r") as f:
         visit(f)
         f.visititems(lambda name, obj: visit(obj))
+
+
+def _read_attribute(obj, key: str) -> None:
+    """Read the attribute ``key`` of ``obj`` if it fits in :data:`MAX_ATTRIBUTE_BYTES`."""
+    if _declared_bytes(obj, key) <= MAX_ATTRIBUTE_BYTES:
+        obj.attrs[key]
+
+
+def _read_text(ds) -> None:
+    """Read the dataset ``ds`` if it holds text and fits in :data:`MAX_DATASET_BYTES`."""
+    if ds.dtype.kind in "OSU" and ds.size * max(ds.dtype.itemsize, 16) <= MAX_DATASET_BYTES:
+        ds[()]
 
 
 def _cap_memory(allowance: int) -> None:
@@ -123,9 +143,8 @@ def _probe(path: Path, where: str) -> None:
             reading = ["its metadata"]
             try:
                 _walk(path, reading)
-            except BaseException as exc:  # the others are the reader's to report
-                if isinstance(exc, MemoryError) or "allocat" in str(exc).lower():
-                    os.write(say, reading[0].encode("utf-8", "replace")[:300])
+            except MemoryError:  # (the walk's other errors are the reader's to report)
+                os.write(say, reading[0].encode("utf-8", "replace")[:300])
         os._exit(0)
     os.close(say)
     try:
@@ -278,6 +297,10 @@ class H5Reader:
             raise ConfigError(f"{self.where}: {name}: not text")
         if len(value) > MAX_CONFIG_BYTES:
             raise ConfigError(f"{self.where}: {name}: longer than {MAX_CONFIG_BYTES >> 10} kB")
+        try:  # (h5py hands bytes that are not UTF-8 over as lone surrogates)
+            value.encode("utf-8")
+        except UnicodeEncodeError:
+            raise ConfigError(f"{self.where}: {name}: not UTF-8 text") from None
         return value
 
     def has_attr(self, key: str, node: str = "") -> bool:

@@ -1328,22 +1328,37 @@ def normalised_front(good: Path, dst: Path) -> Path:
 RANDOM_PREFIX = "random_bytes_"
 
 
+def _flipped(seed: int, i: int):
+    """The builder of random variant ``i`` of ``seed``: 1-8 bytes overwritten at random."""
+
+    def flip(b):
+        rng = np.random.default_rng([seed, 10_000 + i])
+        b = bytearray(b)
+        for _ in range(int(rng.integers(1, 9))):
+            at = int(rng.integers(len(b)))
+            b[at] = int(rng.integers(256))
+        return bytes(b)
+
+    return _bytes_of(flip)
+
+
 def h5_random_variants(n: int, seed: int = SEED) -> list[tuple[str, object, str | None]]:
     """``n`` copies of the normalised front (:func:`normalised_front`) with 1-8 bytes
-    overwritten at random offsets."""
-    out = []
-    for i in range(n):
-
-        def flip(b, i=i):
-            rng = np.random.default_rng([seed, 10_000 + i])
-            b = bytearray(b)
-            for _ in range(int(rng.integers(1, 9))):
-                at = int(rng.integers(len(b)))
-                b[at] = int(rng.integers(256))
-            return bytes(b)
-
-        out.append((f"{RANDOM_PREFIX}{i:04d}", _bytes_of(flip), None))
+    overwritten at random offsets, and the flips of other seeds that once found a fault
+    (:data:`FOUND_FLIPS`)."""
+    out = [(f"{RANDOM_PREFIX}{i:04d}", _flipped(seed, i), None) for i in range(n)]
+    for found_seed, i, _ in FOUND_FLIPS:
+        out.append((f"{RANDOM_PREFIX}seed{found_seed}_{i:04d}", _flipped(found_seed, i), None))
     return out
+
+
+#: Random flips of other seeds (``benchmarks/fuzz_configs.py --h5-only --seed S``) that found a
+#: fault: (seed, variant, what it did). They hold only while the front's bytes stay the same.
+FOUND_FLIPS = [
+    (777, 145, "a text attribute's stored length of 1 GB, allocated before the read failed"),
+    (2024, 292, "a name that is not UTF-8, failing only when written out again"),
+    (2024, 426, "an attribute crashing HDF5, behind a root whose attributes fail to list"),
+]
 
 
 def h5_cases(variants) -> list[Case]:

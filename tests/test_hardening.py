@@ -857,6 +857,20 @@ def test_a_text_attribute_that_declares_a_gigabyte_is_bad_input_before_it_is_rea
     )
 
 
+def test_text_that_is_not_utf8_in_a_utf8_attribute_is_bad_input(tmp_path):
+    """h5py hands such bytes over as lone surrogates, which failed only when written out
+    again, after the run, in a message that named no file (found by fuzzing)."""
+    from suspopt import h5read
+
+    path = tmp_path / "front.h5"
+    with h5py.File(path, "w") as h5:
+        ds = h5.create_dataset("F", data=np.zeros((2, 1)))
+        ds.attrs.create("names", np.array([b"\x80f1"], dtype=object), dtype=h5py.string_dtype())
+    with h5read.H5Reader(path) as h5, pytest.raises(suspopt.ConfigError) as caught:
+        h5.labels("F", "names", 1)
+    assert str(caught.value) == f"{path}: /F: attribute 'names': not UTF-8 text"
+
+
 def test_an_intact_file_passes_the_probe(tmp_path):
     from suspopt import h5read
 
