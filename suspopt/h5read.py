@@ -57,15 +57,14 @@ def _declared_bytes(obj, key: str) -> int:
     return math.prod(declared.shape) * max(declared.dtype.itemsize, 1)
 
 
-def _walk(path: Path, reading: list[str]) -> None:
-    """Read every attribute and every text dataset of ``path`` (within the size limits),
-    ``reading[0]`` naming what is being read. What fails to read is the reader's to report:
-    the walk goes on past it, so that a crash or a hang further on is still met; running
-    out of memory ends it (MemoryError)."""
+def _walk(path: Path) -> None:
+    """Read every attribute and every text dataset of ``path`` (within the size limits).
+    What fails to read is the reader's to report: the walk goes on past it, so that a crash
+    or a hang further on is still met; running out of memory ends it (a MemoryError naming
+    what was being read)."""
     import h5py
 
     def attempt(label: str, read) -> None:
-        reading[0] = label
         try:
             read()
         except Exception as exc:  # the reader's to report, by its own checks
@@ -140,17 +139,15 @@ def _probe(path: Path, where: str) -> None:
             faulthandler.disable()  # its crash is the parent's to report, in one line
             os.dup2(os.open(os.devnull, os.O_WRONLY), 2)
             _cap_memory(allowance)
-            reading = ["its metadata"]
             try:
-                _walk(path, reading)
-            except MemoryError:  # (the walk's other errors are the reader's to report)
-                os.write(say, reading[0].encode("utf-8", "replace")[:300])
+                _walk(path)
+            except MemoryError as exc:  # (the walk's other errors are the reader's to report)
+                os.write(say, (str(exc) or "its metadata").encode("utf-8", "replace")[:300])
         os._exit(0)
     os.close(say)
     try:
         _wait_for_probe(pid, where, budget)
-        with os.fdopen(said, "rb", closefd=False) as pipe:
-            short = pipe.read().decode("utf-8", "replace")
+        short = os.read(said, 1024).decode("utf-8", "replace")  # (the child has left)
     finally:
         os.close(said)
     if short:

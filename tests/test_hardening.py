@@ -820,7 +820,7 @@ def test_a_file_that_hangs_or_crashes_hdf5_is_bad_input(tmp_path, monkeypatch, f
     with h5py.File(path, "w") as h5:
         h5.attrs["x"] = 1
 
-    def walk(_path, _reading):  # stands for a damaged global heap: an endless loop or a crash
+    def walk(_path):  # stands for a damaged global heap: an endless loop, or a crash, in C
         if failure == "hang":
             time.sleep(60)
         os.kill(os.getpid(), signal.SIGSEGV)
