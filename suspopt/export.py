@@ -76,22 +76,6 @@ def _units(ds, columns: int) -> list[str]:
     return units if len(units) == columns else [units[0] if units else ""] * columns
 
 
-def _dims(ds) -> list[tuple[str, object]]:
-    """(name, scale or None) of every axis of ``ds``: its dimension scale, else ``dim<k>``.
-    The scales are looked up only when the dataset's list of them has one entry per axis
-    (libhdf5 reads past the list of a crafted file, where it has fewer)."""
-    listed = ds.attrs.get("DIMENSION_LIST")
-    if listed is None or np.shape(listed) != (ds.ndim,):
-        return [(f"dim{axis}", None) for axis in range(ds.ndim)]
-    out = []
-    for axis in range(ds.ndim):
-        scales = ds.dims[axis]
-        out.append(
-            (scales[0].name.rsplit("/", 1)[-1], scales[0]) if len(scales) else (f"dim{axis}", None)
-        )
-    return out
-
-
 def _names(ds, dims) -> list[str] | None:
     """The column names of a wide table (module docstring), or None."""
     if ds.ndim < 2:
@@ -132,7 +116,7 @@ def _plan(h5) -> list[tuple[str, str, list, list]]:
     dataset, long tables the datasets of one group with one set of dimensions."""
     import h5py
 
-    from .h5read import MAX_DATASET_BYTES
+    from .h5read import MAX_DATASET_BYTES, dimension_scales
 
     groups = [h5]
     h5.visititems(
@@ -154,7 +138,7 @@ def _plan(h5) -> list[tuple[str, str, list, list]]:
                     f"{h5.filename}: {ds.name}: shape {ds.shape} is larger than "
                     f"{MAX_DATASET_BYTES >> 20} MB: not a file of suspopt's"
                 )
-            dims = _dims(ds)
+            dims = dimension_scales(ds)
             if _names(ds, dims) is not None:
                 wide.append((".".join(parts + [_safe(name)]), group.name, [ds], dims))
             else:

@@ -58,8 +58,8 @@ def _declared_bytes(obj, key: str) -> int:
 
 
 def _walk(path: Path) -> None:
-    """Read every attribute and every text dataset of ``path`` (within the size limits).
-    What fails to read is the reader's to report: the walk goes on past it, so that a crash
+    """Read every attribute and every text dataset of ``path`` (within the size limits) and
+    open every dataset's dimension scales (:func:`dimension_scales`). What fails to read is the reader's to report: the walk goes on past it, so that a crash
     or a hang further on is still met; running out of memory ends it (a MemoryError naming
     what was being read)."""
     import h5py
@@ -78,6 +78,7 @@ def _walk(path: Path) -> None:
             attempt(f"{obj.name}: attribute {key!r}", lambda key=key: _read_attribute(obj, key))
         if isinstance(obj, h5py.Dataset):
             attempt(obj.name, lambda: _read_text(obj))
+            attempt(f"{obj.name}: its dimension scales", lambda: dimension_scales(obj))
 
     with h5py.File(path, "r") as f:
         visit(f)
@@ -94,6 +95,24 @@ def _read_text(ds) -> None:
     """Read the dataset ``ds`` if it holds text and fits in :data:`MAX_DATASET_BYTES`."""
     if ds.dtype.kind in "OSU" and ds.size * max(ds.dtype.itemsize, 16) <= MAX_DATASET_BYTES:
         ds[()]
+
+
+def dimension_scales(ds) -> list[tuple[str, object]]:
+    """(name, scale or None) of every axis of the dataset ``ds``: its first dimension scale,
+    else ``dim<k>``. The scales are looked up only when the dataset's list of them has one
+    entry per axis (libhdf5 reads past the list of a crafted file, where it has fewer); a
+    damaged reference in a well-shaped list can still crash the library, which is why the
+    probe (:func:`_walk`) opens them before a reader does."""
+    listed = ds.attrs.get("DIMENSION_LIST")
+    if listed is None or np.shape(listed) != (ds.ndim,):
+        return [(f"dim{axis}", None) for axis in range(ds.ndim)]
+    out: list[tuple[str, object]] = []
+    for axis in range(ds.ndim):
+        scales = ds.dims[axis]
+        out.append(
+            (scales[0].name.rsplit("/", 1)[-1], scales[0]) if len(scales) else (f"dim{axis}", None)
+        )
+    return out
 
 
 def _cap_memory(allowance: int) -> None:

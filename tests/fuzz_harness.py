@@ -1358,6 +1358,7 @@ FOUND_FLIPS = [
     (777, 145, "a text attribute's stored length of 1 GB, allocated before the read failed"),
     (2024, 292, "a name that is not UTF-8, failing only when written out again"),
     (2024, 426, "an attribute crashing HDF5, behind a root whose attributes fail to list"),
+    (99, 515, "a damaged reference to a dimension scale, crashing HDF5 when export opened it"),
 ]
 
 
