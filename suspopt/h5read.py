@@ -59,30 +59,37 @@ def _declared_bytes(obj, key: str) -> int:
 
 def _walk(path: Path) -> None:
     """Read every attribute and every text dataset of ``path`` (within the size limits) and
-    open every dataset's dimension scales (:func:`dimension_scales`). What fails to read is the reader's to report: the walk goes on past it, so that a crash
-    or a hang further on is still met; running out of memory ends it (a MemoryError naming
-    what was being read)."""
+    open every dataset's dimension scales (:func:`dimension_scales`). What fails to read (an
+    object that cannot be opened included) is the reader's to report: the walk goes on past
+    it, so that a crash or a hang further on is still met; running out of memory ends it (a
+    MemoryError naming what was being read)."""
     import h5py
 
-    def attempt(label: str, read) -> None:
+    def attempt(label: str, read):
+        """``read()``, or None when it fails."""
         try:
-            read()
+            return read()
         except Exception as exc:  # the reader's to report, by its own checks
             if isinstance(exc, MemoryError) or "allocat" in str(exc).lower():
                 raise MemoryError(label) from None
+            return None
 
     def visit(obj) -> None:
-        keys: list[str] = []
-        attempt(f"{obj.name}: its attributes", lambda: keys.extend(obj.attrs))
-        for key in keys:
+        for key in attempt(f"{obj.name}: its attributes", lambda: list(obj.attrs)) or []:
             attempt(f"{obj.name}: attribute {key!r}", lambda key=key: _read_attribute(obj, key))
         if isinstance(obj, h5py.Dataset):
             attempt(obj.name, lambda: _read_text(obj))
             attempt(f"{obj.name}: its dimension scales", lambda: dimension_scales(obj))
 
+    def visit_named(f, name: str) -> None:
+        # each object opened here, not by visititems, which stops at one it cannot open
+        obj = attempt(f"/{name}", lambda: f[name])
+        if obj is not None:
+            visit(obj)
+
     with h5py.File(path, "r") as f:
         visit(f)
-        f.visititems(lambda name, obj: visit(obj))
+        f.visit(lambda name: visit_named(f, name))
 
 
 def _read_attribute(obj, key: str) -> None:

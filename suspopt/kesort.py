@@ -148,26 +148,37 @@ def normalise_objectives(
 
     ``max``: offset 0, scale ``max F`` (Eq 7.12); a column whose maximum is not positive is an
     error (dividing by it would reverse or break the order). ``minmax``: offset ``min F``, scale
-    ``max F - min F`` (1 for a constant column, which becomes 0).
+    ``max F - min F`` (1 for a constant column, which becomes 0). A column whose normalised
+    values leave the floating-point range (``F`` spanning more than about 1e308 times its
+    scale, as only a damaged file holds) is an error naming the objective.
     """
     F = _objectives(F)
     names = _names(names, F.shape[1])
-    if how == "max":
-        scale = F.max(axis=0)
-        for j in np.flatnonzero(scale <= 0):
+    with np.errstate(over="ignore", invalid="ignore"):
+        if how == "max":
+            scale = F.max(axis=0)
+            for j in np.flatnonzero(scale <= 0):
+                raise ValueError(
+                    f"objective {names[j]} has maximum {scale[j]:g} <= 0 over the "
+                    f"set: normalising by the maximum (Eq 7.12) needs a positive "
+                    f"one; use min-max normalisation"
+                )
+            offset = np.zeros_like(scale)
+        elif how == "minmax":
+            offset = F.min(axis=0)
+            spread = F.max(axis=0) - offset
+            scale = np.where(spread > 0, spread, 1.0)
+        else:
             raise ValueError(
-                f"objective {names[j]} has maximum {scale[j]:g} <= 0 over the "
-                f"set: normalising by the maximum (Eq 7.12) needs a positive "
-                f"one; use min-max normalisation"
+                f"unknown normalisation {how!r}; use one of {', '.join(NORMALISATIONS)}"
             )
-        offset = np.zeros_like(scale)
-    elif how == "minmax":
-        offset = F.min(axis=0)
-        spread = F.max(axis=0) - offset
-        scale = np.where(spread > 0, spread, 1.0)
-    else:
-        raise ValueError(f"unknown normalisation {how!r}; use one of {', '.join(NORMALISATIONS)}")
-    return (F - offset) / scale, offset, scale
+        NF = (F - offset) / scale
+    for j in np.flatnonzero(~np.isfinite(NF).all(axis=0) | ~np.isfinite(scale)):
+        raise ValueError(
+            f"objective {names[j]} spans {F[:, j].min():g} to {F[:, j].max():g}: normalised "
+            f"({how}) it leaves the floating-point range"
+        )
+    return NF, offset, scale
 
 
 def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
@@ -187,9 +198,14 @@ def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
     if N == 1:
         return np.full(1, m - 1.0)
     soft = eps > 0
-    # Γ = clip(1 - Δ/ε, 0, 1) = clip((1 + f_j/ε) - f_i/ε, 0, 1): one subtraction per pair
+    # Γ = clip(1 - Δ/ε, 0, 1) = clip((1 + f_j/ε) - f_i/ε, 0, 1): one subtraction per pair,
+    # where f/ε stays far enough inside the floating-point range; a column with an ε so
+    # small that it does not (|f/ε| above 2^1020) takes 1 - Δ/ε itself, whose overflow to
+    # ±inf is the right limit (Γ = 0 or 1)
     scaled = F.copy()
-    scaled[:, soft] /= eps[soft]
+    with np.errstate(over="ignore"):
+        scaled[:, soft] /= eps[soft]
+    direct = soft & ~(np.abs(scaled) < 2.0**1020).all(axis=0)
     shifted = scaled + 1.0
     rows = int(max(1, min(N, chunk_bytes // (16 * N))))
     total, merit = np.empty((rows, N)), np.empty((rows, N))
@@ -199,7 +215,13 @@ def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
         S, T = total[: stop - start], merit[: stop - start]
         S.fill(0.0)
         for j in range(m):
-            if soft[j]:
+            if direct[j]:
+                with np.errstate(over="ignore"):
+                    np.subtract(F[start:stop, j, None], F[None, :, j], out=T)
+                    np.divide(T, eps[j], out=T)
+                np.subtract(1.0, T, out=T)
+                np.clip(T, 0.0, 1.0, out=T)
+            elif soft[j]:
                 np.subtract(shifted[None, :, j], scaled[start:stop, j, None], out=T)
                 np.clip(T, 0.0, 1.0, out=T)
             else:
@@ -300,7 +322,7 @@ def kesort(
     names = _names(names, F.shape[1])
     NF, _, scale = normalise_objectives(F, normalise, names)
     if eps is not None:
-        eps_nf = np.broadcast_to(np.asarray(eps, dtype=float), scale.shape) / scale
+        eps_nf = _eps_normalised(eps, scale, names, normalise)
         levels, P_value, auto = k_eps_levels(NF, eps_nf, chunk_bytes), None, False
     elif P is None or P == "auto":
         P_value, eps_nf, levels = _auto_P(NF, P_range, P_step, tie_tol, chunk_bytes)
@@ -321,6 +343,20 @@ def kesort(
         NF=NF,
         names=names,
     )
+
+
+def _eps_normalised(eps, scale: np.ndarray, names: tuple[str, ...], how: str) -> np.ndarray:
+    """The absolute thresholds ``eps`` in the units of the normalised objectives (``eps /
+    scale``); ValueError naming the objective where that leaves the floating-point range."""
+    given = np.broadcast_to(np.asarray(eps, dtype=float), scale.shape)
+    with np.errstate(over="ignore"):
+        eps_nf = given / scale
+    for j in np.flatnonzero(~np.isfinite(eps_nf)):
+        raise ValueError(
+            f"eps {given[j]:g} of objective {names[j]} is beyond the floating-point range "
+            f"in units of its scale {scale[j]:g} ({how} normalisation)"
+        )
+    return eps_nf
 
 
 def _auto_P(NF: np.ndarray, P_range, P_step: float, tie_tol: float, chunk_bytes: int):

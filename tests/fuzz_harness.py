@@ -1359,6 +1359,8 @@ FOUND_FLIPS = [
     (2024, 292, "a name that is not UTF-8, failing only when written out again"),
     (2024, 426, "an attribute crashing HDF5, behind a root whose attributes fail to list"),
     (99, 515, "a damaged reference to a dimension scale, crashing HDF5 when export opened it"),
+    (31337, 855, "an objective of -7e306, whose normalisation overflowed: a warning line"),
+    (606, 402, "a dataset that cannot be opened, ending the probe's walk before a crash"),
 ]
 
 

@@ -148,6 +148,18 @@ def test_masses_follow_the_k_v_rule_of_sec_8_4_3(tmp_path, ps_front):
             assert "X" not in g  # PS: the designs' own values unchanged
 
 
+@pytest.mark.parametrize("change", ["inf", "-inf", "nan", "-1e9"])
+def test_a_mass_change_that_leaves_no_finite_positive_load_is_bad_input(tmp_path, ps_front, change):
+    _, pareto = ps_front
+    out = tmp_path / "masses.h5"
+    proc = run("analyse", "masses", pareto, "--mass-change", change, "-o", out)
+    assert proc.returncode == 2, (proc.stdout, proc.stderr, proc.exception)
+    message = proc.stderr.strip()
+    assert len(message.splitlines()) == 1, message
+    assert message.startswith(f"error: --mass-change {float(change):g}: the load would be")
+    assert message.endswith("a finite load above 0 kg") and not out.exists()
+
+
 def test_masses_keep_x_st_and_k_h_of_nss1_designs(tmp_path):
     """NSS1: K_v = m g / X_ST follows the load, the design's own α is rescaled so that
     K_h = α K_v stays as built (Sec 8.4.3)."""

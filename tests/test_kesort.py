@@ -165,6 +165,30 @@ def test_one_solution_and_bad_input():
         kesort(HAND, normalise="range")
 
 
+@pytest.mark.parametrize("eps", [1e-320, [1e-320, 0.0, 1e-310, 5e-324, 1e-300]])
+def test_thresholds_below_the_float_spacing_give_the_crisp_levels_without_overflow(eps):
+    """|f/ε| beyond the floating-point range: Γ is 0 or 1 (the limit), computed without an
+    overflow (which numpy would report as a warning on the command line)."""
+    F = np.random.default_rng(7).random((60, 5))
+    with np.errstate(over="raise", divide="raise", invalid="raise"):
+        np.testing.assert_array_equal(k_eps_levels(F, eps), k_eps_levels(F, 0.0))
+        np.testing.assert_array_equal(kesort(F, P=1e-320).k_eps, k_eps_levels(F, 0.0))
+        huge = np.array([[1e308, 1.0], [-1e308, 0.5], [0.0, 0.7]])  # Δ itself overflows
+        np.testing.assert_array_equal(k_eps_levels(huge, 1e-300), [-1.0, 1.0, -1.0])
+
+
+def test_objectives_beyond_the_floating_point_range_once_normalised_are_named():
+    F = np.array([[0.18, -7.1e306], [0.2, 0.0324], [0.25, 0.024]])  # a damaged file's F
+    with np.errstate(over="raise", divide="raise", invalid="raise"):
+        with pytest.raises(ValueError, match=r"objective f2 spans -7\.1e\+306 to 0\.0324: "):
+            kesort(F)
+        with pytest.raises(ValueError, match=r"objective RC spans -1e\+308 to 1e\+308"):
+            pareto_picks([[1e308, 1.0], [-1e308, 2.0], [0.0, 0.0]], names=["RC", "X_ST"])
+        with pytest.raises(ValueError, match="eps 1 of objective f1 is beyond"):
+            kesort([[1e-320, 1.0], [2e-320, 0.5]], eps=1.0)
+        assert kesort(F, normalise="minmax").chosen == 0  # min-max keeps it in range
+
+
 def test_pareto_picks_edges_and_knee():
     theta = np.linspace(0.0, np.pi / 2, 21)
     F = np.column_stack([1 - np.cos(theta), 1 - np.sin(theta)])  # convex towards utopia

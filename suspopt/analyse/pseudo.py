@@ -49,6 +49,7 @@ column for X, F, S, as ``suspopt optimise`` writes them; X, F, S also ``names``)
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import partial
@@ -241,10 +242,11 @@ def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) ->
     variants = []
     for delta in changes:
         new = load + float(delta)
-        if not new > lowest:
+        if not (new > lowest and math.isfinite(new)):
+            floor = f"the seat mass ({lowest:g} kg)" if lowest else "0 kg"
             raise ConfigError(
-                f"--mass-change {delta:g}: the load would be {new:g} kg, not "
-                f"above the {'seat mass' if lowest else 'zero'} ({lowest:g} kg)"
+                f"--mass-change {delta:g}: the load would be {new:g} kg; give a change "
+                f"that leaves a finite load above {floor}"
             )
         changed = {path: float(value[0]) for path, value in passenger_mass_change(cfg, new).items()}
         X = None
