@@ -63,6 +63,9 @@ __all__ = [
 
 #: Normalisations of the objectives before ε = P · max NF (Eq 7.12 and min-max).
 NORMALISATIONS = ("max", "minmax")
+#: Most values of P that ``P="auto"`` may try (``P_range`` and ``P_step`` give the grid; each
+#: value is one sort of the set): a hundred times the default grid's 100.
+MAX_P_GRID = 10_000
 
 _CHUNK_BYTES = 64 * 2**20
 
@@ -254,14 +257,20 @@ def check_options(
                 f"got {values.tolist()}"
             )
     elif P is not None and P != "auto":
-        if not float(P) > 0:
-            raise ValueError(f"P must be > 0 or 'auto'; got {P}")
+        if not 0 < float(P) < np.inf:
+            raise ValueError(f"P must be finite and > 0, or 'auto'; got {P}")
     else:
         lo, hi = (float(p) for p in P_range)
-        if not 0 < lo <= hi or not P_step > 0:
+        if not (0 < lo <= hi < np.inf and 0 < P_step < np.inf):
             raise ValueError(
-                f"P_range must satisfy 0 < low <= high and P_step > 0; got "
+                f"P_range must satisfy 0 < low <= high and P_step > 0, all finite; got "
                 f"{tuple(P_range)}, {P_step}"
+            )
+        points = (hi - lo) / P_step + 1
+        if not points <= MAX_P_GRID:
+            raise ValueError(
+                f"P_range {tuple(P_range)} with P_step {P_step} is a grid of {points:.3g} "
+                f"values of P; at most {MAX_P_GRID} (each is one sort)"
             )
     if normalise not in NORMALISATIONS:
         raise ValueError(
@@ -363,7 +372,8 @@ def _auto_P(NF: np.ndarray, P_range, P_step: float, tie_tol: float, chunk_bytes:
     """The smallest P of the grid with a single best solution: (P, ε in NF units, levels)."""
     lo, hi = (float(p) for p in P_range)
     steps = np.arange(int(np.floor((hi - lo) / P_step + 1e-9)) + 1)
-    grid = np.round(lo + P_step * steps, 12)  # 0.15, not 0.15000000000000002
+    # 12 significant digits: 0.15, not 0.15000000000000002 (and 1e-320 stays 1e-320)
+    grid = [float(f"{value:.12g}") for value in lo + P_step * steps]
     peak = NF.max(axis=0)
     for P_value in grid:
         levels = k_eps_levels(NF, P_value * peak, chunk_bytes)

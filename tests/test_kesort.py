@@ -189,6 +189,31 @@ def test_objectives_beyond_the_floating_point_range_once_normalised_are_named():
         assert kesort(F, normalise="minmax").chosen == 0  # min-max keeps it in range
 
 
+@pytest.mark.parametrize(
+    "options, needle",
+    [
+        ({"P": np.inf}, "P must be finite and > 0"),
+        ({"P": np.nan}, "P must be finite and > 0"),
+        ({"P_range": (0.01, np.inf)}, "all finite"),
+        ({"P_step": np.nan}, "all finite"),
+        ({"P_step": 1e-12}, r"a grid of 9.9e\+11 values of P; at most 10000"),
+        ({"P_range": (0.01, 1e300), "P_step": 1e-300}, "a grid of inf values of P"),
+    ],
+)
+def test_options_that_are_not_finite_or_make_a_runaway_grid_are_refused(options, needle):
+    """Before any work: a grid of 10^12 values of P was an allocation of 7 TB."""
+    with pytest.raises(ValueError, match=needle):
+        kesort(HAND, **options)
+
+
+def test_a_grid_of_tiny_P_keeps_its_values():
+    """The grid's values are rounded to 12 significant digits, not decimals (which made a
+    grid of 1e-320 all zeros)."""
+    result = kesort(HAND, P_range=(1e-320, 1e-319), P_step=1e-321)
+    assert 1e-320 <= result.P <= 1e-319
+    assert kesort(HAND, P_range=(0.15, 0.15)).P == 0.15
+
+
 def test_pareto_picks_edges_and_knee():
     theta = np.linspace(0.0, np.pi / 2, 21)
     F = np.column_stack([1 - np.cos(theta), 1 - np.sin(theta)])  # convex towards utopia
@@ -313,6 +338,7 @@ def _pareto_without_F(path, pareto):
         ("plot", "fig.jpg: give a .png or .svg file"),
         ("normalise", "unknown normalisation 'range'"),
         ("configs", "--config: give one config for every file, or one per file (1); got 2"),
+        ("grid", "--P-range (0.01, 1.0) with --P-step 1e-12 is a grid of 9.9e+11 values"),
     ],
 )
 def test_cli_kesort_bad_input_exits_2_with_one_line(pareto, tmp_path, case, needle):
@@ -325,6 +351,7 @@ def test_cli_kesort_bad_input_exits_2_with_one_line(pareto, tmp_path, case, need
         "eps": [str(pareto), "--eps", "1,x"],
         "plot": [str(pareto), "--plot", str(tmp_path / "fig.jpg")],
         "normalise": [str(pareto), "--normalise", "range"],
+        "grid": [str(pareto), "--P-step", "1e-12"],
         "configs": [
             str(pareto),
             "-c",

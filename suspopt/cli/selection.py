@@ -162,8 +162,9 @@ def _kesort(
     options = dict(P=P, normalise=normalise, P_range=tuple(P_lo_hi), P_step=P_step)
     try:
         check_options(eps_values, **options)
-    except ValueError as exc:
-        base.fail(f"kesort options: {exc}")
+    except ValueError as exc:  # (named as the options are on this command line)
+        message = str(exc).replace("P_range", "--P-range").replace("P_step", "--P-step")
+        base.fail(f"kesort options: {message}")
     try:
         sets = load_design_sets(pareto, config, label)
         selection = select(sets, eps_values, feasible_only=not keep_infeasible, **options)
