@@ -50,8 +50,9 @@ class DesignTable:
     configs: list[str]
     config_of: np.ndarray
 
-    def resolve(self, pick: str) -> int:
-        """The row of ``pick`` (a name or a row number); ConfigError listing the choices."""
+    def resolve(self, pick: str, option: str = "--pick") -> int:
+        """The row of ``pick`` (a name or a row number); ConfigError, naming the command-line
+        ``option`` it came from, listing the choices."""
         if pick in self.picks:
             return self.picks[pick]
         try:
@@ -59,11 +60,11 @@ class DesignTable:
         except ValueError:
             known = ", ".join(list(self.picks) + ["a row number"])
             raise ConfigError(
-                f"--pick {pick}: {self.path} has no such pick; it has {known}"
+                f"{option} {pick}: {self.path} has no such pick; it has {known}"
             ) from None
         if not 0 <= row < len(self.X):
             raise ConfigError(
-                f"--pick {pick}: {self.path}: /{self.table} has rows 0 to {len(self.X) - 1}"
+                f"{option} {pick}: {self.path}: /{self.table} has rows 0 to {len(self.X) - 1}"
             )
         return row
 

@@ -136,8 +136,8 @@ def test_the_page_holds_every_design_and_nothing_from_a_file_as_markup(files, tm
     "args, message",
     [
         (["{yaml}"], "not an HDF5 file"),
-        (["{front}", "--with-signals", "knees"], "no such pick"),
-        (["{front}", "--with-signals", "9999"], "has rows 0 to"),
+        (["{front}", "--with-signals", "knees"], "error: --with-signals knees: "),
+        (["{front}", "--with-signals", "9999"], "error: --with-signals 9999: "),
         (["{text}"], "not an HDF5 file"),
         (["{missing}"], "no such file"),
     ],

@@ -101,7 +101,9 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
         **extra,
     }
     study = Study(path.name, kind, data)
-    rows = sorted(set(table.picks.values()) | {table.resolve(r) for r in with_signals})
+    rows = sorted(
+        set(table.picks.values()) | {table.resolve(r, "--with-signals") for r in with_signals}
+    )
     if len(rows) > MAX_SIGNAL_DESIGNS:
         raise ConfigError(
             f"--with-signals: {len(rows)} designs with signals, more than {MAX_SIGNAL_DESIGNS}"
