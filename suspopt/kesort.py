@@ -201,14 +201,15 @@ def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
     if N == 1:
         return np.full(1, m - 1.0)
     soft = eps > 0
-    # Γ = clip(1 - Δ/ε, 0, 1) = clip((1 + f_j/ε) - f_i/ε, 0, 1): one subtraction per pair,
-    # where f/ε stays far enough inside the floating-point range; a column with an ε so
-    # small that it does not (|f/ε| above 2^1020) takes 1 - Δ/ε itself, whose overflow to
-    # ±inf is the right limit (Γ = 0 or 1)
+    # Γ = clip(1 - Δ/ε, 0, 1) = clip((1 + f_j/ε) - f_i/ε, 0, 1): one subtraction per pair.
+    # That form rounds Γ by about |f/ε| 2^-53 (the 1 vanishes beside an f/ε of 2^53, making
+    # a tie Γ = 0): a column where |f/ε| exceeds 2^16 (Γ within 2^-37; an ε far below the
+    # objective's values) takes 1 - Δ/ε itself, where Δ of two values closer than ε is exact
+    # and an overflow to ±inf is the right limit (Γ = 0 or 1)
     scaled = F.copy()
     with np.errstate(over="ignore"):
         scaled[:, soft] /= eps[soft]
-    direct = soft & ~(np.abs(scaled) < 2.0**1020).all(axis=0)
+    direct = soft & ~(np.abs(scaled) <= 2.0**16).all(axis=0)
     shifted = scaled + 1.0
     rows = int(max(1, min(N, chunk_bytes // (16 * N))))
     total, merit = np.empty((rows, N)), np.empty((rows, N))
@@ -345,7 +346,7 @@ def kesort(
         k_eps=levels,
         chosen=int(ties[0]),
         ties=ties,
-        epsilon=eps_nf * scale,
+        epsilon=_eps_in_units(eps_nf, scale, names),
         P=P_value,
         P_auto=auto,
         normalisation=normalise,
@@ -366,6 +367,21 @@ def _eps_normalised(eps, scale: np.ndarray, names: tuple[str, ...], how: str) ->
             f"in units of its scale {scale[j]:g} ({how} normalisation)"
         )
     return eps_nf
+
+
+def _eps_in_units(eps_nf, scale: np.ndarray, names: tuple[str, ...]) -> np.ndarray:
+    """The thresholds ``eps_nf`` of the normalised objectives in the objectives' own units;
+    ValueError naming the objective where that leaves the floating-point range (a ``P`` of
+    10^291 on an objective of 10^17)."""
+    eps_nf = np.broadcast_to(eps_nf, scale.shape)
+    with np.errstate(over="ignore"):
+        epsilon = eps_nf * scale
+    for j in np.flatnonzero(~np.isfinite(epsilon)):
+        raise ValueError(
+            f"objective {names[j]}: a threshold of {eps_nf[j]:g} times its scale "
+            f"{scale[j]:g} is beyond the floating-point range"
+        )
+    return epsilon
 
 
 def _auto_P(NF: np.ndarray, P_range, P_step: float, tie_tol: float, chunk_bytes: int):
@@ -425,6 +441,7 @@ def pareto_picks(F, names: Sequence[str] | None = None) -> dict[str, int]:
     }
     ideal = F.min(axis=0)
     span = F[list(picks.values())].max(axis=0) - ideal
-    scaled = (F - ideal) / np.where(span > 0, span, 1.0)
-    picks["knee"] = int(np.argmin(np.einsum("ij,ij->i", scaled, scaled)))
+    with np.errstate(over="ignore"):  # a design beyond the range's reach is infinitely far
+        scaled = (F - ideal) / np.where(span > 0, span, 1.0)
+        picks["knee"] = int(np.argmin(np.einsum("ij,ij->i", scaled, scaled)))
     return picks
