@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import stat
 from pathlib import Path
 from typing import Annotated, Literal
@@ -242,9 +243,29 @@ def read_profile(path: Path) -> tuple:
     optional header line, then rows ``distance,height``: two finite numbers each, at least two
     rows, distances strictly increasing. ValueError (FileNotFoundError for a missing file)
     names the file and the line, never the line's content: the file may be anything.
-    """
-    import numpy as np
 
+    Its first 1000 lines are read line by line (a bad one is named at once); then a
+    well-formed file is read by numpy's parser and any other line by line, which stops at its
+    first bad line and names it, holding the numbers in compact arrays, never a Python object
+    per line (``benchmarks/bench_road_file.py``).
+    """
+    data = _profile_bytes(path)
+    try:
+        text = data.decode("utf-8")
+        header = _header(text)
+        _rows_line_by_line(path, text, header, lines=1000)  # a bad line near the top, at once
+        table = _fast_rows(data, text, header)
+        if table is not None:
+            return table[:, 0], table[:, 1]
+        return _rows_line_by_line(path, text, header)
+    except MemoryError:  # (under --max-memory, or a process's address-space limit)
+        raise ValueError(
+            f"road profile {path}: reading its {len(data) >> 20} MB ran out of memory"
+        ) from None
+
+
+def _profile_bytes(path: Path) -> bytes:
+    """The bytes of the road profile ``path``, UTF-8 text (see :func:`read_profile`)."""
     if not path.exists():
         raise FileNotFoundError(f"road profile file not found: {path}")
     try:
@@ -261,15 +282,79 @@ def read_profile(path: Path) -> tuple:
     if len(data) > MAX_PROFILE_BYTES:
         raise ValueError(f"road profile {path}: larger than {MAX_PROFILE_BYTES >> 20} MB")
     try:
-        text = data.decode("utf-8")
+        data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
         raise ValueError(f"road profile {path}:{line}: not UTF-8 text") from None
-    lines = text.splitlines()
-    header = 1 if lines and _row(lines[0]) is None else 0
-    rows, numbers = [], []
-    for number, line in enumerate(lines[header:], start=header + 1):
-        if not line.strip():
+    return data
+
+
+def _header(text: str) -> int:
+    """1 when the first line of ``text`` is not a row of two numbers (a header), else 0."""
+    first = text[: text.find("\n")] if "\n" in text else text
+    return 1 if _row((first.splitlines() or [""])[0]) is None else 0
+
+
+#: Line breaks of ``str.splitlines`` other than ``\n`` and ``\r\n``: a file holding one is
+#: read line by line, where the lines are counted as ``splitlines`` counts them.
+_OTHER_BREAKS = re.compile("\r(?!\n)|[\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029]")
+_BREAKS = re.compile("\r\n|[\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029]")
+
+
+def _fast_rows(data: bytes, text: str, header: int):
+    """The ``(N, 2)`` rows of a well-formed profile (``data``, whose text is ``text``) by
+    numpy's parser, or None when it is anything else (the line-by-line reading then finds
+    and names its bad line)."""
+    import io
+    import warnings
+
+    import numpy as np
+
+    if _OTHER_BREAKS.search(text):
+        return None
+    try:
+        with np.errstate(over="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # ("input contained no data": read line by line)
+            table = np.loadtxt(
+                io.BytesIO(data),
+                delimiter=",",
+                skiprows=header,
+                ndmin=2,
+                comments=None,
+                encoding="utf-8",
+            )
+    except (ValueError, TypeError, MemoryError):
+        return None
+    ok = (
+        table.shape[1] == 2
+        and len(table) >= 2
+        and bool(np.isfinite(table).all())
+        and bool((np.diff(table[:, 0]) > 0).all())
+    )
+    return table if ok else None
+
+
+def _lines(text: str):
+    """The lines of ``text`` as ``str.splitlines`` gives them, one at a time."""
+    start = 0
+    for found in _BREAKS.finditer(text):
+        yield text[start : found.start()]
+        start = found.end()
+    if start < len(text):
+        yield text[start:]
+
+
+def _rows_line_by_line(path: Path, text: str, header: int, lines: int | None = None) -> tuple:
+    """The distance and height columns of the profile ``text``, read line by line; ValueError
+    at its first bad line. With ``lines``, only that many lines are read (and not counted)."""
+    from array import array
+    from itertools import islice
+
+    import numpy as np
+
+    distance, height = array("d"), array("d")
+    for number, line in enumerate(islice(_lines(text), lines), start=1):
+        if number <= header or not line.strip():
             continue
         row = _row(line)
         if row is None:
@@ -279,18 +364,16 @@ def read_profile(path: Path) -> tuple:
             )
         if not (math.isfinite(row[0]) and math.isfinite(row[1])):
             raise ValueError(f"road profile {path}:{number}: values must be finite")
-        rows.append(row)
-        numbers.append(number)
-    if len(rows) < 2:
+        if distance and not row[0] > distance[-1]:
+            raise ValueError(f"road profile {path}:{number}: distances must increase strictly")
+        distance.append(row[0])
+        height.append(row[1])
+    if len(distance) < 2 and lines is None:
         raise ValueError(
-            f"road profile {path}: needs at least two rows of 'distance,height', found {len(rows)}"
+            f"road profile {path}: needs at least two rows of 'distance,height', "
+            f"found {len(distance)}"
         )
-    table = np.array(rows)
-    steps = np.diff(table[:, 0])
-    if (steps <= 0).any():
-        line = numbers[int(np.argmax(steps <= 0)) + 1]
-        raise ValueError(f"road profile {path}:{line}: distances must increase strictly")
-    return table[:, 0], table[:, 1]
+    return np.array(distance), np.array(height)
 
 
 def _row(line: str) -> tuple[float, float] | None:
