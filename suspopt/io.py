@@ -86,12 +86,12 @@ def is_suspopt_output(path: Path) -> bool:
     with open(path, "rb") as stream:
         head = stream.read(_HEAD)
     if head.startswith(b"\x89HDF\r\n\x1a\n"):
-        import h5py
+        from .h5read import H5Reader
 
-        try:
-            with h5py.File(path, "r") as h5:
-                return "suspopt_version" in h5.attrs
-        except (OSError, ValueError):
+        try:  # (a damaged file, one that crashes or hangs the HDF5 library included, is
+            with H5Reader(path) as reader:  # not known to be suspopt's)
+                return reader.has_attr("suspopt_version")
+        except ConfigError:
             return False
     return OUTPUT_MARKER.encode() in head
 

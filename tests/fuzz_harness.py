@@ -1361,7 +1361,12 @@ FOUND_FLIPS = [
     (99, 515, "a damaged reference to a dimension scale, crashing HDF5 when export opened it"),
     (31337, 855, "an objective of -7e306, whose normalisation overflowed: a warning line"),
     (606, 402, "a dataset that cannot be opened, ending the probe's walk before a crash"),
+    (4242, 9, "a damaged datatype, a traceback when an output's owner was looked up"),
+    (4242, 159, "an object of no known type, a traceback when an output's owner was looked up"),
 ]
+#: Run on the found flips only (last: it replaces the file where suspopt wrote it): the file
+#: as an existing output, whose owner is looked up before anything is written.
+FOUND_FLIP_RUNS = [["simulate", "configs/quickstart.yaml", "-o", "{path}"]]
 
 
 def h5_cases(variants) -> list[Case]:
@@ -1371,7 +1376,7 @@ def h5_cases(variants) -> list[Case]:
             family="h5",
             label=name,
             setup={"kind": "h5", "variant": name},
-            runs=H5_RUNS,
+            runs=H5_RUNS + (FOUND_FLIP_RUNS if name.startswith(f"{RANDOM_PREFIX}seed") else []),
             source=FRONT,
             name=f"{name}.h5",
             dataset=dataset,
