@@ -249,8 +249,8 @@ def read_profile(path: Path) -> tuple:
     first bad line and names it, holding the numbers in compact arrays, never a Python object
     per line (``benchmarks/bench_road_file.py``).
     """
-    data = _profile_bytes(path)
     try:
+        data = _profile_bytes(path)
         text = data.decode("utf-8")
         header = _header(text)
         _rows_line_by_line(path, text, header, lines=1000)  # a bad line near the top, at once
@@ -260,7 +260,7 @@ def read_profile(path: Path) -> tuple:
         return _rows_line_by_line(path, text, header)
     except MemoryError:  # (under --max-memory, or a process's address-space limit)
         raise ValueError(
-            f"road profile {path}: reading its {len(data) >> 20} MB ran out of memory"
+            f"road profile {path}: reading its {path.stat().st_size >> 20} MB ran out of memory"
         ) from None
 
 
