@@ -334,8 +334,11 @@ def windows(
     rows = 0 if getattr(accumulators, "alone", False) else n  # (every signal in the kernel)
     for j0 in range(0, n_out, width):
         T = min(width, n_out - j0)
-        states, accelerations = np.empty((2 * rows, P, T)), np.empty((rows, P, T))
-        out = (states, accelerations, diverged_at, np.empty((Nl, P, T)))
+        # zeros, not np.empty: the kernel writes only the rows and samples that are read,
+        # and the signals are formed over whole windows (recycled memory there made numpy
+        # warn of overflows in values nobody reads)
+        states, accelerations = np.zeros((2 * rows, P, T)), np.zeros((rows, P, T))
+        out = (states, accelerations, diverged_at, np.zeros((Nl, P, T)))
 
         def advance(k0: int, k1: int, ctl=_no_control(blocks, B), out=out, j0=j0) -> None:
             if k1 <= k0:  # (no step: a call from step 0 would apply the start's impulses)
