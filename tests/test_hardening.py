@@ -96,6 +96,11 @@ def test_hostile_yaml_is_refused_fast_and_small(tmp_path, capsys, text, needle):
         (lambda d: write(d, b"vehicle: \x00\x01\x02"), "holds NUL bytes"),
         (lambda d: write(d, b"vehicle: \xff\xfe"), "is not UTF-8 text"),
         (lambda d: write(d, "# " + "x" * (1 << 20) + "\n"), "is larger than 1024 kB"),
+        # a regular file whose reading fails (EIO): a traceback before
+        (
+            lambda d: os.symlink("/proc/self/mem", d / "mem.yaml") or d / "mem.yaml",
+            "cannot read it (Input/output error)",
+        ),
     ],
 )
 def test_config_files_that_are_no_config_are_refused(tmp_path, capsys, make, needle):
@@ -290,10 +295,14 @@ SECRET = "root:x:0:0:root:/root:/bin/bash"
         (f"0,0\n{SECRET}\n".encode(), "road.csv:2: expected two numbers 'distance,height'"),
         (b"0,0\n1,0\n\xff\xfe\x00", "not UTF-8 text"),
         (b"0,0\n2,0\n1,0\n", "road.csv:3: distances must increase strictly"),
+        (None, "road.csv: cannot read it (Input/output error)"),  # (/proc/self/mem)
     ],
 )
 def test_road_files_are_checked_on_load_and_never_echoed(tmp_path, capsys, content, needle):
-    (tmp_path / "road.csv").write_bytes(content)
+    if content is None:
+        os.symlink("/proc/self/mem", tmp_path / "road.csv")
+    else:
+        (tmp_path / "road.csv").write_bytes(content)
     text = GOOD.split("road:")[0] + (
         "road: {kind: file, path: road.csv, speed: 10}\nsimulation: {duration: 1.0}\n"
     )

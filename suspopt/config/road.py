@@ -277,8 +277,13 @@ def _profile_bytes(path: Path) -> bytes:
     if not stat.S_ISREG(os.fstat(fd).st_mode):
         os.close(fd)
         raise ValueError(f"road profile {path}: not a regular file")
-    with os.fdopen(fd, "rb") as stream:
-        data = stream.read(MAX_PROFILE_BYTES + 1)
+    try:
+        with os.fdopen(fd, "rb") as stream:
+            data = stream.read(MAX_PROFILE_BYTES + 1)
+    except OSError as exc:  # (a regular file that cannot be read: /proc/self/mem)
+        raise ValueError(
+            f"road profile {path}: cannot read it ({exc.strerror or exc.__class__.__name__})"
+        ) from None
     if len(data) > MAX_PROFILE_BYTES:
         raise ValueError(f"road profile {path}: larger than {MAX_PROFILE_BYTES >> 20} MB")
     try:

@@ -84,8 +84,11 @@ def read_text(path: str | Path, limit: int = MAX_CONFIG_BYTES, what: str = "conf
             else "not a regular file"
         )
         raise YamlError(f"is {kind}, not a regular {what} file")
-    with os.fdopen(fd, "rb") as stream:
-        data = stream.read(limit + 1)
+    try:
+        with os.fdopen(fd, "rb") as stream:
+            data = stream.read(limit + 1)
+    except OSError as exc:  # (a regular file that cannot be read: /proc/self/mem)
+        raise YamlError(f"cannot read it ({exc.strerror or exc.__class__.__name__})") from None
     if len(data) > limit:
         raise YamlError(f"is larger than {limit // 1024} kB: not a {what} file")
     if b"\0" in data:
