@@ -176,12 +176,25 @@ def normalise_objectives(
                 f"unknown normalisation {how!r}; use one of {', '.join(NORMALISATIONS)}"
             )
         NF = (F - offset) / scale
-    for j in np.flatnonzero(~np.isfinite(NF).all(axis=0) | ~np.isfinite(scale)):
-        raise ValueError(
-            f"objective {names[j]} spans {F[:, j].min():g} to {F[:, j].max():g}: normalised "
-            f"({how}) it leaves the floating-point range"
-        )
+    _in_range(
+        lambda j: (
+            f"objective {names[j]} spans {F[:, j].min():g} to {F[:, j].max():g}: "
+            f"normalised ({how}) it leaves the floating-point range"
+        ),
+        NF,
+        scale,
+    )
     return NF, offset, scale
+
+
+def _in_range(say, *columns: np.ndarray) -> None:
+    """ValueError ``say(j)`` for the first objective ``j`` (the last axis of each array) with
+    a value that is not finite in any of ``columns``."""
+    finite = np.logical_and.reduce(
+        [np.isfinite(a).reshape(-1, a.shape[-1]).all(axis=0) for a in columns]
+    )
+    for j in np.flatnonzero(~finite):
+        raise ValueError(say(j))
 
 
 def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
@@ -361,11 +374,13 @@ def _eps_normalised(eps, scale: np.ndarray, names: tuple[str, ...], how: str) ->
     given = np.broadcast_to(np.asarray(eps, dtype=float), scale.shape)
     with np.errstate(over="ignore"):
         eps_nf = given / scale
-    for j in np.flatnonzero(~np.isfinite(eps_nf)):
-        raise ValueError(
-            f"eps {given[j]:g} of objective {names[j]} is beyond the floating-point range "
-            f"in units of its scale {scale[j]:g} ({how} normalisation)"
-        )
+    _in_range(
+        lambda j: (
+            f"eps {given[j]:g} of objective {names[j]} is beyond the floating-point "
+            f"range in units of its scale {scale[j]:g} ({how} normalisation)"
+        ),
+        eps_nf,
+    )
     return eps_nf
 
 
@@ -376,11 +391,13 @@ def _eps_in_units(eps_nf, scale: np.ndarray, names: tuple[str, ...]) -> np.ndarr
     eps_nf = np.broadcast_to(eps_nf, scale.shape)
     with np.errstate(over="ignore"):
         epsilon = eps_nf * scale
-    for j in np.flatnonzero(~np.isfinite(epsilon)):
-        raise ValueError(
+    _in_range(
+        lambda j: (
             f"objective {names[j]}: a threshold of {eps_nf[j]:g} times its scale "
             f"{scale[j]:g} is beyond the floating-point range"
-        )
+        ),
+        epsilon,
+    )
     return epsilon
 
 
