@@ -39,7 +39,6 @@ import contextlib
 import errno
 import fcntl
 import os
-import stat
 import sys
 import tempfile
 from collections.abc import Iterable, Iterator, Sequence
@@ -51,6 +50,7 @@ import numpy as np
 
 from . import __version__
 from .config import Config, ConfigError
+from .files import kind_of
 
 __all__ = [
     "OUTPUT_MARKER",
@@ -114,19 +114,7 @@ def check_target(path: str | Path, force: bool = False, option: str = "-o") -> P
         return path
     except OSError as exc:
         raise ConfigError(f"{option} {path}: cannot inspect it ({exc.strerror})") from None
-    kind = (
-        "a directory"
-        if stat.S_ISDIR(mode)
-        else "a symbolic link"
-        if stat.S_ISLNK(mode)
-        else "a FIFO"
-        if stat.S_ISFIFO(mode)
-        else "a socket"
-        if stat.S_ISSOCK(mode)
-        else "a device"
-        if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
-        else None
-    )
+    kind = kind_of(mode)
     if kind is not None:
         raise ConfigError(
             f"{option} {path}: is {kind}; an output must be a regular file or a new name"

@@ -95,7 +95,10 @@ def test_hostile_yaml_is_refused_fast_and_small(tmp_path, capsys, text, needle):
         (lambda d: d, "is a directory"),
         (lambda d: write(d, b"vehicle: \x00\x01\x02"), "holds NUL bytes"),
         (lambda d: write(d, b"vehicle: \xff\xfe"), "is not UTF-8 text"),
-        (lambda d: write(d, "# " + "x" * (1 << 20) + "\n"), "is larger than 1024 kB"),
+        (
+            lambda d: write(d, "# " + "x" * (1 << 20) + "\n"),
+            "is larger than 1 MB, not a config file",
+        ),
         # a regular file whose reading fails (EIO): a traceback before
         (
             lambda d: os.symlink("/proc/self/mem", d / "mem.yaml") or d / "mem.yaml",
@@ -295,12 +298,19 @@ SECRET = "root:x:0:0:root:/root:/bin/bash"
         (f"0,0\n{SECRET}\n".encode(), "road.csv:2: expected two numbers 'distance,height'"),
         (b"0,0\n1,0\n\xff\xfe\x00", "not UTF-8 text"),
         (b"0,0\n2,0\n1,0\n", "road.csv:3: distances must increase strictly"),
-        (None, "road.csv: cannot read it (Input/output error)"),  # (/proc/self/mem)
+        ("/proc/self/mem", "road.csv: cannot read it (Input/output error)"),
+        ("/dev/zero", "road.csv: is a device"),
+        ("fifo", "road.csv: is a FIFO"),
+        ("folder", "road.csv: is a directory"),
     ],
 )
 def test_road_files_are_checked_on_load_and_never_echoed(tmp_path, capsys, content, needle):
-    if content is None:
-        os.symlink("/proc/self/mem", tmp_path / "road.csv")
+    if content == "fifo":
+        os.mkfifo(tmp_path / "road.csv")
+    elif content == "folder":
+        (tmp_path / "road.csv").mkdir()
+    elif isinstance(content, str):
+        os.symlink(content, tmp_path / "road.csv")
     else:
         (tmp_path / "road.csv").write_bytes(content)
     text = GOOD.split("road:")[0] + (

@@ -20,14 +20,13 @@ is checked when the road is generated (:func:`suspopt.road.road_inputs` raises
 from __future__ import annotations
 
 import math
-import os
 import re
-import stat
 from pathlib import Path
 from typing import Annotated, Literal
 
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
+from ..files import Unreadable, read_bounded
 from .base import RoadHeight, RoadLength, Section, Seed, Speed, bounds
 
 __all__ = [
@@ -250,8 +249,7 @@ def read_profile(path: Path) -> tuple:
     per line (``benchmarks/bench_road_file.py``).
     """
     try:
-        data = _profile_bytes(path)
-        text = data.decode("utf-8")
+        data, text = _profile_text(path)
         header = _header(text)
         _rows_line_by_line(path, text, header, lines=1000)  # a bad line near the top, at once
         table = _fast_rows(data, text, header)
@@ -264,34 +262,21 @@ def read_profile(path: Path) -> tuple:
         ) from None
 
 
-def _profile_bytes(path: Path) -> bytes:
-    """The bytes of the road profile ``path``, UTF-8 text (see :func:`read_profile`)."""
-    if not path.exists():
-        raise FileNotFoundError(f"road profile file not found: {path}")
+def _profile_text(path: Path) -> tuple[bytes, str]:
+    """The bytes of the road profile ``path`` and their UTF-8 text (see :func:`read_profile`;
+    :func:`suspopt.files.read_bounded` refuses what is not a regular file of at most
+    :data:`MAX_PROFILE_BYTES`)."""
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
-    except OSError as exc:
-        raise ValueError(
-            f"road profile {path}: cannot open it ({exc.strerror or exc.__class__.__name__})"
-        ) from None
-    if not stat.S_ISREG(os.fstat(fd).st_mode):
-        os.close(fd)
-        raise ValueError(f"road profile {path}: not a regular file")
+        data = read_bounded(path, MAX_PROFILE_BYTES)
+    except FileNotFoundError:
+        raise FileNotFoundError(f"road profile file not found: {path}") from None
+    except Unreadable as exc:
+        raise ValueError(f"road profile {path}: {exc}") from None
     try:
-        with os.fdopen(fd, "rb") as stream:
-            data = stream.read(MAX_PROFILE_BYTES + 1)
-    except OSError as exc:  # (a regular file that cannot be read: /proc/self/mem)
-        raise ValueError(
-            f"road profile {path}: cannot read it ({exc.strerror or exc.__class__.__name__})"
-        ) from None
-    if len(data) > MAX_PROFILE_BYTES:
-        raise ValueError(f"road profile {path}: larger than {MAX_PROFILE_BYTES >> 20} MB")
-    try:
-        data.decode("utf-8")
+        return data, data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
         raise ValueError(f"road profile {path}:{line}: not UTF-8 text") from None
-    return data
 
 
 def _header(text: str) -> int:

@@ -21,9 +21,7 @@ Errors are :class:`YamlError` with the line (1-based) where known.
 
 from __future__ import annotations
 
-import os
 import re
-import stat
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +33,8 @@ from yaml.parser import Parser
 from yaml.reader import Reader
 from yaml.resolver import BaseResolver
 from yaml.scanner import Scanner
+
+from ..files import Unreadable, read_bounded, size_text
 
 __all__ = ["YamlError", "MAX_CONFIG_BYTES", "MAX_DEPTH", "MAX_NODES", "read_text", "parse_yaml"]
 
@@ -56,41 +56,17 @@ class YamlError(ValueError):
 
 def read_text(path: str | Path, limit: int = MAX_CONFIG_BYTES, what: str = "config") -> str:
     """The UTF-8 text of the regular file ``path``, read without following it into a device
-    or FIFO and without reading more than ``limit`` bytes; YamlError otherwise (the message
-    says why; FileNotFoundError for a missing file)."""
+    or FIFO and without reading more than ``limit`` bytes (:func:`suspopt.files.read_bounded`);
+    YamlError otherwise (the message says why; FileNotFoundError for a missing file)."""
     path = Path(path)
     if str(path) == "":
         raise YamlError(f"an empty file name is not a {what} file")
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
-    except FileNotFoundError:
-        raise
-    except IsADirectoryError:
-        raise YamlError(f"is a directory, not a {what} file") from None
-    except OSError as exc:
-        raise YamlError(f"cannot open it ({exc.strerror or exc.__class__.__name__})") from None
-    mode = os.fstat(fd).st_mode
-    if not stat.S_ISREG(mode):
-        os.close(fd)
-        kind = (
-            "a directory"
-            if stat.S_ISDIR(mode)
-            else "a FIFO"
-            if stat.S_ISFIFO(mode)
-            else "a device"
-            if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
-            else "a socket"
-            if stat.S_ISSOCK(mode)
-            else "not a regular file"
-        )
-        raise YamlError(f"is {kind}, not a regular {what} file")
-    try:
-        with os.fdopen(fd, "rb") as stream:
-            data = stream.read(limit + 1)
-    except OSError as exc:  # (a regular file that cannot be read: /proc/self/mem)
-        raise YamlError(f"cannot read it ({exc.strerror or exc.__class__.__name__})") from None
-    if len(data) > limit:
-        raise YamlError(f"is larger than {limit // 1024} kB: not a {what} file")
+        data = read_bounded(path, limit)
+    except Unreadable as exc:  # ("is a FIFO, not a config file"; "cannot read it (...)")
+        reason = str(exc)
+        message = f"{reason}, not a {what} file" if reason.startswith("is ") else reason
+        raise YamlError(message) from None
     if b"\0" in data:
         raise YamlError(f"holds NUL bytes: a binary file, not a YAML {what}")
     try:
@@ -255,7 +231,7 @@ def parse_yaml(text: str) -> tuple[Any, Node | None]:
     """The data of one YAML document and its composed node tree (for line numbers);
     YamlError with the line for malformed, unsafe or oversized input."""
     if len(text) > MAX_CONFIG_BYTES:
-        raise YamlError(f"is larger than {MAX_CONFIG_BYTES // 1024} kB: not a config")
+        raise YamlError(f"is larger than {size_text(MAX_CONFIG_BYTES)}: not a config")
     loader = None
     try:
         loader = _LOADER(text)

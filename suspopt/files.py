@@ -1,0 +1,81 @@
+"""Reading a file a user names as input, within bounds.
+
+An input path may name something that is not a file to read: a directory, a FIFO (reading
+one waits for a writer that may never come), a device (``/dev/zero`` never ends) or a
+regular file far larger than what it claims to be. :func:`read_bounded` opens the path
+without blocking, reads only a regular file and never more than ``limit + 1`` bytes, so
+none of these can hang suspopt or make it allocate without bound. The callers (the YAML
+config reader, the road profile reader) word the reason into their own messages.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+__all__ = ["Unreadable", "kind_of", "read_bounded", "size_text"]
+
+
+class Unreadable(ValueError):
+    """Why an input file was not read; ``str(exc)`` is a phrase that follows the file's name
+    ("is a FIFO", "cannot read it (Input/output error)", "is larger than 1 MB")."""
+
+
+def kind_of(mode: int) -> str | None:
+    """What a file of ``st_mode`` ``mode`` is ("a directory", "a FIFO" ...), or None for a
+    regular file."""
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "a directory"
+    if stat.S_ISLNK(mode):
+        return "a symbolic link"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    return "not a regular file"
+
+
+def size_text(n_bytes: int) -> str:
+    """``n_bytes`` for a message: whole MB (2^20 bytes) where it is one, else kB (2^10)."""
+    if n_bytes >= 1 << 20 and n_bytes % (1 << 20) == 0:
+        return f"{n_bytes >> 20} MB"
+    return f"{n_bytes >> 10} kB"
+
+
+def _reason(exc: OSError) -> str:
+    return exc.strerror or exc.__class__.__name__
+
+
+def read_bounded(path: str | Path, limit: int) -> bytes:
+    """The bytes of the regular file ``path``, of at most ``limit`` bytes.
+
+    Raises FileNotFoundError for a missing file and :class:`Unreadable` for anything else
+    that is not read: not a regular file (a symlink is followed to what it names), a file
+    that cannot be opened or read (a regular file may still fail to read: ``/proc/self/mem``
+    gives an I/O error), or one larger than ``limit``.
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        raise
+    except IsADirectoryError:
+        raise Unreadable("is a directory") from None
+    except OSError as exc:
+        raise Unreadable(f"cannot open it ({_reason(exc)})") from None
+    kind = kind_of(os.fstat(fd).st_mode)
+    if kind is not None:
+        os.close(fd)
+        raise Unreadable(f"is {kind}" if kind.startswith("a ") else kind)
+    try:
+        with os.fdopen(fd, "rb") as stream:
+            data = stream.read(limit + 1)
+    except OSError as exc:
+        raise Unreadable(f"cannot read it ({_reason(exc)})") from None
+    if len(data) > limit:
+        raise Unreadable(f"is larger than {size_text(limit)}")
+    return data
