@@ -467,3 +467,22 @@ def test_cli_optimise_bad_input_exits_2_with_one_line(tmp_path, change, needle):
     assert len(message.splitlines()) == 1 and "Traceback" not in message
     assert needle in message, message
     assert not (tmp_path / "o.h5").exists()
+
+
+@pytest.mark.parametrize(
+    "optimiser",
+    [
+        "{algorithm: gradient, max_evaluations: 1, seed: 1, weighted_sum: {weights: [1, 1]}}",
+        "{algorithm: nsga2, population: 8, max_evaluations: 1, seed: 1}",
+    ],
+)
+def test_a_budget_smaller_than_one_step_still_writes_a_result(tmp_path, optimiser):
+    """A budget of one evaluation ends the run before its first generation is complete (the
+    gradient method's first step needs n + 1 designs): the result is still written, with a
+    history of no generation (before, writing that history raised a ValueError)."""
+    cfg = tiny(**{"{algorithm: nsga2, population: 8, generations: 4, seed: 1}": optimiser})
+    optimise(cfg, tmp_path / "out.h5")
+    with h5py.File(tmp_path / "out.h5") as h5:
+        best = h5["history/best"]
+        assert best.ndim == 2 and best.shape[1] == len(best.attrs["names"])
+        assert len(h5["history/generation"]) == best.shape[0]

@@ -76,7 +76,7 @@ def write_history(h5, history: dict, best_names, best_units) -> None:
     write_dataset(hist, "generation", history["generation"], "1", dims=("generation",))
     for key, values in history.items():
         if key == "best":
-            best = values.reshape(len(values), -1)
+            best = np.reshape(values, (len(values), len(best_names)))  # (zero generations too)
             dims = ("generation", "objective")
             write_dataset(hist, key, best, best_units, dims=dims, names=best_names)
         elif key != "generation":
