@@ -14,7 +14,9 @@ import os
 import stat
 from pathlib import Path
 
-__all__ = ["Unreadable", "kind_of", "read_bounded", "size_text"]
+from .memory import describe
+
+__all__ = ["Unreadable", "kind_of", "read_bounded"]
 
 
 class Unreadable(ValueError):
@@ -38,13 +40,6 @@ def kind_of(mode: int) -> str | None:
     if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
         return "a device"
     return "not a regular file"
-
-
-def size_text(n_bytes: int) -> str:
-    """``n_bytes`` for a message: whole MB (2^20 bytes) where it is one, else kB (2^10)."""
-    if n_bytes >= 1 << 20 and n_bytes % (1 << 20) == 0:
-        return f"{n_bytes >> 20} MB"
-    return f"{n_bytes >> 10} kB"
 
 
 def _reason(exc: OSError) -> str:
@@ -77,5 +72,5 @@ def read_bounded(path: str | Path, limit: int) -> bytes:
     except OSError as exc:
         raise Unreadable(f"cannot read it ({_reason(exc)})") from None
     if len(data) > limit:
-        raise Unreadable(f"is larger than {size_text(limit)}")
+        raise Unreadable(f"is larger than {describe(limit)}")
     return data

@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import pickle
 import platform
+import re
 import shlex
 import signal
 import subprocess
@@ -359,6 +360,27 @@ def test_max_memory_caps_a_run(tmp_path, capsys):
     )
     code, _, _ = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "--max-memory", "2G")
     assert code == 0
+
+
+def test_a_population_whose_pairs_exceed_memory_is_refused_before_allocating(tmp_path, capsys):
+    """The optimiser compares every pair of designs (pymoo's duplicate elimination): a
+    population of a million asked for 7 TB in its first generation, a MemoryError traceback
+    after the whole first generation was simulated."""
+    text = (CONFIGS / "ch6" / "part_a_c2.yaml").read_text()
+    text = re.sub(r"(?m)^(  population:) \d+", r"\1 1000000", text)
+    path = write(tmp_path, text)
+    line = text[: text.index("population: 1000000")].count("\n") + 1
+    tracemalloc.start()
+    for command in ("validate", "optimise"):
+        args = [path] if command == "validate" else [path, "-o", tmp_path / "out.h5"]
+        message = one_error(capsys, command, *args)
+        assert f"case.yaml:{line}: optimiser.population: a population of 1,000,000" in message
+    assert tracemalloc.get_traced_memory()[1] < 200e6
+    tracemalloc.stop()
+    assert not (tmp_path / "out.h5").exists()
+    text = re.sub(r"(?m)^(  population:) \d+", r"\1 2000", text)
+    message = one_error(capsys, "validate", write(tmp_path, text), "--max-memory", "50M")
+    assert "a population of 2,000" in message and "the --max-memory limit (50 MB)" in message
 
 
 def test_large_evaluations_run_in_batches_of_bounded_memory(monkeypatch):

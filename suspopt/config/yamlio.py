@@ -34,7 +34,8 @@ from yaml.reader import Reader
 from yaml.resolver import BaseResolver
 from yaml.scanner import Scanner
 
-from ..files import Unreadable, read_bounded, size_text
+from ..files import Unreadable, read_bounded
+from ..memory import describe
 
 __all__ = ["YamlError", "MAX_CONFIG_BYTES", "MAX_DEPTH", "MAX_NODES", "read_text", "parse_yaml"]
 
@@ -231,7 +232,7 @@ def parse_yaml(text: str) -> tuple[Any, Node | None]:
     """The data of one YAML document and its composed node tree (for line numbers);
     YamlError with the line for malformed, unsafe or oversized input."""
     if len(text) > MAX_CONFIG_BYTES:
-        raise YamlError(f"is larger than {size_text(MAX_CONFIG_BYTES)}: not a config")
+        raise YamlError(f"is larger than {describe(MAX_CONFIG_BYTES)}: not a config")
     loader = None
     try:
         loader = _LOADER(text)
