@@ -9,9 +9,14 @@ capped at ``--memory`` GB of address space, with ``--limit`` s per command (SIGA
 
     python benchmarks/fuzz_configs.py --cases 2000 --seed 1
     python benchmarks/fuzz_configs.py --cases 0 --no-fixed --h5-only --h5-cases 500
+    python benchmarks/fuzz_configs.py --configs-only --optimise --cases 1000 --limit 10
+
+``--optimise`` mutates the optimisation configs only and runs ``validate`` and ``optimise``
+(tiny budgets) on each, instead of ``validate`` and ``simulate``.
 
 Prints, for configs and Pareto files apart, a table of counts (cases, exit 0, exit 2, other
-exits, tracebacks, multi-line messages, time-outs, validate-accepts-but-simulate-rejects),
+exits, tracebacks, multi-line messages, time-outs, validate-accepts-but-simulate-rejects
+(or optimise)),
 the causes (category, exception, where it was raised) with an example each, and the slowest
 cases. ``--json FILE`` keeps every case and result. Asserts nothing; exit code 0.
 """
@@ -66,10 +71,10 @@ def tally(cases, results) -> dict:
         for p in found:
             if p["category"].startswith("message does not name"):
                 c["messages not naming the file / dataset"] += 1
-            if p["category"] == "validate accepts, simulate rejects":
-                c["validate accepts, simulate rejects"] += 1
-            if p["category"].startswith("simulate exit 0 but"):
-                c["simulate exit 0, no file"] += 1
+            if p["category"].startswith("validate accepts"):
+                c["validate accepts, simulate/optimise rejects"] += 1
+            if " exit 0 but" in p["category"]:
+                c["simulate/optimise exit 0, no file"] += 1
     return c
 
 
@@ -85,8 +90,8 @@ ORDER = [
     "multi-line (or empty) messages",
     "messages not naming the file / dataset",
     "time-outs",
-    "validate accepts, simulate rejects",
-    "simulate exit 0, no file",
+    "validate accepts, simulate/optimise rejects",
+    "simulate/optimise exit 0, no file",
     "commands skipped after a time-out",
     "worker crashes / kills / harness errors",
 ]
@@ -165,6 +170,12 @@ def main() -> None:
         help="leave out the seeds, the special inputs and the fixed Pareto files",
     )
     ap.add_argument("--configs-only", action="store_true")
+    ap.add_argument(
+        "--optimise",
+        action="store_true",
+        help="the config cases are the optimisation configs, run through validate and optimise "
+        "(tiny budgets) instead of simulate",
+    )
     ap.add_argument("--h5-only", action="store_true")
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--limit", type=float, default=fh.LIMIT, help="seconds per command")
@@ -196,13 +207,16 @@ def main() -> None:
     if not opts.h5_only:
         start = time.perf_counter()
         configs = fh.bundled_configs()
-        cases = [] if opts.no_fixed else fh.seed_cases(configs) + fh.special_cases()
-        cases += [fh.mutated_case(i, opts.seed, configs) for i in range(opts.cases)]
+        if opts.optimise:
+            cases = fh.optimisation_cases(opts.cases, opts.seed, fixed=not opts.no_fixed)
+        else:
+            cases = [] if opts.no_fixed else fh.seed_cases(configs) + fh.special_cases()
+            cases += [fh.mutated_case(i, opts.seed, configs) for i in range(opts.cases)]
         made = time.perf_counter() - start
         results = fh.run_cases(cases, **run)
         wall = time.perf_counter() - start
         report(
-            f"configs: {len(cases)} cases ({opts.cases} random; made in {made:.1f} s, "
+            f"{'optimisation ' if opts.optimise else ''}configs: {len(cases)} cases ({opts.cases} random; made in {made:.1f} s, "
             f"wall {wall:.1f} s)",
             cases,
             results,

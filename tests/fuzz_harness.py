@@ -48,7 +48,7 @@ import tempfile
 import threading
 import time
 import traceback
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -103,6 +103,12 @@ class Case:
 
 
 CONFIG_RUNS = [["validate", "{path}"], ["simulate", "{path}", "-o", "{out}"]]
+#: ``benchmarks/fuzz_configs.py --optimise``: the optimisation configs through ``optimise``
+OPTIMISE_RUNS = [["validate", "{path}"], ["optimise", "{path}", "-o", "{out}"]]
+#: The commands that write ``{out}`` from a config, and their exit codes that are not a
+#: rejection of a config ``validate`` accepted (``optimise``'s 3: every design failed, a
+#: result of the search, not of the config; it writes the file all the same)
+WRITERS = {"simulate": (0,), "optimise": (0, 3)}
 
 
 def bundled_configs() -> list[Path]:
@@ -925,6 +931,16 @@ def config_cases(n: int, seed: int = SEED) -> list[Case]:
     )
 
 
+def optimisation_cases(n: int, seed: int = SEED, fixed: bool = True) -> list[Case]:
+    """The bundled optimisation configs (those with an ``optimiser:`` section, on the tiny
+    budget of :data:`BUDGET`) and ``n`` random mutations of them, each run through
+    ``validate`` and ``optimise`` (:data:`OPTIMISE_RUNS`)."""
+    configs = [p for p in bundled_configs() if isinstance(_seed_data(p).get("optimiser"), dict)]
+    cases = seed_cases(configs) if fixed else []
+    cases += [mutated_case(i, seed, configs) for i in range(n)]
+    return [replace(c, id=f"opt-{c.id}"[:110], runs=OPTIMISE_RUNS) for c in cases]
+
+
 def case_count(default: int) -> int:
     """The number of random mutations: ``SUSPOPT_FUZZ_CASES`` (env), else ``default``."""
     value = os.environ.get("SUSPOPT_FUZZ_CASES")
@@ -1473,20 +1489,16 @@ def problems(case: Case, result: dict) -> list[dict]:
             if case.dataset and not names_dataset(line, case.dataset):
                 add(f"message does not name {case.dataset}", stderr=line[:300])
     runs = {r["command"]: r for r in result["runs"]}
-    v, s = runs.get("validate"), runs.get("simulate")
-    if (
-        v
-        and s
-        and not v["timeout"]
-        and v["exit"] == 0
-        and not s["timeout"]
-        and not s.get("skipped")
-    ):
-        if s["exit"] != 0:
+    v = runs.get("validate")
+    for command in WRITERS:
+        s = runs.get(command)
+        if not (v and s) or v["timeout"] or v["exit"] != 0 or s["timeout"] or s.get("skipped"):
+            continue
+        if s["exit"] not in WRITERS[command]:
             found.append(
                 {
-                    "category": "validate accepts, simulate rejects",
-                    "command": "simulate",
+                    "category": f"validate accepts, {command} rejects",
+                    "command": command,
                     "exc": s.get("exc", ""),
                     "where": s.get("where", ""),
                     "message": s.get("exc_msg") or (stderr_lines(s["stderr"]) or [""])[0],
@@ -1496,8 +1508,8 @@ def problems(case: Case, result: dict) -> list[dict]:
         elif not s.get("written"):
             found.append(
                 {
-                    "category": "simulate exit 0 but no HDF5 written",
-                    "command": "simulate",
+                    "category": f"{command} exit 0 but no HDF5 written",
+                    "command": command,
                     "exc": "",
                     "where": "",
                     "message": "",
@@ -1969,7 +1981,7 @@ def _invoke(runner, app, args, limit, out, h5py) -> dict:
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
     record["seconds"] = time.perf_counter() - started
-    if record["command"] == "simulate" and record["exit"] == 0:
+    if record["command"] in WRITERS and record["exit"] in WRITERS[record["command"]]:
         try:
             record["written"] = out.is_file() and h5py.is_hdf5(out)
         except OSError:
