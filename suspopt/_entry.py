@@ -4,6 +4,9 @@ codes, with no traceback for anything but a bug.
 - bad input (a usage error, a config, a file): one line ``error: ...``, exit 2;
 - Ctrl-C at any moment, start-up included: ``interrupted``, exit 130 (an output being written
   is left as it was; ``suspopt optimise`` keeps what it found, see its help);
+- SIGTERM (``kill``, a batch system's or CI's time limit) the same way: ``terminated``, exit
+  143, outputs cleaned up and ``suspopt optimise``'s last generation kept, where Python's
+  default would end the process at once, leaving a temporary file beside the output;
 - a numpy floating-point warning: one line ``warning: ...`` per place, not a stack of them;
 - anything else is a bug: its traceback and exit 1.
 
@@ -23,6 +26,8 @@ import warnings
 
 #: Exit code of an interrupted command (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
+#: Exit code of a terminated command (128 + SIGTERM).
+EXIT_TERMINATED = 143
 
 
 def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
@@ -33,20 +38,26 @@ def _one_line_warning(message, category, filename, lineno, file=None, line=None)
 
 def _interrupted() -> int:
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C while leaving
+        for signum in (signal.SIGINT, signal.SIGTERM):  # a second one while leaving
+            signal.signal(signum, signal.SIG_IGN)
+    if _Interrupts.signum == signal.SIGTERM:
+        sys.stderr.write("terminated\n")
+        return EXIT_TERMINATED
     sys.stderr.write("interrupted\n")
     return EXIT_INTERRUPTED
 
 
 class _Interrupts:
-    """Notes that Ctrl-C was pressed (typer turns the KeyboardInterrupt into exit code 130
-    without a word)."""
+    """Notes that Ctrl-C was pressed or SIGTERM came (typer turns the KeyboardInterrupt into
+    exit code 130 without a word), and which."""
 
     seen = False
+    signum: int = signal.SIGINT
 
     @classmethod
     def handler(cls, signum, frame):
         cls.seen = True
+        cls.signum = signum
         raise KeyboardInterrupt
 
 
@@ -54,10 +65,14 @@ def main(argv: list[str] | None = None, leaving: bool = False) -> int:
     """Run ``suspopt`` with ``argv`` (default the process's arguments); return its exit
     code. Ctrl-C's handling is put back as it was on return, unless the process is
     ``leaving`` (the command line's, which ignores a second Ctrl-C until it exits)."""
-    _Interrupts.seen = False
+    _Interrupts.seen, _Interrupts.signum = False, signal.SIGINT
+    main_thread = threading.current_thread() is threading.main_thread()
     found = signal.getsignal(signal.SIGINT)
+    found_term = signal.getsignal(signal.SIGTERM) if main_thread else None
     if found is signal.default_int_handler:
         signal.signal(signal.SIGINT, _Interrupts.handler)
+    if found_term == signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, _Interrupts.handler)
     try:
         warnings.showwarning = _one_line_warning
         warnings.simplefilter("default")  # each place once
@@ -88,12 +103,11 @@ def main(argv: list[str] | None = None, leaving: bool = False) -> int:
         from .memory import set_limit
 
         set_limit(None)  # --max-memory holds for one command
-        if (
-            not leaving
-            and found is not None
-            and threading.current_thread() is threading.main_thread()
-        ):
-            signal.signal(signal.SIGINT, found)
+        if not leaving and main_thread:
+            if found is not None:
+                signal.signal(signal.SIGINT, found)
+            if found_term is not None:
+                signal.signal(signal.SIGTERM, found_term)
 
 
 #: BLAS thread pools the command line sizes to one thread, unless the user set them: the
@@ -115,7 +129,7 @@ def run() -> None:
     # CPython's default first-generation threshold of 700 scans them over and over (0.04 s)
     gc.set_threshold(10_000, 10, 10)
     code = main(leaving=True)
-    if code == EXIT_INTERRUPTED:
+    if code in (EXIT_INTERRUPTED, EXIT_TERMINATED):
         # CPython may remember an interrupt it saw inside C code even though it was caught,
         # and then end the process by SIGINT (status -2) instead of the code given: leave at
         # once, every output already cleaned up

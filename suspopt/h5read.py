@@ -159,6 +159,7 @@ def _probe(path: Path, where: str) -> None:
         with contextlib.suppress(BaseException):
             # the kernel ends the child even in a loop in C, and even if the parent is gone
             signal.signal(signal.SIGALRM, signal.SIG_DFL)
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)  # (not the parent's handler)
             signal.alarm(int(budget) + 2)
             import faulthandler
 

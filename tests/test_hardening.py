@@ -716,11 +716,20 @@ def test_an_interrupted_command_in_process_leaves_ctrl_c_as_it_found_it(capsys, 
 
 @pytest.mark.cli
 @pytest.mark.slow
-@pytest.mark.parametrize("delay", [0.0, 1.5])
-def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
+@pytest.mark.parametrize(
+    "delay, signum, code, said",
+    [
+        (0.0, signal.SIGINT, 130, "interrupted"),
+        (1.5, signal.SIGINT, 130, "interrupted"),
+        (1.5, signal.SIGTERM, 143, "terminated"),
+    ],
+)
+def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay, signum, code, said):
     """Interrupted during the start-up imports (as soon as numpy is being loaded, which
     suspopt's own code does) or during the run. (Before suspopt's first line runs, the
-    interpreter's own start-up is Python's.)"""
+    interpreter's own start-up is Python's.) SIGTERM (a batch system's time limit) the same
+    way, with its own code: before, Python's default ended the process at once, leaving the
+    output's temporary file and lock behind."""
     long = write(
         tmp_path,
         edited(
@@ -745,10 +754,10 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay):
     while "numpy" not in maps.read_text() and time.monotonic() < deadline:
         time.sleep(0.001)
     time.sleep(delay)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(signum)
     out, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130, (out, err)
-    assert "Traceback" not in err and err.strip().splitlines()[-1] == "interrupted"
+    assert proc.returncode == code, (out, err)
+    assert "Traceback" not in err and err.strip().splitlines()[-1] == said
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.yaml"]
 
 

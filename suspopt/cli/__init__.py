@@ -2,7 +2,7 @@
 
 Exit codes: 0 success; 2 bad input (config, file, arguments) with one line naming the YAML key
 and line (or the file and dataset); 3 a run whose every optimum design failed to simulate;
-130 interrupted (suspopt._entry); 1 an unexpected failure (a bug).
+130 interrupted, 143 terminated (SIGTERM; suspopt._entry); 1 an unexpected failure (a bug).
 
 Layout: :mod:`~suspopt.cli.base` holds the app, its global options, the consoles and the
 shared helpers; each command lives in its own module (``configs``: validate, schema, init,
