@@ -109,6 +109,9 @@ OPTIMISE_RUNS = [["validate", "{path}"], ["optimise", "{path}", "-o", "{out}"]]
 #: rejection of a config ``validate`` accepted (``optimise``'s 3: every design failed, a
 #: result of the search, not of the config; it writes the file all the same)
 WRITERS = {"simulate": (0,), "optimise": (0, 3)}
+#: What ``optimise`` may refuse of a config ``validate`` accepts: a config with no optimiser
+#: (a mutation deleted it) is a valid config of the other commands, not one to optimise
+NOT_FOR = {"optimise": ": optimiser: required key is missing"}
 
 
 def bundled_configs() -> list[Path]:
@@ -1494,6 +1497,9 @@ def problems(case: Case, result: dict) -> list[dict]:
         s = runs.get(command)
         if not (v and s) or v["timeout"] or v["exit"] != 0 or s["timeout"] or s.get("skipped"):
             continue
+        message = (stderr_lines(s["stderr"]) or [""])[0]
+        if s["exit"] == 2 and command in NOT_FOR and NOT_FOR[command] in message:
+            continue
         if s["exit"] not in WRITERS[command]:
             found.append(
                 {
@@ -1501,7 +1507,7 @@ def problems(case: Case, result: dict) -> list[dict]:
                     "command": command,
                     "exc": s.get("exc", ""),
                     "where": s.get("where", ""),
-                    "message": s.get("exc_msg") or (stderr_lines(s["stderr"]) or [""])[0],
+                    "message": s.get("exc_msg") or message,
                     "seconds": s["seconds"],
                 }
             )

@@ -103,6 +103,20 @@ def test_gradient_and_hybrid_hold_a_constraint():
     assert np.all(hi - lo <= 0.2 * 4.0 + 1e-12)
 
 
+@pytest.mark.parametrize("shrink", [1e-300, 1e-20])
+def test_a_hybrid_box_below_the_floating_point_resolution_keeps_its_designs_finite(shrink):
+    """A shrink so small that best ± shrink/2 of the range rounds to the best itself made a
+    box of zero span, whose unit box divided 0 by 0: every SLSQP design was NaN (found by
+    ``benchmarks/fuzz_configs.py --optimise --seed 11``)."""
+    problem = Quadratic()
+    hybrid = Hybrid(ga(pop=10, generations=2), Gradient(), shrink=shrink, max_iterations=6)
+    best = minimize(problem, hybrid, seed=1)
+    lo, hi = hybrid.gradient.box
+    assert np.all(hi > lo) and np.all(np.isfinite(best.X)) and np.isfinite(best.F).all()
+    ga_best = hybrid.ga.optimum().X[0]
+    np.testing.assert_allclose(best.X[0], ga_best, rtol=1e-15)  # (no room to move)
+
+
 @pytest.mark.slow
 def test_nsga2_approaches_the_zdt1_front():
     zdt1 = get_problem("zdt1")

@@ -332,7 +332,14 @@ class Hybrid(Optimiser):
         best = self.ga.optimum().X[0]
         xl, xu = self.problem.xl, self.problem.xu
         half = 0.5 * self.shrink * (xu - xl)
-        self.gradient.box = (np.maximum(xl, best - half), np.minimum(xu, best + half))
+        lo, hi = np.maximum(xl, best - half), np.minimum(xu, best + half)
+        # a box below the floating-point resolution at the best (a tiny shrink, or a range
+        # tiny beside its values) is the best's neighbouring numbers: SLSQP's unit box then
+        # has a span (before: 0, and the designs NaN)
+        narrow = ~(hi > lo)
+        lo = np.where(narrow, np.maximum(xl, np.nextafter(best, -np.inf)), lo)
+        hi = np.where(narrow, np.minimum(xu, np.nextafter(best, np.inf)), hi)
+        self.gradient.box = (lo, hi)
         self.gradient.start = best
         if self.max_iterations is not None:
             self.gradient.max_iterations = max(self.max_iterations - self.ga.n_gen, 1)
