@@ -1475,7 +1475,7 @@ def problems(case: Case, result: dict) -> list[dict]:
             add("time-out")
             continue
         code = run["exit"]
-        if code not in (0, 2):
+        if code not in (0, 2) + WRITERS.get(cmd, ()):
             add(f"exit {code}" + (" (traceback)" if run.get("exc") else ""))
             continue
         if "Traceback" in run["stderr"] or "Traceback" in run["stdout"]:

@@ -81,7 +81,21 @@ class _DeterministicRoad(_Road):
         return tracks
 
 
-class BumpStep(_DeterministicRoad):
+class _Bump(_DeterministicRoad):
+    """A bump: its ``height`` is not 0 (a flat road, on which every signal stays at rest and
+    every objective is 0)."""
+
+    @field_validator("height", check_fields=False)
+    @classmethod
+    def _not_flat(cls, height: float) -> float:
+        if height == 0:
+            raise ValueError(
+                "a bump of height 0 is a flat road: give its height (negative for a pothole)"
+            )
+        return height
+
+
+class BumpStep(_Bump):
     """Rectangular bump (step up, plateau, step down), Eq 2.103-2.104.
 
     A wheel is raised by ``height`` from ``start`` for ``length / speed`` seconds; the rear wheels
@@ -98,7 +112,7 @@ class BumpStep(_DeterministicRoad):
     start: _Start = Field(description="time at which the front wheels reach the bump t0 [s]")
 
 
-class BumpHalfSine(_DeterministicRoad):
+class BumpHalfSine(_Bump):
     """Half-sine bump, Eq 2.101-2.102 as corrected (slip: docs/thesis-slips.md#eq-2101).
 
     ``z = height sin(pi (t - start) V / length)`` for ``start <= t < start + length / V``,
