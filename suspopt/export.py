@@ -35,9 +35,10 @@ needs to be). Numbers are written in full (``repr``: they read back bit for bit)
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import re
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from io import TextIOWrapper
 from pathlib import Path
 
@@ -189,7 +190,8 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
     """Write every table of the suspopt HDF5 file ``h5_path`` as a CSV file in ``folder``
     (made if missing; its parent must exist) and return their paths (module docstring).
 
-    Each file is written atomically (:func:`suspopt.io.atomic_file`). A file of that name in
+    The files are written atomically (:func:`suspopt.io.atomic_file`), and together: none
+    is renamed into place before every one is written. A file of that name in
     ``folder`` that suspopt did not write is not replaced unless ``force``: every target is
     checked before any is written. ConfigError (naming the file) for a file that is not a
     suspopt HDF5 file or a folder that cannot be written.
@@ -205,6 +207,7 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
             )
         with _reading(h5_path):
             tables = _plan(reader.file)
+        made = not folder.exists()
         try:
             folder.mkdir(exist_ok=True)
         except OSError as exc:
@@ -218,15 +221,24 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
                 file += "_"
             names.add(file)
             targets.append(check_target(folder / f"{file}.csv", force, "--csv"))
-        for target, (_, group, members, dims) in zip(targets, tables):
-            with _reading(h5_path):
-                header, columns = _columns(members, dims)
-            comment = (
-                f"# written by suspopt {__version__} from "
-                f"{' '.join(str(h5_path).splitlines())} ({group})\n"
-            )
-            with atomic_file(target, force) as stream:
-                _write_table(stream, comment, header, columns)
+        # every file is renamed into place only once all are written (the stack's exit):
+        # a failure on any (a damaged table, a full disk) leaves none of them
+        try:
+            with ExitStack() as written:
+                for target, (_, group, members, dims) in zip(targets, tables):
+                    with _reading(h5_path):
+                        header, columns = _columns(members, dims)
+                    comment = (
+                        f"# written by suspopt {__version__} from "
+                        f"{' '.join(str(h5_path).splitlines())} ({group})\n"
+                    )
+                    stream = written.enter_context(atomic_file(target, force))
+                    _write_table(stream, comment, header, columns)
+        except BaseException:
+            if made:  # (the folder this call made, left empty)
+                with contextlib.suppress(OSError):
+                    folder.rmdir()
+            raise
     return targets
 
 

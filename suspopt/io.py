@@ -54,6 +54,8 @@ from .files import kind_of
 
 __all__ = [
     "OUTPUT_MARKER",
+    "WRITE_ERRNOS",
+    "WriteError",
     "check_target",
     "claim",
     "atomic_file",
@@ -179,8 +181,15 @@ def claim(path: str | Path, force: bool = False, option: str = "-o") -> Iterator
         if same:
             break
         os.close(fd)
-    os.ftruncate(fd, 0)
-    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    except OSError as exc:  # (a full disk: even the lock's few bytes do not fit)
+        lock.unlink(missing_ok=True)
+        os.close(fd)
+        raise ConfigError(
+            f"{option} {path}: cannot write in {path.parent} ({exc.strerror})"
+        ) from None
     for stale in path.parent.glob(f".{_glob_escape(path.name)}.*{_TMP}"):
         stale.unlink(missing_ok=True)
     _held[key] = [fd, 1, force]
@@ -204,12 +213,34 @@ def _glob_escape(name: str) -> str:
     return "".join(f"[{c}]" if c in "*?[" else c for c in name)
 
 
+class WriteError(ConfigError):
+    """An output that could not be written (:data:`WRITE_ERRNOS`); the file is as it was."""
+
+
+#: What a write may fail with that the user, not suspopt, has to mend: a full disk or quota,
+#: a file too large for the file system, a read-only file system, an I/O error.
+WRITE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EIO})
+
+
 @contextmanager
 def atomic_file(path: str | Path, force: bool = False) -> Iterator:
     """A binary file object that becomes ``path`` when the block ends without an exception
     (module docstring); ``path`` is checked with :func:`check_target` first (with the
-    ``force`` of an enclosing :func:`claim`)."""
+    ``force`` of an enclosing :func:`claim`). A write that fails for a reason in
+    :data:`WRITE_ERRNOS` (a full disk) is a :class:`WriteError` naming ``path``, which is
+    left as it was (a traceback before)."""
     path = Path(path)
+    try:
+        with _atomic_file(path, force) as stream:
+            yield stream
+    except OSError as exc:
+        if exc.errno not in WRITE_ERRNOS:
+            raise
+        raise WriteError(f"{path}: cannot write it ({exc.strerror})") from None
+
+
+@contextmanager
+def _atomic_file(path: Path, force: bool) -> Iterator:
     held = _held.get(_key(path)) if path.parent.is_dir() else None
     force = force or (held is not None and held[2])
     with claim(path, force):

@@ -3,6 +3,7 @@ data-only checkpoints, broken HDF5 inputs and the command's messages."""
 
 from __future__ import annotations
 
+import errno
 import os
 import pickle
 import platform
@@ -506,6 +507,61 @@ def test_a_failed_write_leaves_the_old_file(tmp_path, capsys, monkeypatch):
     with pytest.raises(OSError, match="disk full"):
         cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", target)
     assert target.read_bytes() == before and sorted(tmp_path.iterdir()) == [target]
+
+
+def _no_space(*args, **kwargs):
+    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
+def test_a_full_disk_is_one_line_and_leaves_the_old_file(tmp_path, capsys, monkeypatch):
+    """A full disk while the data are written, or already when the output's lock takes its
+    few bytes: one line naming the file, exit 2, the old file as it was and no temporary
+    file or lock left (tracebacks before; checked by hand on a 512 kB tmpfs too)."""
+    from suspopt import io
+
+    target = tmp_path / "out.h5"
+    assert cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", target)[0] == 0
+    before = target.read_bytes()
+    with monkeypatch.context() as patch:
+        patch.setattr(io, "write_dataset", _no_space)
+        message = one_error(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", target)
+    assert message == f"error: {target}: cannot write it (No space left on device)"
+    assert target.read_bytes() == before and sorted(tmp_path.iterdir()) == [target]
+    with monkeypatch.context() as patch:
+        patch.setattr(io.os, "pwrite", _no_space)
+        message = one_error(capsys, "init", "quarter", "-o", tmp_path / "new.yaml")
+    assert (
+        message
+        == f"error: -o {tmp_path / 'new.yaml'}: cannot write in {tmp_path} (No space left on device)"
+    )
+    assert sorted(tmp_path.iterdir()) == [target]
+
+
+def test_a_csv_export_that_fails_on_one_table_leaves_none(tmp_path, capsys, monkeypatch):
+    """The tables of ``export --csv`` are renamed into place together, once all are written:
+    a full disk at the second left the first behind before."""
+    from suspopt import export
+
+    source = tmp_path / "run.h5"
+    assert cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", source)[0] == 0
+    written = []
+    real = export._write_table
+
+    def second_fails(stream, *args):
+        written.append(stream)
+        if len(written) == 2:
+            _no_space()
+        real(stream, *args)
+
+    monkeypatch.setattr(export, "_write_table", second_fails)
+    message = one_error(capsys, "export", source, "--csv", tmp_path / "tables")
+    assert "tables/run." in message and message.endswith(
+        "cannot write it (No space left on device)"
+    )
+    assert sorted(tmp_path.iterdir()) == [source]  # (the folder it made, too, is gone)
+    monkeypatch.setattr(export, "_write_table", real)
+    code, out, _ = cli(capsys, "export", source, "--csv", tmp_path / "tables")
+    assert code == 0 and len(list((tmp_path / "tables").iterdir())) > len(written) == 2
 
 
 # --- checkpoints ------------------------------------------------------------------------------

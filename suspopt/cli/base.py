@@ -201,7 +201,7 @@ _RUN_OPTIONS = (
 def run_options(command: Callable[..., None]) -> Callable[..., None]:
     """``command``, whose last parameter is the keyword-only ``run: RunOptions``, as a typer
     command that takes the :class:`RunOptions` after its own options and hands them over as
-    that one ``run``."""
+    that one ``run``; a ConfigError that leaves ``command`` is bad input (:func:`fail`)."""
     own = [p for p in inspect.signature(command).parameters.values() if p.name != "run"]
     shared = [
         inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=option(), annotation=kind)
@@ -211,7 +211,10 @@ def run_options(command: Callable[..., None]) -> Callable[..., None]:
     @functools.wraps(command)
     def wrapper(**kwargs: Any) -> None:
         run = RunOptions(**{p.name: kwargs.pop(p.name) for p in shared})
-        command(**kwargs, run=run)
+        try:
+            command(**kwargs, run=run)
+        except ConfigError as exc:  # bad input wherever it is found (a full disk on writing)
+            fail(str(exc))
 
     wrapper.__signature__ = inspect.Signature(own + shared)  # type: ignore[attr-defined]
     wrapper.__annotations__ = {p.name: p.annotation for p in own + shared}

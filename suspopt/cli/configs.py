@@ -86,8 +86,11 @@ def init(
         except ValueError as exc:
             fail(f"init: {exc}")
         claim_output(stack, output, force)
-        with atomic_file(output) as stream:
-            stream.write(text.encode())
+        try:
+            with atomic_file(output) as stream:
+                stream.write(text.encode())
+        except ConfigError as exc:  # (a full disk)
+            fail(str(exc))
     command = "optimise" if kind in ("optimise", "kesort", "spectral", "robust") else "simulate"
     out.print(
         f"wrote {output}; next: suspopt validate {output}, then suspopt {command} "

@@ -120,6 +120,7 @@ def _optimise(
     from rich.progress import BarColumn, Progress, TextColumn
 
     from ..checks import check_config
+    from ..io import WriteError
     from ..optimise import optimise as run
 
     cfg = base.read_config(config)
@@ -154,6 +155,14 @@ def _optimise(
         )
         with bar, options.executing(progress=chunk_done, lost_hint=lost):
             result = run(cfg, output, resume=resume, callback=report, command=base.command_line())
+    except WriteError as exc:  # (a full disk: the file holds the last generation it took)
+        kept = (
+            f"; {output} keeps an earlier checkpoint: make room, then continue with suspopt "
+            f"optimise {config} -o {output} --resume"
+            if output.exists()
+            else ""
+        )
+        base.fail(f"{exc}{kept}")
     except ConfigError as exc:
         base.fail(str(exc))
     except KeyboardInterrupt:
