@@ -110,8 +110,11 @@ OPTIMISE_RUNS = [["validate", "{path}"], ["optimise", "{path}", "-o", "{out}"]]
 #: result of the search, not of the config; it writes the file all the same)
 WRITERS = {"simulate": (0,), "optimise": (0, 3)}
 #: What ``optimise`` may refuse of a config ``validate`` accepts: a config with no optimiser
-#: (a mutation deleted it) is a valid config of the other commands, not one to optimise
-NOT_FOR = {"optimise": ": optimiser: required key is missing"}
+#: or no design variables (a mutation deleted them) is a valid config of the other commands,
+#: not one to optimise
+NOT_FOR = {
+    "optimise": (": optimiser: required key is missing", ": design_variables: required key is")
+}
 
 
 def bundled_configs() -> list[Path]:
@@ -1498,7 +1501,7 @@ def problems(case: Case, result: dict) -> list[dict]:
         if not (v and s) or v["timeout"] or v["exit"] != 0 or s["timeout"] or s.get("skipped"):
             continue
         message = (stderr_lines(s["stderr"]) or [""])[0]
-        if s["exit"] == 2 and command in NOT_FOR and NOT_FOR[command] in message:
+        if s["exit"] == 2 and any(text in message for text in NOT_FOR.get(command, ())):
             continue
         if s["exit"] not in WRITERS[command]:
             found.append(
