@@ -116,12 +116,24 @@ def main(argv: list[str] | None = None, leaving: bool = False) -> int:
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
+def _replace_unencodable() -> None:
+    """Where stdout or stderr does not take UTF-8 (``LANG=en_US.ISO-8859-1``,
+    ``PYTHONIOENCODING=ascii``), print what it cannot encode (ε, ±, Γ) as ``?`` rather than
+    fail with a UnicodeEncodeError traceback (``--help`` included)."""
+    for stream in (sys.stdout, sys.stderr):
+        encoding = (getattr(stream, "encoding", None) or "").lower().replace("-", "")
+        if encoding != "utf8":
+            with contextlib.suppress(AttributeError, ValueError, OSError):
+                stream.reconfigure(errors="replace")
+
+
 def run() -> None:
     """Console-script entry point (``suspopt`` and ``python -m suspopt``): one BLAS thread
     unless the environment says otherwise (:data:`BLAS_THREAD_VARIABLES`, set before numpy
     loads, and inherited by the worker processes), then :func:`main`."""
     for variable in BLAS_THREAD_VARIABLES:
         os.environ.setdefault(variable, "1")
+    _replace_unencodable()
     # pydantic's plugins (looked up in every installed package's metadata, 7 ms) observe the
     # validation of suspopt's own config only: none is loaded unless the user asks for them
     os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")

@@ -821,6 +821,22 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay, sig
 
 
 @pytest.mark.cli
+@pytest.mark.parametrize("encoding", ["ascii", "latin-1"])
+def test_a_terminal_that_is_not_utf8_gets_question_marks_not_a_traceback(encoding):
+    """``LANG=en_US.ISO-8859-1`` or ``PYTHONIOENCODING=ascii``: the help's Γ and ε, and
+    kesort's, made a UnicodeEncodeError traceback (exit 1) before."""
+    env = {**os.environ, "PYTHONIOENCODING": encoding}
+    proc = subprocess.run(
+        [sys.executable, "-m", "suspopt", "kesort", "--help"],
+        capture_output=True,
+        env=env,
+        cwd=ROOT,
+    )
+    assert proc.returncode == 0 and proc.stderr == b"", proc.stderr[-500:]
+    assert b"?" in proc.stdout and b"Eq 6.10" in proc.stdout
+
+
+@pytest.mark.cli
 @pytest.mark.slow
 def test_a_reader_that_goes_away_is_not_an_error(tmp_path):
     """``suspopt simulate ... | head -1``: the file is written, nothing on stderr, exit 0 (the
