@@ -434,3 +434,35 @@ def test_importing_the_plots_module_does_not_import_matplotlib():
         [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True
     )
     assert out.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize("home_writable", [False, True])
+def test_an_unwritable_home_gives_matplotlib_a_private_folder(tmp_path, monkeypatch, home_writable):
+    """A container's or CI's user whose HOME cannot be written: matplotlib printed two
+    warning lines on every plotting run and rebuilt its font cache each time. Its folders
+    then go to a private folder of the user in the temporary directory."""
+    import os
+    import tempfile
+
+    from suspopt.plots import style
+
+    home = tmp_path / "home"
+    if home_writable:
+        home.mkdir()
+    else:
+        (tmp_path / "file").write_text("")
+        home = tmp_path / "file" / "home"  # (cannot be made: under a file)
+    for variable in ("MPLCONFIGDIR", "XDG_CONFIG_HOME", "XDG_CACHE_HOME"):
+        monkeypatch.delenv(variable, raising=False)
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    monkeypatch.delitem(sys.modules, "matplotlib", raising=False)  # (as in a fresh process)
+    style._matplotlib_folders()
+    private = tmp_path / "tmp" / f"suspopt-matplotlib-{os.getuid()}"
+    if home_writable:
+        assert "MPLCONFIGDIR" not in os.environ and not private.exists()
+        assert (home / ".config" / "matplotlib").is_dir()
+    else:
+        assert os.environ["MPLCONFIGDIR"] == str(private)
+        assert private.is_dir() and private.stat().st_mode & 0o777 == 0o700

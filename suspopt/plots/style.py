@@ -49,8 +49,43 @@ def check_path(path: str | Path) -> Path:
     return path
 
 
+def _matplotlib_folders() -> None:
+    """Where matplotlib cannot make or write its config and cache folders (``HOME`` unset,
+    read-only or absent, as for a container's or CI's user), point ``MPLCONFIGDIR`` at a
+    private folder of this user in the temporary directory: matplotlib would otherwise print
+    two warning lines on every run and build its font cache again each time. Nothing is
+    changed when ``MPLCONFIGDIR`` is set, matplotlib is loaded, or its folders are fine."""
+    import os
+    import stat
+    import sys
+    import tempfile
+
+    if "MPLCONFIGDIR" in os.environ or "matplotlib" in sys.modules:
+        return
+    home = os.path.expanduser("~")
+    for variable, default in (("XDG_CONFIG_HOME", ".config"), ("XDG_CACHE_HOME", ".cache")):
+        folder = os.path.join(os.environ.get(variable) or os.path.join(home, default), "matplotlib")
+        try:
+            os.makedirs(folder, exist_ok=True)
+        except OSError:
+            break
+        if not os.access(folder, os.W_OK):
+            break
+    else:
+        return
+    private = os.path.join(tempfile.gettempdir(), f"suspopt-matplotlib-{os.getuid()}")
+    try:
+        os.makedirs(private, mode=0o700, exist_ok=True)
+        info = os.lstat(private)
+    except OSError:
+        return
+    if stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid():  # (not another user's)
+        os.environ["MPLCONFIGDIR"] = private
+
+
 def figure_class():
     """matplotlib's ``Figure``, or ValueError naming the extra to install."""
+    _matplotlib_folders()
     try:
         from matplotlib.figure import Figure
     except ImportError:
