@@ -108,7 +108,11 @@ def check_target(path: str | Path, force: bool = False, option: str = "-o") -> P
     if text.endswith(os.sep) or path.name in ("", ".", ".."):
         raise ConfigError(f"{option} {path}: names a folder, not a file")
     folder = path.parent
-    if not folder.is_dir():
+    try:  # (a relative name in a working folder that was deleted: '.' is still a folder)
+        exists = folder.is_dir() and folder.resolve(strict=True).is_dir()
+    except OSError:
+        exists = False
+    if not exists:
         raise ConfigError(f"{option} {path}: folder {folder} does not exist")
     try:
         mode = os.lstat(path).st_mode

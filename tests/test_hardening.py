@@ -447,6 +447,17 @@ def test_outputs_must_be_regular_files_or_new_names(tmp_path, capsys, make, need
     assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written
 
 
+def test_a_relative_output_in_a_deleted_working_folder_is_bad_input(tmp_path, capsys, monkeypatch):
+    """``cd build && rm -r ../build && suspopt simulate ... -o out.h5``: '.' still answers
+    as a folder, so the output's lock looked up its full path and got a traceback."""
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    message = one_error(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", "out.h5")
+    assert message == "error: -o out.h5: folder . does not exist"
+
+
 def test_force_replaces_a_foreign_file_and_suspopt_replaces_its_own(tmp_path, capsys):
     target = write(tmp_path, "my notes\n", "out.h5")
     code, _, err = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", target, "--force")
