@@ -123,8 +123,10 @@ def _replace_unencodable() -> None:
     for stream in (sys.stdout, sys.stderr):
         encoding = (getattr(stream, "encoding", None) or "").lower().replace("-", "")
         if encoding != "utf8":
-            with contextlib.suppress(AttributeError, ValueError, OSError):
-                stream.reconfigure(errors="replace")
+            reconfigure = getattr(stream, "reconfigure", None)  # (a TextIOWrapper's)
+            if reconfigure is not None:
+                with contextlib.suppress(ValueError, OSError):
+                    reconfigure(errors="replace")
 
 
 def run() -> None:

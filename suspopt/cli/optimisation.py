@@ -110,24 +110,11 @@ def _scenarios_line(cfg, output: Path) -> None:
     )
 
 
-def _optimise(
-    config: Path,
-    output: Path,
-    resume: bool,
-    plot: Path | None,
-    options: base.RunOptions,
-) -> None:
+def _progress(cfg):
+    """The run's progress bar (on a terminal; else a line per generation on stderr), its
+    callback per generation and the executor's per chunk."""
     from rich.progress import BarColumn, Progress, TextColumn
 
-    from ..checks import check_config
-    from ..io import WriteError
-    from ..optimise import optimise as run
-
-    cfg = base.read_config(config)
-    try:
-        check_config(cfg)
-    except ConfigError as exc:
-        base.fail(str(exc))
     total = cfg.optimiser.generations if cfg.optimiser is not None else None
     bar = Progress(
         TextColumn("{task.description}"),
@@ -136,7 +123,6 @@ def _optimise(
         disable=not err.is_terminal or out.quiet,
     )
     task = bar.add_task("starting", total=total)
-
     line = ["starting"]
 
     def report(p) -> None:
@@ -148,19 +134,39 @@ def _optimise(
     def chunk_done(done: int, total: int) -> None:  # chunks of an executor other than local
         bar.update(task, description=f"{line[0]} (chunks {done}/{total})")
 
+    return bar, report, chunk_done
+
+
+def _resume_hint(config: Path, output: Path, kept: str, then: str) -> str:
+    """What to do when a run stops early, its output holding what it ``kept``."""
+    return f"; {output} keeps {kept}: {then} with suspopt optimise {config} -o {output} --resume"
+
+
+def _optimise(
+    config: Path,
+    output: Path,
+    resume: bool,
+    plot: Path | None,
+    options: base.RunOptions,
+) -> None:
+    from ..checks import check_config
+    from ..io import WriteError
+    from ..optimise import optimise as run
+
+    cfg = base.read_config(config)
     try:
-        lost = (
-            f"; {output} keeps the last generation's checkpoint: continue with suspopt "
-            f"optimise {config} -o {output} --resume (on any executor)"
-        )
-        with bar, options.executing(progress=chunk_done, lost_hint=lost):
+        check_config(cfg)
+    except ConfigError as exc:
+        base.fail(str(exc))
+    bar, report, chunk_done = _progress(cfg)
+    try:
+        lost = _resume_hint(config, output, "the last generation's checkpoint", "continue")
+        with bar, options.executing(progress=chunk_done, lost_hint=lost + " (on any executor)"):
             result = run(cfg, output, resume=resume, callback=report, command=base.command_line())
     except WriteError as exc:  # (a full disk: the file holds the last generation it took)
+        hint = "make room, then continue"
         kept = (
-            f"; {output} keeps an earlier checkpoint: make room, then continue with suspopt "
-            f"optimise {config} -o {output} --resume"
-            if output.exists()
-            else ""
+            _resume_hint(config, output, "an earlier checkpoint", hint) if output.exists() else ""
         )
         base.fail(f"{exc}{kept}")
     except ConfigError as exc:
