@@ -36,6 +36,7 @@ from __future__ import annotations
 import atexit
 import contextlib
 import os
+import re
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
@@ -45,6 +46,8 @@ __all__ = [
     "DEFAULT_CHUNK",
     "ExecutionLost",
     "SchedulerUnreachable",
+    "SCHEDULER_SCHEMES",
+    "check_scheduler_address",
     "Executor",
     "executor_for",
     "map_chunks",
@@ -65,6 +68,40 @@ DEFAULT_CHUNK = 250
 _ONE_THREAD = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
 #: Seconds a Dask client waits for its scheduler (to connect, and to reconnect after a loss).
 CONNECT_TIMEOUT = 10
+#: The address schemes of a Dask scheduler suspopt's workers can reach (distributed's
+#: ``inproc`` lives inside one process, which suspopt's separate workers are not).
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+_ADDRESS = re.compile(
+    r"(?:(?P<scheme>[A-Za-z][A-Za-z0-9+.-]*)://)?"
+    r"(?P<host>\[[0-9A-Fa-f:.%A-Za-z]+\]|[A-Za-z0-9_.-]+)"
+    r"(?::(?P<port>[0-9]{1,5}))?"
+)
+
+
+def check_scheduler_address(address: str) -> str:
+    """``address`` when it has the form of a Dask scheduler's address, ``[scheme://]host:port``
+    (a scheme of :data:`SCHEDULER_SCHEMES`, tcp when none; an IPv6 host in brackets; a port
+    from 1 to 65535); ValueError saying what is wrong otherwise. The form only: whether a
+    scheduler answers there is known when a command connects."""
+    found = _ADDRESS.fullmatch(address)
+    if found is None:
+        raise ValueError(
+            f"{address!r} is not a scheduler address: give [scheme://]host:port, e.g. "
+            f"tcp://host:8786 (an IPv6 host in brackets: tcp://[::1]:8786)"
+        )
+    scheme, port = found["scheme"], found["port"]
+    if scheme is not None and scheme.lower() not in SCHEDULER_SCHEMES:
+        raise ValueError(
+            f"{address!r}: a scheduler's address starts with one of "
+            f"{', '.join(s + '://' for s in SCHEDULER_SCHEMES)}, not {scheme}://"
+        )
+    if port is None or not 1 <= int(port) <= 65535:
+        raise ValueError(
+            f"{address!r}: give the scheduler's port, from 1 to 65535 (Dask's default is 8786)"
+        )
+    return address
+
+
 #: Worker processes started on this machine per core, at most (more only compete).
 WORKERS_PER_CORE = 4
 
@@ -359,6 +396,13 @@ def executor_for(execution=None) -> Executor:
                 raise SchedulerUnreachable(
                     f"--scheduler / execution.scheduler: no Dask scheduler answers at "
                     f"{s['scheduler']} within {CONNECT_TIMEOUT} s ({exc})"
+                ) from None
+            except (ValueError, TypeError) as exc:  # (tls:// without Dask's TLS settings)
+                if s["scheduler"] is None:
+                    raise
+                raise SchedulerUnreachable(
+                    f"--scheduler / execution.scheduler: cannot connect to {s['scheduler']} "
+                    f"({' '.join(str(exc).split())})"
                 ) from None
         else:
             raise ValueError(f"executor must be one of {EXECUTORS}, not {s['executor']!r}")

@@ -227,6 +227,13 @@ def test_the_dask_executor_without_its_extra_is_bad_input(tmp_path, capsys, monk
         (("--executor", "processes", "--workers", "0"), "4 per core"),
         (("--executor", "local", "--workers", "2"), "needs --executor processes or dask"),
         (("--executor", "processes", "--scheduler", "tcp://h:1"), "give --executor dask"),
+        # the address's form (a traceback from distributed before: ValueError, TypeError)
+        (("--executor", "dask", "--scheduler", "http://h:1"), "not http://"),
+        (("--executor", "dask", "--scheduler", "inproc://"), "give [scheme://]host:port"),
+        (("--executor", "dask", "--scheduler", "::::"), "IPv6 host in brackets"),
+        (("--executor", "dask", "--scheduler", "tcp://h"), "give the scheduler's port"),
+        (("--executor", "dask", "--scheduler", "h:99999"), "from 1 to 65535"),
+        (("--executor", "dask", "--scheduler", ""), "is not a scheduler address"),
     ],
 )
 def test_bad_executor_options_exit_2_with_one_line(capsys, args, needle):
@@ -245,9 +252,22 @@ def test_bad_executor_options_exit_2_with_one_line(capsys, args, needle):
         ("{executor: processes, chunk: 1.0e9}", "execution.chunk"),
         ("5", "execution"),
         ("{executor: [dask]}", "execution.executor"),
+        ("{executor: dask, scheduler: 'ws://h'}", "execution.scheduler: 'ws://h': give"),
     ],
 )
 def test_a_bad_execution_section_is_bad_input(tmp_path, capsys, section, needle):
     config = write(tmp_path, (CONFIGS / "quickstart.yaml").read_text() + f"execution: {section}\n")
     code, _, err = cli(capsys, "validate", config)
     assert code == 2 and needle in err and len(err.splitlines()) == 1, err
+
+
+def test_a_scheduler_that_cannot_be_reached_is_one_line(capsys):
+    """A well-formed address that cannot be connected to (tls:// without Dask's TLS
+    settings: a TypeError traceback from distributed before) is the executor's failure,
+    exit 1 with one line, as a scheduler that does not answer is."""
+    code, _, err = cli(
+        capsys, "simulate", CONFIGS / "quickstart.yaml", "--executor", "dask",
+        "--scheduler", "tls://127.0.0.1:1", "--sweep", "vehicle.body.mass=2000:2100:2",
+    )  # fmt: skip
+    assert code == 1 and len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    assert "cannot connect to tls://127.0.0.1:1" in err

@@ -242,8 +242,11 @@ def executing(
         fail(f"--executor dask needs dask.distributed: {execution.INSTALL_DASK}")
     if scheduler is not None and executor not in ("dask", None):
         fail("--scheduler is the address of a Dask scheduler: give --executor dask")
-    if scheduler is not None and not scheduler.strip():
-        fail("--scheduler: give an address such as tcp://host:8786")
+    if scheduler is not None:
+        try:
+            execution.check_scheduler_address(scheduler)
+        except ValueError as exc:
+            fail(f"--scheduler {exc}")
     if workers is not None and not 1 <= workers <= execution.max_local_workers():
         fail(
             f"--workers {workers}: give a number of worker processes from 1 to "

@@ -6,7 +6,7 @@ from typing import Annotated, Literal
 
 from pydantic import AfterValidator, Field, model_validator
 
-from ..execution import DEFAULT_CHUNK
+from ..execution import DEFAULT_CHUNK, check_scheduler_address
 from .base import Duration, Section, Step
 
 __all__ = ["Simulation", "Output", "Execution"]
@@ -117,7 +117,7 @@ class Execution(Section):
         description="worker processes that processes, or dask without a scheduler, starts "
         "(default: the machine's cores)",
     )
-    scheduler: str | None = Field(
+    scheduler: Annotated[str, AfterValidator(check_scheduler_address)] | None = Field(
         None,
         min_length=1,
         max_length=500,
