@@ -22,9 +22,10 @@ then a few products per frequency), batched over designs and frequencies; each s
 (:class:`suspopt.result.Result`) applied to the complex amplitudes (the signal of the
 response minus the signal of rest, so that a static part such as the tyre's static load
 drops out). The integral is Simpson's rule over ``ln f`` on a grid of frequencies equally spaced in
-``ln f``, refined by adding the midpoints until no value changes by more than
-:data:`TOLERANCE` relative (from :data:`FIRST_POINTS` to at most :data:`MAX_POINTS` points;
-more is an error).
+``ln f``, refined by adding the midpoints until no value of a design changes by more than
+:data:`TOLERANCE` relative (from :data:`FIRST_POINTS` to at most :data:`MAX_POINTS` points);
+each design keeps the values of the grid where it converged, and one that has not converged
+at the most points is a failed design (NaN), as a diverged one is in time.
 
 Metrics with a stationary closed form: ``var``, ``std``, ``rms`` (the response has zero
 mean: ``rms = std``, ``mean = 0``), ``rms_weighted``, ``dissipated_power`` (the mean of
@@ -234,6 +235,41 @@ def _simpson(y: np.ndarray, step: float) -> np.ndarray:
                          + 2.0 * y[..., 2:-1:2].sum(-1))  # fmt: skip
 
 
+def _converged(cfg: Config, P: int, integrands: dict, system, requests, band, points: int):
+    """Each value's variance (P,) from its integrands on ``points`` frequencies over ``band``
+    (``ln f`` from, to), the grid refined by its midpoints until, design by design, no value
+    changes by more than :data:`TOLERANCE` relative: a design's variances are those of the
+    grid where it converged, whatever its batch needs, and NaN (a failed design, as a
+    diverged one) where it has not converged at :data:`MAX_POINTS` frequencies (a mode
+    damped so lightly that its resonance is narrower than the grid: 1e-300 N s/m at a
+    damper gave an error for the whole batch before)."""
+    low, high = band
+    variances = {k: _simpson(y, (high - low) / (points - 1)) for k, y in integrands.items()}
+    final = {k: np.full(P, np.nan) for k in integrands}
+    done = np.zeros(P, dtype=bool)
+    while not done.all() and points < MAX_POINTS:
+        points = 2 * points - 1  # the midpoints added
+        _check_memory(cfg, P, points, len(integrands))
+        middle = np.exp(np.linspace(low, high, points)[1::2])
+        added = _integrands(system, requests, middle)
+        change = np.zeros(P)
+        for key, y in integrands.items():
+            both = np.empty(y.shape[:-1] + (points,))
+            both[..., 0::2], both[..., 1::2] = y, added[key]
+            integrands[key] = both
+            finer = _simpson(both, (high - low) / (points - 1))
+            scale = np.maximum(np.abs(finer), 1e-300)
+            with np.errstate(invalid="ignore"):
+                step = np.abs(finer - variances[key]) / scale
+            change = np.maximum(change, np.where(np.isnan(step), np.inf, step))
+            variances[key] = finer
+        now = ~done & (change <= TOLERANCE)
+        for key in integrands:
+            final[key][now] = variances[key][now]
+        done |= now
+    return final
+
+
 def reduce(
     cfg: Config, params: Mapping[str, Any] | None, requests: Sequence[tuple[Any, Sequence[str]]]
 ):
@@ -252,29 +288,7 @@ def reduce(
     _check_memory(cfg, pv.P, points, sum(len(ns) for _, ns in requests))
     system = _Linear(cfg, pv, model, attachments)
     integrands = _integrands(system, requests, grid)
-    variances = {k: _simpson(y, (high - low) / (points - 1)) for k, y in integrands.items()}
-    while True:
-        if points >= MAX_POINTS:
-            raise cfg.error(
-                ("simulation", "method"),
-                f"spectral: the frequency integral did not converge to {TOLERANCE:g} with "
-                f"{MAX_POINTS} frequencies; narrow the road's band (n_min, n_max) or use time",
-            )
-        points = 2 * points - 1  # the midpoints added
-        _check_memory(cfg, pv.P, points, len(integrands))
-        middle = np.exp(np.linspace(low, high, points)[1::2])
-        added = _integrands(system, requests, middle)
-        change = 0.0
-        for key, y in integrands.items():
-            both = np.empty(y.shape[:-1] + (points,))
-            both[..., 0::2], both[..., 1::2] = y, added[key]
-            integrands[key] = both
-            finer = _simpson(both, (high - low) / (points - 1))
-            scale = np.maximum(np.abs(finer), 1e-300)
-            change = max(change, float(np.nanmax(np.abs(finer - variances[key]) / scale)))
-            variances[key] = finer
-        if change <= TOLERANCE:
-            break
+    variances = _converged(cfg, pv.P, integrands, system, requests, (low, high), points)
     values = {}
     for spec, ns in requests:
         for name in ns:
