@@ -230,7 +230,8 @@ def test_yaml_1_2_numbers():
         ),
         # a flat "bump": optimise with balanced weights found every objective's median 0
         # (benchmarks/fuzz_configs.py --optimise --seed 23), after validate had accepted it
-        ("height: 0.05 ", "height: 0.0 ", "road.height: a bump of height 0 is a flat road", 20),
+        ("height: 0.05 ", "height: 0.0 ", "road.height: a bump of height 0 m is a flat road", 20),
+        ("height: 0.05 ", "height: -1.0e-300 ", "height -1e-300 m is a flat road", 20),
     ],
 )
 def test_validate_rejects_what_simulate_would(tmp_path, capsys, old, new, needle, line):

@@ -39,6 +39,7 @@ __all__ = [
     "resolve_road_file",
     "read_profile",
     "MAX_PROFILE_BYTES",
+    "MIN_BUMP_HEIGHT",
 ]
 
 Tracks = Literal["identical", "independent", "right_only", "left_only"]
@@ -81,16 +82,21 @@ class _DeterministicRoad(_Road):
         return tracks
 
 
+#: The lowest bump [m]: anything lower is a flat road to the model (every signal at rest,
+#: every objective 0 or, for a height like 1e-300 m, squared to nothing).
+MIN_BUMP_HEIGHT = 1e-6
+
+
 class _Bump(_DeterministicRoad):
-    """A bump: its ``height`` is not 0 (a flat road, on which every signal stays at rest and
-    every objective is 0)."""
+    """A bump: its ``height`` is at least :data:`MIN_BUMP_HEIGHT` either way."""
 
     @field_validator("height", check_fields=False)
     @classmethod
     def _not_flat(cls, height: float) -> float:
-        if height == 0:
+        if abs(height) < MIN_BUMP_HEIGHT:
             raise ValueError(
-                "a bump of height 0 is a flat road: give its height (negative for a pothole)"
+                f"a bump of height {height:g} m is a flat road: give a height of at least "
+                f"{MIN_BUMP_HEIGHT:g} m either way (negative for a pothole)"
             )
         return height
 
