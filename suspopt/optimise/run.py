@@ -56,6 +56,7 @@ from pymoo.indicators.hv import HV
 from ..config import Config, ConfigError
 from ..config.optimise import ALGORITHMS
 from ..config.optimise import Hybrid as HybridSettings
+from ..config.optimise import Optimiser as OptimiserSettings
 from ..io import atomic_h5
 from . import algorithms
 from .output import read_checkpoint, write_checkpoint, write_history, write_pareto
@@ -233,6 +234,15 @@ def optimise(
     return _write(output, cfg, problem, snapshot, run, status, command)
 
 
+def settings(cfg: Config) -> OptimiserSettings:
+    """``cfg.optimiser``; ConfigError when the config has none (it is no optimisation)."""
+    if cfg.optimiser is None:
+        raise cfg.error(
+            ("optimiser",), "required key is missing: give at least algorithm, seed and a budget"
+        )
+    return cfg.optimiser
+
+
 #: Memory a generation of a population algorithm holds per pair of designs [bytes]: pymoo's
 #: duplicate elimination measures the distance of every offspring to every design (float64
 #: distances, masks and indices). tracemalloc's peak over two generations (pymoo 0.6) was
@@ -261,11 +271,7 @@ def _check_pairs_memory(cfg: Config, population: int) -> None:
 def build_optimiser(cfg: Config, problem: Problem) -> algorithms.Optimiser:
     """The optimiser of ``cfg.optimiser`` for ``problem`` (not yet set up); ConfigError for a
     combination that cannot work (e.g. GA on three objectives without a weighted sum)."""
-    opt = cfg.optimiser
-    if opt is None:
-        raise cfg.error(
-            ("optimiser",), "required key is missing: give at least algorithm, seed and a budget"
-        )
+    opt = settings(cfg)
     _check_objectives(cfg, problem)
     if opt.algorithm == "gradient":
         return _gradient(cfg, problem, opt.generations, opt.max_evaluations)
@@ -279,8 +285,8 @@ def build_optimiser(cfg: Config, problem: Problem) -> algorithms.Optimiser:
     except ValueError as exc:
         raise cfg.error(("optimiser", "options"), str(exc)) from None
     if opt.algorithm == "hybrid":
-        settings = opt.hybrid or HybridSettings()
-        ga_generations = min(settings.ga_generations, opt.generations or float("inf"))
+        hybrid = opt.hybrid or HybridSettings()
+        ga_generations = min(hybrid.ga_generations, opt.generations or float("inf"))
         ga = algorithms.PymooOptimiser(
             algorithm,
             algorithms.termination(
@@ -290,7 +296,7 @@ def build_optimiser(cfg: Config, problem: Problem) -> algorithms.Optimiser:
         return algorithms.Hybrid(
             ga,
             _gradient(cfg, problem, None, None),
-            settings.shrink,
+            hybrid.shrink,
             opt.generations,
             opt.max_evaluations,
         )
@@ -303,7 +309,7 @@ def build_optimiser(cfg: Config, problem: Problem) -> algorithms.Optimiser:
 
 
 def _gradient(cfg: Config, problem: Problem, iterations, evaluations) -> algorithms.Gradient:
-    opt = cfg.optimiser
+    opt = settings(cfg)
     return algorithms.Gradient(
         max_iterations=iterations,
         max_evaluations=evaluations,
@@ -315,7 +321,7 @@ def _gradient(cfg: Config, problem: Problem, iterations, evaluations) -> algorit
 
 def _check_objectives(cfg: Config, problem: Problem) -> None:
     """The algorithm suits the number of objectives; weights match the objectives."""
-    opt = cfg.optimiser
+    opt = settings(cfg)
     single = ALGORITHMS[opt.algorithm].single_objective
     if opt.weighted_sum is None:
         if single and problem.n_obj > 1:
@@ -354,7 +360,7 @@ def _check_objectives(cfg: Config, problem: Problem) -> None:
 def _start(cfg: Config, recorder: _Recorder, optimiser: algorithms.Optimiser) -> _Run:
     """A run from the start: the Generator of the seed balances the weights (if asked), then
     drives the optimiser; every evaluation goes through ``recorder``."""
-    opt = cfg.optimiser
+    opt = settings(cfg)
     rng = np.random.default_rng(opt.seed)
     weights, working = None, recorder
     if opt.weighted_sum is not None:
@@ -362,14 +368,16 @@ def _start(cfg: Config, recorder: _Recorder, optimiser: algorithms.Optimiser) ->
         if ws.weights is not None:
             weights = np.array(ws.weights, dtype=float)
         else:
+            balance = ws.balance
+            assert balance is not None  # (the section has weights or a balance)
             dominant = (
                 None
-                if ws.balance.dominant is None
-                else recorder.problem.obj_names.index(ws.balance.dominant)
+                if balance.dominant is None
+                else recorder.problem.obj_names.index(balance.dominant)
             )
             try:
                 weights = algorithms.balanced_weights(
-                    recorder, ws.balance.samples, rng, dominant, ws.balance.factor
+                    recorder, balance.samples, rng, dominant, balance.factor
                 )
             except ValueError as exc:
                 raise cfg.error(("optimiser", "weighted_sum", "balance"), str(exc)) from None
@@ -380,7 +388,7 @@ def _start(cfg: Config, recorder: _Recorder, optimiser: algorithms.Optimiser) ->
 
 def _record(run: _Run, cfg: Config) -> Progress:
     """Append this generation to the history; return the progress report."""
-    opt, optimiser = cfg.optimiser, run.optimiser
+    opt, optimiser = settings(cfg), run.optimiser
     optimum, population = optimiser.optimum(), optimiser.population()
     feasible_f = optimum.F[optimum.feasible]
     best = feasible_f.min(axis=0) if len(feasible_f) else np.full(optimum.F.shape[1], np.nan)
@@ -504,7 +512,7 @@ def _write(
     command: str | None,
 ) -> OptimisationResult:
     weights, run_batches = run.weights, run.recorder.batches
-    opt = cfg.optimiser
+    opt = settings(cfg)
     best_names = problem.obj_names if weights is None else ["weighted_sum"]
     best_units = problem.obj_units if weights is None else ["1"]
     with atomic_h5(output, cfg, command) as h5:
