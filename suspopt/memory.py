@@ -91,7 +91,8 @@ def explicit_limit() -> int | None:
 
 def available() -> int:
     """Memory this process may still allocate [bytes]: the kernel's ``MemAvailable``, cut by
-    an address-space limit (``ulimit -v``) if one is set."""
+    what an address-space limit (``ulimit -v``) leaves beyond what the process maps
+    already, if one is set."""
     import os
     import resource
 
@@ -108,14 +109,35 @@ def available() -> int:
         except (ValueError, OSError):
             free = 1 << 62
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
-    return free if soft == resource.RLIM_INFINITY else min(free, soft)
+    if soft == resource.RLIM_INFINITY:
+        return free
+    return min(free, max(soft - _mapped(), 0))
+
+
+def _mapped() -> int:
+    """The address space this process maps now [bytes] (``VmSize``; 0 where unknown): what an
+    address-space limit has left is the limit less this (numpy, scipy and numba alone map
+    several hundred MB)."""
+    import os
+
+    try:
+        with open("/proc/self/statm") as statm:
+            return int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
 
 
 def limit() -> tuple[int, str]:
     """The allocation limit [bytes] and where it comes from."""
+    import resource
+
     if _limit is not None:
         return _limit, "the --max-memory limit"
-    return available(), "the memory this machine has available"
+    free = available()
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft != resource.RLIM_INFINITY and free >= soft - _mapped():
+        return free, "what this process's address-space limit (ulimit -v) leaves"
+    return free, "the memory this machine has available"
 
 
 def describe(size: float) -> str:

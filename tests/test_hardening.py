@@ -354,7 +354,26 @@ def test_a_run_larger_than_memory_is_refused_before_allocating(tmp_path, capsys,
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     assert needle in message and "more than the memory this machine has available" in message
+    assert message.startswith("error: ") and "case.yaml:" in message  # (the file: none before)
+    assert ": simulation: simulating 1 design" in message
     assert peak < 200e6
+
+
+def test_an_address_space_limit_counts_what_the_process_maps_already(monkeypatch):
+    """Under ``ulimit -v``, what is left is the limit less what the process maps (numpy,
+    scipy and numba: several hundred MB). The whole limit was taken as free, so a run the
+    estimate let through met a MemoryError traceback (found under the fuzz workers' 2 GB)."""
+    import resource
+
+    from suspopt import memory
+
+    mapped = memory._mapped()
+    assert mapped > 50 << 20  # (this process: numpy, h5py, suspopt)
+    monkeypatch.setattr(resource, "getrlimit", lambda which: (mapped + (300 << 20), -1))
+    left = memory.available()
+    assert 250 << 20 < left <= 300 << 20
+    cap, source = memory.limit()
+    assert cap == left and source == "what this process's address-space limit (ulimit -v) leaves"
 
 
 def test_max_memory_caps_a_run(tmp_path, capsys):

@@ -429,7 +429,7 @@ def test_a_scenario_road_too_large_for_memory_is_bad_input(monkeypatch):
     try:
         text = ISO + "scenarios:\n  cases: [{name: dense, set: {road.n_waves: 2000000}}]\n"
         cfg = load_config_text(text)
-        with pytest.raises(ConfigError, match="in scenario dense: simulating 1 design"):
+        with pytest.raises(ConfigError, match="in scenario dense: simulation: simulating 1 design"):
             check_config(cfg)
         problem = Problem.from_config(cfg)  # the library path checks each road too
         with pytest.raises(ConfigError, match="needs about"):
