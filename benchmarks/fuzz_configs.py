@@ -12,7 +12,12 @@ capped at ``--memory`` GB of address space, with ``--limit`` s per command (SIGA
     python benchmarks/fuzz_configs.py --configs-only --optimise --cases 1000 --limit 10
 
 ``--optimise`` mutates the optimisation configs only and runs ``validate`` and ``optimise``
-(tiny budgets) on each, instead of ``validate`` and ``simulate``.
+(tiny budgets) on each, instead of ``validate`` and ``simulate``. ``--bounds`` sets every
+number of every bundled config, one at a time, to each bound its schema allows (and 0),
+instead of random mutations (with ``--optimise``: the optimisation configs, optimised):
+
+    python benchmarks/fuzz_configs.py --configs-only --bounds
+    python benchmarks/fuzz_configs.py --configs-only --bounds --optimise --limit 20
 
 Prints, for configs and Pareto files apart, a table of counts (cases, exit 0, exit 2, other
 exits, tracebacks, multi-line messages, time-outs, validate-accepts-but-simulate-rejects
@@ -171,6 +176,12 @@ def main() -> None:
     )
     ap.add_argument("--configs-only", action="store_true")
     ap.add_argument(
+        "--bounds",
+        action="store_true",
+        help="instead of random mutations, every number of every bundled config at each "
+        "bound its schema allows (and 0), one at a time",
+    )
+    ap.add_argument(
         "--optimise",
         action="store_true",
         help="the config cases are the optimisation configs, run through validate and optimise "
@@ -207,7 +218,9 @@ def main() -> None:
     if not opts.h5_only:
         start = time.perf_counter()
         configs = fh.bundled_configs()
-        if opts.optimise:
+        if opts.bounds:
+            cases = fh.bound_cases(opts.optimise)
+        elif opts.optimise:
             cases = fh.optimisation_cases(opts.cases, opts.seed, fixed=not opts.no_fixed)
         else:
             cases = [] if opts.no_fixed else fh.seed_cases(configs) + fh.special_cases()
@@ -216,7 +229,8 @@ def main() -> None:
         results = fh.run_cases(cases, **run)
         wall = time.perf_counter() - start
         report(
-            f"{'optimisation ' if opts.optimise else ''}configs: {len(cases)} cases ({opts.cases} random; made in {made:.1f} s, "
+            f"{'optimisation ' if opts.optimise else ''}configs"
+            f"{' at their bounds' if opts.bounds else ''}: {len(cases)} cases ({opts.cases} random; made in {made:.1f} s, "
             f"wall {wall:.1f} s)",
             cases,
             results,

@@ -947,6 +947,60 @@ def optimisation_cases(n: int, seed: int = SEED, fixed: bool = True) -> list[Cas
     return [replace(c, id=f"opt-{c.id}"[:110], runs=OPTIMISE_RUNS) for c in cases]
 
 
+#: pydantic's message for a number out of range: which side and the bound
+_BOUND = re.compile(r"(less|greater) than or equal to (-?[0-9.eE+-]+)")
+
+
+def bound_cases(optimise: bool = False) -> list[Case]:
+    """Every number of every bundled config (the optimisation configs only, run through
+    ``optimise``, with ``optimise``) set to each closed bound its schema allows, and to 0
+    where that is allowed: the values most likely to pass ``validate`` and still break a
+    run. The bounds are found by loading the config with the number at ±1e308 and reading
+    the range from the error."""
+    from suspopt.config import ConfigError
+    from suspopt.config.loader import load_config_text
+
+    out, seen = [], set()
+    for path in bundled_configs():
+        data = seed_data(path)
+        if optimise and not isinstance(data.get("optimiser"), dict):
+            continue
+        source = rel_name(path)
+        for leaf in _leaves(data, lambda v: is_number(v) and not isinstance(v, bool)):
+            value = get_at(data, leaf)
+            for probe in (1e308, -1e308, 0.0):
+                probed = copy.deepcopy(data)
+                set_at(probed, leaf, probe)
+                try:
+                    load_config_text(dump(probed), path)
+                    bound: float | None = probe if probe == 0.0 else None
+                except ConfigError as exc:
+                    found = _BOUND.search(str(exc))
+                    bound = float(found.group(2)) if found and probe != 0.0 else None
+                if bound is None:
+                    continue
+                if isinstance(value, int) and bound.is_integer():
+                    bound = int(bound)
+                case_id = _case_id("bound", source, dotted(leaf), str(bound))
+                if case_id in seen:
+                    continue
+                seen.add(case_id)
+                bounded = copy.deepcopy(data)
+                set_at(bounded, leaf, bound)
+                out.append(
+                    Case(
+                        id=case_id,
+                        family="config",
+                        label=f"bound: {dotted(leaf)} = {bound}",
+                        setup={"kind": "text", "text": dump(bounded)},
+                        runs=OPTIMISE_RUNS if optimise else CONFIG_RUNS,
+                        source=source,
+                        name=_file_name(source),
+                    )
+                )
+    return out
+
+
 def case_count(default: int) -> int:
     """The number of random mutations: ``SUSPOPT_FUZZ_CASES`` (env), else ``default``."""
     value = os.environ.get("SUSPOPT_FUZZ_CASES")
