@@ -35,10 +35,9 @@ needs to be). Numbers are written in full (``repr``: they read back bit for bit)
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import re
-from contextlib import ExitStack, contextmanager
+from contextlib import ExitStack, contextmanager, suppress
 from io import TextIOWrapper
 from pathlib import Path
 
@@ -236,7 +235,7 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
                     _write_table(stream, comment, header, columns)
         except BaseException:
             if made:  # (the folder this call made, left empty)
-                with contextlib.suppress(OSError):
+                with suppress(OSError):
                     folder.rmdir()
             raise
     return targets
