@@ -91,8 +91,13 @@ def explicit_limit() -> int | None:
 
 def available() -> int:
     """Memory this process may still allocate [bytes]: the kernel's ``MemAvailable``, cut by
-    what an address-space limit (``ulimit -v``) leaves beyond what the process maps
-    already, if one is set."""
+    what an address-space limit (``ulimit -v``) leaves beyond what the process holds
+    already (:func:`_mapped`), if one is set."""
+    return _available()[0]
+
+
+def _available() -> tuple[int, bool]:
+    """:func:`available`, and whether the address-space limit is what bounds it."""
     import os
     import resource
 
@@ -110,32 +115,55 @@ def available() -> int:
             free = 1 << 62
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft == resource.RLIM_INFINITY:
-        return free
-    return min(free, max(soft - _mapped(), 0))
+        return free, False
+    left = max(soft - _mapped(), 0)
+    return min(free, left), left <= free
 
 
 def _mapped() -> int:
-    """The address space this process maps now [bytes] (``VmSize``; 0 where unknown): what an
-    address-space limit has left is the limit less this (numpy, scipy and numba alone map
-    several hundred MB)."""
+    """The address space this process holds now [bytes]: ``VmSize`` (0 where unknown) less
+    what the allocator keeps free for reuse (:func:`reuse_memory` keeps freed arrays
+    mapped; the next ones are served from them). What an address-space limit has left is
+    the limit less this (numpy, scipy and numba alone map several hundred MB)."""
     import os
 
     try:
         with open("/proc/self/statm") as statm:
-            return int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+            size = int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
     except (OSError, ValueError, IndexError):
         return 0
+    return max(size - _heap_free(), 0)
+
+
+class _MallInfo2(ctypes.Structure):
+    """glibc's ``struct mallinfo2`` (all ``size_t``)."""
+
+    _fields_ = [
+        (name, ctypes.c_size_t)
+        for name in (
+            "arena", "ordblks", "smblks", "hblks", "hblkhd",
+            "usmblks", "fsmblks", "uordblks", "fordblks", "keepcost",
+        )
+    ]  # fmt: skip
+
+
+def _heap_free() -> int:
+    """Free bytes the allocator holds for reuse (glibc's ``mallinfo2().fordblks``; 0 where
+    the C library has no ``mallinfo2``: glibc before 2.33, or another one)."""
+    try:
+        mallinfo2 = ctypes.CDLL(None).mallinfo2
+    except (OSError, AttributeError, TypeError):
+        return 0
+    mallinfo2.argtypes, mallinfo2.restype = (), _MallInfo2
+    return int(mallinfo2().fordblks)
 
 
 def limit() -> tuple[int, str]:
     """The allocation limit [bytes] and where it comes from."""
-    import resource
-
     if _limit is not None:
         return _limit, "the --max-memory limit"
-    free = available()
-    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
-    if soft != resource.RLIM_INFINITY and free >= soft - _mapped():
+    free, by_rlimit = _available()
+    if by_rlimit:
         return free, "what this process's address-space limit (ulimit -v) leaves"
     return free, "the memory this machine has available"
 
