@@ -1481,8 +1481,14 @@ def build_h5_cases(cases: list[Case], variants, folder: Path) -> list[Case]:
 # --- judging -------------------------------------------------------------------------------
 
 
+#: ``optimise``'s progress line per generation, which goes to stderr when it is no terminal
+#: (``cli/optimisation._progress_line``): not part of a message
+PROGRESS = re.compile(r"^\S+ gen \d+(?:/\d+)?, \d+ evaluations, ")
+
+
 def stderr_lines(text: str) -> list[str]:
-    return [line for line in text.splitlines() if line.strip()]
+    """The lines of a command's stderr that are messages (not blank, not progress)."""
+    return [line for line in text.splitlines() if line.strip() and not PROGRESS.match(line)]
 
 
 def names_dataset(line: str, dataset: str) -> bool:
