@@ -230,8 +230,8 @@ def main() -> None:
         wall = time.perf_counter() - start
         report(
             f"{'optimisation ' if opts.optimise else ''}configs"
-            f"{' at their bounds' if opts.bounds else ''}: {len(cases)} cases ({opts.cases} random; made in {made:.1f} s, "
-            f"wall {wall:.1f} s)",
+            f"{' at their bounds' if opts.bounds else ''}: {len(cases)} cases "
+            f"({0 if opts.bounds else opts.cases} random; made in {made:.1f} s, wall {wall:.1f} s)",
             cases,
             results,
             opts.slowest,
