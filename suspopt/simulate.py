@@ -140,7 +140,9 @@ def run_memory(
     half_steps = 2 * sim.n_steps + 1
     samples = sim.n_steps // sim.output_every + 1
     span = road.speed * sim.duration + float(np.max(model.offsets, initial=0.0))
-    shared = road_memory(road, corners, half_steps, span) + 8.0 * half_steps * 2 * rows
+    # the inputs' offsets, 2 rows each per half step, and as much again while they are made
+    # (network.offsets: the products, then their transposed copy)
+    shared = road_memory(road, corners, half_steps, span) + 8.0 * half_steps * 4 * rows
     # states, accelerations, deformation and force caches, held records, signals, transforms
     held = min(samples, window or samples)
     per_design = 8.0 * held * (3 * n + 8 * corners + 4 * corners + signals + 6)
