@@ -317,6 +317,15 @@ def test_a_hand_written_front_on_its_own_road_gives_the_simulated_objective(seat
         ),
         (["analyse", "controllers", "{seatless}"], "give at least one --with"),
         (["analyse", "controllers", "{seatless}", "--with", "{tmp}/none.yaml"], "no such file"),
+        # a --with file's sections of the wrong type: AttributeError tracebacks before
+        (
+            ["analyse", "controllers", "{seatless}", "--with", "{tmp}/flat.yaml"],
+            "flat.yaml:1: vehicle: must be a mapping, not bool",
+        ),
+        (
+            ["analyse", "controllers", "{seatless}", "--with", "{tmp}/listed.yaml"],
+            "listed.yaml:2: vehicle.corners: must be a mapping, not list",
+        ),
         (["analyse", "masses", "{config}"], "not an HDF5 file"),
         (["analyse", "masses", "{tmp}/missing.h5"], "no such file"),
         (["analyse", "histogram", "{seatless}"], "unknown kind 'histogram'"),
@@ -330,6 +339,8 @@ def test_bad_input_exits_2_with_one_line_and_no_partial_output(
 ):
     config = tmp_path / "case.yaml"
     config.write_text((CONFIGS / "quickstart.yaml").read_text())
+    (tmp_path / "flat.yaml").write_text("vehicle: true\ncontrol: {sample_time: 0.001}\n")
+    (tmp_path / "listed.yaml").write_text("vehicle:\n  corners: [F1, R1]\n")
     fill = {"seatless": seatless_front, "config": config, "tmp": tmp_path}
     out = tmp_path / "out.h5"
     proc = run(*[a.format(**fill) for a in args], "-o", out)

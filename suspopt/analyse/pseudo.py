@@ -138,19 +138,46 @@ class PseudoFronts:
         return relative_change(self.values(i), self.reference)
 
 
-def read_sections(path: Path, option: str) -> dict:
-    """The YAML mapping of config sections in ``path``; ConfigError naming ``option``."""
+def read_sections(path: Path, option: str, with_node: bool = False):
+    """The YAML mapping of config sections in ``path`` (and, ``with_node``, its composed node
+    tree, for :func:`mapping_at`); ConfigError naming ``option``."""
     from ..config.yamlio import YamlError, parse_yaml, read_text
 
     try:
-        data, _ = parse_yaml(read_text(path))
+        data, node = parse_yaml(read_text(path))
     except FileNotFoundError:
         raise ConfigError(f"{option} {path}: no such file") from None
     except YamlError as exc:
         raise ConfigError(f"{option} {path}{f':{exc.line}' if exc.line else ''}: {exc}") from None
     if not isinstance(data, dict):
         raise ConfigError(f"{option} {path}: must be a YAML mapping of config sections")
-    return data
+    return (data, node) if with_node else data
+
+
+def mapping_at(data: dict, node, keys: tuple[str, ...], where: str) -> dict:
+    """The mapping at ``keys`` of the sections ``data`` (``node``: their YAML tree), {} where
+    it is absent or null; ConfigError naming ``where``, the line and the keys where it is
+    anything else (a list, a number: an AttributeError traceback before)."""
+    value: object = data
+    for key in keys:
+        value = value.get(key) if isinstance(value, dict) else None
+    if value is None:
+        return {}
+    if isinstance(value, dict):
+        return value
+    line = "?"
+    for key in keys:  # the line of the last key found, from the YAML tree
+        found = (
+            [(k, v) for k, v in getattr(node, "value", ()) if getattr(k, "value", None) == key]
+            if isinstance(getattr(node, "value", None), list)
+            else []
+        )
+        if not found:
+            break
+        line, node = str(found[0][0].start_mark.line + 1), found[0][1]
+    raise ConfigError(
+        f"{where}:{line}: {'.'.join(keys)}: must be a mapping, not {type(value).__name__}"
+    )
 
 
 # --- changes -------------------------------------------------------------------------------
@@ -282,13 +309,14 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
     variants = []
     for source in sources:
         source = Path(source)
-        other = read_sections(source, "--with")
-        vehicle = other.get("vehicle") or {}
+        other, node = read_sections(source, "--with", with_node=True)
+        where = f"--with {source}"
         control = other.get("control")
-        default = (vehicle.get("corner_defaults") or {}).get("damper")
+        mapping_at(other, node, ("vehicle",), where)
+        default = mapping_at(other, node, ("vehicle", "corner_defaults"), where).get("damper")
         own = {
             c: v["damper"]
-            for c, v in (vehicle.get("corners") or {}).items()
+            for c, v in mapping_at(other, node, ("vehicle", "corners"), where).items()
             if isinstance(v, dict) and "damper" in v
         }
         if control is None and default is None and not own:
