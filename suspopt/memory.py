@@ -176,13 +176,15 @@ def describe(size: float) -> str:
     return f"{size / 1024:.3g} kB"
 
 
-def check(need: float, what: str, advice: str) -> None:
+def check(need: float, what: str, advice: str, cfg=None, key: tuple = ()) -> None:
     """ConfigError when ``need`` bytes exceed the limit (:func:`limit`): the message gives
-    the estimate, the limit and ``advice``."""
+    the estimate, the limit and ``advice``, located at ``key`` of ``cfg`` (its file and
+    line: ``Config.error``) when a config is given."""
     from .config import ConfigError
 
     cap, source = limit()
     if need > cap:
-        raise ConfigError(
+        message = (
             f"{what} needs about {describe(need)}, more than {source} ({describe(cap)}); {advice}"
         )
+        raise ConfigError(message) if cfg is None else cfg.error(key, message)

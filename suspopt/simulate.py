@@ -18,7 +18,7 @@ import numpy as np
 
 from . import memory
 from .checks import check_steps, full_network
-from .config import Config, ConfigError
+from .config import Config
 from .control.controller import build_controller
 from .integrator import DIVERGENCE_LIMIT, Controller, Edges, Held, Run, Trajectory, integrate
 from .network import Assembled
@@ -155,18 +155,17 @@ def check_memory(
     """ConfigError when a run of P designs (:func:`run_memory`, with its ``signals``,
     ``window`` and ``kept``) needs more memory than the limit (:func:`suspopt.memory.check`)."""
     shared, per_design = run_memory(cfg, model, attachments, P, **sizes)
-    try:
-        memory.check(
-            shared + P * per_design,
-            f"simulating {P} design{'s' if P > 1 else ''} for "
-            f"{cfg.simulation.duration:g} s at dt = {cfg.simulation.dt:g} s",
-            ("simulate fewer designs at once, " if P > 1 else "")
-            + "shorten simulation.duration, raise simulation.dt or output_dt, store fewer "
-            "output.signals"
-            + (", lower road.n_max or set road.n_waves" if cfg.road.kind == "iso8608" else ""),
-        )
-    except ConfigError as exc:  # (named at the config's simulation section, file and line)
-        raise cfg.error(("simulation",), str(exc)) from None
+    memory.check(
+        shared + P * per_design,
+        f"simulating {P} design{'s' if P > 1 else ''} for "
+        f"{cfg.simulation.duration:g} s at dt = {cfg.simulation.dt:g} s",
+        ("simulate fewer designs at once, " if P > 1 else "")
+        + "shorten simulation.duration, raise simulation.dt or output_dt, store fewer "
+        "output.signals"
+        + (", lower road.n_max or set road.n_waves" if cfg.road.kind == "iso8608" else ""),
+        cfg,
+        ("simulation",),
+    )
 
 
 def _run(cfg: Config, prepared: Prepared, roads: Sequence[Any] | None = None) -> Result:

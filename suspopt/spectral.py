@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from .config import Config, ConfigError
+from .config import Config
 from .config.road import Iso8608Road
 
 __all__ = ["METRICS", "reduce", "check", "TOLERANCE", "FIRST_POINTS", "MAX_POINTS"]
@@ -209,15 +209,13 @@ def _check_memory(cfg: Config, P: int, points: int, values: int) -> None:
     limit (:func:`suspopt.memory.check`)."""
     from . import memory
 
-    try:
-        memory.check(
-            8.0 * P * (points * values + 40 * BLOCK),
-            f"the spectral integral over {points} frequencies for {P} designs",
-            "narrow the road's band (n_min, n_max), evaluate fewer designs at once or use "
-            "method time",
-        )
-    except ConfigError as exc:
-        raise cfg.error(("simulation", "method"), str(exc)) from None
+    memory.check(
+        8.0 * P * (points * values + 40 * BLOCK),
+        f"the spectral integral over {points} frequencies for {P} designs",
+        "narrow the road's band (n_min, n_max), evaluate fewer designs at once or use method time",
+        cfg,
+        ("simulation", "method"),
+    )
 
 
 def _reads(spec, name: str) -> list[str]:

@@ -258,14 +258,13 @@ def _check_pairs_memory(cfg: Config, population: int) -> None:
     generation (a MemoryError traceback before)."""
     from .. import memory
 
-    try:
-        memory.check(
-            PAIR_BYTES * float(population) ** 2,
-            f"a population of {population:,} (the optimiser compares every pair of designs)",
-            "give a smaller population",
-        )
-    except ConfigError as exc:
-        raise cfg.error(("optimiser", "population"), str(exc)) from None
+    memory.check(
+        PAIR_BYTES * float(population) ** 2,
+        f"a population of {population:,} (the optimiser compares every pair of designs)",
+        "give a smaller population",
+        cfg,
+        ("optimiser", "population"),
+    )
 
 
 def build_optimiser(cfg: Config, problem: Problem) -> algorithms.Optimiser:
