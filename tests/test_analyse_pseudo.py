@@ -349,3 +349,19 @@ def test_bad_input_exits_2_with_one_line_and_no_partial_output(
     assert len(message.splitlines()) == 1 and needle in message, message
     assert "Traceback" not in message and not out.exists()
     assert not list(tmp_path.glob("*.png")) + list(tmp_path.glob("*.jpg"))
+
+
+def test_an_error_located_in_the_edited_config_keeps_its_own_place(tmp_path, sh2_front):
+    """SH-ADD-2-CDF's control (one fixed threshold over conditions of two units) on the SH-2
+    front: the error, located at control.threshold.value of the edited config, was nested
+    inside a second location, at design_variables."""
+    _, path = sh2_front
+    out = tmp_path / "out.h5"
+    proc = run(
+        "analyse", "controllers", path, "--with", CONFIGS / "ch4" / "sh_add_2_cdf_bump.yaml",
+        "-o", out,
+    )  # fmt: skip
+    message = proc.stderr.strip()
+    assert proc.returncode == 2 and len(message.splitlines()) == 1, message
+    assert message.count(":config:") == 1 and "design_variables" not in message, message
+    assert ": control.threshold.value: one fixed threshold" in message and not out.exists()
