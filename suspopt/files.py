@@ -39,7 +39,7 @@ def kind_of(mode: int) -> str | None:
         return "a socket"
     if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
         return "a device"
-    return "not a regular file"
+    return "an unknown kind of file"
 
 
 def _reason(exc: OSError) -> str:
@@ -65,7 +65,7 @@ def read_bounded(path: str | Path, limit: int) -> bytes:
     kind = kind_of(os.fstat(fd).st_mode)
     if kind is not None:
         os.close(fd)
-        raise Unreadable(f"is {kind}" if kind.startswith("a ") else kind)
+        raise Unreadable(f"is {kind}")
     try:
         with os.fdopen(fd, "rb") as stream:
             data = stream.read(limit + 1)

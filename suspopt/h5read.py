@@ -15,7 +15,6 @@ import contextlib
 import math
 import os
 import signal
-import stat
 import time
 from pathlib import Path
 
@@ -23,6 +22,7 @@ import numpy as np
 
 from .config import ConfigError
 from .config.yamlio import MAX_CONFIG_BYTES
+from .files import kind_of
 
 __all__ = ["H5Reader", "MAX_DATASET_BYTES", "MAX_ATTRIBUTE_BYTES"]
 
@@ -231,8 +231,9 @@ class H5Reader:
             raise ConfigError(f"{self.where}: no such file") from None
         except OSError as exc:
             raise ConfigError(f"{self.where}: cannot read it ({exc.strerror})") from None
-        if not stat.S_ISREG(mode):
-            raise ConfigError(f"{self.where}: not a regular file")
+        kind = kind_of(mode)
+        if kind is not None:
+            raise ConfigError(f"{self.where}: is {kind}, not a regular file")
         _probe(self.path, self.where)
         try:
             self.file = h5py.File(self.path, "r")

@@ -59,7 +59,7 @@ import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError
-from ..config.loader import edit_config, set_path
+from ..config.loader import edit_config, line_of, set_path
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..kesort import pareto_picks
 from ..seat import build_seat, passenger_mass_change
@@ -165,16 +165,7 @@ def mapping_at(data: dict, node, keys: tuple[str, ...], where: str) -> dict:
         return {}
     if isinstance(value, dict):
         return value
-    line = "?"
-    for key in keys:  # the line of the last key found, from the YAML tree
-        found = (
-            [(k, v) for k, v in getattr(node, "value", ()) if getattr(k, "value", None) == key]
-            if isinstance(getattr(node, "value", None), list)
-            else []
-        )
-        if not found:
-            break
-        line, node = str(found[0][0].start_mark.line + 1), found[0][1]
+    line = line_of(node, keys) or "?"
     raise ConfigError(
         f"{where}:{line}: {'.'.join(keys)}: must be a mapping, not {type(value).__name__}"
     )

@@ -35,6 +35,7 @@ __all__ = [
     "config_schema",
     "edit_config",
     "set_path",
+    "line_of",
     "SCHEMA_DIALECT",
     "SCHEMA_ID",
 ]
@@ -134,6 +135,12 @@ def _line_map(node: yaml.Node, prefix: tuple = (), out: dict | None = None) -> d
             out[path] = item.start_mark.line + 1
             _line_map(item, path, out)
     return out
+
+
+def line_of(node: yaml.Node | None, keys: tuple) -> int | None:
+    """The 1-based line of the key path ``keys`` in the composed YAML ``node`` (that of the
+    nearest enclosing key when it is not there), or None."""
+    return _line_of(tuple(keys), _line_map(node)) if node is not None else None
 
 
 def _line_of(loc: tuple, lines: dict) -> int | None:

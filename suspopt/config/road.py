@@ -301,8 +301,7 @@ def _profile_text(path: Path) -> tuple[bytes, str]:
 
 def _header(text: str) -> int:
     """1 when the first line of ``text`` is not a row of two numbers (a header), else 0."""
-    first = text[: text.find("\n")] if "\n" in text else text
-    return 1 if _row((first.splitlines() or [""])[0]) is None else 0
+    return 1 if _row(next(_lines(text), "")) is None else 0
 
 
 #: Line breaks of ``str.splitlines`` other than ``\n`` and ``\r\n``: a file holding one is

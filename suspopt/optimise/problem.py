@@ -493,19 +493,17 @@ def _at_variable(cfg: Config, message: str) -> ConfigError:
     """Locate a model error about a design parameter at the design variable it names; one
     already located in the config (``FILE:LINE: key: ...``) about no design variable keeps
     its own place (it was put inside a second one before)."""
-    original = message
-    located = f"{cfg.source if cfg.source is not None else '<config>'}:"
-    if message.startswith(located):
-        line, _, rest = message[len(located) :].partition(": ")
-        message = rest if line.isdigit() or line == "?" else message
-    message = message.removeprefix("params: ")
+    original, place = message, f"{cfg.source if cfg.source is not None else '<config>'}:"
+    line, _, rest = message.removeprefix(place).partition(": ")
+    located = message.startswith(place) and (line.isdigit() or line == "?")
+    message = (rest if located else message).removeprefix("params: ")
     for i, var in sorted(enumerate(cfg.design_variables), key=lambda iv: -len(iv[1].path)):
         if var.path in message:
             return cfg.error(
                 ("design_variables", i),
                 f"with every variable at its lower (design 0) or upper (design 1) bound: {message}",
             )
-    if original is not message and original.startswith(located):
+    if located:
         return ConfigError(original)
     return cfg.error(("design_variables",), message)
 
