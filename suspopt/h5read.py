@@ -123,15 +123,21 @@ def dimension_scales(ds) -> list[tuple[str, object]]:
 
 
 def _cap_memory(allowance: int) -> None:
-    """Limit this process's address space to what it holds now plus ``allowance`` bytes
-    (Linux; elsewhere nothing is limited)."""
+    """Limit this process (the probe's child) to ``allowance`` more bytes than it holds now
+    (Linux; elsewhere nothing is limited). The address-space limit cannot stop the allocator
+    from serving a request from memory freed earlier and kept (:func:`memory.reuse_memory`:
+    after a large run, a heap of a GB or more), so the heap's free top is given back first
+    and its remaining holes are counted in the allowance."""
     import resource
 
+    from .memory import release_free
+
     with contextlib.suppress(OSError, ValueError):
+        holes = release_free()
         with open("/proc/self/statm") as statm:
             held = int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
         soft, hard = resource.getrlimit(resource.RLIMIT_AS)
-        cap = held + allowance
+        cap = held + max(allowance - holes, 0)
         if soft != resource.RLIM_INFINITY:
             cap = min(cap, soft)
         resource.setrlimit(resource.RLIMIT_AS, (cap, hard))

@@ -147,6 +147,21 @@ class _MallInfo2(ctypes.Structure):
     ]  # fmt: skip
 
 
+def release_free() -> int:
+    """Give the free memory at the top of the heap back to the kernel (glibc's
+    ``malloc_trim``, which :func:`reuse_memory`'s setting does not stop) and return the free
+    bytes the allocator still holds, in holes between blocks in use, which it serves again
+    without mapping anything: an address-space limit set after this bounds only what is
+    allocated beyond them [bytes]. Elsewhere than glibc nothing is released and 0 returned."""
+    try:
+        trim = ctypes.CDLL(None).malloc_trim
+    except (OSError, AttributeError, TypeError):
+        return 0
+    trim.argtypes, trim.restype = (ctypes.c_size_t,), ctypes.c_int
+    trim(0)
+    return _heap_free()
+
+
 def _heap_free() -> int:
     """Free bytes the allocator holds for reuse (glibc's ``mallinfo2().fordblks``; 0 where
     the C library has no ``mallinfo2``: glibc before 2.33, or another one)."""
