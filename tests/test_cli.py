@@ -64,6 +64,39 @@ def test_missing_config_file_exits_2(tmp_path):
     assert proc.returncode == 2 and "no such config file" in proc.stderr
 
 
+def test_help_prints_each_text_as_written():
+    """Every command's docstring paragraphs and every argument's help appear in ``--help``
+    as written: each paragraph on one line of a wide terminal (typer's markup kept the
+    docstring's line breaks) and nothing in brackets dropped (``pip install
+    'suspopt[report]'`` came out as ``'suspopt'``)."""
+    import inspect
+    import re
+
+    from typer.testing import CliRunner
+
+    from suspopt.cli import app
+
+    runner = CliRunner()
+    listing = runner.invoke(app, ["--help"], env={"COLUMNS": "400"}).output
+    for command in app.registered_commands:
+        name = command.name or command.callback.__name__
+        output = runner.invoke(app, [name, "--help"], env={"COLUMNS": "400"}).output
+        paragraphs = inspect.cleandoc(command.callback.__doc__).split("\n\n")
+        flowed = [" ".join(p.split()) for p in paragraphs]
+        assert flowed[0] in listing, name
+        for paragraph in flowed:
+            assert paragraph in output, (name, paragraph)
+        helps = [
+            p.default.help
+            for p in inspect.signature(command.callback).parameters.values()
+            if isinstance(getattr(p.default, "help", None), str)
+        ]
+        for text in [*flowed, *helps]:
+            for token in re.findall(r"\S*\[[^\]]*\]\S*", text.replace("\\[", "[")):
+                assert token in output, (name, token)
+    assert "suspopt[report]" in runner.invoke(app, ["report", "--help"]).output
+
+
 @pytest.mark.slow
 def test_validate_and_schema():
     proc = run("validate", CONFIGS / "quickstart.yaml")

@@ -13,6 +13,8 @@ it on the app when imported here.
 from __future__ import annotations
 
 from . import analysis, configs, optimisation, report, selection, simulation  # noqa: F401  (register)
-from .base import EXIT_ALL_FAILED, app, err, out
+from .base import EXIT_ALL_FAILED, app, err, out, plain_helps
+
+plain_helps(app)
 
 __all__ = ["app", "out", "err", "EXIT_ALL_FAILED"]

@@ -84,8 +84,10 @@ def analyse(
     *,
     run: base.RunOptions,
 ) -> None:
-    """Run an analysis of configs or of a Pareto file and print its table: models, roads,
-    masses, controllers, transmissibility or cdf-sensitivity (see KIND below)."""
+    """Run an analysis of configs or of a Pareto file and print its table.
+
+    The kinds: models, roads, masses, controllers, transmissibility, scenarios and
+    cdf-sensitivity (see KIND below)."""
     from ..plots import check_path
 
     given = {

@@ -374,6 +374,29 @@ def show_table(table: Table, keys: int = 1) -> None:
         out.print(part)
 
 
+def plain_helps(typer_app: typer.Typer) -> None:
+    """Make the help texts of ``typer_app``'s commands print as written. Typer's help markup
+    keeps a docstring's line breaks, which then break the terminal's own wrapping, and reads
+    ``[...]`` as a style and drops it (``pip install 'suspopt[report]'`` came out without its
+    extra). Each docstring paragraph becomes one line, and every ``[`` of a docstring or an
+    argument's help is escaped."""
+    import inspect
+    import re
+
+    escape = re.compile(r"(?<!\\)\[")  # (once: a second call changes nothing)
+    for command in typer_app.registered_commands:
+        if command.callback is None:
+            continue
+        if command.help is None:
+            paragraphs = inspect.cleandoc(command.callback.__doc__ or "").split("\n\n")
+            command.help = "\n\n".join(" ".join(p.split()) for p in paragraphs)
+        command.help = escape.sub(r"\\[", command.help)
+        for parameter in inspect.signature(command.callback).parameters.values():
+            info = parameter.default
+            if isinstance(getattr(info, "help", None), str):
+                info.help = escape.sub(r"\\[", info.help)
+
+
 def fail(message: str) -> None:
     """Report bad input in one line and exit with code 2."""
     err.print("error: " + " ".join(str(message).split()), soft_wrap=True)

@@ -28,8 +28,9 @@ def validate(
     config: Path = typer.Argument(..., help="YAML config file"),
     max_memory: str | None = max_memory_option(),
 ) -> None:
-    """Check a config and report its first problem with its line (what any command would
-    reject about it)."""
+    """Check a config and report its first problem, with its line.
+
+    What it reports is what any command would reject about the config."""
     from ..checks import check_config
 
     set_memory_limit(max_memory)
@@ -114,8 +115,9 @@ def export(
     ),
     force: bool = force_option(),
 ) -> None:
-    """Write a picked design as a standalone config (-o design.yaml), or a result file's
-    tables as CSV (--csv DIR)."""
+    """Write a picked design as a standalone config, or a result file's tables as CSV.
+
+    With -o design.yaml it writes the config of one pick; with --csv DIR, the tables."""
     if (output is None) == (csv is None):
         fail("export: give -o FILE.yaml (with --pick) or --csv DIR")
     with ExitStack() as stack:

@@ -28,9 +28,10 @@ def report(
     title: str | None = typer.Option(None, "--title", help="the page's title"),
     force: bool = base.force_option(),
 ) -> None:
-    """Write one self-contained HTML page to explore the fronts of result files: the front
-    and parallel coordinates, each design's row on click, the picks' signals, the history
-    and the provenance (needs plotly: pip install 'suspopt[report]')."""
+    """Write one self-contained HTML page to explore the fronts of result files.
+
+    The page holds the front and parallel coordinates, each design's row on click, the picks'
+    signals, the history and the provenance. It needs plotly: pip install 'suspopt[report]'."""
     from ..report import build_report
 
     rows = [r.strip() for item in with_signals for r in item.split(",") if r.strip()]

@@ -132,8 +132,9 @@ def kesort(
     *,
     run: base.RunOptions,
 ) -> None:
-    """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12); supplementary
-    objectives are re-simulated in one batch."""
+    """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12).
+
+    Supplementary objectives are re-simulated in one batch."""
     with run.outputs(output, plot):
         _kesort(
             pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot
