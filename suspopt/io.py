@@ -146,12 +146,34 @@ def _key(path: Path) -> Path:
     return path.parent.resolve() / path.name
 
 
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name the same file: the same inode where both exist (links
+    and other spellings of a path included), else the same folder and name."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return _key(a) == _key(b)
+
+
 @contextmanager
-def claim(path: str | Path, force: bool = False, option: str = "-o") -> Iterator[Path]:
+def claim(
+    path: str | Path,
+    force: bool = False,
+    option: str = "-o",
+    inputs: Iterable[tuple[str, str | Path]] = (),
+) -> Iterator[Path]:
     """Check ``path`` (:func:`check_target`), hold the writer's lock of it (module docstring)
     and clear the temporary files of dead writers; ConfigError when another process writes
-    it. Re-entrant in one process; a write inside the block may replace the file when
-    ``force`` was given here."""
+    it, or when it is one of the command's ``inputs`` (``(option, path)`` pairs: a file the
+    command reads, or its other output), which writing would replace or overwrite, whatever
+    ``force`` says (``kesort front.h5 -o front.h5`` replaced the front). Re-entrant in one
+    process; a write inside the block may replace the file when ``force`` was given here."""
+    for given, source in inputs:
+        if str(path).strip() and _same_file(Path(path), Path(source)):
+            raise ConfigError(
+                f"{option} {path}: is the same file as {given} {source}, which writing it "
+                "would replace; choose another output"
+            )
     path = check_target(path, force, option)
     key = _key(path)
     if key in _held:

@@ -692,6 +692,42 @@ def test_a_damaged_checkpoint_is_a_clear_error(front, capsys, damage, needle):
     assert needle in message and str(out) in message, message
 
 
+def test_an_output_that_is_an_input_is_bad_input_and_the_input_stays(front, capsys, tmp_path):
+    """Every command wrote over its own input when told to (``kesort front.h5 -o front.h5``
+    replaced the front; ``simulate cfg.yaml -o cfg.yaml`` the config, with HDF5; ``report``
+    the front with HTML), and ``-o`` and ``--plot`` on one file kept only the figure. Each is
+    now refused, whatever ``--force`` says, and nothing is written; another spelling of the
+    path, a hard link and a symbolic link to the input count as the input."""
+    import hashlib
+
+    config, out = front
+    (tmp_path / "link.h5").hardlink_to(out)
+    (tmp_path / "symlink.h5").symlink_to(out)
+    other = tmp_path / "sub" / ".." / out.name
+    (tmp_path / "sub").mkdir()
+    commands = [
+        ["kesort", out, "-o", out],
+        ["kesort", tmp_path / "symlink.h5", "-o", tmp_path / "link.h5"],
+        ["kesort", out, "-c", config, "-o", config],
+        ["simulate", out, "--pick", "knee", "-o", other],
+        ["simulate", config, "-o", config, "--force"],
+        ["simulate", config, "-o", tmp_path / "s.png", "--plot", tmp_path / "s.png"],
+        ["optimise", config, "-o", config],
+        ["export", out, "--pick", "knee", "-o", out],
+        ["report", out, "-o", out],
+        ["analyse", "roads", out, "--road", config, "-o", config],
+        ["analyse", "controllers", out, "--with", config, "-o", config],
+        ["analyse", "masses", out, "-o", out, "--force"],
+        ["analyse", "models", config, "--reference", config, "-o", config],
+    ]
+    digests = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (config, out)}
+    for argv in commands:
+        message = one_error(capsys, *argv)
+        assert "is the same file as" in message and "choose another output" in message, argv
+        assert not (tmp_path / "s.png").exists()
+    assert {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (config, out)} == digests
+
+
 def test_a_finished_run_resumes_to_itself(front, capsys):
     config, out = front
     with h5py.File(out) as h5:

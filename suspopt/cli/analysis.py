@@ -102,7 +102,10 @@ def analyse(
             check_path(plot)
     except ValueError as exc:
         base.fail(str(exc))
-    with run.outputs(output, plot):
+    inputs = [("the input", s) for s in sources]
+    inputs += [("--reference", reference)] if reference is not None else []
+    inputs += [("--road", Path(r)) for r in road or []] + [("--with", w) for w in with_ or []]
+    with run.outputs(output, plot, inputs=inputs):
         try:
             report = spec.run(sources if spec.many else sources[0], output, plot, **options)
         except (ConfigError, FileNotFoundError, ValueError) as exc:

@@ -8,7 +8,7 @@ import inspect
 import os
 import shlex
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -174,17 +174,23 @@ class RunOptions:
 
     @contextmanager
     def outputs(
-        self, output: Path | None, plot: Path | None, execute: bool = True
+        self,
+        output: Path | None,
+        plot: Path | None,
+        execute: bool = True,
+        inputs: Sequence[tuple[str, Path]] = (),
     ) -> Iterator[None]:
         """``--max-memory`` applied; then, for the block, the executor options in force (unless
         ``execute`` is False: the command puts them in force itself) and ``output`` and
-        ``plot`` claimed (:func:`claim_output`, ``--force``)."""
+        ``plot`` claimed (:func:`claim_output`, ``--force``), neither of them one of the
+        command's ``inputs`` nor the other."""
         set_memory_limit(self.max_memory)
         with ExitStack() as stack:
             if execute:
                 stack.enter_context(self.executing())
-            claim_output(stack, output, self.force)
-            claim_output(stack, plot, self.force, "--plot")
+            claim_output(stack, output, self.force, inputs=inputs)
+            others = [*inputs, ("-o", output)] if output is not None else inputs
+            claim_output(stack, plot, self.force, "--plot", others)
             yield
 
 
@@ -413,15 +419,21 @@ def set_memory_limit(max_memory: str | None) -> None:
         fail(f"--max-memory: {exc}")
 
 
-def claim_output(stack: ExitStack, path: Path | None, force: bool, option: str = "-o") -> None:
-    """Check an output and hold its writer's lock for the rest of the command
-    (:func:`suspopt.io.claim`)."""
+def claim_output(
+    stack: ExitStack,
+    path: Path | None,
+    force: bool,
+    option: str = "-o",
+    inputs: Sequence[tuple[str, Path]] = (),
+) -> None:
+    """Check an output (not one of the command's ``inputs``: ``(option, path)`` pairs) and
+    hold its writer's lock for the rest of the command (:func:`suspopt.io.claim`)."""
     from ..io import claim
 
     if path is None:
         return
     try:
-        stack.enter_context(claim(path, force, option))
+        stack.enter_context(claim(path, force, option, inputs))
     except ConfigError as exc:
         fail(str(exc))
 

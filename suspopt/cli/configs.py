@@ -133,7 +133,7 @@ def export(
             from ..io import atomic_file
             from ..picks import design_config, read_picks, split_picks
 
-            claim_output(stack, output, force)
+            claim_output(stack, output, force, inputs=[("the input", source)])
             names = split_picks(pick)
             if len(names) != 1:
                 fail(f"--pick: -o writes one design; got {len(names)} ({', '.join(names)})")

@@ -92,7 +92,7 @@ def optimise(
             check_path(plot)
         except ValueError as exc:
             base.fail(str(exc))
-    with run.outputs(output, plot, execute=False):
+    with run.outputs(output, plot, execute=False, inputs=[("the config", config)]):
         _optimise(config, output, resume, plot, run)
 
 

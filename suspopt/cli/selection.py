@@ -135,7 +135,8 @@ def kesort(
     """Choose the optimum of Pareto sets by k-ε optimality (Eq 6.10-6.12).
 
     Supplementary objectives are re-simulated in one batch."""
-    with run.outputs(output, plot):
+    inputs = [("the input", p) for p in pareto] + [("--config", c) for c in config]
+    with run.outputs(output, plot, inputs=inputs):
         _kesort(
             pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot
         )

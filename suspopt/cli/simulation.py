@@ -120,7 +120,7 @@ def simulate(
     run: base.RunOptions,
 ) -> None:
     """Simulate a config (or designs picked from a result file) and write signals to HDF5."""
-    with run.outputs(output, plot):
+    with run.outputs(output, plot, inputs=[("the input", source)]):
         try:
             _simulate(source, output, pick, set_, sweep_, zipped, plot, scenario)
         except (ConfigError, ValueError) as exc:
