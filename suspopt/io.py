@@ -4,7 +4,11 @@
 folder. An empty name, a directory, a device (``/dev/null``), a FIFO, a socket or a symbolic
 link is bad input, and so is an existing file that suspopt did not write (an HDF5 file without
 the root attribute ``suspopt_version``, or another file without the word ``suspopt`` in its
-first 4 kB: suspopt writes it into every figure and text it makes) unless ``force``.
+first 4 kB: suspopt writes it into every figure and text it makes) unless ``force``. A config
+(``init``, ``export -o``) ends in a signature line, the SHA-256 of the lines above it
+(:func:`suspopt.signature.signed_config`): it is suspopt's only while they are unedited, and a ``.yaml`` or
+``.yml`` file without a signature is the user's. An output that is the same file as one of
+the command's inputs is bad input even with ``force`` (:func:`claim`).
 
 **One writer** (:func:`claim`): a writer holds an exclusive ``flock`` on ``.NAME.suspopt-lock``
 beside the target for as long as it writes (``suspopt optimise``: the whole run), so a second
@@ -51,6 +55,7 @@ import numpy as np
 from . import __version__
 from .config import Config, ConfigError
 from .files import kind_of
+from .signature import CONFIG_SUFFIXES, signature_state
 
 __all__ = [
     "OUTPUT_MARKER",
@@ -84,18 +89,34 @@ def _seed_of(cfg: Config) -> int:
 
 
 def is_suspopt_output(path: Path) -> bool:
-    """Whether the regular file ``path`` was written by suspopt (module docstring)."""
+    """Whether the regular file ``path`` was written by suspopt (module docstring). A config
+    (a file ending in a config signature, or any ``.yaml``/``.yml`` file) is suspopt's only
+    while its signature matches its lines: once edited it is the user's, and ``init`` or
+    ``export`` run again replace it only with ``--force``."""
+    return _not_ours(path) is None
+
+
+def _not_ours(path: Path) -> str | None:
+    """Why suspopt may not replace the regular file ``path`` without ``--force``, or None
+    (:func:`is_suspopt_output`)."""
+    foreign = "exists and was not written by suspopt"
     with open(path, "rb") as stream:
         head = stream.read(_HEAD)
+        size = os.fstat(stream.fileno()).st_size
     if head.startswith(b"\x89HDF\r\n\x1a\n"):
         from .h5read import H5Reader
 
         try:  # (a damaged file, one that crashes or hangs the HDF5 library included, is
             with H5Reader(path) as reader:  # not known to be suspopt's)
-                return reader.has_attr("suspopt_version")
+                return None if reader.has_attr("suspopt_version") else foreign
         except ConfigError:
-            return False
-    return OUTPUT_MARKER.encode() in head
+            return foreign
+    signed = signature_state(path, size)
+    if signed is False:
+        return "was edited since suspopt wrote it"
+    if signed is None and path.suffix.lower() in CONFIG_SUFFIXES:
+        return foreign
+    return None if signed or OUTPUT_MARKER.encode() in head else foreign
 
 
 def check_target(path: str | Path, force: bool = False, option: str = "-o") -> Path:
@@ -127,14 +148,11 @@ def check_target(path: str | Path, force: bool = False, option: str = "-o") -> P
         )
     if not force:
         try:
-            ours = is_suspopt_output(path)
+            why = _not_ours(path)
         except OSError as exc:
             raise ConfigError(f"{option} {path}: cannot read it ({exc.strerror})") from None
-        if not ours:
-            raise ConfigError(
-                f"{option} {path}: exists and was not written by suspopt; "
-                f"give --force to replace it"
-            )
+        if why is not None:
+            raise ConfigError(f"{option} {path}: {why}; give --force to replace it")
     return path
 
 
@@ -152,7 +170,11 @@ def _same_file(a: Path, b: Path) -> bool:
     try:
         return os.path.samefile(a, b)
     except OSError:
+        pass
+    try:
         return _key(a) == _key(b)
+    except OSError:  # (a working folder that was deleted: check_target says so)
+        return False
 
 
 @contextmanager

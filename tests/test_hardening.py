@@ -496,6 +496,50 @@ def test_force_replaces_a_foreign_file_and_suspopt_replaces_its_own(tmp_path, ca
     assert oct(target.stat().st_mode & 0o777) != oct(0o600)
 
 
+def test_a_config_suspopt_wrote_is_the_users_once_edited(tmp_path, capsys, front):
+    """``init`` and ``export -o`` sign the configs they write (the last line: the SHA-256 of
+    the lines above). Run again, they replace their own unedited config, but not one the
+    user has edited since (they did: an hour's edits gone at a rerun from the shell's
+    history), nor a YAML file without a signature that merely mentions suspopt."""
+    from suspopt.io import is_suspopt_output
+
+    config = tmp_path / "car.yaml"
+    for _ in range(2):
+        assert cli(capsys, "init", "quarter", "-o", config)[0] == 0
+    signature = config.read_text().splitlines()[-1]
+    assert signature.startswith("# suspopt ") and " sha256 " in signature
+    assert is_suspopt_output(config)
+    for edit in (
+        lambda text: text.replace("dt:", "dt: ", 1),  # a line changed
+        lambda text: text + "# my note\n",  # a line added after the signature
+        lambda text: text.replace(signature, signature.replace("sha256 ", "sha256 0", 1)[:-1]),
+    ):
+        original = config.read_text()
+        config.write_text(edit(original))
+        edited = config.read_bytes()
+        message = one_error(capsys, "init", "quarter", "-o", config)
+        assert (
+            message
+            == f"error: -o {config}: was edited since suspopt wrote it; give --force to replace it"
+        )
+        assert config.read_bytes() == edited and not is_suspopt_output(config)
+        assert cli(capsys, "init", "quarter", "-o", config, "--force")[0] == 0
+        assert config.read_text() == original
+    mine = write(tmp_path, "# my suspopt study\nvehicle: {preset: quarter}\n", "mine.yaml")
+    assert "not written by suspopt" in one_error(capsys, "init", "quarter", "-o", mine)
+    # a design exported from a front of an exported design: one signature, the last line
+    _, pareto = front
+    design = tmp_path / "design.yaml"
+    for _ in range(2):
+        assert cli(capsys, "export", pareto, "--pick", "knee", "-o", design)[0] == 0
+    again = tmp_path / "again.h5"
+    assert cli(capsys, "optimise", design, "-o", again)[0] == 0
+    assert cli(capsys, "export", again, "--pick", "knee", "-o", tmp_path / "d2.yaml")[0] == 0
+    lines = (tmp_path / "d2.yaml").read_text().splitlines()
+    assert [i for i, line in enumerate(lines) if " sha256 " in line] == [len(lines) - 1]
+    assert is_suspopt_output(tmp_path / "d2.yaml")
+
+
 def test_a_killed_writers_temporary_files_are_removed(tmp_path, capsys):
     stale = [
         write(tmp_path, b"half a file", f".out.h5.{tag}.suspopt-tmp") for tag in ("a1b2c3", "zz")

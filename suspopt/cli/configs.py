@@ -79,6 +79,7 @@ def init(
 ) -> None:
     """Write a commented starter config of one kind of study, ready to validate and run."""
     from ..io import atomic_file
+    from ..signature import signed_config
     from ..templates import template_text
 
     with ExitStack() as stack:
@@ -89,7 +90,7 @@ def init(
         claim_output(stack, output, force)
         try:
             with atomic_file(output) as stream:
-                stream.write(text.encode())
+                stream.write(signed_config(text).encode())
         except ConfigError as exc:  # (a full disk)
             fail(str(exc))
     command = "optimise" if kind in ("optimise", "kesort", "spectral", "robust") else "simulate"
@@ -132,6 +133,7 @@ def export(
                 return
             from ..io import atomic_file
             from ..picks import design_config, read_picks, split_picks
+            from ..signature import signed_config
 
             claim_output(stack, output, force, inputs=[("the input", source)])
             names = split_picks(pick)
@@ -140,7 +142,7 @@ def export(
             picked = read_picks(source, names)
             _, text = design_config(picked)
             with atomic_file(output) as stream:
-                stream.write(text.encode())
+                stream.write(signed_config(text).encode())
         except ConfigError as exc:
             fail(str(exc))
     out.print(f"wrote {output} (design {names[0]!r}, row {int(picked.rows[0])} of {source})")
