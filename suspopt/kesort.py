@@ -208,7 +208,7 @@ def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
     """
     F = _objectives(F)
     N, m = F.shape
-    eps = np.broadcast_to(np.asarray(eps, dtype=float), (m,))
+    eps = _per_objective(eps, m)
     if (eps < 0).any() or not np.isfinite(eps).all():
         raise ValueError(f"eps must be finite and >= 0; got {eps.tolist()}")
     if N == 1:
@@ -368,10 +368,23 @@ def kesort(
     )
 
 
+def _per_objective(eps, m: int, names: tuple[str, ...] = ()) -> np.ndarray:
+    """``eps`` as ``(m,)`` thresholds, one per objective; ValueError unless it is one value
+    or ``m`` of them (a numpy broadcasting message before)."""
+    values = np.asarray(eps, dtype=float)
+    if values.size not in (1, m) or values.ndim > 1:
+        listed = f" ({', '.join(names)})" if names else ""
+        raise ValueError(
+            f"eps gives {values.size} values for {m} objectives{listed}; give one value, "
+            "or one per objective"
+        )
+    return np.broadcast_to(values.reshape(-1), (m,))
+
+
 def _eps_normalised(eps, scale: np.ndarray, names: tuple[str, ...], how: str) -> np.ndarray:
     """The absolute thresholds ``eps`` in the units of the normalised objectives (``eps /
     scale``); ValueError naming the objective where that leaves the floating-point range."""
-    given = np.broadcast_to(np.asarray(eps, dtype=float), scale.shape)
+    given = _per_objective(eps, scale.size, names)
     with np.errstate(over="ignore"):
         eps_nf = given / scale
     _in_range(
