@@ -4,10 +4,10 @@
 folder. An empty name, a directory, a device (``/dev/null``), a FIFO, a socket or a symbolic
 link is bad input, and so is an existing file that suspopt did not write (an HDF5 file without
 the root attribute ``suspopt_version``, or another file without the word ``suspopt`` in its
-first 4 kB: suspopt writes it into every figure and text it makes) unless ``force``. A config
-(``init``, ``export -o``) ends in a signature line, the SHA-256 of the lines above it
-(:func:`suspopt.signature.signed_config`): it is suspopt's only while they are unedited, and a ``.yaml`` or
-``.yml`` file without a signature is the user's. An output that is the same file as one of
+first 4 kB: suspopt writes it into every figure and text it makes) unless ``force``. A
+config (``init``, ``export -o``) ends in a signature line, the SHA-256 of the lines above it
+(:func:`suspopt.signature.signed_config`): it is suspopt's only while they are unedited, and
+a ``.yaml`` or ``.yml`` file without a signature is the user's. An output that is the same file as one of
 the command's inputs is bad input even with ``force`` (:func:`claim`).
 
 **One writer** (:func:`claim`): a writer holds an exclusive ``flock`` on ``.NAME.suspopt-lock``

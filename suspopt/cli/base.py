@@ -386,7 +386,6 @@ def plain_helps(typer_app: typer.Typer) -> None:
     ``[...]`` as a style and drops it (``pip install 'suspopt[report]'`` came out without its
     extra). Each docstring paragraph becomes one line, and every ``[`` of a docstring or an
     argument's help is escaped."""
-    import inspect
     import re
 
     escape = re.compile(r"(?<!\\)\[")  # (once: a second call changes nothing)
