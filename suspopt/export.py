@@ -207,12 +207,12 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
         with _reading(h5_path):
             tables = _plan(reader.file)
         made = not folder.exists()
+        if not made and not folder.is_dir():  # (mkdir would say "File exists")
+            raise ConfigError(f"--csv {folder}: is not a folder")
         try:
             folder.mkdir(exist_ok=True)
         except OSError as exc:
             raise ConfigError(f"--csv {folder}: cannot make the folder ({exc.strerror})") from None
-        if not folder.is_dir():
-            raise ConfigError(f"--csv {folder}: is not a folder")
         stem, names, targets = _safe(h5_path.stem), set(), []
         for name, *_ in tables:
             file = f"{stem}.{name}" if name else stem

@@ -621,7 +621,8 @@ def test_a_full_disk_is_one_line_and_leaves_the_old_file(tmp_path, capsys, monke
 
 def test_a_csv_export_that_fails_on_one_table_leaves_none(tmp_path, capsys, monkeypatch):
     """The tables of ``export --csv`` are renamed into place together, once all are written:
-    a full disk at the second left the first behind before."""
+    a full disk at the second left the first behind before. A file given as the folder is
+    named as such."""
     from suspopt import export
 
     source = tmp_path / "run.h5"
@@ -644,6 +645,9 @@ def test_a_csv_export_that_fails_on_one_table_leaves_none(tmp_path, capsys, monk
     monkeypatch.setattr(export, "_write_table", real)
     code, out, _ = cli(capsys, "export", source, "--csv", tmp_path / "tables")
     assert code == 0 and len(list((tmp_path / "tables").iterdir())) > len(written) == 2
+    # a file where the folder should be: said so (mkdir's "File exists" before)
+    message = one_error(capsys, "export", source, "--csv", source)
+    assert message == f"error: --csv {source}: is not a folder"
 
 
 # --- checkpoints ------------------------------------------------------------------------------
