@@ -74,8 +74,18 @@ BOMB = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
             GOOD + "simulation: {duration: 1.0}\n",
             "key 'simulation' appears twice in one mapping (first on line 24)",
         ),
+        # Python reads no integer of more than 4300 digits: said without its line before
+        (
+            "a: 1\nb: " + "9" * 5000 + "\n",
+            ":2: malformed YAML: a value that cannot be read as int '99999999999999999999' "
+            "(5000 characters)",
+        ),
+        (
+            "c: !!timestamp 2020-13-45\n",
+            ":1: malformed YAML: a value that cannot be read as timestamp '2020-13-45'",
+        ),
     ],
-    ids=["alias_bomb", "deep_nesting", "recursive_alias", "duplicate_key"],
+    ids=["alias_bomb", "deep_nesting", "recursive_alias", "duplicate_key", "huge_int", "tag"],
 )
 def test_hostile_yaml_is_refused_fast_and_small(tmp_path, capsys, text, needle):
     path = write(tmp_path, text)

@@ -114,6 +114,24 @@ class _Constructor(SafeConstructor):
             return float("nan")
         return float(text)
 
+    def construct_object(self, node, deep=False):
+        """The constructor's object of ``node``; YamlError with the node's line and an
+        excerpt of its text for a value its constructor cannot read (a number Python cannot
+        hold, like an integer of more than 4300 digits; an explicit tag such as
+        ``!!timestamp`` on text that is not one)."""
+        try:
+            return super().construct_object(node, deep)
+        except YamlError:
+            raise
+        except (ValueError, OverflowError, TypeError, AttributeError):
+            value = node.value if isinstance(node, ScalarNode) else ""
+            shown = f" {value[:20]!r}" + (f" ({len(value)} characters)" if len(value) > 20 else "")
+            kind = node.tag.rsplit(":", 1)[-1]
+            raise YamlError(
+                f"malformed YAML: a value that cannot be read as {kind}{shown if value else ''}",
+                node.start_mark.line + 1,
+            ) from None
+
 
 _Constructor.add_constructor("tag:yaml.org,2002:int", _Constructor.construct_yaml_int)
 _Constructor.add_constructor("tag:yaml.org,2002:float", _Constructor.construct_yaml_float)
