@@ -161,6 +161,35 @@ def test_an_existing_file_of_someone_else_is_not_replaced(files, tmp_path):
     assert page.read_text() == "<html>my own page</html>"
 
 
+def test_a_page_over_its_size_is_refused_once_its_data_show_it(files, tmp_path, monkeypatch):
+    """The page is refused when it would pass ``MAX_BYTES`` (10 MB), and as soon as the data
+    of the files read so far pass it: 200 files were all read (20 s, 0.9 GB) before."""
+    import suspopt.report as report
+    from suspopt.report.page import data_bytes
+
+    one = data_bytes(report.collect(files["front"]))
+    read = []
+    collect = report.collect
+
+    def counted(path, with_signals=()):
+        read.append(path)
+        return collect(path, with_signals)
+
+    monkeypatch.setattr(report, "collect", counted)
+    monkeypatch.setattr(report, "MAX_BYTES", int(1.5 * one))
+    page = tmp_path / "out.html"
+    res = _invoke("report", *[files["front"]] * 10, "-o", page)
+    assert res.exit_code == 2, res.output
+    assert res.output.startswith(
+        f"error: report: the page would be more than 0 MB (the data of its first 2 of 10 files"
+    ), res.output
+    assert len(read) == 2 and not page.exists()
+    monkeypatch.setattr(report, "MAX_BYTES", one + 1)  # the data fit; the page does not
+    res = _invoke("report", files["front"], "-o", page)
+    assert res.exit_code == 2 and "error: report: the page would be more than 0 MB (" in res.output
+    assert len(res.output.strip().splitlines()) == 1 and not page.exists()
+
+
 def _browser():
     """A headless Chromium driven by selenium, or a skip (a failure when required)."""
     required = os.environ.get("SUSPOPT_BROWSER_REQUIRED") == "1"

@@ -222,6 +222,13 @@ def _transmissibility(picked, rows: list[int], out: dict) -> None:
             tr["dofs"].setdefault(name, []).extend(_list(curves[:, :, j]))
 
 
+def _too_large(detail: str) -> None:
+    raise ConfigError(
+        f"report: the page would be more than {MAX_BYTES >> 20} MB ({detail}): fewer "
+        f"--with-signals designs or fewer files"
+    )
+
+
 def build_report(
     paths: Sequence[str | Path],
     output: str | Path,
@@ -232,18 +239,23 @@ def build_report(
     ``with_signals`` rows (or pick names) of every file get their signals too. Returns the
     path, its size [bytes] and the notes (what was thinned). ConfigError for a file that is
     not a suspopt front, a missing pick or row, or without plotly."""
-    from .page import render
+    from .page import data_bytes, render
 
     if not paths:
         raise ConfigError("report: give at least one result file")
-    studies = [collect(p, with_signals) for p in paths]
+    studies: list[Study] = []
+    data = 0
+    for p in paths:  # (stopped as soon as the data alone are too large: 200 files took 20 s)
+        studies.append(collect(p, with_signals))
+        data += data_bytes(studies[-1])
+        if data > MAX_BYTES:
+            _too_large(
+                f"the data of its first {len(studies)} of {len(paths)} files alone take {data >> 20} MB"
+            )
     html = render(studies, title or ", ".join(s.label for s in studies))
     size = len(html.encode())
     if size > MAX_BYTES:
-        raise ConfigError(
-            f"report: the page would be {size >> 20} MB, more than {MAX_BYTES >> 20} MB: "
-            f"fewer --with-signals designs or fewer files"
-        )
+        _too_large(f"{size >> 20} MB")
     from ..io import atomic_file
 
     with atomic_file(output) as stream:

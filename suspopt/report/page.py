@@ -239,6 +239,11 @@ def _json(value: Any) -> str:
     return text.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
 
 
+def data_bytes(study) -> int:
+    """The bytes ``study``'s data take in the page (:func:`render`) [bytes]."""
+    return len(_json(study.data).encode())
+
+
 def _section(i: int, study) -> str:
     d = study.data
     e = html.escape
