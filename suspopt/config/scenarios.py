@@ -21,6 +21,7 @@ its own (:mod:`suspopt.optimise.scenarios`).
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Any, Literal
 
 from pydantic import Field, field_validator, model_validator
@@ -123,11 +124,7 @@ class Scenarios(Section):
 
     @model_validator(mode="after")
     def _count(self) -> Scenarios:
-        combinations = 1
-        for factor in self.product:
-            combinations *= len(factor)
-            if combinations > MAX_SCENARIOS:
-                break
+        combinations = math.prod(len(factor) for factor in self.product)
         total = int(self.nominal) + len(self.cases) + (combinations if self.product else 0)
         if total > MAX_SCENARIOS:
             raise ValueError(f"{total} scenarios, more than {MAX_SCENARIOS}: use fewer")
