@@ -181,7 +181,7 @@ def test_a_page_over_its_size_is_refused_once_its_data_show_it(files, tmp_path, 
     res = _invoke("report", *[files["front"]] * 10, "-o", page)
     assert res.exit_code == 2, res.output
     assert res.output.startswith(
-        f"error: report: the page would be more than 0 MB (the data of its first 2 of 10 files"
+        "error: report: the page would be more than 0 MB (the data of its first 2 of 10 files"
     ), res.output
     assert len(read) == 2 and not page.exists()
     monkeypatch.setattr(report, "MAX_BYTES", one + 1)  # the data fit; the page does not
