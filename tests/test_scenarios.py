@@ -310,6 +310,7 @@ def test_simulate_a_pick_under_one_scenario(tmp_path):
     for bad, message in (
         (["--scenario", "C/115"], "did you mean C/115kg"),
         (["--scenario", "nominal"], "no such scenario"),
+        (["--scenario", "A/75kg,C/115kg"], "one scenario per run"),
     ):
         res = runner.invoke(app, ["simulate", str(front), "--pick", "knee", *bad])
         assert res.exit_code == 2 and message in res.output, res.output

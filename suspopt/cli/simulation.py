@@ -170,6 +170,8 @@ def _under_scenario(cfg, params, picked, name: str):
     where = cfg.source if cfg.source is not None else "the config"
     if scenarios is None:
         raise ConfigError(f"--scenario {name}: {where} has no scenarios: section")
+    if "," in name and all(part.strip() in scenarios.names for part in name.split(",")):
+        raise ConfigError(f"--scenario {name}: one scenario per run; simulate each on its own")
     if name not in scenarios.names:
         close = difflib.get_close_matches(name, scenarios.names, n=3)
         raise ConfigError(
