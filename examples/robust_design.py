@@ -207,6 +207,11 @@ def _fronts_in_the_worst_case(problem, runs, robust_knee: np.ndarray) -> None:
             f"robust knee's is {knee:.3f} m/s², {abs(percent):.1f} % "
             f"{'lower' if percent >= 0 else 'higher'}."
         )
+    elif not front.size:
+        print(
+            "None of the nominal designs holds every constraint in every scenario: no "
+            "comparison at equal deflection."
+        )
     else:
         print(
             f"The robust knee's worst X_ST ({1e3 * at:.1f} mm) lies outside the worst X_ST "
