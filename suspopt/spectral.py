@@ -60,6 +60,9 @@ FIRST_POINTS = 129
 MAX_POINTS = 65537
 #: Frequencies whose responses are computed at a time (bounds the memory of a batch).
 BLOCK = 256
+#: Most memory [bytes] a refinement's arrays take at a time: beyond it the designs not yet
+#: converged are refined in parts (the values are the same bits).
+REFINE_BYTES = 1 << 30
 #: ISO 8608's reference spatial frequency n0 [cycles/m].
 _N0 = 0.1
 
@@ -215,14 +218,21 @@ def _integrands(system: _Linear, requests, f: np.ndarray) -> dict:
     return {key: np.concatenate(parts, axis=-1) for key, parts in out.items()}
 
 
+def _bytes(P: int, points: int, values: int) -> float:
+    """The most memory [bytes] the integrands of ``values`` values over ``points``
+    frequencies for P designs take while refined (the coarser grid's, the midpoints' and
+    the finer grid's at once) with one block's responses."""
+    return 8.0 * P * (2.5 * points * values + 40 * BLOCK)
+
+
 def _check_memory(cfg: Config, P: int, points: int, values: int) -> None:
     """ConfigError (at ``simulation.method``) when the integrands of ``values`` values over
-    ``points`` frequencies for P designs, and one block's responses, exceed the memory
-    limit (:func:`suspopt.memory.check`)."""
+    ``points`` frequencies for P designs (:func:`_bytes`) exceed the memory limit
+    (:func:`suspopt.memory.check`)."""
     from . import memory
 
     memory.check(
-        8.0 * P * (points * values + 40 * BLOCK),
+        _bytes(P, points, values),
         f"the spectral integral over {points} frequencies for {P} designs",
         "narrow the road's band (n_min, n_max), evaluate fewer designs at once or use method time",
         cfg,
@@ -245,7 +255,7 @@ def _simpson(y: np.ndarray, step: float) -> np.ndarray:
                          + 2.0 * y[..., 2:-1:2].sum(-1))  # fmt: skip
 
 
-def _converged(cfg: Config, P: int, integrands: dict, system, requests, band, points: int):
+def _converged(P: int, integrands: dict, system, requests, band, points: int):
     """Each value's variance (P,) from its integrands on ``points`` frequencies over ``band``
     (``ln f`` from, to), the grid refined by its midpoints until, design by design, no value
     changes by more than :data:`TOLERANCE` relative: a design's variances are those of the
@@ -254,16 +264,43 @@ def _converged(cfg: Config, P: int, integrands: dict, system, requests, band, po
     damped so lightly that its resonance is narrower than the grid: 1e-300 N s/m at a
     damper gave an error for the whole batch before). Each finer grid is computed for the
     designs not yet converged alone (the whole batch was refined until its last design
-    converged: one such design made a batch up to 500 times dearer)."""
+    converged: one such design made a batch up to 500 times dearer), and for as many of
+    them at a time as fit in :data:`REFINE_BYTES` (:func:`_refine`)."""
     low, high = band
     variances = {k: _simpson(y, (high - low) / (points - 1)) for k, y in integrands.items()}
     final = {k: np.full(P, np.nan) for k in integrands}
-    left = np.arange(P)  # the batch's designs that ``system`` and the arrays hold
+    _refine(final, (np.arange(P), system, integrands, variances), requests, band, points)
+    return final
+
+
+def _refine(final: dict, part: tuple, requests, band, points: int) -> None:
+    """Refine the designs of ``part``: ``(left, system, integrands, variances)``, their
+    indices in the batch and their model, integrands and variances alone, whose grid has
+    ``points`` frequencies; write each design's variances into ``final`` where it converges.
+    When the next grid's arrays for them would take more than :data:`REFINE_BYTES` (or half
+    of ``--max-memory``), they are refined in parts, each as many designs as fit in that at
+    the finest grid: a design's values do not depend on its batch mates, so the bits are
+    the same, and the memory stays bounded (2000 designs that never converge took 12 GB
+    at the finest grid before)."""
+    from . import memory
+
+    low, high = band
+    left, system, integrands, variances = part
+    cap = memory.explicit_limit()
+    budget = REFINE_BYTES if cap is None else min(REFINE_BYTES, cap // 2)
     while left.size and points < MAX_POINTS:
+        if left.size > 1 and _bytes(left.size, 2 * points - 1, len(integrands)) > budget:
+            width = max(1, int(budget // _bytes(1, MAX_POINTS, len(integrands))))
+            which = np.arange(left.size) // width
+            parts = [_part(which == i, *part) for i in range(which[-1] + 1)]
+            integrands.clear()  # (the parts hold copies: freed here)
+            variances.clear()
+            while parts:  # each part fits at the finest grid, and is freed once refined
+                _refine(final, parts.pop(), requests, band, points)
+            return
         points = 2 * points - 1  # the midpoints added
-        _check_memory(cfg, left.size, points, len(integrands))
-        middle = np.exp(np.linspace(low, high, points)[1::2])
-        added = _integrands(system, requests, middle)
+        _check_memory(system.cfg, left.size, points, len(integrands))
+        added = _integrands(system, requests, np.exp(np.linspace(low, high, points)[1::2]))
         change = np.zeros(left.size)
         for key, y in integrands.items():
             both = np.empty(y.shape[:-1] + (points,))
@@ -278,14 +315,22 @@ def _converged(cfg: Config, P: int, integrands: dict, system, requests, band, po
         now = change <= TOLERANCE
         for key in integrands:
             final[key][left[now]] = variances[key][now]
-        if now.any() and not now.all():
-            keep = ~now
-            left, system = left[keep], system.subset(keep)
-            integrands = {k: y[keep] for k, y in integrands.items()}
-            variances = {k: v[keep] for k, v in variances.items()}
-        elif now.all():
-            break
-    return final
+        if now.all():
+            return
+        if now.any():  # (the arrays of ``part`` are those just refined)
+            part = _part(~now, *part)
+            left, system, integrands, variances = part
+
+
+def _part(keep: np.ndarray, left, system, integrands: dict, variances: dict) -> tuple:
+    """The designs ``keep`` (a mask) of a refinement's ``left, system, integrands,
+    variances`` alone."""
+    return (
+        left[keep],
+        system.subset(keep),
+        {k: y[keep] for k, y in integrands.items()},
+        {k: v[keep] for k, v in variances.items()},
+    )
 
 
 def reduce(
@@ -306,7 +351,7 @@ def reduce(
     _check_memory(cfg, pv.P, points, sum(len(ns) for _, ns in requests))
     system = _Linear(cfg, pv, model, attachments)
     integrands = _integrands(system, requests, grid)
-    variances = _converged(cfg, pv.P, integrands, system, requests, (low, high), points)
+    variances = _converged(pv.P, integrands, system, requests, (low, high), points)
     values = {}
     for spec, ns in requests:
         for name in ns:

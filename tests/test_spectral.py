@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from conftest import CONFIGS
 
-from suspopt import simulate, spectral
+from suspopt import memory, simulate, spectral
 from suspopt.cli import app
 from suspopt.config import load_config
 from suspopt.config.metrics import MetricSpec
@@ -148,6 +148,34 @@ def test_a_batch_refines_only_its_designs_not_yet_converged(monkeypatch):
     for p in range(4):
         spectral.reduce(cfg, {k: v[p : p + 1] for k, v in params.items()}, requests)
     assert batch == sum(cost)
+
+
+def test_designs_slow_to_converge_are_refined_in_parts_that_fit_the_memory(monkeypatch):
+    """Four designs that never converge need about 13 MB at the finest grid; under a 10 MB
+    limit they were bad input for the whole batch (found by reading the refinement's
+    memory estimate). They are refined one by one now, each within half the limit where
+    it fits, and every value is the same bits as without a limit."""
+    cfg, names = _case("qc")
+    params = _random_designs(cfg, 6)
+    params["vehicle.corners.F1.damper.c"][1:5] = 1e-9
+    requests = _requests(names)
+    whole = spectral.reduce(cfg, params, requests)
+    counted = spectral._integrands
+    sizes = []
+
+    def counting(system, requests, f):
+        sizes.append((len(f), system.pv.P))
+        return counted(system, requests, f)
+
+    monkeypatch.setattr(spectral, "_integrands", counting)
+    monkeypatch.setattr(memory, "_limit", 10 << 20)
+    parts = spectral.reduce(cfg, params, requests)
+    for spec, (signal,) in requests:
+        got = parts.metric(spec, signal)
+        np.testing.assert_array_equal(got, whole.metric(spec, signal))
+        assert np.isnan(got[1:5]).all() and np.isfinite(got[[0, 5]]).all()
+    finest = (spectral.MAX_POINTS - 1) // 2
+    assert {P for f, P in sizes if f == finest} == {1}
 
 
 def test_the_body_acceleration_response_is_the_linear_models():
