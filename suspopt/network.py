@@ -43,7 +43,39 @@ __all__ = [
     "parameter_rows",
     "shared_rows",
     "widen",
+    "frequencies",
+    "check_response_memory",
 ]
+
+#: Frequencies solved at a time by :meth:`LinearModel.frequency_response` (bounds the memory
+#: of its (P, F, n, n) matrices).
+_BLOCK = 256
+
+
+def frequencies(f) -> np.ndarray:
+    """``f`` as a float array of frequencies ``(F,)`` [Hz]; ValueError unless it is 1-D (or
+    one value), finite and >= 0."""
+    f = np.atleast_1d(np.asarray(f, dtype=float))
+    if f.ndim != 1:
+        raise ValueError(f"f must be a 1-D array of frequencies [Hz]; got shape {f.shape}")
+    bad = np.flatnonzero(~(np.isfinite(f) & (f >= 0)))
+    if bad.size:
+        raise ValueError(f"f must be finite and >= 0 [Hz]; f[{bad[0]}] is {f[bad[0]]}")
+    return f
+
+
+def check_response_memory(P: int, F: int, n: int, inputs: int) -> None:
+    """ConfigError when a frequency response of P designs at F frequencies (n DOFs, its
+    inputs' amplitudes given) would take more memory than the limit
+    (:func:`suspopt.memory.check`): the amplitudes ``(P, F, n)``, the inputs ``(F, n_u)``
+    and one block's matrices."""
+    from . import memory
+
+    memory.check(
+        16.0 * (P * F * n + F * inputs + P * _BLOCK * n * (n + inputs + 2)),
+        f"the frequency response of {P} designs at {F} frequencies",
+        "give fewer frequencies or designs at once",
+    )
 
 
 def apply(matrix: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -177,19 +209,24 @@ class LinearModel:
         [m] (default: a unit amplitude on every input). Accelerations are ``-ω² Q``; for a
         unit input displacement, ``Q`` is also the acceleration ratio to the input's.
         """
-        f = np.atleast_1d(np.asarray(f, dtype=float))
-        omega = 2.0 * np.pi * f
+        f = frequencies(f)
         n, nu = len(self.dof_names), self.input_stiffness.shape[-1]
         R = np.ones((f.size, nu)) if inputs is None else np.asarray(inputs)
-        w = omega[None, :, None, None]
-        dyn = (
-            self.stiffness[:, None]
-            - w**2 * (self.mass[:, None, :, None] * np.eye(n))
-            + 1j * w * self.damping[:, None]
-        )
-        B = self.input_stiffness[:, None] + 1j * w * self.input_damping[:, None]  # (P, F, n, nu)
-        rhs = np.broadcast_to(B @ R[None, :, :, None], (self.P, f.size, n, 1))
-        return np.linalg.solve(dyn, rhs)[..., 0]
+        if R.shape != (f.size, nu):
+            raise ValueError(f"inputs must be (F, n_u) = {(f.size, nu)}; got shape {R.shape}")
+        check_response_memory(self.P, f.size, n, nu)
+        Q = np.empty((self.P, f.size, n), complex)
+        for start in range(0, f.size, _BLOCK):  # (bounds the (P, F, n, n) matrices)
+            w = 2.0 * np.pi * f[None, start : start + _BLOCK, None, None]
+            dyn = (
+                self.stiffness[:, None]
+                - w**2 * (self.mass[:, None, :, None] * np.eye(n))
+                + 1j * w * self.damping[:, None]
+            )
+            B = self.input_stiffness[:, None] + 1j * w * self.input_damping[:, None]
+            rhs = B @ R[None, start : start + _BLOCK, :, None]  # (P or 1, F, n, 1)
+            Q[:, start : start + _BLOCK] = np.linalg.solve(dyn, rhs)[..., 0]
+        return Q
 
     def modal_form(self) -> tuple[np.ndarray, ...]:
         """The state matrix ``A = [[0, I], [-M^-1 K, -M^-1 C]]`` decomposed for

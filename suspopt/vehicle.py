@@ -29,13 +29,23 @@ designs are stored once.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from .config import Config, ConfigError
 from .config.vehicle import DOF_FIELDS, PRESET_BODY_DOFS, PRESET_CORNERS
-from .network import Elements, LinearModel, Network, parameter_rows, shared_rows, widen
+from .network import (
+    Elements,
+    LinearModel,
+    Network,
+    check_response_memory,
+    frequencies,
+    parameter_rows,
+    shared_rows,
+    widen,
+)
 from .params import ParamView
 
 __all__ = [
@@ -503,7 +513,8 @@ def frequency_response(
     f : array_like
         Frequencies ``(F,)`` [Hz].
     speed : float, optional
-        Forward speed [m/s] for the wheelbase delay of the rear wheels; none without it.
+        Forward speed [m/s] for the wheelbase delay of the rear wheels; none without it (or
+        at 0).
     corners : tuple of str, optional
         The corners whose wheels see the road (default all, e.g. ``("F1", "R1")``).
 
@@ -512,7 +523,15 @@ def frequency_response(
     ndarray
         Complex DOF amplitudes ``(P, F, n)`` per metre of road height [m/m, rad/m].
     """
-    f = np.atleast_1d(np.asarray(f, dtype=float))
+    f = frequencies(f)
+    speed = None if speed is None else float(speed)
+    if speed is not None and not (math.isfinite(speed) and speed >= 0):
+        raise ValueError(f"speed must be finite and >= 0 [m/s]; got {speed}")
+    if isinstance(corners, str) or not all(c in model.corners for c in corners or ()):
+        raise ValueError(
+            f"corners must be a tuple of this model's corners {model.corners}; got {corners!r}"
+        )
+    check_response_memory(model.P, f.size, model.n_dof, len(model.corners))
     omega = 2 * np.pi * f
     use = np.array([c in (corners or model.corners) for c in model.corners], dtype=float)
     delay = model.offsets / speed if speed else np.zeros(len(model.corners))

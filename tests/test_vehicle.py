@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from conftest import CONFIGS, corner, make_config
@@ -127,6 +129,46 @@ def test_frequency_response_peaks_at_body_mode(load):
     H = suspopt.frequency_response(model, f)[0, :, 0]
     assert f[np.argmax(np.abs(H))] == pytest.approx(0.93, abs=0.05)
     assert abs(H[0]) == pytest.approx(1.0, rel=0.05)  # body follows the road at low frequency
+
+
+@pytest.mark.parametrize(
+    "kwargs, needle",
+    [
+        ({"f": np.ones((2, 2))}, "1-D array of frequencies"),
+        ({"f": [1.0, np.nan]}, "f[1] is nan"),
+        ({"f": [-1.0]}, "f[0] is -1.0"),
+        ({"f": [np.inf]}, "f[0] is inf"),
+        ({"f": [1.0], "speed": -3.0}, "speed must be finite and >= 0"),
+        ({"f": [1.0], "speed": np.nan}, "speed must be finite and >= 0"),
+        ({"f": [1.0], "corners": ("X9",)}, "corners must be a tuple of this model's corners"),
+        ({"f": [1.0], "corners": "F1"}, "got 'F1'"),
+    ],
+)
+def test_frequency_response_refuses_arguments_it_cannot_answer(load, kwargs, needle):
+    """A 2-D ``f``, a frequency that is not finite and >= 0, a negative or NaN speed and a
+    corner the model lacks are a ValueError naming the argument (they gave NaN, numpy's
+    broadcasting message, or an unknown corner silently left out; a corner name as a
+    string was read letter by letter)."""
+    model = build_vehicle(load("ch3/part1a_hc2_bump.yaml"))
+    with pytest.raises(ValueError, match=re.escape(needle)):
+        suspopt.frequency_response(model, **kwargs)
+
+
+def test_frequency_response_in_blocks_is_the_whole_solve_and_bounded(load, monkeypatch):
+    """The response is solved a block of frequencies at a time: the same bits as one solve
+    of all of them; a response larger than the memory limit is refused before anything is
+    allocated (10^9 frequencies were the process killed by the kernel, its (F, n, n)
+    matrices at once)."""
+    from suspopt import memory, network
+
+    model = build_vehicle(load("ch3/part1a_hc2_bump.yaml"))
+    f = np.linspace(0.0, 30.0, 1000)
+    blocks = suspopt.frequency_response(model, f, speed=20.0)
+    monkeypatch.setattr(network, "_BLOCK", f.size)
+    np.testing.assert_array_equal(suspopt.frequency_response(model, f, speed=20.0), blocks)
+    monkeypatch.setattr(memory, "_limit", 1 << 16)  # (about 230 kB are needed)
+    with pytest.raises(suspopt.ConfigError, match="frequency response of 1 designs at 1000 "):
+        suspopt.frequency_response(model, f)
 
 
 @pytest.mark.parametrize(
