@@ -107,7 +107,7 @@ class ParamView:
     """Read config values by dotted path, overridden per design by ``params``.
 
     ``get(path)`` returns a float64 array of shape (P,); ``P`` is the common length of the
-    ``params`` arrays (1 when there are none).
+    ``params`` arrays (1 when there are none; an empty array is a ConfigError).
     """
 
     def __init__(self, cfg: Config, params: Mapping[str, Any] | None = None):
@@ -122,6 +122,8 @@ class ParamView:
             arr = np.atleast_1d(np.asarray(value, dtype=float))
             if arr.ndim != 1:
                 raise ConfigError(f"params: {path}: values must be a 1-D array of designs")
+            if not arr.size:
+                raise ConfigError(f"params: {path}: no designs (an empty array); give one or more")
             if not np.all(np.isfinite(arr)):
                 raise ConfigError(f"params: {path}: values must be finite")
             _check_range(cfg, path, arr)

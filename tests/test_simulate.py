@@ -266,3 +266,6 @@ def test_bad_params_are_config_errors(load):
         suspopt.simulate(cfg, params={"vehicle.body.mass": [1000.0, -1.0]})
     with pytest.raises(suspopt.ConfigError, match=r"cubic: must be in .* got 1e\+300"):
         suspopt.simulate(cfg, params={"vehicle.corners.F1.spring.cubic": [1e300]})
+    # no designs: numpy's broadcasting message before
+    with pytest.raises(suspopt.ConfigError, match=r"c: no designs \(an empty array\)"):
+        suspopt.simulate(cfg, params={"vehicle.corners.F1.damper.c": []})
