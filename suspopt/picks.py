@@ -18,6 +18,7 @@ batch, and :func:`design_config` writes one of them into its config as a standal
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -177,8 +178,11 @@ def _stored_picks(h5, group: str, rows: int) -> dict[str, int]:
     return {name: _index(h5, f"{group}/{name}", rows) for name in h5.group(group)}
 
 
-def read_picks(path: str | Path, picks: list[str]) -> Picked:
-    """The designs ``picks`` of the file ``path`` (module docstring), with their config."""
+def read_picks(path: str | Path, picks: str | Sequence[str]) -> Picked:
+    """The designs ``picks`` of the file ``path`` (module docstring), with their config.
+    ``picks`` as ``--pick`` takes them: names or row numbers, a list or one string, each
+    item possibly several separated by commas; none is a ConfigError."""
+    picks = split_picks([picks] if isinstance(picks, str) else [str(p) for p in picks])
     table = read_table(path)
     rows = np.array([table.resolve(p) for p in picks])
     which = sorted({int(table.config_of[r]) for r in rows})
@@ -234,6 +238,14 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
     it came from. Returns the config and its YAML text."""
     from . import __version__
 
+    if (
+        isinstance(i, bool)
+        or not isinstance(i, (int, np.integer))
+        or not -len(picked.X) <= i < len(picked.X)
+    ):
+        raise IndexError(
+            f"design {i!r}: picked holds {len(picked.X)} design(s), 0..{len(picked.X) - 1}"
+        )
     cfg = picked.config
     values = {path: float(picked.X[i, j]) for j, path in enumerate(picked.paths)}
 

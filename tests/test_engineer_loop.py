@@ -94,6 +94,26 @@ def test_unknown_picks_list_the_choices(kesort_file, capsys):
     assert code == 2 and "name the designs to simulate with --pick" in err
 
 
+@pytest.mark.slow
+def test_the_library_takes_picks_as_the_command_line_does(kesort_file):
+    """``read_picks`` takes one string as ``--pick`` does (it was read letter by letter:
+    "no such pick k"), and no pick is a ConfigError (an IndexError before);
+    ``design_config`` names the designs it holds for an index it lacks."""
+    from suspopt.picks import design_config, read_picks
+
+    _, ke = kesort_file
+    assert read_picks(ke, "chosen,knee").names == ["chosen", "knee"]
+    assert read_picks(ke, [0, "knee"]).names == ["0", "knee"]
+    with pytest.raises(suspopt.ConfigError, match="name a design"):
+        read_picks(ke, [])
+    picked = read_picks(ke, "knee")
+    with pytest.raises(IndexError, match=r"design 1: picked holds 1 design\(s\), 0..0"):
+        design_config(picked, 1)
+    with pytest.raises(IndexError, match="design 0.5"):
+        design_config(picked, 0.5)
+    assert design_config(picked, -1)[1] == design_config(picked, 0)[1]
+
+
 def test_a_sweep_of_3_by_4_values_is_one_batch_of_12_named_designs(tmp_path, capsys, monkeypatch):
     import importlib
 
