@@ -533,8 +533,8 @@ def open_dataset(path: str | Path, group: str | None = None):
     named dimensions with their coordinates, those held by the groups above included (``time``
     and ``design`` for ``/signals``), and each variable's attributes (``units``, ``names``).
     ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
-    pandas DataFrame. Needs ``pip install 'suspopt[xarray]'`` (ModuleNotFoundError naming it
-    otherwise)."""
+    pandas DataFrame. A group the file lacks is a KeyError listing the groups it has. Needs
+    ``pip install 'suspopt[xarray]'`` (ModuleNotFoundError naming it otherwise)."""
     try:
         import h5netcdf  # noqa: F401
         import xarray
@@ -553,7 +553,21 @@ def open_dataset(path: str | Path, group: str | None = None):
             decode_timedelta=False,
         )
 
-    ds = load(group)
+    try:
+        ds = load(group)
+    except OSError as exc:
+        if "group not found" not in str(exc):
+            raise
+        import h5py
+
+        groups: list[str] = []
+        with h5py.File(path, "r") as h5:
+            h5.visititems(
+                lambda name, obj: groups.append(name) if isinstance(obj, h5py.Group) else None
+            )
+        raise KeyError(
+            f"{path}: no group {group!r}; it has {', '.join(groups) or 'none'}"
+        ) from None
     parts = [p for p in (group or "").split("/") if p]
     for depth in range(len(parts) - 1, -1, -1):  # the nearest group above first
         missing = [d for d in ds.sizes if d not in ds.coords]

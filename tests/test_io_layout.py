@@ -233,6 +233,14 @@ def test_open_dataset_names_the_extra_when_xarray_is_missing(files, monkeypatch)
         open_dataset(files["front"], "pareto")
 
 
+@pytest.mark.slow
+def test_open_dataset_of_a_group_the_file_lacks_lists_its_groups(files):
+    """xarray said "[Errno group not found: bogus] 'bogus'"."""
+    pytest.importorskip("xarray")
+    with pytest.raises(KeyError, match=r"no group 'pareto/F'; it has .*pareto"):
+        open_dataset(files["front"], "pareto/F")
+
+
 def read_table(path):
     """Header and rows of a CSV file of suspopt's, with the Python csv module."""
     with open(path, newline="", encoding="utf-8") as stream:
