@@ -16,7 +16,13 @@ from pathlib import Path
 
 from .memory import describe
 
-__all__ = ["Unreadable", "kind_of", "read_bounded"]
+__all__ = ["Unreadable", "kind_of", "read_bounded", "listed"]
+
+
+def listed(items) -> list:
+    """``items`` as a list, one path or string being one item (a library call given
+    ``"front.h5"`` where it takes several files read it letter by letter before)."""
+    return [items] if isinstance(items, (str, os.PathLike)) else list(items)
 
 
 class Unreadable(ValueError):

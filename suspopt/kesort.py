@@ -45,6 +45,7 @@ hand for this (0.55-0.65 in Ch. 6, 0.10-0.20 in Ch. 7).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -271,8 +272,12 @@ def check_options(
                 f"got {values.tolist()}"
             )
     elif P is not None and P != "auto":
-        if not 0 < float(P) < np.inf:
-            raise ValueError(f"P must be finite and > 0, or 'auto'; got {P}")
+        try:
+            value = float(P)
+        except (TypeError, ValueError):
+            value = math.nan
+        if not 0 < value < np.inf:
+            raise ValueError(f"P must be finite and > 0, or 'auto'; got {P!r}")
     else:
         lo, hi = (float(p) for p in P_range)
         if not (0 < lo <= hi < np.inf and 0 < P_step < np.inf):

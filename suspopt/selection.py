@@ -50,6 +50,7 @@ import numpy as np
 
 from .config import Config, ConfigError, load_config
 from .config.loader import load_config_text
+from .files import listed
 from .io import atomic_h5, write_attrs, write_dataset
 from .kesort import KEpsilonSort, kesort, pareto_picks
 from .optimise.problem import PENALTY, Problem
@@ -293,7 +294,8 @@ def load_design_sets(
     name when one is given, else the file's, made unique (``name#2``) so that only labels you
     give merge files.
     """
-    files = [Path(f) for f in files]
+    files = [Path(f) for f in listed(files)]
+    configs, labels = listed(configs), [str(label) for label in listed(labels)]
     if not files:
         raise ConfigError("give at least one Pareto file")
     if len(configs) not in (0, 1, len(files)):

@@ -270,6 +270,26 @@ def test_controller_files_without_a_controller_or_with_unknown_corners_are_rejec
         controller_variants(p, [stranger])
 
 
+def test_the_library_takes_one_path_or_road_as_a_list_of_one(ps_front):
+    """A library call given one file or road where it takes several read the string letter
+    by letter ("f: no such file", "a config is given twice"); a kind that is not a pseudo
+    front's and no changes at all gave a front of nothing."""
+    from suspopt.analyse.models import compare_models
+    from suspopt.analyse.pseudo import pseudo_fronts, road_variants
+    from suspopt.selection import load_design_sets
+
+    _, path = ps_front
+    pareto = read_pareto(path)
+    assert [s.label for s in load_design_sets(str(path), labels="mine")] == ["mine"]
+    assert [v.label for v in road_variants(pareto, "B")] == ["class B"]
+    with pytest.raises(suspopt.ConfigError, match="compares at least two configs"):
+        compare_models(str(CONFIGS / "quickstart.yaml"))
+    with pytest.raises(suspopt.ConfigError, match="'road': not a kind of pseudo front"):
+        pseudo_fronts("road", pareto, road_variants(pareto, "B"))
+    with pytest.raises(suspopt.ConfigError, match="no changes to evaluate the designs under"):
+        pseudo_fronts("roads", pareto, [])
+
+
 @pytest.fixture
 def seatless_front(tmp_path):
     """A Pareto file written by hand with the documented layout: quickstart's car, no seat."""

@@ -194,6 +194,7 @@ def test_objectives_beyond_the_floating_point_range_once_normalised_are_named():
     [
         ({"P": np.inf}, "P must be finite and > 0"),
         ({"P": np.nan}, "P must be finite and > 0"),
+        ({"P": "bogus"}, "P must be finite and > 0, or 'auto'; got 'bogus'"),  # (float's message)
         ({"P_range": (0.01, np.inf)}, "all finite"),
         ({"P_step": np.nan}, "all finite"),
         ({"P_step": 1e-12}, r"a grid of 9.9e\+11 values of P; at most 10000"),

@@ -51,6 +51,7 @@ import numpy as np
 from .. import plots
 from ..config import Config, ConfigError, load_config
 from ..config.metrics import MetricSpec
+from ..files import listed
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..metrics import psd
 from ..simulate import Result, simulate
@@ -229,7 +230,7 @@ def compare_models(
 ) -> ModelComparison:
     """Simulate every config of ``sources`` and compare them with ``reference`` (one of
     them; default the first), as the module docstring says."""
-    sources = [Path(s) for s in sources]
+    sources = [Path(s) for s in listed(sources)]
     if len(sources) < 2:
         raise ConfigError("analyse models compares at least two configs")
     resolved = [s.resolve() for s in sources]

@@ -60,6 +60,7 @@ import numpy as np
 from .. import plots
 from ..config import Config, ConfigError
 from ..config.loader import edit_config, line_of, set_path
+from ..files import listed
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..kesort import pareto_picks
 from ..seat import build_seat, passenger_mass_change
@@ -189,6 +190,7 @@ def config_with(pareto: ParetoSet, edit: Callable[[dict], None], what: str) -> C
 def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
     """One variant per road: an ISO 8608 class letter (A-E: the stored road with that class)
     or a config file whose ``road`` and ``simulation`` sections replace the stored ones."""
+    roads = [str(road) for road in listed(roads)]
     if not roads:
         raise ConfigError(
             "analyse roads: give at least one --road CLASS (A-E) or --road CONFIG.yaml"
@@ -346,9 +348,18 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
 # --- evaluation, output ----------------------------------------------------------------------
 
 
+#: The changes a pseudo front is evaluated under (``analyse roads``, ``masses``,
+#: ``controllers``).
+PSEUDO_KINDS = ("roads", "masses", "controllers")
+
+
 def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> PseudoFronts:
     """Evaluate the stored designs under every variant, one batch each; the stored designs
     are simulated too when the config has supplementary objectives (the file has none)."""
+    if kind not in PSEUDO_KINDS:
+        raise ConfigError(f"{kind!r}: not a kind of pseudo front ({', '.join(PSEUDO_KINDS)})")
+    if not variants:
+        raise ConfigError(f"analyse {kind}: no changes to evaluate the designs under")
     labels = [v.label for v in variants]
     if len(set(labels)) != len(labels):
         raise ConfigError(f"analyse {kind}: the changes must differ (got {', '.join(labels)})")
