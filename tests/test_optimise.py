@@ -75,6 +75,26 @@ def ga(pop=40, generations=60, n_obj=1):
     return PymooOptimiser(GA(pop_size=pop), termination(n_obj, generations, None, 1e-10, 30))
 
 
+def test_a_design_matrix_of_the_wrong_shape_is_a_value_error_naming_it():
+    """``evaluate``, ``to_physical``, ``to_search`` and ``params`` of an X that is not
+    (N, n_var): pymoo's AssertionError, or numpy's "boolean index did not match" before;
+    ``scenario_values`` of a problem without scenarios was a bare AssertionError."""
+    from conftest import CONFIGS
+
+    problem = suspopt.Problem.from_config(
+        suspopt.load_config(CONFIGS / "ch8" / "pareto_ps_class_a.yaml")
+    )
+    shape = rf"must be \(N designs, 2: {', '.join(problem.var_names)}\); got shape"
+    for call in (problem.evaluate, problem.to_physical, problem.to_search, problem.params):
+        with pytest.raises(ValueError, match=shape + r" \(2, 3\)"):
+            call(np.ones((2, 3)))
+        with pytest.raises(ValueError, match=shape + r" \(2, 1, 2\)"):
+            call(np.ones((2, 1, 2)))
+    assert problem.params(np.ones(2))[problem.variables[0].path].shape == (1,)
+    with pytest.raises(ValueError, match="no scenarios: section"):
+        problem.scenario_values(np.ones((1, 2)))
+
+
 def test_ga_finds_the_minimum_of_a_quadratic():
     best = minimize(Quadratic(), ga(), seed=1)
     np.testing.assert_allclose(best.X[0], Quadratic.optimum, atol=0.05)

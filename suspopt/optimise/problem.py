@@ -204,7 +204,7 @@ class Problem(_PymooProblem):
     def to_physical(self, X) -> np.ndarray:
         """Values of the design variables (N, n_var) in SI units: ``10**X`` on a log scale,
         rounded for integer variables."""
-        values = np.array(np.atleast_2d(X), dtype=float)
+        values = self._rows(X, "X")
         values[:, self._log] = 10.0 ** values[:, self._log]
         values[:, self._integer] = np.round(values[:, self._integer])
         return values
@@ -213,9 +213,26 @@ class Problem(_PymooProblem):
         """The search coordinates ``X`` of physical values (N, n_var): the inverse of
         :meth:`to_physical` (``log10`` on a log scale), e.g. to re-evaluate a Pareto file's
         designs."""
-        X = np.array(np.atleast_2d(values), dtype=float)
+        X = self._rows(values, "values")
         X[:, self._log] = np.log10(X[:, self._log])
         return X
+
+    def evaluate(self, X, *args, **kwargs):
+        """pymoo's :meth:`~pymoo.core.problem.Problem.evaluate`, an ``X`` that is not
+        ``(N, n_var)`` a ValueError naming its shape (pymoo asserts it)."""
+        if isinstance(X, np.ndarray) and X.dtype != object:
+            self._rows(X, "X")
+        return super().evaluate(X, *args, **kwargs)
+
+    def _rows(self, X, what: str) -> np.ndarray:
+        """``X`` as a float copy (N, n_var); ValueError naming the shape for any other."""
+        rows = np.array(np.atleast_2d(X), dtype=float)
+        if rows.ndim != 2 or rows.shape[1] != self.n_var:
+            raise ValueError(
+                f"{what} must be (N designs, {self.n_var}: {', '.join(self.var_names)}); "
+                f"got shape {rows.shape}"
+            )
+        return rows
 
     def params(self, X) -> dict[str, np.ndarray]:
         """``simulate``'s ``params``: each variable's dotted path -> its (N,) values."""
@@ -351,8 +368,9 @@ class Problem(_PymooProblem):
         designs of physical ``values (N, n_var)`` under every scenario (NaN where one failed,
         and ``simulation_failed`` :data:`PENALTY` there), from the evaluations that found
         them, else simulated now."""
-        assert self.scenarios is not None
-        values = np.atleast_2d(np.asarray(values, dtype=float))
+        if self.scenarios is None:
+            raise ValueError("scenario_values: this problem's config has no scenarios: section")
+        values = self._rows(values, "values")
         missing = [i for i, row in enumerate(values) if row.tobytes() not in self._scenario_values]
         if missing:
             self.evaluate(self.to_search(values[missing]), return_values_of=["F", "G"])
