@@ -39,8 +39,12 @@ the levels are invariant to a change of an objective's unit. ``P="auto"`` takes 
 hand for this (0.55-0.65 in Ch. 6, 0.10-0.20 in Ch. 7).
 
 **Cost.** The pairwise comparison is ``N² m`` work, done in row blocks of about
-``chunk_bytes`` of memory, so 10,000 solutions × 10 objectives take seconds in about 64 MB
-(``benchmarks/bench_kesort.py``); ``P="auto"`` repeats it once per grid point tried.
+``chunk_bytes`` of memory, so 10,000 solutions × 10 objectives take about a second in less
+than 64 MB (``benchmarks/bench_kesort.py``). ``P="auto"`` sorts the whole set at the first P
+of its grid; at each next P it only asks whether one solution leads, from upper bounds of
+every level (the minimum over a few hundred columns) and the exact levels of the solutions
+whose bounds reach the top, then sorts the P it settles on whole: the same P and levels as
+a whole sort at every P, with a few N pairs per P instead of N² where no P breaks a tie.
 """
 
 from __future__ import annotations
@@ -214,40 +218,83 @@ def k_eps_levels(F, eps, chunk_bytes: int = _CHUNK_BYTES) -> np.ndarray:
         raise ValueError(f"eps must be finite and >= 0; got {eps.tolist()}")
     if N == 1:
         return np.full(1, m - 1.0)
-    soft = eps > 0
-    # Γ = clip(1 - Δ/ε, 0, 1) = clip((1 + f_j/ε) - f_i/ε, 0, 1): one subtraction per pair.
-    # That form rounds Γ by about |f/ε| 2^-53 (the 1 vanishes beside an f/ε of 2^53, making
-    # a tie Γ = 0): a column where |f/ε| exceeds 2^16 (Γ within 2^-37; an ε far below the
-    # objective's values) takes 1 - Δ/ε itself, where Δ of two values closer than ε is exact
-    # and an overflow to ±inf is the right limit (Γ = 0 or 1)
-    scaled = F.copy()
-    with np.errstate(over="ignore"):
-        scaled[:, soft] /= eps[soft]
-    direct = soft & ~(np.abs(scaled) <= 2.0**16).all(axis=0)
-    shifted = scaled + 1.0
-    rows = int(max(1, min(N, chunk_bytes // (16 * N))))
-    total, merit = np.empty((rows, N)), np.empty((rows, N))
-    levels = np.empty(N)
-    for start in range(0, N, rows):
-        stop = min(start + rows, N)
-        S, T = total[: stop - start], merit[: stop - start]
-        S.fill(0.0)
-        for j in range(m):
-            if direct[j]:
+    return _Merits(F, eps).levels(np.arange(N), chunk_bytes)
+
+
+class _Merits:
+    """The pairwise sums ``Σ_l Γ(Δ_l(i, j))`` of Eq 6.10 for the rows ``F (N, m)`` and the
+    thresholds ``eps (m,)``, for any rows against any columns: each pair's sum is computed
+    by the same operations whatever the block it is in, so that levels computed for some
+    rows alone, or bounded by some columns, are the bits of the whole comparison."""
+
+    def __init__(self, F: np.ndarray, eps: np.ndarray):
+        self.F, self.eps, self.N = F, eps, F.shape[0]
+        self.soft = eps > 0
+        # Γ = clip(1 - Δ/ε, 0, 1) = clip((1 + f_j/ε) - f_i/ε, 0, 1): one subtraction per
+        # pair. That form rounds Γ by about |f/ε| 2^-53 (the 1 vanishes beside an f/ε of
+        # 2^53, making a tie Γ = 0): a column where |f/ε| exceeds 2^16 (Γ within 2^-37; an ε
+        # far below the objective's values) takes 1 - Δ/ε itself, where Δ of two values
+        # closer than ε is exact and an overflow to ±inf is the right limit (Γ = 0 or 1)
+        self.scaled = F.copy()
+        with np.errstate(over="ignore"):
+            self.scaled[:, self.soft] /= eps[self.soft]
+        self.direct = self.soft & ~(np.abs(self.scaled) <= 2.0**16).all(axis=0)
+        self.shifted = self.scaled + 1.0
+
+    def sums(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """``(len(rows), len(cols))``: the sum of merits of each row against each column
+        (``cols`` ascending), a row against itself ``inf`` (not compared with itself)."""
+        F, eps = self.F, self.eps
+        S, T = np.zeros((rows.size, cols.size)), np.empty((rows.size, cols.size))
+        for j in range(F.shape[1]):
+            if self.direct[j]:
                 with np.errstate(over="ignore"):
-                    np.subtract(F[start:stop, j, None], F[None, :, j], out=T)
+                    np.subtract(F[rows, j, None], F[None, cols, j], out=T)
                     np.divide(T, eps[j], out=T)
                 np.subtract(1.0, T, out=T)
                 np.clip(T, 0.0, 1.0, out=T)
-            elif soft[j]:
-                np.subtract(shifted[None, :, j], scaled[start:stop, j, None], out=T)
+            elif self.soft[j]:
+                np.subtract(self.shifted[None, cols, j], self.scaled[rows, j, None], out=T)
                 np.clip(T, 0.0, 1.0, out=T)
             else:
-                np.less_equal(F[start:stop, j, None], F[None, :, j], out=T)
+                np.less_equal(F[rows, j, None], F[None, cols, j], out=T)
             S += T
-        S[np.arange(stop - start), np.arange(start, stop)] = np.inf  # not against itself
-        levels[start:stop] = S.min(axis=1) - 1.0
-    return levels
+        at = np.minimum(np.searchsorted(cols, rows), cols.size - 1)  # (cols is sorted)
+        itself = np.flatnonzero(cols[at] == rows)
+        S[itself, at[itself]] = np.inf
+        return S
+
+    def levels(self, rows: np.ndarray, chunk_bytes: int, cols: np.ndarray | None = None):
+        """The levels of ``rows`` against every solution (or, against ``cols`` alone, an
+        upper bound of them: the minimum over fewer pairs), in blocks of about
+        ``chunk_bytes``."""
+        cols = np.arange(self.N) if cols is None else cols
+        width = int(max(1, min(rows.size, chunk_bytes // (24 * max(cols.size, 1)))))
+        out = np.empty(rows.size)
+        for start in range(0, rows.size, width):
+            out[start : start + width] = self.sums(rows[start : start + width], cols).min(1) - 1.0
+        return out
+
+    def unique_top(self, tie_tol: float, probe: np.ndarray, chunk_bytes: int):
+        """Whether one solution alone holds the top level (within ``tie_tol``), and the
+        rows whose levels came within it, without the levels of every solution: bounds
+        against the ``probe`` rows, then the exact levels of the solutions in the order of
+        their bounds until no bound reaches the top found less ``tie_tol``, or none can
+        rise above it and two hold it. The answer is the whole comparison's (a solution
+        not compared exactly has a level at most its bound); ``near`` may then hold only
+        some of the tied rows."""
+        bound = self.levels(np.arange(self.N), chunk_bytes, probe)
+        order = np.argsort(-bound, kind="stable")
+        most = int(max(1, chunk_bytes // (24 * self.N)))
+        done, exact, top, batch = 0, np.empty(0), -np.inf, 16
+        while done < self.N and bound[order[done]] >= top - tie_tol:
+            if bound[order[done]] <= top and np.sum(exact >= top - tie_tol) > 1:
+                break  # (none left can rise above the top, and two hold it already)
+            rows = order[done : done + min(batch, most)]
+            exact = np.concatenate([exact, self.levels(rows, chunk_bytes)])
+            top, done, batch = max(top, float(exact.max())), done + rows.size, 2 * batch
+        near = order[:done][exact >= top - tie_tol]
+        return near.size == 1, near
 
 
 def _ties(levels: np.ndarray, tie_tol: float) -> np.ndarray:
@@ -420,17 +467,30 @@ def _eps_in_units(eps_nf, scale: np.ndarray, names: tuple[str, ...]) -> np.ndarr
 
 
 def _auto_P(NF: np.ndarray, P_range, P_step: float, tie_tol: float, chunk_bytes: int):
-    """The smallest P of the grid with a single best solution: (P, ε in NF units, levels)."""
+    """The smallest P of the grid with a single best solution: (P, ε in NF units, levels).
+    The first P sorts the whole set; the next ones ask :meth:`_Merits.unique_top` alone
+    (a few N pairs instead of N²; a tie no P breaks, such as a design pooled twice,
+    made every value of the grid a whole sort), and the P found is sorted whole."""
     lo, hi = (float(p) for p in P_range)
     steps = np.arange(int(np.floor((hi - lo) / P_step + 1e-9)) + 1)
     # 12 significant digits: 0.15, not 0.15000000000000002 (and 1e-320 stays 1e-320)
     grid = [float(f"{value:.12g}") for value in lo + P_step * steps]
     peak = NF.max(axis=0)
-    for P_value in grid:
-        levels = k_eps_levels(NF, P_value * peak, chunk_bytes)
-        if len(_ties(levels, tie_tol)) == 1:
+    P_value = grid[0]
+    levels = k_eps_levels(NF, P_value * peak, chunk_bytes)
+    near = _ties(levels, tie_tol)
+    if len(near) == 1 or len(NF) == 1 or len(grid) == 1:
+        return P_value, P_value * peak, levels
+    spread = np.linspace(
+        0, len(NF) - 1, min(len(NF), max(16, min(256, int(2 * len(NF) ** 0.5))))
+    ).astype(int)
+    for P_value in grid[1:]:
+        probe = np.unique(np.concatenate([near[:32], NF.argmin(axis=0), spread]))
+        merits = _Merits(NF, _per_objective(P_value * peak, NF.shape[1]))
+        unique, near = merits.unique_top(tie_tol, probe, chunk_bytes)
+        if unique:
             break
-    return float(P_value), P_value * peak, levels
+    return float(P_value), P_value * peak, k_eps_levels(NF, P_value * peak, chunk_bytes)
 
 
 def pareto_picks(F, names: Sequence[str] | None = None) -> dict[str, int]:

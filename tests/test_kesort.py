@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import importlib
+
 import h5py
 import numpy as np
 import pytest
@@ -144,6 +146,46 @@ def test_ties_are_reported_when_no_P_separates_them():
     result = kesort(F)
     assert not result.unique and list(result.ties) == [0, 1]
     assert result.P == pytest.approx(1.0)  # the grid ran out
+
+
+def _sorted_at_every_P(F, tie_tol=1e-9, step=0.01):
+    """P = "auto" the long way: every P of the grid sorts the whole set (normalised by the
+    maximum), the first with one solution on top is taken."""
+    NF = F / F.max(axis=0)
+    for k in range(int(round(0.99 / step)) + 1):
+        P = float(f"{0.01 + k * step:.12g}")
+        levels = k_eps_levels(NF, P * NF.max(axis=0))
+        if (levels >= levels.max() - tie_tol).sum() == 1:
+            break
+    return P, levels
+
+
+@pytest.mark.parametrize("kind", ["pooled twice", "straight front", "random"])
+def test_auto_P_asks_only_which_solution_leads_and_agrees_with_sorting_every_P(kind, monkeypatch):
+    """After the first P, each P of the grid is answered from bounds and the exact levels of
+    the leading solutions: the same P and the same bits as sorting the whole set at every
+    P, in a fraction of the pairs (a tie no P breaks, as a design pooled twice, made every
+    P of the grid a whole sort; benchmarks/bench_kesort.py times both)."""
+    ke = importlib.import_module("suspopt.kesort")  # (the module: suspopt.kesort is the sort)
+
+    rng = np.random.default_rng(8)
+    if kind == "pooled twice":
+        F = np.tile(rng.dirichlet(np.ones(3), 150), (2, 1))
+    elif kind == "straight front":
+        F = np.column_stack([np.linspace(1, 2, 300), np.linspace(2, 1, 300)])
+    else:
+        F = rng.uniform(0.1, 1.0, (300, 4))
+    P, levels = _sorted_at_every_P(F)
+    pairs = []
+    sums = ke._Merits.sums
+    monkeypatch.setattr(
+        ke._Merits, "sums", lambda self, r, c: pairs.append(r.size * c.size) or sums(self, r, c)
+    )
+    result = kesort(F, P="auto")
+    assert result.P == P and result.unique == (kind == "random")
+    np.testing.assert_array_equal(result.k_eps, levels)
+    if kind != "random":  # (100 values of P: 100 N² pairs the long way)
+        assert sum(pairs) < 30 * len(F) ** 2
 
 
 def test_blocks_of_rows_give_the_same_levels():
