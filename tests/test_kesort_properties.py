@@ -10,6 +10,8 @@ objective. The examples are derandomised: the same on every run.
 
 from __future__ import annotations
 
+import importlib
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -71,6 +73,54 @@ def test_the_picks_are_rows_of_the_set_or_the_objective_is_named(F):
     assert all(0 <= row < len(F) for row in picks.values())
     for j in range(F.shape[1]):  # each edge is a best value of its objective
         assert F[picks[f"best_f{j + 1}"], j] == F[:, j].min()
+
+
+#: sets of 17-80 designs (more than the bounds' probe spans) with coarse values: ties
+#: and designs repeated, so that P = "auto" often runs through its grid
+TIED = st.tuples(st.integers(17, 80), st.integers(1, 4)).flatmap(
+    lambda shape: arrays(np.float64, shape, elements=st.sampled_from([0.5, 1.0, 1.5, 2.0, 4.0]))
+)
+
+
+@settings(max_examples=150, deadline=None, derandomize=True, database=None)
+@given(F=TIED, how=st.sampled_from(["max", "minmax"]), tie_tol=st.sampled_from([0.0, 1e-9, 0.05]))
+def test_auto_P_is_the_first_P_whose_whole_sort_has_one_leader(F, how, tie_tol):
+    """The bounds and partial sorts of ``P = "auto"`` give what sorting the whole set at
+    every P of the grid gives: the same P, the same levels, bit for bit."""
+    try:
+        result = kesort(F, P="auto", normalise=how, tie_tol=tie_tol, P_step=0.05)
+    except ValueError as exc:  # (a constant objective under min-max)
+        assert str(exc).startswith("objective f"), exc
+        return
+    for k in range(20):
+        P = float(f"{0.01 + k * 0.05:.12g}")
+        levels = kesort(F, P=P, normalise=how, tie_tol=tie_tol).k_eps
+        if (levels >= levels.max() - tie_tol).sum() == 1:
+            break
+    assert result.P == P
+    np.testing.assert_array_equal(result.k_eps, levels)
+
+
+@settings(max_examples=300, deadline=None, derandomize=True, database=None)
+@given(
+    F=TIED,
+    eps=st.sampled_from([0.0, 0.3, 1.0, 3.0]),
+    tie_tol=st.sampled_from([0.0, 1e-9, 0.05, 0.3]),
+    probe=st.lists(st.integers(0, 79), min_size=1, max_size=6),
+    batch=st.sampled_from([1, 10**9]),
+)
+def test_the_leader_found_from_bounds_is_the_whole_sorts(F, eps, tie_tol, probe, batch):
+    """``_Merits.unique_top`` with bounds from a handful of columns (loose ones: most
+    solutions must then be compared exactly): whether one solution leads, and which, as
+    the whole sort says."""
+    ke = importlib.import_module("suspopt.kesort")  # (the module: suspopt.kesort is the sort)
+    merits = ke._Merits(F, np.full(F.shape[1], eps))
+    probe = np.unique([p % len(F) for p in probe])
+    unique, near = merits.unique_top(tie_tol, probe, chunk_bytes=batch * 24 * len(F))
+    levels = k_eps_levels(F, eps)
+    leaders = np.flatnonzero(levels >= levels.max() - tie_tol)
+    assert unique == (leaders.size == 1)
+    assert set(near) <= set(leaders) and (not unique or near[0] == leaders[0])
 
 
 @pytest.mark.parametrize("eps", [1.2e-257, 1e-320, 5e-324])
