@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import stat
+import sys
 from pathlib import Path
 
 from .memory import describe
@@ -58,7 +59,9 @@ def read_bounded(path: str | Path, limit: int) -> bytes:
     Raises FileNotFoundError for a missing file and :class:`Unreadable` for anything else
     that is not read: not a regular file (a symlink is followed to what it names), a file
     that cannot be opened or read (a regular file may still fail to read: ``/proc/self/mem``
-    gives an I/O error), or one larger than ``limit``.
+    gives an I/O error), one larger than ``limit``, or an output the running command has
+    claimed (:func:`suspopt.io.is_output`: a road profile that ``-o`` names, which the
+    command would replace, even with ``--force``).
     """
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
@@ -72,6 +75,10 @@ def read_bounded(path: str | Path, limit: int) -> bytes:
     if kind is not None:
         os.close(fd)
         raise Unreadable(f"is {kind}")
+    io = sys.modules.get(__package__ + ".io")  # (no output is claimed before it is imported)
+    if io is not None and io.is_output(path):
+        os.close(fd)
+        raise Unreadable("is an output of this command, which writing would replace it")
     try:
         with os.fdopen(fd, "rb") as stream:
             data = stream.read(limit + 1)

@@ -63,6 +63,7 @@ __all__ = [
     "WriteError",
     "check_target",
     "claim",
+    "is_output",
     "atomic_file",
     "atomic_h5",
     "write_dataset",
@@ -175,6 +176,12 @@ def _same_file(a: Path, b: Path) -> bool:
         return _key(a) == _key(b)
     except OSError:  # (a working folder that was deleted: check_target says so)
         return False
+
+
+def is_output(path: str | Path) -> bool:
+    """Whether ``path`` is the same file as an output claimed now (:func:`claim`): an
+    input that the running command would replace."""
+    return any(_same_file(Path(path), key) for key in _held)
 
 
 @contextmanager

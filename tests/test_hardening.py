@@ -786,6 +786,25 @@ def test_an_output_that_is_an_input_is_bad_input_and_the_input_stays(front, caps
     assert {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (config, out)} == digests
 
 
+def test_a_road_profile_that_is_the_output_is_bad_input_and_stays(tmp_path, capsys):
+    """A config's road profile was no input of the output check: ``simulate cfg.yaml -o
+    road.csv --force`` replaced the profile with HDF5. It is now refused at the key that
+    names it, and the profile stays as it was."""
+    road = tmp_path / "road.csv"
+    road.write_bytes(b"distance,height\n0,0\n10,0.01\n20,0\n30,0.02\n40,0\n")
+    text = GOOD.split("road:")[0] + (
+        "road: {kind: file, path: road.csv, speed: 10}\nsimulation: {duration: 1.0}\n"
+    )
+    config = write(tmp_path, text)
+    message = one_error(capsys, "simulate", config, "-o", tmp_path / "." / "road.csv", "--force")
+    assert message.startswith(f"error: {config}:18: road.path: road profile") and (
+        "is an output of this command, which writing would replace it" in message
+    )
+    assert road.read_bytes().startswith(b"distance,height")
+    cli(capsys, "simulate", config, "-o", tmp_path / "out.h5")  # (the profile reads again)
+    assert (tmp_path / "out.h5").exists()
+
+
 def test_a_finished_run_resumes_to_itself(front, capsys):
     config, out = front
     with h5py.File(out) as h5:
