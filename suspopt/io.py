@@ -540,8 +540,10 @@ def open_dataset(path: str | Path, group: str | None = None):
     named dimensions with their coordinates, those held by the groups above included (``time``
     and ``design`` for ``/signals``), and each variable's attributes (``units``, ``names``).
     ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
-    pandas DataFrame. A group the file lacks is a KeyError listing the groups it has. Needs
-    ``pip install 'suspopt[xarray]'`` (ModuleNotFoundError naming it otherwise)."""
+    pandas DataFrame. A file that is missing, not HDF5 or damaged is a ConfigError naming it
+    (:class:`suspopt.h5read.H5Reader`), a group the file lacks a KeyError listing the
+    groups it has. Needs ``pip install 'suspopt[xarray]'`` (ModuleNotFoundError naming it
+    otherwise)."""
     try:
         import h5netcdf  # noqa: F401
         import xarray
@@ -560,21 +562,18 @@ def open_dataset(path: str | Path, group: str | None = None):
             decode_timedelta=False,
         )
 
-    try:
-        ds = load(group)
-    except OSError as exc:
-        if "group not found" not in str(exc):
-            raise
-        import h5py
+    import h5py
 
-        groups: list[str] = []
-        with h5py.File(path, "r") as h5:
-            h5.visititems(
+    from .h5read import H5Reader
+
+    with H5Reader(path) as h5:  # (a missing, foreign or damaged file: ConfigError first)
+        if group and not isinstance(h5.file.get(group), h5py.Group):
+            groups: list[str] = []
+            h5.file.visititems(
                 lambda name, obj: groups.append(name) if isinstance(obj, h5py.Group) else None
             )
-        raise KeyError(
-            f"{path}: no group {group!r}; it has {', '.join(groups) or 'none'}"
-        ) from None
+            raise KeyError(f"{path}: no group {group!r}; it has {', '.join(groups) or 'none'}")
+    ds = load(group)
     parts = [p for p in (group or "").split("/") if p]
     for depth in range(len(parts) - 1, -1, -1):  # the nearest group above first
         missing = [d for d in ds.sizes if d not in ds.coords]

@@ -234,11 +234,17 @@ def test_open_dataset_names_the_extra_when_xarray_is_missing(files, monkeypatch)
 
 
 @pytest.mark.slow
-def test_open_dataset_of_a_group_the_file_lacks_lists_its_groups(files):
-    """xarray said "[Errno group not found: bogus] 'bogus'"."""
+def test_open_dataset_of_a_group_the_file_lacks_lists_its_groups(files, tmp_path):
+    """xarray said "[Errno group not found: bogus] 'bogus'", and h5py "Unable to
+    synchronously open file (file signature not found)" for a file that is no HDF5."""
     pytest.importorskip("xarray")
     with pytest.raises(KeyError, match=r"no group 'pareto/F'; it has .*pareto"):
         open_dataset(files["front"], "pareto/F")
+    (tmp_path / "case.yaml").write_text("vehicle: {}\n")
+    with pytest.raises(suspopt.ConfigError, match="case.yaml: not an HDF5 file"):
+        open_dataset(tmp_path / "case.yaml")
+    with pytest.raises(suspopt.ConfigError, match="nowhere.h5: no such file"):
+        open_dataset(tmp_path / "nowhere.h5", "pareto")
 
 
 def read_table(path):
