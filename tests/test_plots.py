@@ -176,6 +176,11 @@ def test_bad_signals_and_designs_are_value_errors_before_anything_is_written(swe
         plots.plot_simulation(sweep, path, designs=range(9))
     with pytest.raises(ValueError, match="suffix must be one of"):
         plots.plot_simulation(sweep, tmp_path / "sim.pdf")
+    # 0.5 was design 0; one signal name as a string was read letter by letter ("'b'")
+    with pytest.raises(ValueError, match=r"give design indices, whole numbers; got \[0.5\]"):
+        plots.plot_simulation(sweep, path, designs=[0.5])
+    with pytest.raises(ValueError, match="unknown signal 'body.heave_ac';"):
+        plots.plot_simulation(sweep, path, signals="body.heave_ac")
     assert list(tmp_path.iterdir()) == []
 
 

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import operator
 import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
+from ..files import listed
 from .panels import draw_front, draw_history, draw_spectra, draw_time_responses, draw_weighted_rms
 from .style import (
     COMFORT_WEIGHTING,
@@ -211,7 +213,10 @@ def chosen_designs(P: int, designs: Sequence[int] | None) -> tuple[list[int], st
             f"{len(chosen)} of {P} designs drawn (evenly spaced by index; at "
             f"most {MAX_DESIGNS} on one figure)"
         )
-    chosen = [int(i) for i in designs]
+    try:  # (int() took 0.5 for design 0)
+        chosen = [operator.index(i) for i in listed(designs)]
+    except TypeError:
+        raise ValueError(f"designs: give design indices, whole numbers; got {designs!r}") from None
     if not chosen:
         raise ValueError("designs: choose at least one design")
     if len(chosen) > MAX_DESIGNS:
@@ -241,7 +246,7 @@ def plot_simulation(
     import difflib
 
     path = check_path(path)
-    names = list(signals) if signals is not None else default_signals(result)
+    names = listed(signals) if signals is not None else default_signals(result)  # (one name: str)
     for name in names:
         if name not in result.signals:
             close = difflib.get_close_matches(name, list(result.signals), n=3)
