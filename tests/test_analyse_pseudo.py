@@ -282,6 +282,8 @@ def test_the_library_takes_one_path_or_road_as_a_list_of_one(ps_front):
     pareto = read_pareto(path)
     assert [s.label for s in load_design_sets(str(path), labels="mine")] == ["mine"]
     assert [v.label for v in road_variants(pareto, "B")] == ["class B"]
+    assert len(mass_variants(pareto, "20")) == 1 == len(mass_variants(pareto, 20.0))  # ("2", "0")
+    assert len(controller_variants(pareto, str(CONFIGS / "ch8" / "pareto_ps_class_a.yaml"))) == 1
     with pytest.raises(suspopt.ConfigError, match="compares at least two configs"):
         compare_models(str(CONFIGS / "quickstart.yaml"))
     with pytest.raises(suspopt.ConfigError, match="'road': not a kind of pseudo front"):

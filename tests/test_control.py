@@ -713,3 +713,17 @@ def test_cdf_sensitivity_needs_an_adaptive_threshold(tmp_path):
     proc = run("analyse", "cdf-sensitivity", path)
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
     assert "needs an adaptive threshold" in proc.stderr
+
+
+def test_the_c_max_share_of_a_time_outside_the_run_or_of_passive_dampers_is_refused():
+    """A ``share_after`` beyond the run (or NaN) averaged no sample: NaN and numpy's "mean of
+    empty slice"; a result without a semi-active damper, the same."""
+    from suspopt.analyse.cdf import c_max_share
+
+    result = suspopt.simulate(suspopt.load_config(CONFIGS / "ch4" / "sh_2_bump.yaml"))
+    assert 0.0 < c_max_share(result, 0.5)[0] < 1.0
+    for late in (5.0, 1e9, float("nan"), -1.0):
+        with pytest.raises(ValueError, match=r"share_after must be a time \[s\] in \[0, 5\)"):
+            c_max_share(result, late)
+    with pytest.raises(ValueError, match="no semi-active damper"):
+        c_max_share(suspopt.simulate(suspopt.load_config(CONFIGS / "quickstart.yaml")))

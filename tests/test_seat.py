@@ -581,3 +581,14 @@ def test_analyse_transmissibility_linear_and_simulated_agree(tmp_path):
             error = np.abs(sim / lin - 1)
             assert np.median(error) < 0.02 and np.percentile(error, 90) < 0.04
         assert h5["linear/head"][0].max() > 1.5  # the seat-passenger resonance
+
+
+@pytest.mark.parametrize("segment", [0.0, 1e-9, float("nan"), float("inf"), -8.0])
+def test_a_welch_segment_of_fewer_than_8_samples_is_refused_before_simulating(segment):
+    """scipy's "nperseg=0 is not a positive integer" (or NaN's "cannot convert float NaN to
+    integer") after the whole simulation before."""
+    from suspopt.analyse.transmissibility import seat_transmissibility
+
+    cfg = suspopt.load_config(CONFIGS / "ch8" / "pareto_ps_class_a.yaml")
+    with pytest.raises(ValueError, match="segment must be a finite time of at least 8 samples"):
+        seat_transmissibility(cfg, segment=segment)

@@ -47,6 +47,14 @@ def c_max_share(result, share_after: float = 0.0) -> np.ndarray:
     active = [
         c for c in result.model.corners if cfg.vehicle.corners[c].damper.kind == "semi_active"
     ]
+    duration = cfg.simulation.duration
+    if not active or not 0.0 <= share_after < duration:  # (NaN and an empty mean before)
+        raise ValueError(
+            "c_max_share: the result has no semi-active damper"
+            if not active
+            else f"share_after must be a time [s] in [0, {duration:g}) (the run's); "
+            f"got {share_after}"
+        )
     late = result.time >= share_after - 0.5 * cfg.simulation.dt
     return np.mean([np.mean(sig[f"damper_state.{c}"][:, late], axis=-1) for c in active], axis=0)
 

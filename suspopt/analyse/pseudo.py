@@ -240,6 +240,7 @@ def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) ->
     The rule is :func:`passenger_mass_change`'s; its new masses go into the config. It scales
     ``seat.stiffness_ratio`` from the config's value, so where that ratio is a design variable
     each design's own takes the factor the rule gives a ratio of 1."""
+    changes = [changes] if isinstance(changes, (str, int, float)) else list(changes)  # (one)
     cfg = pareto.config()
     if cfg.seat is None:
         raise ConfigError(
@@ -296,6 +297,7 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
     """One variant per file whose ``control:`` section and dampers replace the stored ones
     (a damper in ``vehicle.corner_defaults`` replaces every corner's, one under
     ``vehicle.corners.<c>`` that corner's)."""
+    sources = listed(sources)
     if not sources:
         raise ConfigError("analyse controllers: give at least one --with FILE.yaml")
     corners = set(pareto.config().vehicle.corners)

@@ -144,17 +144,22 @@ def seat_transmissibility(
     """Linear and simulated transmissibility of ``cfg``'s seat (see the module docstring),
     for one design or, with ``params`` (dotted path -> (P,)), for P designs in one batch.
 
-    ``segment`` is the Welch segment length [s] of the simulated estimate (at most the run).
+    ``segment`` is the Welch segment length [s] of the simulated estimate (at most the run;
+    at least 8 samples, else a ValueError: scipy's "nperseg=0" before).
     """
     if cfg.seat is None:
         raise ConfigError(
             f"{cfg.source or '<config>'}: analyse transmissibility needs a seat: section"
         )
+    fs = cfg.simulation.output_rate
+    if not segment * fs >= 8 or not np.isfinite(segment):
+        raise ValueError(
+            f"segment must be a finite time of at least 8 samples ({8 / fs:g} s) [s]; got {segment}"
+        )
     seat = build_seat(cfg, ParamView(cfg, params))
     lin = linearise(seat)
     linear = np.abs(base_transmissibility(lin, LINEAR_FREQUENCIES))
     result = simulate(cfg, params)
-    fs = cfg.simulation.output_rate
     nperseg = int(round(segment * fs))
     floor = result.signals["seat.base_acc"]
     outputs = np.stack([result.signals[_acc_signal(name)] for name in seat.dof_names], axis=1)
