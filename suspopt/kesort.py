@@ -307,8 +307,11 @@ def check_options(
     normalise: str = "max",
     P_range: tuple[float, float] = (0.01, 1.0),
     P_step: float = 0.01,
+    tie_tol: float = 1e-9,
 ) -> None:
     """Raise ValueError for options :func:`kesort` cannot use (before any work is done)."""
+    if not 0 <= _number(tie_tol) < math.inf:  # (NaN left no tie: an IndexError)
+        raise ValueError(f"tie_tol must be finite and >= 0; got {tie_tol!r}")
     if eps is not None and P is not None:
         raise ValueError("give either eps (absolute thresholds) or P (eps = P max NF), not both")
     if eps is not None:
@@ -319,14 +322,17 @@ def check_options(
                 f"got {values.tolist()}"
             )
     elif P is not None and P != "auto":
-        try:
-            value = float(P)
-        except (TypeError, ValueError):
-            value = math.nan
-        if not 0 < value < np.inf:
+        if not 0 < _number(P) < np.inf:
             raise ValueError(f"P must be finite and > 0, or 'auto'; got {P!r}")
     else:
-        lo, hi = (float(p) for p in P_range)
+        try:
+            lo, hi = (float(p) for p in P_range)
+            P_step = float(P_step)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"P_range must be two numbers (low, high) and P_step one; got {P_range!r}, "
+                f"{P_step!r}"
+            ) from None
         if not (0 < lo <= hi < np.inf and 0 < P_step < np.inf):
             raise ValueError(
                 f"P_range must satisfy 0 < low <= high and P_step > 0, all finite; got "
@@ -342,6 +348,14 @@ def check_options(
         raise ValueError(
             f"unknown normalisation {normalise!r}; use one of {', '.join(NORMALISATIONS)}"
         )
+
+
+def _number(value) -> float:
+    """``value`` as a float, NaN when it is not a number (refused by the range checks)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
 
 
 def kesort(
@@ -392,7 +406,7 @@ def kesort(
     KEpsilonSort
         The k-ε level of each solution and the chosen one.
     """
-    check_options(eps, P, normalise, P_range, P_step)
+    check_options(eps, P, normalise, P_range, P_step, tie_tol)
     F = _objectives(F)
     names = _names(names, F.shape[1])
     NF, _, scale = normalise_objectives(F, normalise, names)

@@ -376,6 +376,8 @@ def select(
     ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`suspopt.kesort.kesort`.
     ConfigError when the sets have different objectives or no design is left to sort."""
     sets = list(sets)
+    if not sets:
+        raise ConfigError("give at least one design set (load_design_sets)")
     names, units = _common_objectives(sets)
     var_names, var_units = [], []
     for s in sets:

@@ -237,6 +237,10 @@ def test_objectives_beyond_the_floating_point_range_once_normalised_are_named():
         ({"P": np.inf}, "P must be finite and > 0"),
         ({"P": np.nan}, "P must be finite and > 0"),
         ({"P": "bogus"}, "P must be finite and > 0, or 'auto'; got 'bogus'"),  # (float's message)
+        ({"tie_tol": np.nan}, "tie_tol must be finite and >= 0; got nan"),  # (an IndexError)
+        ({"tie_tol": -1.0}, "tie_tol must be finite and >= 0"),
+        ({"P_range": (0.5,)}, r"P_range must be two numbers \(low, high\)"),  # (unpacking's)
+        ({"P_step": "x"}, "and P_step one; got .*'x'"),
         ({"P_range": (0.01, np.inf)}, "all finite"),
         ({"P_step": np.nan}, "all finite"),
         ({"P_step": 1e-12}, r"a grid of 9.9e\+11 values of P; at most 10000"),
@@ -247,6 +251,11 @@ def test_options_that_are_not_finite_or_make_a_runaway_grid_are_refused(options,
     """Before any work: a grid of 10^12 values of P was an allocation of 7 TB."""
     with pytest.raises(ValueError, match=needle):
         kesort(HAND, **options)
+
+
+def test_select_of_no_design_set_is_a_config_error():
+    with pytest.raises(suspopt.ConfigError, match="give at least one design set"):
+        select([])  # (an IndexError before)
 
 
 def test_a_grid_of_tiny_P_keeps_its_values():
