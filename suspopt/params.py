@@ -15,6 +15,7 @@ import annotated_types
 import numpy as np
 
 from .config import Config, ConfigError
+from .files import listed
 
 __all__ = ["ParamView", "numeric_paths", "field_range", "one_per_run", "ONE_PER_RUN"]
 
@@ -184,7 +185,7 @@ def apply_sets(cfg: Config, items: list[str]) -> Config:
     from .config.yamlio import YamlError, parse_yaml
 
     values = {}
-    for item in items:
+    for item in listed(items):  # (one PATH=VALUE as a string: not letter by letter)
         path, text = _split(item, "--set")
         _numeric_path(cfg, path, "--set")
         try:
@@ -210,7 +211,7 @@ def sweep(cfg: Config, items: list[str], zipped: bool = False) -> dict[str, np.n
     included): the grid of all sweeps (every combination, the last sweep varying fastest),
     or with ``zipped`` their values side by side (every sweep the same N)."""
     ranges = {}
-    for item in items:
+    for item in listed(items):
         path, text = _split(item, "--sweep")
         _numeric_path(cfg, path, "--sweep")
         why = one_per_run(path)

@@ -114,6 +114,27 @@ def test_the_library_takes_picks_as_the_command_line_does(kesort_file):
     assert design_config(picked, -1)[1] == design_config(picked, 0)[1]
 
 
+@pytest.mark.slow
+def test_sets_sweeps_and_names_given_as_one_string_are_one_item(kesort_file):
+    """``apply_sets(cfg, "PATH=VALUE")`` and ``sweep`` said "--set 'v': expected
+    PATH=VALUE" (the first letter), ``report.collect(path, "knee")`` "no such pick k", and
+    ``kesort(F, names="RC")`` took R and C as two objectives' names."""
+    from suspopt.params import apply_sets, sweep
+    from suspopt.report import collect
+
+    cfg = suspopt.load_config(CONFIGS / "quickstart.yaml")
+    assert apply_sets(cfg, "vehicle.body.mass=300").vehicle.body.mass == 300
+    assert sweep(cfg, "vehicle.body.mass=300:400:3")["vehicle.body.mass"].tolist() == [
+        300.0,
+        350.0,
+        400.0,
+    ]
+    front, _ = kesort_file
+    assert collect(front, "knee").data == collect(front, ["knee"]).data
+    with pytest.raises(ValueError, match="1 names for 2 objectives"):
+        suspopt.kesort(np.eye(2) + 1.0, names="RC")
+
+
 def test_a_sweep_of_3_by_4_values_is_one_batch_of_12_named_designs(tmp_path, capsys, monkeypatch):
     import importlib
 

@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from ..config import ConfigError
+from ..files import listed
 
 __all__ = ["build_report", "collect", "Study", "MAX_SAMPLES", "MAX_BYTES"]
 
@@ -74,7 +75,7 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
     from ..h5read import H5Reader
     from ..picks import read_table
 
-    path = Path(path)
+    path, with_signals = Path(path), listed(with_signals)
     table = read_table(path)
     with H5Reader(path) as h5:
         attrs = {
@@ -241,6 +242,7 @@ def build_report(
     not a suspopt front, a missing pick or row, or without plotly."""
     from .page import data_bytes, render
 
+    paths, with_signals = listed(paths), listed(with_signals)
     if not paths:
         raise ConfigError("report: give at least one result file")
     studies: list[Study] = []
