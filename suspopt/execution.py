@@ -35,6 +35,8 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import math
+import operator
 import os
 import re
 from collections.abc import Callable, Iterator, Sequence
@@ -48,6 +50,7 @@ __all__ = [
     "SchedulerUnreachable",
     "SCHEDULER_SCHEMES",
     "check_scheduler_address",
+    "check_settings",
     "Executor",
     "executor_for",
     "map_chunks",
@@ -337,6 +340,51 @@ def _close_all() -> None:
 atexit.register(_close_all)
 
 
+def check_settings(
+    executor: str | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    chunk: int | None = None,
+    dashes: str = "",
+) -> None:
+    """ValueError naming the setting for settings :func:`use` cannot run: an unknown
+    executor, dask without dask.distributed, a scheduler that is not an address or comes
+    with another executor or with workers, workers that are not a whole number from 1 to
+    :func:`max_local_workers`, a chunk below 1. ``dashes="--"`` words them as the command
+    line's options."""
+    o = dashes
+    if executor is not None and executor not in EXECUTORS:
+        raise ValueError(f"{o}executor {executor}: choose one of {', '.join(EXECUTORS)}")
+    if executor == "dask" and not dask_available():
+        raise ValueError(f"{o}executor dask needs dask.distributed: {INSTALL_DASK}")
+    if scheduler is not None and executor not in ("dask", None):
+        raise ValueError(f"{o}scheduler is the address of a Dask scheduler: give {o}executor dask")
+    if scheduler is not None:
+        try:
+            check_scheduler_address(scheduler)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{o}scheduler {exc}") from None
+    if workers is not None and not 1 <= _whole(workers) <= max_local_workers():
+        raise ValueError(
+            f"{o}workers {workers!r}: give a number of worker processes from 1 to "
+            f"{max_local_workers()} (4 per core of this machine)"
+        )  # (use() took 0 or 10**6: the cap of the config and the command line did not apply)
+    if workers is not None and scheduler is not None:
+        raise ValueError(f"{o}workers starts local workers; a running {o}scheduler has its own")
+    if workers is not None and executor == "local":
+        raise ValueError(f"{o}workers needs {o}executor processes or dask")
+    if chunk is not None and not _whole(chunk) >= 1:
+        raise ValueError(f"chunk {chunk}: give a whole number of designs, 1 or more")
+
+
+def _whole(value) -> float:
+    """``value`` as an integer, NaN when it is not a whole number (refused by the checks)."""
+    try:
+        return operator.index(value)
+    except TypeError:
+        return math.nan
+
+
 @contextlib.contextmanager
 def use(
     executor: str | None = None,
@@ -348,7 +396,9 @@ def use(
     """Within the block, these settings win over every config's ``execution:`` section (None
     leaves a setting to the config), ``progress(done, total)`` hears of every finished chunk,
     and the executors opened are closed at its end (the command line's ``--executor``,
-    ``--scheduler``, ``--workers``)."""
+    ``--scheduler``, ``--workers``). Settings it cannot run are a ValueError first
+    (:func:`check_settings`)."""
+    check_settings(executor, scheduler, workers, chunk)
     given = {"executor": executor, "scheduler": scheduler, "workers": workers, "chunk": chunk}
     saved = dict(_OVERRIDES), list(_PROGRESS)
     _OVERRIDES.update({k: v for k, v in given.items() if v is not None})

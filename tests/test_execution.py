@@ -6,6 +6,7 @@ scheduler is lost or the extra is missing."""
 from __future__ import annotations
 
 import os
+import re
 import signal
 import threading
 import time
@@ -239,6 +240,28 @@ def test_the_dask_executor_without_its_extra_is_bad_input(tmp_path, capsys, monk
 def test_bad_executor_options_exit_2_with_one_line(capsys, args, needle):
     code, _, err = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", *args)
     assert code == 2 and needle in err and len(err.splitlines()) == 1, err
+
+
+@pytest.mark.parametrize(
+    "settings, needle",
+    [
+        ({"executor": "cluster"}, "executor cluster: choose one of local, processes, dask"),
+        ({"executor": "processes", "workers": 0}, "workers 0: give a number of worker"),
+        ({"executor": "processes", "workers": 10**6}, "4 per core of this machine"),
+        ({"executor": "processes", "workers": "2"}, "workers '2': give a number"),
+        ({"executor": "local", "workers": 2}, "workers needs executor processes or dask"),
+        ({"executor": "dask", "scheduler": "tcp://h"}, "scheduler 'tcp://h': give the"),
+        ({"executor": "processes", "chunk": 0}, "chunk 0: give a whole number"),
+    ],
+)
+def test_the_library_settings_are_checked_as_the_command_lines(settings, needle):
+    """``execution.use`` took any settings: 10**6 workers, 0 workers, workers "2" (a
+    TypeError from a comparison), a chunk of 0; they are the command line's checks now,
+    in the library's words, and nothing is put in force."""
+    with pytest.raises(ValueError, match=re.escape(needle)):
+        with execution.use(**settings):
+            pass
+    assert execution.settings()["executor"] == "local"
 
 
 @pytest.mark.parametrize(

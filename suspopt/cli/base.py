@@ -242,26 +242,10 @@ def executing(
     whether a server listens there)."""
     from .. import execution
 
-    if executor is not None and executor not in execution.EXECUTORS:
-        fail(f"--executor {executor}: choose one of {', '.join(execution.EXECUTORS)}")
-    if executor == "dask" and not execution.dask_available():
-        fail(f"--executor dask needs dask.distributed: {execution.INSTALL_DASK}")
-    if scheduler is not None and executor not in ("dask", None):
-        fail("--scheduler is the address of a Dask scheduler: give --executor dask")
-    if scheduler is not None:
-        try:
-            execution.check_scheduler_address(scheduler)
-        except ValueError as exc:
-            fail(f"--scheduler {exc}")
-    if workers is not None and not 1 <= workers <= execution.max_local_workers():
-        fail(
-            f"--workers {workers}: give a number of worker processes from 1 to "
-            f"{execution.max_local_workers()} (4 per core of this machine)"
-        )
-    if workers is not None and scheduler is not None:
-        fail("--workers starts local workers; a running --scheduler has its own")
-    if workers is not None and executor == "local":
-        fail("--workers needs --executor processes or dask")
+    try:
+        execution.check_settings(executor, scheduler, workers, dashes="--")
+    except ValueError as exc:
+        fail(str(exc))
     executor = "dask" if scheduler is not None and executor is None else executor
     with execution.use(executor, scheduler, workers, progress=progress):
         try:
