@@ -592,3 +592,14 @@ def test_a_welch_segment_of_fewer_than_8_samples_is_refused_before_simulating(se
     cfg = suspopt.load_config(CONFIGS / "ch8" / "pareto_ps_class_a.yaml")
     with pytest.raises(ValueError, match="segment must be a finite time of at least 8 samples"):
         seat_transmissibility(cfg, segment=segment)
+
+
+@pytest.mark.parametrize("load", [0.0, -5.0, float("nan"), [[95.0, 95.0]]])
+def test_a_passenger_load_that_is_no_load_is_refused(load):
+    """0, -5 kg and NaN gave seat masses that a run then refused at ``seat.mass``, or NaN."""
+    from suspopt.seat import passenger_mass_change
+
+    cfg = suspopt.load_config(CONFIGS / "ch8" / "pareto_ps_class_a.yaml")
+    assert passenger_mass_change(cfg, [75.0, 115.0])["seat.mass"].tolist() == [75.0, 115.0]
+    with pytest.raises(ValueError, match=r"load_mass must be \(P,\) finite loads > 0 \[kg\]"):
+        passenger_mass_change(cfg, load)

@@ -121,6 +121,13 @@ def passenger_mass_change(cfg: Config, load_mass) -> dict[str, np.ndarray]:
     seat = cfg.seat
     if seat is None:
         raise ConfigError("seat: the config has no seat section")
+    bad = np.flatnonzero(~(np.isfinite(load_mass) & (load_mass > 0)))
+    if load_mass.ndim != 1 or bad.size:  # (0, -5 and NaN gave masses the run then refused)
+        raise ValueError(
+            f"load_mass must be (P,) finite loads > 0 [kg]; got {load_mass.ravel()[bad[:3]]}"
+            if bad.size
+            else f"load_mass must be (P,) finite loads > 0 [kg]; got shape {load_mass.shape}"
+        )
     old = float(build_seat(cfg).isolator["load_mass"][0])
     if seat.passenger is None:
         params = {"seat.mass": load_mass}
