@@ -24,7 +24,7 @@ from .config import ConfigError
 from .config.yamlio import MAX_CONFIG_BYTES
 from .files import kind_of
 
-__all__ = ["H5Reader", "MAX_DATASET_BYTES", "MAX_ATTRIBUTE_BYTES"]
+__all__ = ["H5Reader", "MAX_DATASET_BYTES", "MAX_ATTRIBUTE_BYTES", "open_dataset"]
 
 #: Largest dataset read from an input file [bytes]. A Pareto set of a million designs with a
 #: hundred columns is 800 MB.
@@ -402,3 +402,56 @@ class H5Reader:
                 f"{self.where}: {label}: {len(entries)} entries for {columns} columns"
             )
         return entries
+
+
+def open_dataset(path: str | Path, group: str | None = None):
+    """The datasets of ``group`` (default the root; ``"pareto"``, ``"kesort/cases/A"``) of a
+    suspopt HDF5 file as an ``xarray.Dataset`` (lazy, through xarray's ``h5netcdf`` engine):
+    named dimensions with their coordinates, those held by the groups above included (``time``
+    and ``design`` for ``/signals``), and each variable's attributes (``units``, ``names``).
+    ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
+    pandas DataFrame. A file that is missing, not HDF5 or damaged is a ConfigError naming it
+    (:class:`H5Reader`), a group the file lacks a KeyError listing the
+    groups it has. Needs ``pip install 'suspopt[xarray]'`` (ModuleNotFoundError naming it
+    otherwise)."""
+    try:
+        import h5netcdf  # noqa: F401
+        import xarray
+    except ImportError:
+        raise ModuleNotFoundError(
+            "suspopt.io.open_dataset needs xarray and h5netcdf: pip install 'suspopt[xarray]'"
+        ) from None
+
+    def load(name: str | None):
+        return xarray.open_dataset(
+            path,
+            engine="h5netcdf",
+            group=name,
+            phony_dims="sort",
+            decode_times=False,
+            decode_timedelta=False,
+        )
+
+    import h5py
+
+    with H5Reader(path) as h5:  # (a missing, foreign or damaged file: ConfigError first)
+        if group and not isinstance(h5.file.get(group), h5py.Group):
+            groups: list[str] = []
+            h5.file.visititems(
+                lambda name, obj: groups.append(name) if isinstance(obj, h5py.Group) else None
+            )
+            raise KeyError(f"{path}: no group {group!r}; it has {', '.join(groups) or 'none'}")
+    ds = load(group)
+    parts = [p for p in (group or "").split("/") if p]
+    for depth in range(len(parts) - 1, -1, -1):  # the nearest group above first
+        missing = [d for d in ds.sizes if d not in ds.coords]
+        if not missing:
+            break
+        with load("/".join(parts[:depth]) or None) as above:
+            found = {
+                d: above[d].load()
+                for d in missing
+                if d in above.coords and above.sizes[d] == ds.sizes[d]
+            }
+        ds = ds.assign_coords(found)
+    return ds

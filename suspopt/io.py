@@ -55,6 +55,7 @@ import numpy as np
 from . import __version__
 from .config import Config, ConfigError
 from .files import kind_of
+from .h5read import open_dataset  # (suspopt.io.open_dataset, where the README reads it)
 from .signature import CONFIG_SUFFIXES, signature_state
 
 __all__ = [
@@ -66,6 +67,8 @@ __all__ = [
     "is_output",
     "atomic_file",
     "atomic_h5",
+    "config_inputs",
+    "check_not_input",
     "write_dataset",
     "write_attrs",
     "text_array",
@@ -184,6 +187,20 @@ def is_output(path: str | Path) -> bool:
     return any(_same_file(Path(path), key) for key in _held)
 
 
+def check_not_input(
+    path: str | Path, inputs: Iterable[tuple[str, str | Path]], option: str = "-o"
+) -> None:
+    """ConfigError when ``path`` is the same file as one of ``inputs`` (``(what, path)``
+    pairs; another spelling, a hard or a symbolic link count), which writing it would
+    replace."""
+    for given, source in inputs:
+        if str(path).strip() and _same_file(Path(path), Path(source)):
+            raise ConfigError(
+                f"{option} {path}: is the same file as {given} {source}, which writing it "
+                "would replace; choose another output"
+            )
+
+
 @contextmanager
 def claim(
     path: str | Path,
@@ -197,12 +214,7 @@ def claim(
     command reads, or its other output), which writing would replace or overwrite, whatever
     ``force`` says (``kesort front.h5 -o front.h5`` replaced the front). Re-entrant in one
     process; a write inside the block may replace the file when ``force`` was given here."""
-    for given, source in inputs:
-        if str(path).strip() and _same_file(Path(path), Path(source)):
-            raise ConfigError(
-                f"{option} {path}: is the same file as {given} {source}, which writing it "
-                "would replace; choose another output"
-            )
+    check_not_input(path, inputs, option)
     path = check_target(path, force, option)
     key = _key(path)
     if key in _held:
@@ -278,7 +290,9 @@ WRITE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, 
 
 
 @contextmanager
-def atomic_file(path: str | Path, force: bool = False) -> Iterator:
+def atomic_file(
+    path: str | Path, force: bool = False, inputs: Iterable[tuple[str, str | Path]] = ()
+) -> Iterator:
     """A binary file object that becomes ``path`` when the block ends without an exception
     (module docstring); ``path`` is checked with :func:`check_target` first (with the
     ``force`` of an enclosing :func:`claim`). A write that fails for a reason in
@@ -286,7 +300,7 @@ def atomic_file(path: str | Path, force: bool = False) -> Iterator:
     left as it was (a traceback before)."""
     path = Path(path)
     try:
-        with _atomic_file(path, force) as stream:
+        with _atomic_file(path, force, inputs) as stream:
             yield stream
     except OSError as exc:
         if exc.errno not in WRITE_ERRNOS:
@@ -295,10 +309,10 @@ def atomic_file(path: str | Path, force: bool = False) -> Iterator:
 
 
 @contextmanager
-def _atomic_file(path: Path, force: bool) -> Iterator:
+def _atomic_file(path: Path, force: bool, inputs: Iterable[tuple[str, str | Path]]) -> Iterator:
     held = _held.get(_key(path)) if path.parent.is_dir() else None
     force = force or (held is not None and held[2])
-    with claim(path, force):
+    with claim(path, force, inputs=inputs):
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=_TMP, dir=path.parent)
         try:
             os.fchmod(fd, 0o666 & ~_umask())  # mkstemp's 0600 is for the temp name only
@@ -323,12 +337,21 @@ def _atomic_file(path: Path, force: bool) -> Iterator:
 
 
 @contextmanager
-def atomic_h5(path: str | Path, cfg: Config, command: str | None = None, force: bool = False):
+def atomic_h5(
+    path: str | Path,
+    cfg: Config,
+    command: str | None = None,
+    force: bool = False,
+    inputs: Iterable[tuple[str, str | Path]] = (),
+):
     """A new HDF5 file written atomically (:func:`atomic_file`) with the root attributes of
-    every suspopt file. On any exception ``path`` is left untouched."""
+    every suspopt file. On any exception ``path`` is left untouched. ``path`` may not be one
+    of ``inputs``, nor ``cfg``'s own file or road profile (:func:`config_inputs`): the
+    library's writers replaced them (``optimise(cfg, "study.yaml")`` wrote over the config)
+    where the command line refused."""
     import h5py
 
-    with atomic_file(path, force) as stream:
+    with atomic_file(path, force, [*config_inputs(cfg), *inputs]) as stream:
         with h5py.File(stream, "w") as h5:
             h5.attrs["suspopt_version"] = __version__
             h5.attrs["created"] = datetime.now(UTC).isoformat(timespec="seconds")
@@ -336,6 +359,16 @@ def atomic_h5(path: str | Path, cfg: Config, command: str | None = None, force: 
             h5.attrs["config"] = cfg.text
             h5.attrs["seed"] = _seed_of(cfg)
             yield h5
+
+
+def config_inputs(cfg: Config) -> list[tuple[str, Path]]:
+    """The files ``cfg`` was read from: its own (when it has one) and its road profile."""
+    from .config.road import FileRoad, resolve_road_file
+
+    found = [("the config", Path(cfg.source))] if cfg.source is not None else []
+    if isinstance(cfg.road, FileRoad):
+        found.append(("the road profile", resolve_road_file(cfg.road, cfg.base_dir)))
+    return found
 
 
 def text_array(values) -> np.ndarray:
@@ -532,58 +565,3 @@ def read_simulation_signals(path: str | Path) -> tuple[np.ndarray, dict[str, np.
 
     with h5py.File(path, "r") as h5:
         return h5["time"][()], {k: v[()] for k, v in h5["signals"].items()}
-
-
-def open_dataset(path: str | Path, group: str | None = None):
-    """The datasets of ``group`` (default the root; ``"pareto"``, ``"kesort/cases/A"``) of a
-    suspopt HDF5 file as an ``xarray.Dataset`` (lazy, through xarray's ``h5netcdf`` engine):
-    named dimensions with their coordinates, those held by the groups above included (``time``
-    and ``design`` for ``/signals``), and each variable's attributes (``units``, ``names``).
-    ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
-    pandas DataFrame. A file that is missing, not HDF5 or damaged is a ConfigError naming it
-    (:class:`suspopt.h5read.H5Reader`), a group the file lacks a KeyError listing the
-    groups it has. Needs ``pip install 'suspopt[xarray]'`` (ModuleNotFoundError naming it
-    otherwise)."""
-    try:
-        import h5netcdf  # noqa: F401
-        import xarray
-    except ImportError:
-        raise ModuleNotFoundError(
-            "suspopt.io.open_dataset needs xarray and h5netcdf: pip install 'suspopt[xarray]'"
-        ) from None
-
-    def load(name: str | None):
-        return xarray.open_dataset(
-            path,
-            engine="h5netcdf",
-            group=name,
-            phony_dims="sort",
-            decode_times=False,
-            decode_timedelta=False,
-        )
-
-    import h5py
-
-    from .h5read import H5Reader
-
-    with H5Reader(path) as h5:  # (a missing, foreign or damaged file: ConfigError first)
-        if group and not isinstance(h5.file.get(group), h5py.Group):
-            groups: list[str] = []
-            h5.file.visititems(
-                lambda name, obj: groups.append(name) if isinstance(obj, h5py.Group) else None
-            )
-            raise KeyError(f"{path}: no group {group!r}; it has {', '.join(groups) or 'none'}")
-    ds = load(group)
-    parts = [p for p in (group or "").split("/") if p]
-    for depth in range(len(parts) - 1, -1, -1):  # the nearest group above first
-        missing = [d for d in ds.sizes if d not in ds.coords]
-        if not missing:
-            break
-        with load("/".join(parts[:depth]) or None) as above:
-            found = {
-                d: above[d].load()
-                for d in missing
-                if d in above.coords and above.sizes[d] == ds.sizes[d]
-            }
-        ds = ds.assign_coords(found)
-    return ds

@@ -476,7 +476,8 @@ def _write_sort(group, sort: KEpsilonSort, rows: np.ndarray | None, picks: dict[
 def write_selection(path: str | Path, selection: Selection, command: str | None = None) -> Path:
     """Write ``/kesort`` (module docstring) to a new HDF5 file, atomically."""
     s = selection
-    with atomic_h5(path, s.sets[0].config, command) as h5:
+    inputs = [("the input", d.source) for d in s.sets]  # (the fronts it sorted)
+    with atomic_h5(path, s.sets[0].config, command, inputs=inputs) as h5:
         grp = h5.create_group("kesort")
         write_dataset(grp, "F", s.F, s.units, dims=("design", "objective"), names=s.names)
         write_dataset(grp, "X", s.X, s.var_units, dims=("design", "variable"), names=s.var_names)

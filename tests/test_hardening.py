@@ -805,6 +805,35 @@ def test_a_road_profile_that_is_the_output_is_bad_input_and_stays(tmp_path, caps
     assert (tmp_path / "out.h5").exists()
 
 
+def test_the_librarys_writers_refuse_their_own_inputs_too(front, tmp_path):
+    """``optimise(cfg, "study.yaml")`` wrote the front over the config after its first
+    generation, and ``write_selection`` and ``write_pseudo_fronts`` over the front they
+    read; the command line refused each. Now the library does, before any simulation."""
+    import hashlib
+
+    from suspopt.analyse.pseudo import pseudo_fronts, road_variants, write_pseudo_fronts
+    from suspopt.optimise import optimise
+    from suspopt.selection import load_design_sets, read_pareto, select, write_selection
+
+    config, out = front
+    digests = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (config, out)}
+    cfg = suspopt.load_config(config)
+    pareto = read_pareto(out)
+    heard: list = []
+    writes = [
+        lambda: optimise(cfg, tmp_path / ".." / tmp_path.name / config.name, callback=heard.append),
+        lambda: write_selection(out, select(load_design_sets([out]))),
+        lambda: write_pseudo_fronts(
+            out, pseudo_fronts("roads", pareto, road_variants(pareto, config))
+        ),
+    ]
+    for write in writes:
+        with pytest.raises(suspopt.ConfigError, match="is the same file as the (config|input)"):
+            write()
+    assert {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (config, out)} == digests
+    assert heard == []  # (optimise refused before its first generation)
+
+
 def test_a_finished_run_resumes_to_itself(front, capsys):
     config, out = front
     with h5py.File(out) as h5:

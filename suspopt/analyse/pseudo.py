@@ -388,7 +388,7 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts, command: str | N
     """Write ``fronts`` with the layout of the module docstring (atomically)."""
     p, m = fronts.pareto, fronts.m
     names, units = fronts.stored.names, fronts.stored.units
-    with atomic_h5(path, p.config(), command) as h5:
+    with atomic_h5(path, p.config(), command, inputs=[("the input", p.path)]) as h5:
         h5.attrs["analysis"] = fronts.kind
         h5.attrs["source"] = str(p.path)
         grp = h5.create_group("pareto")

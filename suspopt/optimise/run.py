@@ -57,7 +57,7 @@ from ..config import Config, ConfigError
 from ..config.optimise import ALGORITHMS
 from ..config.optimise import Hybrid as HybridSettings
 from ..config.optimise import Optimiser as OptimiserSettings
-from ..io import atomic_h5
+from ..io import atomic_h5, check_not_input, config_inputs
 from . import algorithms
 from .output import read_checkpoint, write_checkpoint, write_history, write_pareto
 from .problem import PENALTY, Problem
@@ -195,6 +195,7 @@ def optimise(
     KeyboardInterrupt only when interrupted before the first generation completed.
     """
     output = Path(output)
+    check_not_input(output, config_inputs(cfg))  # (before any simulation, not at a write)
     problem = Problem.from_config(cfg)
     optimiser = build_optimiser(cfg, problem)
     run = (
