@@ -21,9 +21,9 @@ __all__ = ["Unreadable", "kind_of", "read_bounded", "listed"]
 
 
 def listed(items) -> list:
-    """``items`` as a list, one path or string being one item (a library call given
+    """``items`` as a list, one path, string or number being one item (a library call given
     ``"front.h5"`` where it takes several files read it letter by letter before)."""
-    return [items] if isinstance(items, (str, os.PathLike)) else list(items)
+    return [items] if isinstance(items, (str, os.PathLike, int, float)) else list(items)
 
 
 class Unreadable(ValueError):

@@ -171,10 +171,8 @@ def _key(path: Path) -> Path:
 def _same_file(a: Path, b: Path) -> bool:
     """Whether ``a`` and ``b`` name the same file: the same inode where both exist (links
     and other spellings of a path included), else the same folder and name."""
-    try:
+    with contextlib.suppress(OSError):  # (one of them does not exist: compare names)
         return os.path.samefile(a, b)
-    except OSError:
-        pass
     try:
         return _key(a) == _key(b)
     except OSError:  # (a working folder that was deleted: check_target says so)

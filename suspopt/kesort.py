@@ -144,7 +144,9 @@ def _objectives(F) -> np.ndarray:
 def _names(names: Sequence[str] | None, m: int) -> tuple[str, ...]:
     if names is None:
         return tuple(f"f{j + 1}" for j in range(m))
-    names = [names] if isinstance(names, str) else list(names)  # ("RC": one name, not two)
+    from .files import listed
+
+    names = listed(names)  # ("RC": one name, not two)
     if len(names) != m:
         raise ValueError(f"{len(names)} names for {m} objectives")
     return tuple(names)

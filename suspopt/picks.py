@@ -27,6 +27,7 @@ import numpy as np
 from .config import Config, ConfigError
 from .config.loader import edit_config, load_config_text, set_path
 from .config.road import FileRoad, resolve_road_file
+from .files import listed
 from .params import ParamView
 
 __all__ = ["Picked", "DesignTable", "read_table", "read_picks", "design_config", "split_picks"]
@@ -182,7 +183,7 @@ def read_picks(path: str | Path, picks: str | Sequence[str]) -> Picked:
     """The designs ``picks`` of the file ``path`` (module docstring), with their config.
     ``picks`` as ``--pick`` takes them: names or row numbers, a list or one string, each
     item possibly several separated by commas; none is a ConfigError."""
-    picks = split_picks([picks] if isinstance(picks, str) else [str(p) for p in picks])
+    picks = split_picks([str(p) for p in listed(picks)])
     table = read_table(path)
     rows = np.array([table.resolve(p) for p in picks])
     which = sorted({int(table.config_of[r]) for r in rows})

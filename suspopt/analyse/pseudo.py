@@ -240,7 +240,7 @@ def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) ->
     The rule is :func:`passenger_mass_change`'s; its new masses go into the config. It scales
     ``seat.stiffness_ratio`` from the config's value, so where that ratio is a design variable
     each design's own takes the factor the rule gives a ratio of 1."""
-    changes = [changes] if isinstance(changes, (str, int, float)) else list(changes)  # (one)
+    changes = listed(changes)  # (one change: "20" or 20.0)
     cfg = pareto.config()
     if cfg.seat is None:
         raise ConfigError(

@@ -220,7 +220,8 @@ class Problem(_PymooProblem):
     def evaluate(self, X, *args, **kwargs):
         """pymoo's :meth:`~pymoo.core.problem.Problem.evaluate`, an ``X`` that is not
         ``(N, n_var)`` a ValueError naming its shape (pymoo asserts it)."""
-        if isinstance(X, np.ndarray) and X.dtype != object:
+        odd = isinstance(X, np.ndarray) and (X.ndim > 2 or X.shape[-1:] != (self.n_var,))
+        if odd and X.dtype != object:  # (a population of the right shape is not copied)
             self._rows(X, "X")
         return super().evaluate(X, *args, **kwargs)
 
