@@ -361,9 +361,11 @@ def atomic_h5(
 
 def config_inputs(cfg: Config) -> list[tuple[str, Path]]:
     """The files ``cfg`` was read from: its own (when it has one) and its road profile."""
+    from .config.loader import require_config
     from .config.road import FileRoad, resolve_road_file
 
-    found = [("the config", Path(cfg.source))] if cfg.source is not None else []
+    source = require_config(cfg).source
+    found = [("the config", Path(source))] if source is not None else []
     if isinstance(cfg.road, FileRoad):
         found.append(("the road profile", resolve_road_file(cfg.road, cfg.base_dir)))
     return found

@@ -15,6 +15,7 @@ import annotated_types
 import numpy as np
 
 from .config import Config, ConfigError
+from .config.loader import require_config
 from .files import listed
 
 __all__ = ["ParamView", "numeric_paths", "field_range", "one_per_run", "ONE_PER_RUN"]
@@ -50,7 +51,7 @@ def _walk(node: Any, prefix: str, out: dict[str, float]) -> None:
 def numeric_paths(cfg: Config) -> dict[str, float]:
     """Every numeric field of ``cfg`` by dotted path, with its value."""
     out: dict[str, float] = {}
-    _walk(cfg.model_dump(), "", out)
+    _walk(require_config(cfg).model_dump(), "", out)
     return out
 
 
@@ -113,6 +114,11 @@ class ParamView:
 
     def __init__(self, cfg: Config, params: Mapping[str, Any] | None = None):
         self.values = numeric_paths(cfg)
+        if params is not None and not isinstance(params, Mapping):
+            raise TypeError(
+                "params must be a mapping of dotted config paths to arrays of designs, e.g. "
+                f"{{'vehicle.corners.F1.damper.c': [1000.0, 2000.0]}}; got {type(params).__name__}"
+            )
         self.params: dict[str, np.ndarray] = {}
         sizes = set()
         for path, value in (params or {}).items():

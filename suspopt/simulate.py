@@ -19,6 +19,7 @@ import numpy as np
 from . import memory
 from .checks import check_steps, full_network
 from .config import Config
+from .config.loader import require_config
 from .control.controller import build_controller
 from .integrator import DIVERGENCE_LIMIT, Controller, Edges, Held, Run, Trajectory, integrate
 from .network import Assembled
@@ -59,7 +60,7 @@ def prepare(cfg: Config, params: Mapping[str, Any] | None = None) -> Prepared:
     integration (so that bad input fails before any): the time grid and the road against
     ``dt`` (:func:`suspopt.checks.check_steps`), and the metric specs and ``output.signals``
     against the signals the run will have."""
-    check_steps(cfg)
+    check_steps(require_config(cfg))
     pv = ParamView(cfg, params)
     model = build_vehicle(cfg, pv)
     controller: Controller | None = build_controller(cfg, pv, model)

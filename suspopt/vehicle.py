@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .config import Config, ConfigError
+from .config.loader import require_config
 from .config.vehicle import DOF_FIELDS, PRESET_BODY_DOFS, PRESET_CORNERS
 from .network import (
     Elements,
@@ -223,8 +224,8 @@ def build_vehicle(cfg: Config, pv: ParamView | None = None) -> VehicleModel:
         The batched model: masses [kg, kg m^2], stiffness [N/m, N m/rad] and damping
         [N s/m] matrices, the element network and the static tyre loads [N].
     """
-    pv = pv or ParamView(cfg)
-    veh = cfg.vehicle
+    pv = pv or ParamView(require_config(cfg))
+    veh = require_config(cfg).vehicle
     P = pv.P
     corners = PRESET_CORNERS[veh.preset]
     body_dofs = PRESET_BODY_DOFS[veh.preset]
@@ -454,6 +455,17 @@ def _mode_labels(shape: np.ndarray, energy: np.ndarray, names: np.ndarray) -> np
     return labels.astype(str)
 
 
+def _vehicle_model(model: object) -> VehicleModel:
+    """``model`` when it is a :class:`VehicleModel`, else a TypeError that says how to build
+    one (a config given where its model belongs is the usual slip)."""
+    if not isinstance(model, VehicleModel):
+        raise TypeError(
+            "model must be a VehicleModel (from suspopt.build_vehicle(cfg)); "
+            f"got {type(model).__name__}"
+        )
+    return model
+
+
 def modal_analysis(model: VehicleModel) -> ModalResult:
     """Undamped natural frequencies and mode shapes of the linearised model (K φ = ω² M φ).
 
@@ -474,7 +486,7 @@ def modal_analysis(model: VehicleModel) -> ModalResult:
         Natural frequencies ``(P, n)`` [Hz], mode shapes ``(P, n, n)`` (largest entry 1, in
         m or rad), kinetic-energy shares ``(P, n, n)`` [-] and a label per mode.
     """
-    linear = model.linear
+    linear = _vehicle_model(model).linear
     frequency, shape = linear.modes()
     m = linear.mass
     shape = shape / np.max(np.abs(shape), axis=1, keepdims=True)
@@ -523,6 +535,7 @@ def frequency_response(
     ndarray
         Complex DOF amplitudes ``(P, F, n)`` per metre of road height [m/m, rad/m].
     """
+    model = _vehicle_model(model)
     f = frequencies(f)
     speed = None if speed is None else float(speed)
     if speed is not None and not (math.isfinite(speed) and speed >= 0):

@@ -192,3 +192,52 @@ def test_a_preset_without_a_body_field_it_needs_is_bad_input(name, field):
     assert cut != text
     with pytest.raises(suspopt.ConfigError, match=f"body.{field}"):
         load_config_text(cut)
+
+
+def test_the_entry_points_name_the_object_they_want_when_given_another(load, tmp_path):
+    """A path given where the loaded config belongs, a list where the designs' mapping
+    belongs, a config where its model belongs: a TypeError that says what to pass and how to
+    make it (they were AttributeErrors from deep inside, "'str' object has no attribute
+    'simulation'")."""
+    from suspopt.config.loader import load_config_text
+    from suspopt.optimise.problem import Problem
+    from suspopt.optimise.run import optimise
+    from suspopt.params import sweep
+    from suspopt.seat import passenger_mass_change, seat_constraints
+
+    path = str(CONFIGS / "ch8" / "pareto_ps_class_a.yaml")
+    load_first = re.escape(f"cfg must be a Config (load it first: suspopt.load_config({path!r}))")
+    for call in (
+        lambda: suspopt.simulate(path),
+        lambda: build_vehicle(path),
+        lambda: Problem.from_config(path),
+        lambda: optimise(path, tmp_path / "front.h5"),
+        lambda: sweep(path, ["vehicle.body.mass=1:2:3"]),
+        lambda: seat_constraints(path),
+        lambda: passenger_mass_change(path, [95.0]),
+    ):
+        with pytest.raises(TypeError, match=load_first):
+            call()
+    assert not (tmp_path / "front.h5").exists()
+    with pytest.raises(TypeError, match=r"cfg must be a Config \(from suspopt.load_config"):
+        suspopt.simulate(None)
+    cfg = load("ch3/part1a_qc_bump.yaml")
+    with pytest.raises(TypeError, match="params must be a mapping of dotted config paths"):
+        suspopt.simulate(cfg, [1000.0, 2000.0])
+    for call in (
+        lambda: modal_analysis(cfg),
+        lambda: suspopt.frequency_response(cfg, [1.0]),
+    ):
+        with pytest.raises(TypeError, match=r"model must be a VehicleModel .*got Config"):
+            call()
+    for call, needle in (
+        (lambda: suspopt.load_config(None), "path must be a str or Path to a YAML config"),
+        (lambda: suspopt.load_config(cfg), "path must be a str or Path to a YAML config"),
+        (lambda: load_config_text(None), "text must be the YAML as a str; got NoneType"),
+        (lambda: load_config_text(b"vehicle: {}"), "text must be the YAML as a str; got bytes"),
+    ):
+        with pytest.raises(TypeError, match=re.escape(needle)):
+            call()
+    text = (CONFIGS / "ch3" / "part1a_qc_bump.yaml").read_text()
+    same = load_config_text(text, str(CONFIGS / "ch3" / "part1a_qc_bump.yaml"))  # str source
+    assert same.source == CONFIGS / "ch3" / "part1a_qc_bump.yaml"

@@ -8,6 +8,7 @@ key they came from.
 from __future__ import annotations
 
 import difflib
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, get_args, get_origin
@@ -32,6 +33,7 @@ __all__ = [
     "ConfigError",
     "load_config",
     "load_config_text",
+    "require_config",
     "config_schema",
     "edit_config",
     "set_path",
@@ -275,7 +277,11 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
     """Parse and validate YAML text; raise ConfigError with file, line and key path.
 
     The YAML is read by :func:`suspopt.config.yamlio.parse_yaml`: safe tags, the YAML 1.2
-    core schema, bounded depth and size, no duplicate keys."""
+    core schema, bounded depth and size, no duplicate keys. ``source`` (a str or Path) names
+    the file in messages, and relative paths inside the config are read from its folder."""
+    if not isinstance(text, str):
+        raise TypeError(f"text must be the YAML as a str; got {_kind(text)}")
+    source = Path(source) if source is not None else None
     name = str(source) if source is not None else "<config>"
     data, node = _sections(text, name)
     lines = _line_map(node) if node is not None else {}
@@ -319,7 +325,11 @@ def load_config(path: str | Path) -> Config:
     ------
     ConfigError
         For anything wrong with the file, naming the file, the key and its line.
+    TypeError
+        When ``path`` is no path (None, a number, a loaded config).
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a str or Path to a YAML config; got {_kind(path)}")
     path = Path(path)
     try:
         text = read_text(path)
@@ -328,6 +338,25 @@ def load_config(path: str | Path) -> Config:
     except YamlError as exc:
         raise ConfigError(f"{path}{f':{exc.line}' if exc.line else ''}: {exc}") from None
     return load_config_text(text, path)
+
+
+def require_config(cfg: object, argument: str = "cfg") -> Config:
+    """``cfg`` when it is a :class:`Config`, else a TypeError that says how to make one: the
+    library's entry points call it first, so that a path given where the loaded config
+    belongs (the usual slip) is not an AttributeError from deep inside."""
+    if isinstance(cfg, Config):
+        return cfg
+    if isinstance(cfg, (str, os.PathLike)):
+        how = f"load it first: suspopt.load_config({str(cfg)!r})"
+    else:
+        how = "from suspopt.load_config(path)"
+    raise TypeError(f"{argument} must be a Config ({how}); got {_kind(cfg)}")
+
+
+def _kind(value: object) -> str:
+    """The type of ``value`` for a message, and the value itself when it is short."""
+    shown = repr(value)
+    return type(value).__name__ + (f" {shown}" if len(shown) <= 60 else "")
 
 
 def set_path(data: dict, path: str, value: Any) -> None:

@@ -31,6 +31,7 @@ from pymoo.core.problem import Problem as _PymooProblem
 
 from .. import execution, streaming
 from ..config import Config, ConfigError
+from ..config.loader import require_config
 from ..config.optimise import DesignVariable, Objective
 from ..config.scenarios import CONSTRAINT_DEFAULT, OBJECTIVE_DEFAULT
 from ..control.controller import build_controller
@@ -157,7 +158,7 @@ class Problem(_PymooProblem):
     def from_config(cls, cfg: Config) -> Problem:
         """Build the problem of ``cfg``; raise ConfigError (with the YAML line) for a bad path,
         a bound the model rejects, an unknown signal or an objective with several values."""
-        if not cfg.design_variables:
+        if not require_config(cfg).design_variables:
             raise cfg.error(
                 ("design_variables",),
                 "required key is missing: list the config fields to optimise, with their bounds",

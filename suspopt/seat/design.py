@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..config import Config, ConfigError
+from ..config.loader import require_config
 from ..params import ParamView
 from .model import PASSENGER_PARTS, build_seat, linearise
 
@@ -118,7 +119,7 @@ def passenger_mass_change(cfg: Config, load_mass) -> dict[str, np.ndarray]:
     Pass the result to :func:`suspopt.simulate` as ``params``.
     """
     load_mass = np.atleast_1d(np.asarray(load_mass, dtype=float))
-    seat = cfg.seat
+    seat = require_config(cfg).seat
     if seat is None:
         raise ConfigError("seat: the config has no seat section")
     bad = np.flatnonzero(~(np.isfinite(load_mass) & (load_mass > 0)))
