@@ -37,6 +37,7 @@ import numpy as np
 from .config import Config, ConfigError
 from .config.loader import require_config
 from .config.vehicle import DOF_FIELDS, PRESET_BODY_DOFS, PRESET_CORNERS
+from .files import listed
 from .network import (
     Elements,
     LinearModel,
@@ -528,7 +529,8 @@ def frequency_response(
         Forward speed [m/s] for the wheelbase delay of the rear wheels; none without it (or
         at 0).
     corners : tuple of str, optional
-        The corners whose wheels see the road (default all, e.g. ``("F1", "R1")``).
+        The corners whose wheels see the road (default all, e.g. ``("F1", "R1")``; one name
+        is one corner, ``"F1"``; an empty tuple is an error, not all of them).
 
     Returns
     -------
@@ -540,7 +542,8 @@ def frequency_response(
     speed = None if speed is None else float(speed)
     if speed is not None and not (math.isfinite(speed) and speed >= 0):
         raise ValueError(f"speed must be finite and >= 0 [m/s]; got {speed}")
-    if isinstance(corners, str) or not all(c in model.corners for c in corners or ()):
+    corners = None if corners is None else tuple(listed(corners))  # ("F1" is one corner)
+    if corners == () or not all(isinstance(c, str) and c in model.corners for c in corners or ()):
         raise ValueError(
             f"corners must be a tuple of this model's corners {model.corners}; got {corners!r}"
         )

@@ -141,7 +141,8 @@ def test_frequency_response_peaks_at_body_mode(load):
         ({"f": [1.0], "speed": -3.0}, "speed must be finite and >= 0"),
         ({"f": [1.0], "speed": np.nan}, "speed must be finite and >= 0"),
         ({"f": [1.0], "corners": ("X9",)}, "corners must be a tuple of this model's corners"),
-        ({"f": [1.0], "corners": "F1"}, "got 'F1'"),
+        ({"f": [1.0], "corners": ("F1", 3)}, "got ('F1', 3)"),
+        ({"f": [1.0], "corners": ()}, "got ()"),
     ],
 )
 def test_frequency_response_refuses_arguments_it_cannot_answer(load, kwargs, needle):
@@ -152,6 +153,18 @@ def test_frequency_response_refuses_arguments_it_cannot_answer(load, kwargs, nee
     model = build_vehicle(load("ch3/part1a_hc2_bump.yaml"))
     with pytest.raises(ValueError, match=re.escape(needle)):
         suspopt.frequency_response(model, **kwargs)
+
+
+def test_one_corner_named_as_a_string_is_that_corner(load):
+    """``corners="F1"`` is the corner F1, as one string is one item everywhere else in the
+    library (it was an error, and before that read letter by letter); the front wheel alone
+    moves the half car differently from both wheels."""
+    model = build_vehicle(load("ch3/part1a_hc2_bump.yaml"))
+    f = np.linspace(0.5, 20.0, 40)
+    one = suspopt.frequency_response(model, f, speed=10.0, corners="F1")
+    assert np.array_equal(one, suspopt.frequency_response(model, f, speed=10.0, corners=("F1",)))
+    both = suspopt.frequency_response(model, f, speed=10.0)
+    assert not np.allclose(one, both)
 
 
 def test_frequency_response_in_blocks_is_the_whole_solve_and_bounded(load, monkeypatch):
