@@ -151,14 +151,18 @@ class SignalMap(Mapping):
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name not in self._cache:
-            if name not in self._table:
-                close = difflib.get_close_matches(name, list(self._table), n=3)
-                raise KeyError(
-                    f"unknown signal {name!r}"
-                    + (f"; did you mean {', '.join(close)}?" if close else "")
-                )
-            self._cache[name] = self._table[name].compute(self._result)
+            self._cache[name] = _row(self._table, name).compute(self._result)
         return self._cache[name]
+
+
+def _row(table: dict[str, Signal], name: str) -> Signal:
+    """The table's row of signal ``name``, or a KeyError with the closest names."""
+    if name not in table:
+        close = difflib.get_close_matches(str(name), list(table), n=3)
+        raise KeyError(
+            f"unknown signal {name!r}" + (f"; did you mean {', '.join(close)}?" if close else "")
+        )
+    return table[name]
 
 
 @dataclass
@@ -241,7 +245,7 @@ class Result:
 
     def signal_unit(self, name: str) -> str:
         """SI unit of a signal of this result."""
-        return self._table[name].unit
+        return _row(self._table, name).unit
 
     def metric(self, spec, name: str) -> np.ndarray:
         """The (P,) values of metric spec ``spec`` on signal ``name`` (:mod:`suspopt.specs`)."""

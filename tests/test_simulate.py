@@ -269,3 +269,16 @@ def test_bad_params_are_config_errors(load):
     # no designs: numpy's broadcasting message before
     with pytest.raises(suspopt.ConfigError, match=r"c: no designs \(an empty array\)"):
         suspopt.simulate(cfg, params={"vehicle.corners.F1.damper.c": []})
+
+
+def test_an_unknown_signal_is_named_with_the_closest_ones(load):
+    """``signal_unit`` of a signal the run lacks, like ``signals[...]``, is a KeyError with
+    the closest names (it was a bare KeyError 'body.heave_ac'); a name that is no string is
+    the same KeyError, not difflib's TypeError."""
+    result = suspopt.simulate(load("quickstart.yaml"))
+    for get in (result.signal_unit, result.signals.__getitem__):
+        with pytest.raises(KeyError, match="unknown signal 'body.heave_ac'; did you mean"):
+            get("body.heave_ac")
+        with pytest.raises(KeyError, match="unknown signal 3"):
+            get(3)
+    assert result.signal_unit("body.heave_acc") == "m/s^2"
