@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import csv
 import re
+import stat
 from contextlib import ExitStack, contextmanager, suppress
 from io import TextIOWrapper
 from pathlib import Path
@@ -45,6 +46,7 @@ import numpy as np
 
 from . import __version__
 from .config import ConfigError
+from .files import Unreadable, status
 
 __all__ = ["write_csv"]
 
@@ -206,8 +208,12 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
             )
         with _reading(h5_path):
             tables = _plan(reader.file)
-        made = not folder.exists()
-        if not made and not folder.is_dir():  # (mkdir would say "File exists")
+        try:
+            found = status(folder)
+        except Unreadable as exc:
+            raise ConfigError(f"--csv {folder}: {exc}") from None
+        made = found is None
+        if found is not None and not stat.S_ISDIR(found.st_mode):  # (mkdir: "File exists")
             raise ConfigError(f"--csv {folder}: is not a folder")
         try:
             folder.mkdir(exist_ok=True)

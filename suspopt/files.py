@@ -17,7 +17,7 @@ from pathlib import Path
 
 from .memory import describe
 
-__all__ = ["Unreadable", "kind_of", "read_bounded", "listed"]
+__all__ = ["Unreadable", "kind_of", "read_bounded", "listed", "status"]
 
 
 def listed(items) -> list:
@@ -51,6 +51,21 @@ def kind_of(mode: int) -> str | None:
 
 def _reason(exc: OSError) -> str:
     return exc.strerror or exc.__class__.__name__
+
+
+def status(path: str | Path) -> os.stat_result | None:
+    """``os.stat`` of what ``path`` names (a symlink followed), or None when it, or a folder on
+    its way, is missing. :class:`Unreadable` when the system cannot tell: a name longer than
+    the system takes, a folder that may not be searched, a symlink loop. (``Path.exists``
+    raises OSError for the first two, which reached the user as a traceback.)"""
+    try:
+        return os.stat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    except OSError as exc:
+        raise Unreadable(f"cannot inspect it ({_reason(exc)})") from None
+    except ValueError:  # (a NUL in the name, which no argument list can hold, but a call can)
+        raise Unreadable("is no valid file name (it holds a NUL)") from None
 
 
 def read_bounded(path: str | Path, limit: int) -> bytes:

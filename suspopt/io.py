@@ -43,6 +43,7 @@ import contextlib
 import errno
 import fcntl
 import os
+import stat
 import sys
 import tempfile
 from collections.abc import Iterable, Iterator, Sequence
@@ -54,7 +55,7 @@ import numpy as np
 
 from . import __version__
 from .config import Config, ConfigError
-from .files import kind_of
+from .files import Unreadable, kind_of, status
 from .h5read import open_dataset  # (suspopt.io.open_dataset, where the README reads it)
 from .signature import CONFIG_SUFFIXES, signature_state
 
@@ -133,8 +134,14 @@ def check_target(path: str | Path, force: bool = False, option: str = "-o") -> P
     if text.endswith(os.sep) or path.name in ("", ".", ".."):
         raise ConfigError(f"{option} {path}: names a folder, not a file")
     folder = path.parent
+    try:
+        found = status(folder)
+    except Unreadable as exc:  # (a name too long, a folder that may not be searched)
+        raise ConfigError(f"{option} {path}: folder {folder}: {exc}") from None
+    if found is not None and not stat.S_ISDIR(found.st_mode):
+        raise ConfigError(f"{option} {path}: {folder} is not a folder")
     try:  # (a relative name in a working folder that was deleted: '.' is still a folder)
-        exists = folder.is_dir() and folder.resolve(strict=True).is_dir()
+        exists = found is not None and folder.resolve(strict=True).is_dir()
     except OSError:
         exists = False
     if not exists:

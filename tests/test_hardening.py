@@ -19,7 +19,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from conftest import CONFIGS, run
+from conftest import CONFIGS, optimised_front, run
 
 import suspopt
 import suspopt.cli  # noqa: F401  (imported before any timing)
@@ -469,12 +469,15 @@ def test_large_evaluations_run_in_batches_of_bounded_memory(monkeypatch):
             "is a symbolic link",
         ),
         (lambda d: d / "no" / "out.h5", "does not exist"),
+        (lambda d: write(d, "x\n", "notes.txt") / "out.h5", "notes.txt is not a folder"),
+        (lambda d: d / ("x" * 300) / "out.h5", "cannot inspect it (File name too long)"),
         (lambda d: "", "-o .: names a folder, not a file"),  # (typer makes '' a '.')
         (
             lambda d: write(d, "my notes\n", "out.h5"),
             "exists and was not written by suspopt; give --force",
         ),
     ],
+    ids=["fifo", "directory", "symlink", "no-folder", "file-as-folder", "long", "empty", "foreign"],
 )
 def test_outputs_must_be_regular_files_or_new_names(tmp_path, capsys, make, needle):
     target = make(tmp_path)
@@ -482,6 +485,43 @@ def test_outputs_must_be_regular_files_or_new_names(tmp_path, capsys, make, need
     message = one_error(capsys, "simulate", CONFIGS / "quickstart.yaml", "-o", target)
     assert needle in message, message
     assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written
+
+
+LONG = "x" * 300  # (a name longer than the system takes: os.stat raises ENAMETOOLONG)
+
+
+@pytest.fixture(scope="module")
+def tiny_front(tmp_path_factory):
+    """A real tiny Pareto file (a Ch. 8 seat, 0.3 s runs)."""
+    return optimised_front(tmp_path_factory.mktemp("front"), "ch8/pareto_ps_class_a", 0.3)[1]
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (
+            ("analyse", "models", LONG, "{config}"),
+            f"{LONG}: cannot inspect it (File name too long)",
+        ),
+        (("analyse", "transmissibility", LONG), "cannot inspect it (File name too long)"),
+        (
+            ("analyse", "roads", "{front}", "--road", LONG),
+            f"--road {LONG}: cannot inspect it (File name too long)",
+        ),
+        (("export", "{front}", "--csv", LONG), f"--csv {LONG}: cannot inspect it (File name"),
+        (("export", "{front}", "--csv", "{config}"), "is not a folder"),
+    ],
+    ids=["models", "transmissibility", "road", "csv-long", "csv-file"],
+)
+def test_a_path_the_system_cannot_look_up_is_bad_input(tiny_front, capsys, args, needle):
+    """A name longer than the system takes, given where a command looks a path up before it
+    reads it (``analyse``'s sources and ``--road``, ``export --csv``'s folder): Path.exists
+    raised OSError there, a traceback."""
+    argv = [a.format(front=tiny_front, config=CONFIGS / "quickstart.yaml") for a in args]
+    before = sorted(p.name for p in tiny_front.parent.iterdir())
+    message = one_error(capsys, *argv)
+    assert needle in message, message
+    assert sorted(p.name for p in tiny_front.parent.iterdir()) == before  # nothing written
 
 
 def test_a_relative_output_in_a_deleted_working_folder_is_bad_input(tmp_path, capsys, monkeypatch):

@@ -60,7 +60,7 @@ import numpy as np
 from .. import plots
 from ..config import Config, ConfigError
 from ..config.loader import edit_config, line_of, set_path
-from ..files import listed
+from ..files import Unreadable, listed, status
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..kesort import pareto_picks
 from ..seat import build_seat, passenger_mass_change
@@ -215,7 +215,11 @@ def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
             variants.append(Variant(f"class {letter}", cfg, attrs={"road_class": letter}))
             continue
         path = Path(road)
-        if not path.exists():
+        try:
+            missing = status(path) is None
+        except Unreadable as exc:
+            raise ConfigError(f"--road {road}: {exc}") from None
+        if missing:
             raise ConfigError(f"--road {road}: neither a road class (A-E) nor a file")
         other = read_sections(path, "--road")
         if not isinstance(other.get("road"), dict):

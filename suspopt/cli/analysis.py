@@ -33,6 +33,7 @@ def _analysis_kinds(incomplete: str) -> list[str]:
 def _checked(kind: str, sources: list[Path], given: dict):
     """The analysis of ``kind`` and the options given to it, checked as bad input."""
     from ..analyse import analysis_kinds
+    from ..files import Unreadable, status
 
     kinds = analysis_kinds()
     if kind not in kinds:
@@ -41,8 +42,11 @@ def _checked(kind: str, sources: list[Path], given: dict):
     if len(sources) > 1 and not spec.many:
         base.fail(f"analyse {kind} takes one SOURCE, got {len(sources)}")
     for source in sources:
-        if not source.exists():
-            base.fail(f"{source}: no such file")
+        try:
+            if status(source) is None:
+                base.fail(f"{source}: no such file")
+        except Unreadable as exc:
+            base.fail(f"{source}: {exc}")
     options = {key: value for key, value in given.items() if value is not None}
     wrong = [_ANALYSE_OPTIONS[key] for key in options if key not in spec.options]
     if wrong:
