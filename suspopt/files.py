@@ -17,7 +17,7 @@ from pathlib import Path
 
 from .memory import describe
 
-__all__ = ["Unreadable", "kind_of", "read_bounded", "listed", "status"]
+__all__ = ["Unreadable", "kind_of", "read_bounded", "listed", "status", "is_hdf5"]
 
 
 def listed(items) -> list:
@@ -66,6 +66,23 @@ def status(path: str | Path) -> os.stat_result | None:
         raise Unreadable(f"cannot inspect it ({_reason(exc)})") from None
     except ValueError:  # (a NUL in the name, which no argument list can hold, but a call can)
         raise Unreadable("is no valid file name (it holds a NUL)") from None
+
+
+def is_hdf5(path: str | Path) -> bool:
+    """Whether ``path`` is an HDF5 file by its signature (a command's source may be a YAML
+    config or a result file). False for anything that cannot be opened or read, which the
+    YAML reader then words (:func:`read_bounded`: ``/proc/self/mem`` is a regular file that
+    gives an I/O error), and for a FIFO or a device, which are never read."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except (OSError, ValueError):
+        return False
+    try:
+        return stat.S_ISREG(os.fstat(fd).st_mode) and os.read(fd, 8) == b"\x89HDF\r\n\x1a\n"
+    except OSError:
+        return False
+    finally:
+        os.close(fd)
 
 
 def read_bounded(path: str | Path, limit: int) -> bytes:

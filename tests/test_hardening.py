@@ -118,9 +118,25 @@ def test_hostile_yaml_is_refused_fast_and_small(tmp_path, capsys, text, needle):
         ),
     ],
 )
-def test_config_files_that_are_no_config_are_refused(tmp_path, capsys, make, needle):
-    message = one_error(capsys, "validate", make(tmp_path))
+@pytest.mark.parametrize(
+    "command",
+    [
+        ("validate", "{}"),
+        ("simulate", "{}", "-o", "{out}"),
+        ("optimise", "{}", "-o", "{out}"),
+        ("analyse", "transmissibility", "{}"),
+        ("analyse", "models", "{}", str(CONFIGS / "quickstart.yaml")),
+    ],
+    ids=["validate", "simulate", "optimise", "transmissibility", "models"],
+)
+def test_config_files_that_are_no_config_are_refused(tmp_path, capsys, make, needle, command):
+    """Every command whose source may be a config says so in the same words (``simulate``
+    and ``analyse transmissibility`` first look for a result file's signature: reading
+    ``/proc/self/mem`` for it was a traceback)."""
+    source, out = make(tmp_path), tmp_path / "out.h5"
+    message = one_error(capsys, *[a.format(source, out=out) for a in command])
     assert needle in message
+    assert not out.exists()
 
 
 @pytest.mark.parametrize(

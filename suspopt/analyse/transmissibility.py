@@ -49,11 +49,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-import h5py
 import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError, load_config
+from ..files import is_hdf5
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..kesort import pareto_picks
 from ..metrics import coherence, transmissibility, weighted_rms
@@ -445,7 +445,7 @@ def run(
     file (then ``with_`` may give the passenger, module docstring)."""
     if plot is not None:
         plots.check_path(plot)
-    if h5py.is_hdf5(source):
+    if is_hdf5(source):
         return _run_front(Path(source), output, plot, with_)
     if with_:
         raise ConfigError(f"analyse transmissibility {source}: --with is for a Pareto file")

@@ -64,21 +64,6 @@ def _metrics_table(result) -> Table:
     return table
 
 
-def _is_hdf5(path: Path) -> bool:
-    """Whether ``path`` is an HDF5 file (by its signature), not a YAML config."""
-    import os
-    import stat
-
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
-    except OSError:
-        return False
-    try:  # (a FIFO or a device is no HDF5 file: never read it)
-        return stat.S_ISREG(os.fstat(fd).st_mode) and os.read(fd, 8) == b"\x89HDF\r\n\x1a\n"
-    finally:
-        os.close(fd)
-
-
 _PICK_HELP = (
     "designs of a result file to simulate: knee, best_<objective>, chosen (the k-ε "
     "optimum of a kesort file) or a row number; repeatable, or separated by commas"
@@ -129,9 +114,10 @@ def simulate(
 
 def _inputs(source: Path, pick, sets, sweeps, zipped):
     """(config, design parameters or None, the picks or None) of ``simulate``'s arguments."""
+    from ..files import is_hdf5
     from ..params import apply_sets, sweep
 
-    if _is_hdf5(source):
+    if is_hdf5(source):
         from ..picks import read_picks, split_picks
 
         if not pick:
