@@ -11,6 +11,14 @@ capped at ``--memory`` GB of address space, with ``--limit`` s per command (SIGA
     python benchmarks/fuzz_configs.py --cases 0 --no-fixed --h5-only --h5-cases 500
     python benchmarks/fuzz_configs.py --configs-only --optimise --cases 1000 --limit 10
 
+``--options`` runs, instead, every command's every option that takes a value, and every
+positional argument, with each of a list of hostile values (``fuzz_harness.OPTION_VALUES``:
+numbers out of range, names the system cannot look up, special files, the command's own
+inputs) on a folder of valid inputs made first (a tiny front, its k-ε choice, a robust
+front); a command that refuses must also leave that folder as it was:
+
+    python benchmarks/fuzz_configs.py --options --limit 20
+
 ``--optimise`` mutates the optimisation configs only and runs ``validate`` and ``optimise``
 (tiny budgets) on each, instead of ``validate`` and ``simulate``. ``--bounds`` sets every
 number of every bundled config, one at a time, to each bound its schema allows (and 0),
@@ -188,6 +196,11 @@ def main() -> None:
         "(tiny budgets) instead of simulate",
     )
     ap.add_argument("--h5-only", action="store_true")
+    ap.add_argument(
+        "--options",
+        action="store_true",
+        help="only the command-line options and arguments, each given hostile values",
+    )
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--limit", type=float, default=fh.LIMIT, help="seconds per command")
     ap.add_argument(
@@ -215,7 +228,23 @@ def main() -> None:
     )
     run = dict(workers=opts.workers, memory=int(opts.memory * 2**30), limit=opts.limit)
     dumped = {}
-    if not opts.h5_only:
+    if opts.options:
+        start = time.perf_counter()
+        with tempfile.TemporaryDirectory(prefix="suspopt-fuzz-options-") as folder:
+            cases = fh.option_cases(fh.option_fixtures(Path(folder) / "inputs"))
+            made = time.perf_counter() - start
+            results = fh.run_cases(cases, **run)
+        wall = time.perf_counter() - start
+        report(
+            f"options and arguments: {len(cases)} cases (inputs made in {made:.1f} s, "
+            f"wall {wall:.1f} s)",
+            cases,
+            results,
+            opts.slowest,
+            opts.causes,
+        )
+        dumped["options"] = [{"case": fh.asdict(c), "result": results[c.id]} for c in cases]
+    if not (opts.h5_only or opts.options):
         start = time.perf_counter()
         configs = fh.bundled_configs()
         if opts.bounds:
@@ -238,7 +267,7 @@ def main() -> None:
             opts.causes,
         )
         dumped["configs"] = [{"case": fh.asdict(c), "result": results[c.id]} for c in cases]
-    if not opts.configs_only:
+    if not (opts.configs_only or opts.options):
         start = time.perf_counter()
         variants = ([] if opts.no_fixed else fh.h5_variants()) + fh.h5_random_variants(
             opts.h5_cases, opts.seed

@@ -83,14 +83,16 @@ class Case:
 
     ``setup``: how the worker makes the input at ``{path}``: ``{"kind": "text", "text": ...}``,
     ``{"kind": "bytes", "b64": ...}``, ``{"kind": "dir"}``, ``{"kind": "fifo"}``,
-    ``{"kind": "symlink", "target": ...}``, ``{"kind": "missing"}`` or ``{"kind":
-    "existing", "path": ...}`` (a file the parent made, e.g. a broken Pareto file).
+    ``{"kind": "symlink", "target": ...}``, ``{"kind": "missing"}``, ``{"kind":
+    "existing", "path": ...}`` (a file the parent made, e.g. a broken Pareto file) or
+    ``{"kind": "folder", "path": ...}`` (a copy of a folder the parent made, for option cases;
+    a refused command must leave it as it was).
     ``runs``: argv lists with ``{path}`` and ``{out}`` (an output file in the case's folder).
     ``dataset``: for Pareto cases, the dataset or attribute an exit-2 message must name.
     """
 
     id: str
-    family: str  # "config" or "h5"
+    family: str  # "config", "h5" or "options"
     label: str
     setup: dict
     runs: list[list[str]]
@@ -1478,6 +1480,139 @@ def build_h5_cases(cases: list[Case], variants, folder: Path) -> list[Case]:
     return out
 
 
+# --- command-line options ------------------------------------------------------------------
+
+#: Hostile values for every option that takes one and every positional argument
+#: (``benchmarks/fuzz_configs.py --options``): numbers out of every range, non-finite and
+#: unparsable ones, names the system cannot look up, special files, and names of the case's
+#: own inputs (``{path}`` is the case's copy of :func:`option_fixtures`).
+OPTION_VALUES = [
+    "nan", "inf", "-inf", "-1", "0", "1e309", "1e-320", "99999999999999999999999", "0x10",
+    "3.5", "1,2", ",", "", "-", "..", "~", "ü/ß", "x" * 300, "x/" * 200, "/", "/dev/zero",
+    "/dev/stdin", "/proc/self/mem", "/proc/self/status", "{path}", "{path}/fifo",
+    "{path}/study.yaml", "{path}/front.h5", "{path}/nofile/x.h5", "{path}/study.yaml/x",
+]  # fmt: skip
+#: One valid run of every command on :func:`option_fixtures` (``{path}``: the case's copy of
+#: the folder; ``{out}``: an output beside it); the options of each are fuzzed on it
+OPTION_BASES = [
+    ["validate", "{path}/study.yaml"],
+    ["init", "quarter", "-o", "{out}.yaml"],
+    ["simulate", "{path}/study.yaml", "-o", "{out}"],
+    ["optimise", "{path}/study.yaml", "-o", "{out}"],
+    ["kesort", "{path}/front.h5", "-o", "{out}"],
+    ["export", "{path}/choice.h5", "--pick", "chosen", "-o", "{out}.yaml"],
+    ["report", "{path}/front.h5", "-o", "{out}.html"],
+    ["analyse", "roads", "{path}/front.h5", "--road", "{path}/road.yaml", "-o", "{out}"],
+    ["analyse", "masses", "{path}/front.h5", "-o", "{out}"],
+    ["analyse", "models", "{path}/study.yaml", "{path}/study2.yaml"],
+    ["analyse", "transmissibility", "{path}/front.h5"],
+    ["analyse", "scenarios", "{path}/robust.h5"],
+]
+
+
+def option_fixtures(folder: Path) -> Path:
+    """The inputs of :data:`OPTION_BASES` in ``folder``: the ``kesort`` starter config with a
+    tiny budget, its front, the front's k-ε choice, a robust front, a second config, a road
+    config and a FIFO (made by ``python -m suspopt``, as a user would)."""
+    folder.mkdir(parents=True, exist_ok=True)
+
+    def suspopt(*args: str) -> None:
+        done = subprocess.run(
+            [sys.executable, "-m", "suspopt", "-q", *args],
+            cwd=folder,
+            capture_output=True,
+            text=True,
+            env=worker_env(),
+        )
+        if done.returncode != 0:
+            raise RuntimeError(f"suspopt {' '.join(args)}: {done.stderr[-500:]}")
+
+    budget = {"population": 8, "generations": 2}
+    for kind, config, front in (("kesort", "study", "front"), ("robust", "robust", "robust")):
+        suspopt("init", kind, "-o", f"{config}.yaml")
+        text = (folder / f"{config}.yaml").read_text()
+        for key, value in budget.items():
+            text = re.sub(rf"(?m)^(\s+{key}:) \d+", rf"\1 {value}", text)
+        (folder / f"{config}.yaml").write_text(text)
+        suspopt("optimise", f"{config}.yaml", "-o", f"{front}.h5")
+    suspopt("kesort", "front.h5", "-o", "choice.h5")
+    (folder / "study2.yaml").write_text((folder / "study.yaml").read_text())
+    (folder / "road.yaml").write_text((CONFIGS / "quickstart.yaml").read_text())
+    os.mkfifo(folder / "fifo")
+    return folder
+
+
+def _value_slots(base: list[str]) -> list[tuple[str, int | None]]:
+    """(label, index) of each positional argument of ``base`` that may be replaced."""
+    start = 2 if base[0] == "analyse" else 1
+    return [
+        (f"argument {i}", i)
+        for i in range(start, len(base))
+        if not base[i].startswith("-") and not base[i - 1].startswith("-")
+    ]
+
+
+def option_cases(fixtures: Path, values: list[str] | None = None) -> list[Case]:
+    """Every option that takes a value, of every command of :data:`OPTION_BASES`, and every
+    positional argument, given each of ``values`` (default :data:`OPTION_VALUES`), one case
+    each. The options are read from the command tree, so a new option is fuzzed as it comes."""
+    import typer.main
+
+    from suspopt.cli import app
+
+    tree = typer.main.get_command(app)
+    cases = []
+    for base in OPTION_BASES:
+        command = tree.commands[base[0]]
+        slots = [
+            (param.opts[0], None)
+            for param in command.params
+            if param.param_type_name == "option" and not param.is_flag and not param.count
+        ] + _value_slots(base)
+        for slot, index in slots:
+            for k, value in enumerate(OPTION_VALUES if values is None else values):
+                argv = list(base)
+                if index is None:
+                    argv += [slot, value]
+                else:
+                    argv[index] = value
+                cases.append(
+                    Case(
+                        id=_case_id("opt", _command_name(base), slot, f"{k:02d}"),
+                        family="options",
+                        label=f"{' '.join(base[:2])} {slot} {short(value, 30)!r}",
+                        setup={"kind": "folder", "path": str(fixtures)},
+                        runs=[argv],
+                        source=" ".join(base),
+                        name="",  # (a message names the option or the file it is about)
+                        dataset=None,
+                    )
+                )
+    return cases
+
+
+def _copy_folder(src: Path, dst: Path) -> None:
+    """``src``'s files into the new folder ``dst``, a FIFO made anew (never read)."""
+    dst.mkdir()
+    for item in src.iterdir():
+        if item.is_fifo():
+            os.mkfifo(dst / item.name)
+        else:
+            (dst / item.name).write_bytes(item.read_bytes())
+
+
+def _changed(src: Path, dst: Path) -> list[str]:
+    """What differs in ``dst`` from ``src`` (:func:`_copy_folder`): new, lost or changed."""
+    have = {p.name for p in dst.iterdir()}
+    want = {p.name for p in src.iterdir()}
+    out = [f"new {n}" for n in sorted(have - want)] + [f"lost {n}" for n in sorted(want - have)]
+    for name in sorted(have & want):
+        a, b = src / name, dst / name
+        if a.is_fifo() != b.is_fifo() or (not a.is_fifo() and a.read_bytes() != b.read_bytes()):
+            out.append(f"changed {name}")
+    return out
+
+
 # --- judging -------------------------------------------------------------------------------
 
 
@@ -1543,6 +1678,8 @@ def problems(case: Case, result: dict) -> list[dict]:
             continue
         if "Traceback" in run["stderr"] or "Traceback" in run["stdout"]:
             add("traceback in the output")
+        if run.get("changed"):  # (an option case: a refused command changed its inputs)
+            add("refused, but changed the inputs", stderr="; ".join(run["changed"])[:300])
         if code == 2:
             if run["stderr_lines"] != 1:
                 add(
@@ -1871,6 +2008,8 @@ def _make_input(setup: dict, path: Path) -> None:
         os.symlink(path if setup["target"] == "self" else setup["target"], path)
     elif kind == "missing":
         pass
+    elif kind == "folder":
+        _copy_folder(Path(setup["path"]), path)
     else:
         raise ValueError(kind)
 
@@ -1927,7 +2066,7 @@ def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: boo
             if case["setup"]["kind"] == "existing":
                 path = Path(case["setup"]["path"])
             else:
-                path = work / case["name"]
+                path = work / (case["name"] or "inputs")
                 _make_input(case["setup"], path)
             out = work / "out.h5"
             runs = []
@@ -1951,7 +2090,11 @@ def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: boo
                 # the log says which command was running if the worker has to be killed
                 sys.stderr.write(f"case {case['id']}: running {_command_name(args)}\n")
                 sys.stderr.flush()
-                runs.append(_invoke(runner, app, args, limit, out, h5py))
+                entry = case["family"] == "options"  # (usage errors: worded by the entry)
+                runs.append(_invoke(runner, app, args, limit, out, h5py, entry))
+                done = runs[-1]  # (optimise's exit 3 writes its file all the same)
+                if case["setup"]["kind"] == "folder" and done["exit"] not in (0, 3):
+                    done["changed"] = _changed(Path(case["setup"]["path"]), path)
                 if out.exists():
                     out.unlink()
             answer = {"id": case["id"], "runs": runs}
@@ -2009,7 +2152,38 @@ def _clip(text: str, head: int = 3000, tail: int = 1000) -> str:
     return text if len(text) <= head + tail else text[:head] + " [...] " + text[-tail:]
 
 
-def _invoke(runner, app, args, limit, out, h5py) -> dict:
+def _through_entry(runner, args):
+    """``suspopt._entry.main(args)``, the command line's own entry point, in the runner's
+    isolation: a :class:`typer.testing.Result`. The option cases run through it, since it
+    words click's usage errors (a bad option value) as the one line a user sees, where
+    ``runner.invoke`` would print click's box."""
+    from typer.testing import Result
+
+    from suspopt._entry import main
+
+    exception, exc_info, code = None, None, 1
+    with runner.isolation() as streams:
+        try:
+            code = main(list(args))
+        except Exception as exc:  # noqa: BLE001 - a bug, reported as invoke reports it
+            exception, exc_info = exc, sys.exc_info()
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            stdout, stderr, output = (stream.getvalue() for stream in streams)
+    return Result(
+        runner=runner,
+        stdout_bytes=stdout,
+        stderr_bytes=stderr,
+        output_bytes=output,
+        return_value=None,
+        exit_code=code,
+        exception=exception,
+        exc_info=exc_info,
+    )
+
+
+def _invoke(runner, app, args, limit, out, h5py, entry: bool = False) -> dict:
     record = {
         "command": _command_name(args),
         "argv": args,
@@ -2024,7 +2198,10 @@ def _invoke(runner, app, args, limit, out, h5py) -> dict:
     started = time.perf_counter()
     signal.setitimer(signal.ITIMER_REAL, limit)
     try:
-        result = runner.invoke(app, args, catch_exceptions=True)
+        if entry:
+            result = _through_entry(runner, args)
+        else:
+            result = runner.invoke(app, args, catch_exceptions=True)
         signal.setitimer(signal.ITIMER_REAL, 0)
     except CaseTimeout as exc:
         record["timeout"] = True
