@@ -434,15 +434,18 @@ def open_dataset(path: str | Path, group: str | None = None):
 
     import h5py
 
+    if group is not None and not isinstance(group, str):
+        raise TypeError(f"group must be a str, e.g. 'pareto'; got {type(group).__name__}")
+    parts = [p for p in (group or "").split("/") if p not in ("", ".")]  # ("." is the root)
+    asked, group = group, "/".join(parts) or None
     with H5Reader(path) as h5:  # (a missing, foreign or damaged file: ConfigError first)
-        if group and not isinstance(h5.file.get(group), h5py.Group):
+        if group and (".." in parts or not isinstance(h5.file.get(group), h5py.Group)):
             groups: list[str] = []
             h5.file.visititems(
                 lambda name, obj: groups.append(name) if isinstance(obj, h5py.Group) else None
             )
-            raise KeyError(f"{path}: no group {group!r}; it has {', '.join(groups) or 'none'}")
+            raise KeyError(f"{path}: no group {asked!r}; it has {', '.join(groups) or 'none'}")
     ds = load(group)
-    parts = [p for p in (group or "").split("/") if p]
     for depth in range(len(parts) - 1, -1, -1):  # the nearest group above first
         missing = [d for d in ds.sizes if d not in ds.coords]
         if not missing:

@@ -27,6 +27,7 @@ import numpy as np
 from .config import Config, ConfigError
 from .config.loader import edit_config, load_config_text, set_path
 from .config.road import FileRoad, resolve_road_file
+from .errors import require, type_name
 from .files import listed
 from .params import ParamView
 
@@ -239,11 +240,10 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
     it came from. Returns the config and its YAML text."""
     from . import __version__
 
-    if (
-        isinstance(i, bool)
-        or not isinstance(i, (int, np.integer))
-        or not -len(picked.X) <= i < len(picked.X)
-    ):
+    require(picked, Picked, "picked", "from read_picks(path, picks)")
+    if isinstance(i, bool) or not isinstance(i, (int, np.integer)):
+        raise TypeError(f"i must be a design's row number in picked; got {type_name(i)}")
+    if not -len(picked.X) <= i < len(picked.X):
         raise IndexError(
             f"design {i!r}: picked holds {len(picked.X)} design(s), 0..{len(picked.X) - 1}"
         )

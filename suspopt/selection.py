@@ -50,6 +50,7 @@ import numpy as np
 
 from .config import Config, ConfigError, load_config
 from .config.loader import load_config_text
+from .errors import require
 from .files import listed
 from .io import atomic_h5, write_attrs, write_dataset
 from .kesort import KEpsilonSort, kesort, pareto_picks
@@ -375,7 +376,10 @@ def select(
     """Pool ``sets`` and sort them by k-ε optimality (see the module docstring); ``eps``,
     ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`suspopt.kesort.kesort`.
     ConfigError when the sets have different objectives or no design is left to sort."""
-    sets = list(sets)
+    sets = [
+        require(s, DesignSet, f"sets[{i}]", "from load_design_sets(paths)")
+        for i, s in enumerate(listed(sets))
+    ]
     if not sets:
         raise ConfigError("give at least one design set (load_design_sets)")
     names, units = _common_objectives(sets)
@@ -475,7 +479,7 @@ def _write_sort(group, sort: KEpsilonSort, rows: np.ndarray | None, picks: dict[
 
 def write_selection(path: str | Path, selection: Selection, command: str | None = None) -> Path:
     """Write ``/kesort`` (module docstring) to a new HDF5 file, atomically."""
-    s = selection
+    s = require(selection, Selection, "selection", "from select(sets)")
     inputs = [("the input", d.source) for d in s.sets]  # (the fronts it sorted)
     with atomic_h5(path, s.sets[0].config, command, inputs=inputs) as h5:
         grp = h5.create_group("kesort")

@@ -37,6 +37,7 @@ import numpy as np
 from .config import Config, ConfigError
 from .config.loader import require_config
 from .config.vehicle import DOF_FIELDS, PRESET_BODY_DOFS, PRESET_CORNERS
+from .errors import require
 from .files import listed
 from .network import (
     Elements,
@@ -459,12 +460,7 @@ def _mode_labels(shape: np.ndarray, energy: np.ndarray, names: np.ndarray) -> np
 def _vehicle_model(model: object) -> VehicleModel:
     """``model`` when it is a :class:`VehicleModel`, else a TypeError that says how to build
     one (a config given where its model belongs is the usual slip)."""
-    if not isinstance(model, VehicleModel):
-        raise TypeError(
-            "model must be a VehicleModel (from suspopt.build_vehicle(cfg)); "
-            f"got {type(model).__name__}"
-        )
-    return model
+    return require(model, VehicleModel, "model", "from suspopt.build_vehicle(cfg)")
 
 
 def modal_analysis(model: VehicleModel) -> ModalResult:

@@ -109,9 +109,26 @@ def test_the_library_takes_picks_as_the_command_line_does(kesort_file):
     picked = read_picks(ke, "knee")
     with pytest.raises(IndexError, match=r"design 1: picked holds 1 design\(s\), 0..0"):
         design_config(picked, 1)
-    with pytest.raises(IndexError, match="design 0.5"):
-        design_config(picked, 0.5)
+    for i in (0.5, None, "0"):  # (no row number: a TypeError, as a list's index gives)
+        with pytest.raises(TypeError, match="i must be a design's row number in picked"):
+            design_config(picked, i)
     assert design_config(picked, -1)[1] == design_config(picked, 0)[1]
+
+
+def test_the_selection_functions_name_the_object_they_want(kesort_file):
+    """``select`` of file names, ``write_selection`` of no selection and ``design_config`` of
+    no picks were AttributeErrors from inside ("'str' object has no attribute 'names'")."""
+    from suspopt.picks import design_config
+    from suspopt.selection import select, write_selection
+
+    front, ke = kesort_file
+    with pytest.raises(TypeError, match=r"sets\[0\] must be a DesignSet \(from load_design_sets"):
+        select(str(front))
+    with pytest.raises(TypeError, match=r"selection must be a Selection \(from select\(sets\)\)"):
+        write_selection(ke.parent / "new.h5", None)
+    assert not (ke.parent / "new.h5").exists()
+    with pytest.raises(TypeError, match=r"picked must be a Picked \(from read_picks"):
+        design_config(str(ke))
 
 
 @pytest.mark.slow

@@ -247,6 +247,19 @@ def test_open_dataset_of_a_group_the_file_lacks_lists_its_groups(files, tmp_path
         open_dataset(tmp_path / "nowhere.h5", "pareto")
 
 
+def test_open_dataset_reads_dot_as_the_root_and_refuses_a_way_out(files):
+    """``"."`` and ``"./pareto/"`` name the root and ``/pareto`` as h5py reads them (xarray
+    said "group not found: ."); ``"pareto/.."`` leaves the group it names, and a group that
+    is no string is a TypeError, not xarray's."""
+    pytest.importorskip("xarray")
+    assert open_dataset(files["front"], "./pareto/").equals(open_dataset(files["front"], "pareto"))
+    assert open_dataset(files["front"], ".").equals(open_dataset(files["front"]))
+    with pytest.raises(KeyError, match=r"no group 'pareto/\.\.'"):
+        open_dataset(files["front"], "pareto/..")
+    with pytest.raises(TypeError, match="group must be a str"):
+        open_dataset(files["front"], 3)
+
+
 def read_table(path):
     """Header and rows of a CSV file of suspopt's, with the Python csv module."""
     with open(path, newline="", encoding="utf-8") as stream:

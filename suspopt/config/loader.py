@@ -16,7 +16,7 @@ from typing import Any, get_args, get_origin
 import yaml
 from pydantic import Field, PrivateAttr, ValidationError
 
-from ..errors import ConfigError
+from ..errors import ConfigError, require, type_name
 from .base import Section
 from .control import Control
 from .metrics import MetricSpec
@@ -280,7 +280,7 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
     core schema, bounded depth and size, no duplicate keys. ``source`` (a str or Path) names
     the file in messages, and relative paths inside the config are read from its folder."""
     if not isinstance(text, str):
-        raise TypeError(f"text must be the YAML as a str; got {_kind(text)}")
+        raise TypeError(f"text must be the YAML as a str; got {type_name(text)}")
     source = Path(source) if source is not None else None
     name = str(source) if source is not None else "<config>"
     data, node = _sections(text, name)
@@ -329,7 +329,7 @@ def load_config(path: str | Path) -> Config:
         When ``path`` is no path (None, a number, a loaded config).
     """
     if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a str or Path to a YAML config; got {_kind(path)}")
+        raise TypeError(f"path must be a str or Path to a YAML config; got {type_name(path)}")
     path = Path(path)
     try:
         text = read_text(path)
@@ -344,19 +344,11 @@ def require_config(cfg: object, argument: str = "cfg") -> Config:
     """``cfg`` when it is a :class:`Config`, else a TypeError that says how to make one: the
     library's entry points call it first, so that a path given where the loaded config
     belongs (the usual slip) is not an AttributeError from deep inside."""
-    if isinstance(cfg, Config):
-        return cfg
     if isinstance(cfg, (str, os.PathLike)):
         how = f"load it first: suspopt.load_config({str(cfg)!r})"
     else:
         how = "from suspopt.load_config(path)"
-    raise TypeError(f"{argument} must be a Config ({how}); got {_kind(cfg)}")
-
-
-def _kind(value: object) -> str:
-    """The type of ``value`` for a message, and the value itself when it is short."""
-    shown = repr(value)
-    return type(value).__name__ + (f" {shown}" if len(shown) <= 60 else "")
+    return require(cfg, Config, argument, how)
 
 
 def set_path(data: dict, path: str, value: Any) -> None:
