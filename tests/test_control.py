@@ -718,7 +718,7 @@ def test_cdf_sensitivity_needs_an_adaptive_threshold(tmp_path):
 def test_the_c_max_share_of_a_time_outside_the_run_or_of_passive_dampers_is_refused():
     """A ``share_after`` beyond the run (or NaN) averaged no sample: NaN and numpy's "mean of
     empty slice"; a result without a semi-active damper, the same."""
-    from suspopt.analyse.cdf import c_max_share
+    from suspopt.analyse.cdf import c_max_share, semi_active_metrics
 
     result = suspopt.simulate(suspopt.load_config(CONFIGS / "ch4" / "sh_2_bump.yaml"))
     assert 0.0 < c_max_share(result, 0.5)[0] < 1.0
@@ -727,3 +727,8 @@ def test_the_c_max_share_of_a_time_outside_the_run_or_of_passive_dampers_is_refu
             c_max_share(result, late)
     with pytest.raises(ValueError, match="no semi-active damper"):
         c_max_share(suspopt.simulate(suspopt.load_config(CONFIGS / "quickstart.yaml")))
+    for wrong in (result.config, None):  # (AttributeErrors from inside before)
+        with pytest.raises(TypeError, match=r"result must be a Result \(from suspopt.simulate"):
+            c_max_share(wrong)
+        with pytest.raises(TypeError, match=r"result must be a Result \(from suspopt.simulate"):
+            semi_active_metrics(wrong)

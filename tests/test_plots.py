@@ -184,6 +184,23 @@ def test_bad_signals_and_designs_are_value_errors_before_anything_is_written(swe
     assert list(tmp_path.iterdir()) == []
 
 
+def test_each_plot_names_the_result_it_draws_when_given_another(sweep, tmp_path):
+    """A config, a file name or None where a result belongs: a TypeError naming what to
+    pass (AttributeErrors from inside before: "'Config' object has no attribute 'F'")."""
+    path = tmp_path / "plot.png"
+    for draw, needle in (
+        (plots.plot_simulation, r"result must be a Result \(from suspopt.simulate\(cfg\)\)"),
+        (plots.plot_optimisation, r"result must be a OptimisationResult \(from suspopt.optimise"),
+        (plots.plot_kesort, r"selection must be a Selection \(from suspopt.selection.select"),
+    ):
+        for wrong in (sweep.config, "front.h5", None):
+            if draw is plots.plot_simulation and wrong is None:
+                continue  # (covered by the other two)
+            with pytest.raises(TypeError, match=needle):
+                draw(wrong, path)
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.slow
 def test_more_designs_than_fit_are_thinned_evenly_and_the_title_says_so(tmp_path):
     cfg = suspopt.load_config(CONFIGS / "quickstart.yaml")

@@ -212,6 +212,7 @@ def test_the_entry_points_name_the_object_they_want_when_given_another(load, tmp
     belongs, a config where its model belongs: a TypeError that says what to pass and how to
     make it (they were AttributeErrors from deep inside, "'str' object has no attribute
     'simulation'")."""
+    from suspopt.analyse.transmissibility import seat_transmissibility
     from suspopt.config.loader import load_config_text
     from suspopt.optimise.problem import Problem
     from suspopt.optimise.run import optimise
@@ -228,6 +229,7 @@ def test_the_entry_points_name_the_object_they_want_when_given_another(load, tmp
         lambda: sweep(path, ["vehicle.body.mass=1:2:3"]),
         lambda: seat_constraints(path),
         lambda: passenger_mass_change(path, [95.0]),
+        lambda: seat_transmissibility(path),
     ):
         with pytest.raises(TypeError, match=load_first):
             call()

@@ -27,8 +27,10 @@ import numpy as np
 
 from .. import plots
 from ..config import load_config
+from ..errors import require
 from ..io import atomic_h5, write_dataset
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
+from ..result import Result
 from ..simulate import simulate
 from . import KINDS, Kind, Report, relative_change
 
@@ -43,6 +45,7 @@ METRIC_UNITS = {"SW": "1", "RC": "m/s^2", "ST": "m", "TD": "m", "DE": "W"}
 def c_max_share(result, share_after: float = 0.0) -> np.ndarray:
     """The mean damper state (the C_max share of the on-off laws) over the samples at
     ``t >= share_after``, averaged over the semi-active corners, (P,)."""
+    require(result, Result, "result", "from suspopt.simulate(cfg)")
     cfg, sig = result.config, result.signals
     active = [
         c for c in result.model.corners if cfg.vehicle.corners[c].damper.kind == "semi_active"
@@ -66,6 +69,7 @@ def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarra
 
     SW counts state changes between output samples, so ``simulation.output_dt`` must not exceed
     ``control.sample_time`` (every sample seen)."""
+    require(result, Result, "result", "from suspopt.simulate(cfg)")
     cfg, sig, t = result.config, result.signals, result.time
     corners = result.model.corners
     active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]

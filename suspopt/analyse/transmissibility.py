@@ -53,6 +53,7 @@ import numpy as np
 
 from .. import plots
 from ..config import Config, ConfigError, load_config
+from ..config.loader import require_config
 from ..files import is_hdf5
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..kesort import pareto_picks
@@ -147,7 +148,7 @@ def seat_transmissibility(
     ``segment`` is the Welch segment length [s] of the simulated estimate (at most the run;
     at least 8 samples, else a ValueError: scipy's "nperseg=0" before).
     """
-    if cfg.seat is None:
+    if require_config(cfg).seat is None:
         raise ConfigError(
             f"{cfg.source or '<config>'}: analyse transmissibility needs a seat: section"
         )

@@ -181,7 +181,11 @@ def plot_kesort(selection, path: str | Path) -> Path:
     the k-ε level of every design against the first objective (Fig. 6.7). With one objective
     only the right panel is drawn.
     """
-    s, path = selection, check_path(path)
+    from ..errors import require
+    from ..selection import Selection
+
+    s = require(selection, Selection, "selection", "from suspopt.selection.select(sets)")
+    path = check_path(path)
     F, levels, names, units = s.F, s.sort.k_eps, s.names, s.units
     markers = "os^Dv<>phX*"
     two = F.shape[1] > 1

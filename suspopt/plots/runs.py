@@ -245,6 +245,10 @@ def plot_simulation(
     more than :data:`MAX_DESIGNS` designs, or no matplotlib."""
     import difflib
 
+    from ..errors import require
+    from ..result import Result
+
+    require(result, Result, "result", "from suspopt.simulate(cfg)")
     path = check_path(path)
     names = listed(signals) if signals is not None else default_signals(result)  # (one name: str)
     for name in names:
@@ -344,6 +348,10 @@ def optimisation_figure(
 def plot_optimisation(result, path: str | Path) -> Path:
     """Draw a :class:`suspopt.optimise.OptimisationResult` (:func:`optimisation_figure`) to
     ``path`` (.png or .svg): the front or the best value, and the history per generation."""
+    from ..errors import require
+    from ..optimise.run import OptimisationResult
+
+    require(result, OptimisationResult, "result", "from suspopt.optimise.optimise(cfg, path)")
     path = check_path(path)
     history = result.history
     generations = len(np.atleast_1d(history["generation"]))
