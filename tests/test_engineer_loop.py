@@ -115,20 +115,19 @@ def test_the_library_takes_picks_as_the_command_line_does(kesort_file):
     assert design_config(picked, -1)[1] == design_config(picked, 0)[1]
 
 
-def test_the_selection_functions_name_the_object_they_want(kesort_file):
+def test_the_selection_functions_name_the_object_they_want(tmp_path):
     """``select`` of file names, ``write_selection`` of no selection and ``design_config`` of
     no picks were AttributeErrors from inside ("'str' object has no attribute 'names'")."""
     from suspopt.picks import design_config
     from suspopt.selection import select, write_selection
 
-    front, ke = kesort_file
     with pytest.raises(TypeError, match=r"sets\[0\] must be a DesignSet \(from load_design_sets"):
-        select(str(front))
+        select("front.h5")
     with pytest.raises(TypeError, match=r"selection must be a Selection \(from select\(sets\)\)"):
-        write_selection(ke.parent / "new.h5", None)
-    assert not (ke.parent / "new.h5").exists()
+        write_selection(tmp_path / "new.h5", None)
+    assert list(tmp_path.iterdir()) == []
     with pytest.raises(TypeError, match=r"picked must be a Picked \(from read_picks"):
-        design_config(str(ke))
+        design_config("choice.h5")
 
 
 @pytest.mark.slow

@@ -512,6 +512,7 @@ def tiny_front(tmp_path_factory):
     return optimised_front(tmp_path_factory.mktemp("front"), "ch8/pareto_ps_class_a", 0.3)[1]
 
 
+@pytest.mark.slow  # (the tiny front: 1.5 s)
 @pytest.mark.parametrize(
     "args, needle",
     [
