@@ -222,6 +222,17 @@ def _from_h5py(kind, tb) -> bool:
     return tb is not None and "h5py" in Path(tb.tb_frame.f_code.co_filename).parts
 
 
+#: The top-level groups that tell what a suspopt file holds (the first one found names it),
+#: for a file without the root attribute ``analysis``: the layouts of the README.
+_HOLDS = (
+    ("kesort", "a k-ε selection (suspopt kesort)"),
+    ("pareto", "a Pareto front (suspopt optimise)"),
+    ("signals", "a simulation's signals (suspopt simulate)"),
+    ("linear", "transmissibilities (suspopt analyse transmissibility)"),
+    ("cdf_sensitivity", "a threshold sweep (suspopt analyse cdf-sensitivity)"),
+)
+
+
 class H5Reader:
     """An open HDF5 input file (a context manager); ``where`` starts every message (default
     the file's name)."""
@@ -270,10 +281,25 @@ class H5Reader:
 
         node = self._node(name)
         if not isinstance(node, getattr(h5py, kind)):
-            raise ConfigError(
-                f"{self.where}: /{name}: missing (is this a suspopt file of the right kind?)"
-            )
+            raise ConfigError(f"{self.where}: /{name}: missing{self._holds()}")
         return node
+
+    def _holds(self) -> str:
+        """What the file holds, for a message about a group it lacks: a result of another
+        command is the usual slip (``kesort chosen.h5``)."""
+        import h5py
+
+        try:
+            top = {k for k, v in self.file.items() if isinstance(v, h5py.Group)}
+            analysis = self.file.attrs.get("analysis")
+        except (OSError, RuntimeError, KeyError, ValueError, TypeError):
+            top, analysis = set(), None
+        if isinstance(analysis, str) and analysis.isidentifier():
+            return f"; the file holds the results of suspopt analyse {analysis}"
+        for group, what in _HOLDS:
+            if group in top:
+                return f"; the file holds {what}"
+        return " (is this a suspopt file of the right kind?)"
 
     def group(self, name: str):
         """The group ``/name``."""

@@ -316,3 +316,32 @@ def test_simulate_of_a_config_writes_its_plot(tmp_path, capsys):
     code, out, err = cli(capsys, "simulate", CONFIGS / "quickstart.yaml", "--plot", fig)
     assert code == 0, err
     assert fig.stat().st_size > 10_000 and re.search(r"wrote .*run\.png", out)
+
+
+@pytest.mark.parametrize(
+    "groups, attrs, needle",
+    [
+        (["kesort"], {}, "the file holds a k-ε selection (suspopt kesort)"),
+        (["signals", "metrics"], {}, "the file holds a simulation's signals (suspopt simulate)"),
+        (
+            ["pareto", "pseudo"],
+            {"analysis": "masses"},
+            "the file holds the results of suspopt analyse masses",
+        ),
+        ([], {}, "(is this a suspopt file of the right kind?)"),
+    ],
+    ids=["kesort", "simulate", "analyse", "unknown"],
+)
+def test_a_result_of_another_command_is_named_for_what_it_holds(
+    tmp_path, capsys, groups, attrs, needle
+):
+    """``kesort chosen.h5`` (a simulation) said "/pareto/X: missing (is this a suspopt file
+    of the right kind?)"; it now says what the file holds and which command writes that."""
+    path = tmp_path / "other.h5"
+    with h5py.File(path, "w") as h5:
+        h5.attrs.update({"suspopt_version": suspopt.__version__, **attrs})
+        for group in groups:
+            h5.create_group(group)
+    code, _, err = cli(capsys, "kesort", path)
+    assert code == 2 and err.count("\n") == 1, err
+    assert f"other.h5: /pareto/X: missing{'; ' if needle[0] != '(' else ' '}{needle}" in err, err

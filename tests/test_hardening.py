@@ -139,6 +139,23 @@ def test_config_files_that_are_no_config_are_refused(tmp_path, capsys, make, nee
     assert not out.exists()
 
 
+@pytest.mark.parametrize("command", ["validate", "optimise", "models"])
+def test_a_result_file_where_a_config_belongs_is_named_so(tmp_path, capsys, command):
+    """``validate front.h5`` said "holds NUL bytes: a binary file", and a larger result
+    "is larger than 1 MB"; the commands that take only configs say what the file is."""
+    front, out = tmp_path / "front.h5", tmp_path / "out.h5"
+    with h5py.File(front, "w") as h5:
+        h5.attrs["suspopt_version"] = suspopt.__version__
+    args = {
+        "validate": ["validate", front],
+        "optimise": ["optimise", front, "-o", out],
+        "models": ["analyse", "models", front, CONFIGS / "quickstart.yaml"],
+    }[command]
+    message = one_error(capsys, *args)
+    assert message == f"error: {front}: is an HDF5 file, not a YAML config", message
+    assert not out.exists()
+
+
 @pytest.mark.parametrize(
     "old, new, needle, line",
     [

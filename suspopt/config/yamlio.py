@@ -34,7 +34,7 @@ from yaml.reader import Reader
 from yaml.resolver import BaseResolver
 from yaml.scanner import Scanner
 
-from ..files import Unreadable, read_bounded
+from ..files import Unreadable, is_hdf5, read_bounded
 from ..memory import describe
 
 __all__ = ["YamlError", "MAX_CONFIG_BYTES", "MAX_DEPTH", "MAX_NODES", "read_text", "parse_yaml"]
@@ -62,6 +62,8 @@ def read_text(path: str | Path, limit: int = MAX_CONFIG_BYTES, what: str = "conf
     path = Path(path)
     if str(path) == "":
         raise YamlError(f"an empty file name is not a {what} file")
+    if is_hdf5(path):  # (a result where a config belongs: "holds NUL bytes" said less)
+        raise YamlError(f"is an HDF5 file, not a YAML {what}")
     try:
         data = read_bounded(path, limit)
     except Unreadable as exc:  # ("is a FIFO, not a config file"; "cannot read it (...)")
