@@ -2091,7 +2091,13 @@ def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: boo
                 sys.stderr.write(f"case {case['id']}: running {_command_name(args)}\n")
                 sys.stderr.flush()
                 entry = case["family"] == "options"  # (usage errors: worded by the entry)
-                runs.append(_invoke(runner, app, args, limit, out, h5py, entry))
+                home = os.getcwd()
+                if entry:  # (a relative name given as a value lands in the case's folder)
+                    os.chdir(path)
+                try:
+                    runs.append(_invoke(runner, app, args, limit, out, h5py, entry))
+                finally:
+                    os.chdir(home)
                 done = runs[-1]  # (optimise's exit 3 writes its file all the same)
                 if case["setup"]["kind"] == "folder" and done["exit"] not in (0, 3):
                     done["changed"] = _changed(Path(case["setup"]["path"]), path)
