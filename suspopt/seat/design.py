@@ -118,8 +118,8 @@ def passenger_mass_change(cfg: Config, load_mass) -> dict[str, np.ndarray]:
 
     Pass the result to :func:`suspopt.simulate` as ``params``.
     """
-    load_mass = np.atleast_1d(np.asarray(load_mass, dtype=float))
     seat = require_config(cfg).seat
+    load_mass = np.atleast_1d(np.asarray(load_mass, dtype=float))
     if seat is None:
         raise ConfigError("seat: the config has no seat section")
     bad = np.flatnonzero(~(np.isfinite(load_mass) & (load_mass > 0)))
