@@ -387,8 +387,9 @@ def test_an_evaluation_on_the_fused_step_gives_the_walked_networks_objectives(mo
 def test_the_fused_modules_cache_is_rewritten_when_changed_and_skipped_when_unwritable(
     monkeypatch, tmp_path
 ):
-    """The generated module is kept whole under its hash; a file changed since is written
-    again (what runs is the text generated in the process, never the file), and where the
+    """The generated module is kept whole under its hash; a file changed since (or damaged:
+    not UTF-8) is written again (what runs is the text generated in the process, never the
+    file), a damaged copy of numba's is compiled again, and where the
     cache cannot be written the kernel walks the network (``steps`` is None)."""
     from suspopt.integrator import _fused
 
@@ -408,6 +409,17 @@ def test_the_fused_modules_cache_is_rewritten_when_changed_and_skipped_when_unwr
     monkeypatch.setattr(_fused, "_LOADED", {})
     assert _fused.steps(idx, lay) is not None
     assert path.read_text() == _fused.source(idx, lay)
+    path.write_bytes(b"\xff\xfe not UTF-8")  # (damaged: a UnicodeDecodeError before)
+    monkeypatch.setattr(_fused, "_LOADED", {})
+    assert _fused.steps(idx, lay) is not None
+    assert path.read_text() == _fused.source(idx, lay)
+    for kept, damage in ((".nbi", b""), (".nbi", b"\x80\x04garbage"), (".nbc", b"\x00")):
+        copies = sorted((tmp_path / "fused" / "__pycache__").glob(f"fused_*{kept}"))
+        assert copies  # (numba kept its compiled copies; damaged: numba's EOFError before)
+        for copy in copies:
+            copy.write_bytes(damage)
+        monkeypatch.setattr(_fused, "_LOADED", {})
+        assert _fused.steps(idx, lay) is not None
     blocked = tmp_path / "a file"
     blocked.write_text("")
     monkeypatch.setenv("SUSPOPT_CACHE_DIR", str(blocked))

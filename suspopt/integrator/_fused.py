@@ -22,7 +22,9 @@ user's cache (``$SUSPOPT_CACHE_DIR/fused``, else ``$XDG_CACHE_HOME/suspopt/fused
 ``cache=True`` keeps the compiled functions for later processes: about 2 s of compilation per
 structure and machine on its first use. What runs is the text generated in this process,
 compiled under that file's name, never the file read back. Where the cache cannot be
-written, :func:`steps` returns None and the kernel walks the network.
+written, :func:`steps` returns None and the kernel walks the network. A damaged file of the
+cache (the source, or numba's copy, which numba would fail to read instead of compiling
+again) is written anew.
 """
 
 from __future__ import annotations
@@ -202,7 +204,11 @@ def load(text: str, names: tuple[str, ...]) -> tuple | None:
         return None
     path = folder / f"fused_{digest}.py"
     try:
-        if not path.is_file() or path.read_text() != text:
+        kept = path.read_text(encoding="utf-8") if path.is_file() else None
+    except (OSError, UnicodeDecodeError):  # (a damaged file is written anew)
+        kept = None
+    try:
+        if kept != text:
             folder.mkdir(parents=True, exist_ok=True)
             temporary = folder / f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp"
             temporary.write_text(text)
@@ -213,5 +219,17 @@ def load(text: str, names: tuple[str, ...]) -> tuple | None:
     module = types.ModuleType(f"suspopt_fused_{digest}")
     module.__file__ = str(path)
     sys.modules[module.__name__] = module  # (numba's cache finds the module by its name)
-    exec(compile(text, str(path), "exec"), module.__dict__)
+    code = compile(text, str(path), "exec")
+    try:
+        exec(code, module.__dict__)
+    except Exception:
+        # numba's cache of this module may be damaged (a truncated or overwritten index or
+        # data file): numba raises where it would compile again (EOFError, an unpickling
+        # error), so its files go and it compiles; anything else raises again
+        copies = list((folder / "__pycache__").glob(f"fused_{digest}.*"))
+        if not copies:
+            raise
+        for copy in copies:
+            copy.unlink(missing_ok=True)
+        exec(code, module.__dict__)
     return tuple(getattr(module, name) for name in names)
