@@ -39,7 +39,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from . import _fused
+from . import _fused, _numba_cache
+
+_numba_cache.heal()  # (a damaged file of numba's cache compiles again: ._numba_cache)
 
 __all__ = ["accumulate", "fused", "summed", "source", "ACCUMULATE", "PER_SIGNAL", "PER_PAIR"]
 

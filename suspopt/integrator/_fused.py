@@ -22,9 +22,9 @@ user's cache (``$SUSPOPT_CACHE_DIR/fused``, else ``$XDG_CACHE_HOME/suspopt/fused
 ``cache=True`` keeps the compiled functions for later processes: about 2 s of compilation per
 structure and machine on its first use. What runs is the text generated in this process,
 compiled under that file's name, never the file read back. Where the cache cannot be
-written, :func:`steps` returns None and the kernel walks the network. A damaged file of the
-cache (the source, or numba's copy, which numba would fail to read instead of compiling
-again) is written anew.
+written, :func:`steps` returns None and the kernel walks the network. A source file there
+that is damaged (not UTF-8) is written anew, and numba reads a damaged copy of its own as a
+missing one (:mod:`._numba_cache`).
 """
 
 from __future__ import annotations
@@ -219,17 +219,8 @@ def load(text: str, names: tuple[str, ...]) -> tuple | None:
     module = types.ModuleType(f"suspopt_fused_{digest}")
     module.__file__ = str(path)
     sys.modules[module.__name__] = module  # (numba's cache finds the module by its name)
-    code = compile(text, str(path), "exec")
-    try:
-        exec(code, module.__dict__)
-    except Exception:
-        # numba's cache of this module may be damaged (a truncated or overwritten index or
-        # data file): numba raises where it would compile again (EOFError, an unpickling
-        # error), so its files go and it compiles; anything else raises again
-        copies = list((folder / "__pycache__").glob(f"fused_{digest}.*"))
-        if not copies:
-            raise
-        for copy in copies:
-            copy.unlink(missing_ok=True)
-        exec(code, module.__dict__)
+    from . import _numba_cache
+
+    _numba_cache.heal()  # (numba's damaged copy of the module: compiled again)
+    exec(compile(text, str(path), "exec"), module.__dict__)
     return tuple(getattr(module, name) for name in names)

@@ -27,6 +27,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from . import _numba_cache
+
+_numba_cache.heal()  # (a damaged file of numba's cache compiles again: ._numba_cache)
 _jit = numba.njit(cache=True, nogil=True)
 
 
