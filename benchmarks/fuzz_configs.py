@@ -161,6 +161,13 @@ def report(title: str, cases, results, slowest: int, causes: int) -> None:
         print(f"| {seconds:.2f} | {cmd} | `{case.id}` |")
 
 
+def reported(title: str, cases, results, opts) -> list[dict]:
+    """Print the tables of a family of cases (:func:`report`); its cases and results, for
+    ``--json``."""
+    report(title, cases, results, opts.slowest, opts.causes)
+    return [{"case": fh.asdict(c), "result": results[c.id]} for c in cases]
+
+
 def keep(cases, results, folder: Path) -> None:
     """Copy the inputs of the failing Pareto cases (regular files only) to ``folder``."""
     import shutil
@@ -235,15 +242,8 @@ def main() -> None:
             made = time.perf_counter() - start
             results = fh.run_cases(cases, **run)
         wall = time.perf_counter() - start
-        report(
-            f"options and arguments: {len(cases)} cases (inputs made in {made:.1f} s, "
-            f"wall {wall:.1f} s)",
-            cases,
-            results,
-            opts.slowest,
-            opts.causes,
-        )
-        dumped["options"] = [{"case": fh.asdict(c), "result": results[c.id]} for c in cases]
+        title = f"options and arguments: {len(cases)} cases (inputs made in {made:.1f} s"
+        dumped["options"] = reported(f"{title}, wall {wall:.1f} s)", cases, results, opts)
     if not (opts.h5_only or opts.options):
         start = time.perf_counter()
         configs = fh.bundled_configs()
@@ -257,16 +257,12 @@ def main() -> None:
         made = time.perf_counter() - start
         results = fh.run_cases(cases, **run)
         wall = time.perf_counter() - start
-        report(
+        title = (
             f"{'optimisation ' if opts.optimise else ''}configs"
             f"{' at their bounds' if opts.bounds else ''}: {len(cases)} cases "
-            f"({0 if opts.bounds else opts.cases} random; made in {made:.1f} s, wall {wall:.1f} s)",
-            cases,
-            results,
-            opts.slowest,
-            opts.causes,
+            f"({0 if opts.bounds else opts.cases} random; made in {made:.1f} s, wall {wall:.1f} s)"
         )
-        dumped["configs"] = [{"case": fh.asdict(c), "result": results[c.id]} for c in cases]
+        dumped["configs"] = reported(title, cases, results, opts)
     if not (opts.configs_only or opts.options):
         start = time.perf_counter()
         variants = ([] if opts.no_fixed else fh.h5_variants()) + fh.h5_random_variants(
@@ -278,14 +274,8 @@ def main() -> None:
             if opts.keep:
                 keep(cases, results, opts.keep)
         wall = time.perf_counter() - start
-        report(
-            f"Pareto files: {len(cases)} cases ({opts.h5_cases} random; wall {wall:.1f} s)",
-            cases,
-            results,
-            opts.slowest,
-            opts.causes,
-        )
-        dumped["h5"] = [{"case": fh.asdict(c), "result": results[c.id]} for c in cases]
+        title = f"Pareto files: {len(cases)} cases ({opts.h5_cases} random; wall {wall:.1f} s)"
+        dumped["h5"] = reported(title, cases, results, opts)
     if opts.json:
         opts.json.write_text(json.dumps(dumped))
         print(f"\nwrote {opts.json}")
