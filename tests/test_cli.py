@@ -18,7 +18,7 @@ BAD_INPUTS = {
     "malformed_yaml": (
         GOOD.replace("  preset: half_pitch", "  preset: [half_pitch"),
         "malformed YAML",
-        None,
+        6,
     ),
     "unknown_key": (
         GOOD.replace("unsprung_mass: 50", "unsprung_mas: 50"),
@@ -55,6 +55,8 @@ def test_bad_input_exits_2_with_one_line(tmp_path, case):
     assert needle in message
     if line is not None:
         assert f"case.yaml:{line}:" in message
+    else:  # (a key absent with every key above it: the file alone, "case.yaml:?:" before)
+        assert message.startswith(f"error: {cfg}: "), message
     assert not out.exists()
     assert list(tmp_path.glob("*.tmp")) == [] and list(tmp_path.glob(".*tmp")) == []
 

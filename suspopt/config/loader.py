@@ -2,7 +2,8 @@
 
 Every error names the YAML key path and its line: ``case.yaml:12: vehicle.body.mass: ...``.
 Values built into the config by merging (``corner_defaults``) are reported at the line of the
-key they came from.
+key they came from; a key absent from the file at the line of the nearest key above it that
+is there, or with no line when none is (``case.yaml: road: required key is missing``).
 """
 
 from __future__ import annotations
@@ -101,7 +102,7 @@ class Config(Section):
         """A ConfigError for a problem found after validation, located like a load error."""
         name = str(self._source) if self._source is not None else "<config>"
         line = _line_of(loc, self._lines) if self._lines else None
-        return ConfigError(f"{name}:{line if line else '?'}: {_dotted(loc)}: {message}")
+        return ConfigError(f"{_at(name, line)}: {_dotted(loc)}: {message}")
 
     @property
     def source(self) -> Path | None:
@@ -143,6 +144,13 @@ def line_of(node: yaml.Node | None, keys: tuple) -> int | None:
     """The 1-based line of the key path ``keys`` in the composed YAML ``node`` (that of the
     nearest enclosing key when it is not there), or None."""
     return _line_of(tuple(keys), _line_map(node)) if node is not None else None
+
+
+def _at(name: str, line: int | None) -> str:
+    """``file:line`` of a message, or the file alone when the key and every key above it are
+    absent from the file (a section left out: ``case.yaml: road: required key is missing``,
+    where ``case.yaml:?:`` was written before)."""
+    return f"{name}:{line}" if line else name
 
 
 def _line_of(loc: tuple, lines: dict) -> int | None:
@@ -300,7 +308,7 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
         msg, line = _format(first, lines, data)
         more = len(exc.errors()) - 1
         tail = f" (+{more} more error{'s' if more > 1 else ''})" if more else ""
-        raise ConfigError(f"{name}:{line if line else '?'}: {msg}{tail}") from None
+        raise ConfigError(f"{_at(name, line)}: {msg}{tail}") from None
     cfg._source = source
     cfg._text = text
     cfg._lines = lines
