@@ -1491,6 +1491,7 @@ OPTION_VALUES = [
     "3.5", "1,2", ",", "", "-", "..", "~", "ü/ß", "x" * 300, "x/" * 200, "/", "/dev/zero",
     "/dev/stdin", "/proc/self/mem", "/proc/self/status", "{path}", "{path}/fifo",
     "{path}/study.yaml", "{path}/front.h5", "{path}/nofile/x.h5", "{path}/study.yaml/x",
+    "4G", "1e30G", "-2G", "0.5K", "--force", "--help", "A", "knee,chosen,0,-1,99",
 ]  # fmt: skip
 #: One valid run of every command on :func:`option_fixtures` (``{path}``: the case's copy of
 #: the folder; ``{out}``: an output beside it); the options of each are fuzzed on it
