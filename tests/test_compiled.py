@@ -9,6 +9,8 @@ the numpy engine and say so.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import yaml
@@ -416,6 +418,15 @@ def test_a_damaged_file_of_numbas_cache_is_compiled_again_and_a_sound_one_is_rea
         kept.write_bytes(damage)
         assert not compiled_from_cache()  # (compiled again, where numba raised)
         assert compiled_from_cache()  # (and its cache written anew)
+
+
+def test_the_fused_modules_cache_folder_expands_a_home_that_no_shell_expanded(monkeypatch):
+    """``SUSPOPT_CACHE_DIR=~/cache`` from an environment file (no shell to expand ``~``)
+    made a folder named ``~`` in the working folder."""
+    from suspopt.integrator import _fused
+
+    monkeypatch.setenv("SUSPOPT_CACHE_DIR", "~/suspopt-cache")
+    assert _fused.cache_dir() == Path.home() / "suspopt-cache" / "fused"
 
 
 def test_the_fused_modules_cache_is_rewritten_when_changed_and_skipped_when_unwritable(

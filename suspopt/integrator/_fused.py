@@ -174,8 +174,8 @@ def source(idx: np.ndarray, lay: np.ndarray) -> str:
 
 def cache_dir() -> Path:
     """Where the generated modules (and numba's compiled copies) are kept."""
-    if os.environ.get("SUSPOPT_CACHE_DIR"):
-        return Path(os.environ["SUSPOPT_CACHE_DIR"]) / "fused"
+    if os.environ.get("SUSPOPT_CACHE_DIR"):  # ("~/cache" from a file that no shell expanded)
+        return Path(os.environ["SUSPOPT_CACHE_DIR"]).expanduser() / "fused"
     xdg = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(xdg) / "suspopt" / "fused"
 
