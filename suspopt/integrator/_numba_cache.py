@@ -7,7 +7,8 @@ every process, until someone deletes the file. :func:`heal` makes numba treat su
 missing, as a change pending in numba does: the function compiles again and its cache is
 written anew. It wraps the two methods of ``numba.core.caching.IndexDataCacheFile`` that read
 the index and the data, once per process, and only where numba has them; nothing else of
-numba's changes. The modules that compile with ``cache=True`` call it before their first
+numba's changes. It holds for every cached numba function of the process, suspopt's or not
+(a damaged file is then compiled again where numba would have raised). The modules that compile with ``cache=True`` call it before their first
 function (``._kernel``, ``._accumulate``, ``._reductions``, and ``._fused`` before a
 generated module).
 """
