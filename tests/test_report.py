@@ -183,11 +183,15 @@ def test_a_page_over_its_size_is_refused_once_its_data_show_it(files, tmp_path, 
     assert res.output.startswith(
         "error: report: the page would be more than 0 MB (the data of its first 2 of 10 files"
     ), res.output
+    assert res.output.strip().endswith("MB): give fewer files"), res.output  # (no rows asked)
     assert len(read) == 2 and not page.exists()
     monkeypatch.setattr(report, "MAX_BYTES", one + 1)  # the data fit; the page does not
     res = _invoke("report", files["front"], "-o", page)
     assert res.exit_code == 2 and "error: report: the page would be more than 0 MB (" in res.output
     assert len(res.output.strip().splitlines()) == 1 and not page.exists()
+    res = _invoke("report", files["front"], "-o", page, "--with-signals", "0")  # (rows asked)
+    assert res.output.strip().endswith("give fewer --with-signals designs or fewer files")
+    assert res.exit_code == 2 and not page.exists()
 
 
 def _browser():

@@ -223,10 +223,10 @@ def _transmissibility(picked, rows: list[int], out: dict) -> None:
             tr["dofs"].setdefault(name, []).extend(_list(curves[:, :, j]))
 
 
-def _too_large(detail: str) -> None:
+def _too_large(detail: str, with_signals: Sequence[str]) -> None:
+    fewer = "fewer --with-signals designs or fewer files" if with_signals else "fewer files"
     raise ConfigError(
-        f"report: the page would be more than {MAX_BYTES >> 20} MB ({detail}): fewer "
-        f"--with-signals designs or fewer files"
+        f"report: the page would be more than {MAX_BYTES >> 20} MB ({detail}): give {fewer}"
     )
 
 
@@ -252,12 +252,14 @@ def build_report(
         data += data_bytes(studies[-1])
         if data > MAX_BYTES:
             _too_large(
-                f"the data of its first {len(studies)} of {len(paths)} files alone take {data >> 20} MB"
+                f"the data of its first {len(studies)} of {len(paths)} files alone take "
+                f"{data >> 20} MB",
+                with_signals,
             )
     html = render(studies, title or ", ".join(s.label for s in studies))
     size = len(html.encode())
     if size > MAX_BYTES:
-        _too_large(f"{size >> 20} MB")
+        _too_large(f"{size >> 20} MB", with_signals)
     from ..io import atomic_file
 
     with atomic_file(output) as stream:
