@@ -315,7 +315,11 @@ def atomic_file(
 
 @contextmanager
 def _atomic_file(path: Path, force: bool, inputs: Iterable[tuple[str, str | Path]]) -> Iterator:
-    held = _held.get(_key(path)) if path.parent.is_dir() else None
+    try:  # (the folder: the one look-up, as check_target's, which words what is wrong)
+        parent = status(path.parent)
+    except Unreadable:
+        parent = None
+    held = _held.get(_key(path)) if parent is not None and stat.S_ISDIR(parent.st_mode) else None
     force = force or (held is not None and held[2])
     with claim(path, force, inputs=inputs):
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=_TMP, dir=path.parent)

@@ -558,6 +558,18 @@ def test_a_path_the_system_cannot_look_up_is_bad_input(tiny_front, capsys, args,
     assert sorted(p.name for p in tiny_front.parent.iterdir()) == before  # nothing written
 
 
+def test_the_librarys_writers_refuse_a_folder_the_system_cannot_look_up(tmp_path):
+    """``atomic_file`` (every writer's) looked its folder up with ``Path.is_dir`` before
+    ``check_target``: a name too long was an OSError there (the command line checks its
+    outputs first, so only the library met it)."""
+    from suspopt.io import atomic_file
+
+    with pytest.raises(suspopt.ConfigError, match=r"cannot inspect it \(File name too long\)"):
+        with atomic_file(tmp_path / LONG / "out.h5") as stream:
+            stream.write(b"never")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_relative_output_in_a_deleted_working_folder_is_bad_input(tmp_path, capsys, monkeypatch):
     """``cd build && rm -r ../build && suspopt simulate ... -o out.h5``: '.' still answers
     as a folder, so the output's lock looked up its full path and got a traceback."""
