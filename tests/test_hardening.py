@@ -567,6 +567,10 @@ def test_the_librarys_writers_refuse_a_folder_the_system_cannot_look_up(tmp_path
     with pytest.raises(suspopt.ConfigError, match=r"cannot inspect it \(File name too long\)"):
         with atomic_file(tmp_path / LONG / "out.h5") as stream:
             stream.write(b"never")
+    from suspopt.optimise.output import read_checkpoint  # (optimise(..., resume=True))
+
+    with pytest.raises(suspopt.ConfigError, match=r"--resume: .*: cannot inspect it \(File name"):
+        read_checkpoint(tmp_path / LONG, None, None)
     assert list(tmp_path.iterdir()) == []
 
 

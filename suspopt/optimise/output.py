@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import Config, ConfigError
+from ..files import Unreadable, status
 from ..io import text_array, write_dataset
 from .problem import Problem
 
@@ -102,7 +103,11 @@ def read_checkpoint(output: Path, cfg: Config, problem: Problem):
     from ..h5read import H5Reader
 
     where = f"--resume: {output}"
-    if not output.exists():
+    try:
+        missing = status(output) is None
+    except Unreadable as exc:  # (a name too long: Path.exists raised)
+        raise ConfigError(f"{where}: {exc}") from None
+    if missing:
         raise ConfigError(f"{where}: does not exist (run without --resume to start)")
     with H5Reader(output, where) as h5:
         if h5.text_attr("config") != cfg.text:
