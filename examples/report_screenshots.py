@@ -31,6 +31,24 @@ def _browser(width: int = 1400, height: int = 2000):
     )
 
 
+#: True while a parallel-coordinates plot on screen is not drawn yet (the page draws each
+#: when it comes on screen, after the rest)
+UNDRAWN_ON_SCREEN = (
+    "return [...document.querySelectorAll('[id^=parallel-]')].some(d => {"
+    " const r = d.getBoundingClientRect();"
+    " return r.bottom > 0 && r.top < innerHeight && !d.hasAttribute('data-drawn'); })"
+)
+
+
+def _settle(browser, deadline: float) -> bool:
+    """Wait until the parallel-coordinates plots on screen are drawn; False past ``deadline``."""
+    while browser.execute_script(UNDRAWN_ON_SCREEN):
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.1)
+    return True
+
+
 def check(page: Path, crops: dict[str, str] | None = None) -> str | None:
     """The problem with ``page`` in the browser, or None; its screenshot is written, and
     each ``crops`` element (CSS selector -> PNG path)."""
@@ -42,6 +60,8 @@ def check(page: Path, crops: dict[str, str] | None = None) -> str | None:
             if time.monotonic() > deadline:
                 return "the plots did not render in 120 s"
             time.sleep(0.2)
+        if not _settle(browser, deadline):
+            return "the parallel coordinates on screen did not draw in 120 s"
         errors = [e["message"] for e in browser.get_log("browser") if e["level"] == "SEVERE"]
         if errors:
             return f"console errors: {errors[:3]}"
@@ -54,7 +74,11 @@ def check(page: Path, crops: dict[str, str] | None = None) -> str | None:
             return f"network requests: {urls[:3]}"
         browser.save_screenshot(str(page.with_suffix(".png")))
         for selector, target in (crops or {}).items():
-            browser.find_element(By.CSS_SELECTOR, selector).screenshot(target)
+            element = browser.find_element(By.CSS_SELECTOR, selector)
+            browser.execute_script("arguments[0].scrollIntoView()", element)
+            if not _settle(browser, time.monotonic() + 60):
+                return f"{selector}: the parallel coordinates did not draw in 60 s"
+            element.screenshot(target)
     finally:
         browser.quit()
     return None

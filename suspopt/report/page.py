@@ -141,14 +141,53 @@ SCRIPT = r"""
     return Plotly.react(div, traces, layout, { displaylogo: false });
   }
 
+  // Parallel coordinates are WebGL plots of three contexts each, and a browser keeps about 16
+  // per page, losing the oldest beyond (Chromium: "Too many active WebGL contexts"). So each is
+  // drawn when it comes on screen (or its button is pressed), and when PARALLEL_LIVE are drawn
+  // the one drawn longest ago that is off screen is freed (its contexts lost on purpose) and
+  // drawn again when it comes back. It draws at the screen's pixel ratio (plotly's default, 2,
+  // draws four times the pixels on an ordinary screen).
+  const PARALLEL_LIVE = 3, parallelLive = [], parallelSeen = new Set();
+  function parallelButton(i) {
+    const div = document.getElementById("parallel-" + i);
+    div.textContent = "";
+    el("button", "draw the parallel coordinates", div).addEventListener("click", () => drawParallel(i));
+  }
+  function freeParallel(i) {
+    const div = document.getElementById("parallel-" + i);
+    div.querySelectorAll("canvas.gl-canvas").forEach(c => {
+      const gl = c.getContext("webgl") || c.getContext("experimental-webgl");
+      const lose = gl && gl.getExtension("WEBGL_lose_context");
+      if (lose) lose.loseContext();
+    });
+    Plotly.purge(div);
+    div.removeAttribute("data-drawn");
+    parallelButton(i);
+  }
   function drawParallel(i) {
-    const study = data.studies[i], d = study.data;
+    if (parallelLive.includes(i)) return Promise.resolve();
+    while (parallelLive.length >= PARALLEL_LIVE) {
+      const k = parallelLive.findIndex(j => !parallelSeen.has(j));
+      freeParallel(parallelLive.splice(k < 0 ? 0 : k, 1)[0]);
+    }
+    parallelLive.push(i);
+    const study = data.studies[i], d = study.data, div = document.getElementById("parallel-" + i);
     const dims = d.objectives.map((n, j) => ({ label: n, values: column(study, "F:" + j) }))
       .concat(d.variables.map((n, j) => ({ label: n, values: column(study, "X:" + j) })));
     const colour = d.feasible ? d.feasible.map(v => (v ? 1 : 0)) : column(study, "F:0");
-    return Plotly.newPlot("parallel-" + i, [{ type: "parcoords", dimensions: dims,
-      line: { color: colour, colorscale: "Viridis" } }], { margin: { t: 40 } }, { displaylogo: false });
+    const ratio = Math.min(2, Math.max(1, window.devicePixelRatio || 1));
+    div.textContent = "";
+    return Plotly.newPlot(div, [{ type: "parcoords", dimensions: dims,
+      line: { color: colour, colorscale: "Viridis" } }], { margin: { t: 40 } },
+      { displaylogo: false, plotGlPixelRatio: ratio })
+      .then(() => { if (parallelLive.includes(i)) div.setAttribute("data-drawn", "1"); });
   }
+  const parallelWatch = "IntersectionObserver" in window ? new IntersectionObserver(entries => {
+    for (const e of entries) {
+      const i = Number(e.target.id.slice("parallel-".length));
+      if (e.isIntersecting) { parallelSeen.add(i); drawParallel(i); } else parallelSeen.delete(i);
+    }
+  }, { rootMargin: "200px" }) : null;
 
   function drawHistory(i) {
     const h = data.studies[i].data.history;
@@ -214,11 +253,16 @@ SCRIPT = r"""
       const e = document.getElementById(id + i); if (e) e.addEventListener("change", () => drawFront(i));
     }
     if (sig) sig.addEventListener("change", () => drawSignals(i));
-    api.studies.push({ label: study.label, points: d.rows, front: "front-" + i });
-    done.push(front, drawParallel(i), drawHistory(i), drawSignals(i), drawTransmissibility(i));
+    api.studies.push({ label: study.label, points: d.rows, front: "front-" + i, parallel: "parallel-" + i });
+    parallelButton(i);
+    done.push(front, drawHistory(i), drawSignals(i), drawTransmissibility(i));
     showDesign(i, Object.values(d.picks)[0] || 0);
   });
-  Promise.all(done).then(() => { document.body.setAttribute("data-rendered", "1"); });
+  Promise.all(done).then(() => {
+    document.body.setAttribute("data-rendered", "1");
+    // (the parallel coordinates after the rest: the front shows first)
+    if (parallelWatch) data.studies.forEach((_, i) => parallelWatch.observe(document.getElementById("parallel-" + i)));
+  });
 })();
 """
 
