@@ -302,16 +302,22 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
     18 contexts, over the 16 Chromium keeps, which loses the oldest plots' lines. Scrolled
     through, each plot on screen is drawn with one line per design on live contexts, at most
     three are drawn at once, the console never reports a lost context; scrolled back, the
-    first is drawn again."""
+    first is drawn again, with the range brushed on it before it was freed: the designs in
+    the range are the front's selected points. Its lines take the front's colour."""
     folder = chapters["ch6"].parent
     sources = [files["front"], files["kesort"], files["roads"], files["robust"],
                folder / "ch6_part_b.h5", folder / "ch8_pareto_ps_class_a.h5"]  # fmt: skip
     page = tmp_path / "many.html"
     assert _invoke("report", *sources, "-o", page).exit_code == 0
+    with h5py.File(files["front"]) as h5:
+        f1 = h5["pareto/F"][:, 0]
+    brush = [float(f1.min()), float(sorted(f1)[len(f1) // 2])]
+    inside = [r for r, v in enumerate(f1) if brush[0] <= v <= brush[1]]
+    assert 0 < len(inside) < len(f1)
     browser.get_log("browser")
     browser.get(page.resolve().as_uri())
     _wait(browser, "return document.body.getAttribute('data-rendered')", "the plots drew")
-    for i in [*range(len(sources)), 0]:
+    for k, i in enumerate([*range(len(sources)), 0]):
         div = f"document.getElementById('parallel-{i}')"
         browser.execute_script(f"{div}.scrollIntoView({{block: 'center'}})")
         _wait(browser, f"return {div}.getAttribute('data-drawn')", f"parallel-{i} drew")
@@ -324,5 +330,24 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
         assert lines == points and lost == [False, False, False], (i, lines, points, lost)
         drawn = browser.execute_script("return document.querySelectorAll('[data-drawn]').length")
         assert 1 <= drawn <= 3
+        if k == 0:  # brushing f1 of the first study
+            browser.execute_script(
+                f"Plotly.restyle({div}, {{'dimensions[0].constraintrange': [arguments[0]]}})", brush
+            )
     warnings = [e["message"] for e in browser.get_log("browser") if "WebGL" in e["message"]]
     assert not [m for m in warnings if "context" in m.lower()], warnings
+    kept, selected, note = browser.execute_script(
+        "return [document.getElementById('parallel-0').data[0].dimensions[0].constraintrange,"
+        " document.getElementById('front-0').data[0].selectedpoints,"
+        " document.getElementById('brush-0').textContent]"
+    )
+    assert kept in (brush, [brush]) and selected == inside
+    assert note == f"{len(inside)} of {len(f1)} designs in the brushed ranges"
+    browser.execute_script(
+        "const c = document.getElementById('c-0'); c.value = 'F:1';"
+        " c.dispatchEvent(new Event('change'))"
+    )
+    with h5py.File(files["front"]) as h5:
+        f2 = h5["pareto/F"][:, 1]
+    line = browser.execute_script("return document.getElementById('parallel-0').data[0].line")
+    assert line["color"] == f2.tolist() and line["colorscale"] == "Viridis"

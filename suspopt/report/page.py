@@ -48,10 +48,13 @@ SCRIPT = r"""
     const rows = kind === "F" ? d.F : d.X;
     return rows.map(r => r[Number(j)]);
   }
+  function name(study, key) {
+    const d = study.data, [kind, j] = key.split(":");
+    return kind === "F" ? d.objectives[j] : d.variables[j];
+  }
   function label(study, key) {
     const d = study.data, [kind, j] = key.split(":");
-    return kind === "F" ? d.objectives[j] + " [" + d.objective_units[j] + "]"
-                        : d.variables[j] + " [" + d.variable_units[j] + "]";
+    return name(study, key) + " [" + (kind === "F" ? d.objective_units[j] : d.variable_units[j]) + "]";
   }
   function select(el_, options, value) {
     for (const [k, text] of options) {
@@ -96,6 +99,33 @@ SCRIPT = r"""
     return column(study, key);
   }
 
+  // the colour of the designs (the front's markers and the parallel coordinates' lines)
+  function colouring(study, c) {
+    const out = { color: colourValues(study, c), colorscale: "Viridis",
+                  colorbar: { title: { text: (colours(study).find(o => o[0] === c) || [c, c])[1] } } };
+    if (c === "feasible") Object.assign(out, { colorscale: [[0, "#d62728"], [1, "#1f77b4"]], cmin: 0, cmax: 1,
+      colorbar: { title: { text: "feasible" }, tickvals: [0, 1], ticktext: ["no", "yes"] } });
+    return out;
+  }
+
+  // Brushing: the ranges dragged along the parallel coordinates' axes (kept while a plot is
+  // freed), and the rows inside all of them, which the front shows as selected.
+  const brushes = data.studies.map(() => []);
+  function inside(value, range) {
+    return (Array.isArray(range[0]) ? range : [range]).some(r => value >= r[0] && value <= r[1]);
+  }
+  function brushed(i) {
+    const study = data.studies[i], keys = parallelKeys(study);
+    const active = keys.map((k, j) => [k, brushes[i][j]]).filter(([, r]) => r && r.length);
+    if (!active.length) return null;
+    const values = active.map(([k, r]) => [column(study, k), r]);
+    return study.data.F.map((_, row) => row).filter(row => values.every(([v, r]) => inside(v[row], r)));
+  }
+  function showBrush(i) {
+    const rows = brushed(i), note = document.getElementById("brush-" + i);
+    note.textContent = rows ? rows.length + " of " + data.studies[i].data.rows + " designs in the brushed ranges" : "";
+  }
+
   function drawFront(i) {
     const study = data.studies[i], d = study.data;
     const x = document.getElementById("x-" + i).value, y = document.getElementById("y-" + i).value;
@@ -103,12 +133,10 @@ SCRIPT = r"""
     const three = document.getElementById("d3-" + i);
     const rows = d.F.map((_, r) => r);
     const hover = rows.map(r => "row " + r + "<br>" + d.objectives.map((n, j) => n + " " + fmt(d.F[r][j])).join("<br>"));
-    const marker = { color: colourValues(study, c), colorscale: "Viridis", showscale: true, size: 7,
-                     colorbar: { title: { text: (colours(study).find(o => o[0] === c) || [c, c])[1] } } };
-    if (c === "feasible") Object.assign(marker, { colorscale: [[0, "#d62728"], [1, "#1f77b4"]], cmin: 0, cmax: 1,
-      colorbar: { title: { text: "feasible" }, tickvals: [0, 1], ticktext: ["no", "yes"] } });
+    const marker = Object.assign(colouring(study, c), { showscale: true, size: 7 });
     const traces = [];
     const use3d = three && three.checked;
+    const chosen = brushed(i);
     if (use3d) {
       traces.push({ type: "scatter3d", mode: "markers", name: "designs", x: column(study, "F:0"),
         y: column(study, "F:1"), z: column(study, "F:2"), customdata: rows, text: hover,
@@ -116,7 +144,8 @@ SCRIPT = r"""
     } else {
       traces.push({ type: "scatter",
         mode: "markers", name: "designs", x: column(study, x), y: column(study, y), customdata: rows,
-        text: hover, hoverinfo: "text", marker: marker });
+        text: hover, hoverinfo: "text", marker: marker, selectedpoints: chosen,
+        unselected: { marker: { opacity: 0.15 } } });
       const names = Object.keys(d.picks), pr = names.map(n => d.picks[n]);
       traces.push({ type: "scatter", mode: "markers+text", name: "picks", x: pr.map(r => column(study, x)[r]),
         y: pr.map(r => column(study, y)[r]), text: names, textposition: "top center", customdata: pr,
@@ -171,16 +200,33 @@ SCRIPT = r"""
       freeParallel(parallelLive.splice(k < 0 ? 0 : k, 1)[0]);
     }
     parallelLive.push(i);
-    const study = data.studies[i], d = study.data, div = document.getElementById("parallel-" + i);
-    const dims = d.objectives.map((n, j) => ({ label: n, values: column(study, "F:" + j) }))
-      .concat(d.variables.map((n, j) => ({ label: n, values: column(study, "X:" + j) })));
-    const colour = d.feasible ? d.feasible.map(v => (v ? 1 : 0)) : column(study, "F:0");
-    const ratio = Math.min(2, Math.max(1, window.devicePixelRatio || 1));
+    const div = document.getElementById("parallel-" + i);
     div.textContent = "";
-    return Plotly.newPlot(div, [{ type: "parcoords", dimensions: dims,
-      line: { color: colour, colorscale: "Viridis" } }], { margin: { t: 40 } },
-      { displaylogo: false, plotGlPixelRatio: ratio })
-      .then(() => { if (parallelLive.includes(i)) div.setAttribute("data-drawn", "1"); });
+    return Plotly.newPlot(div, parallelTraces(i), { margin: { t: 40 } }, parallelConfig())
+      .then(() => {
+        if (!parallelLive.includes(i)) return;
+        div.setAttribute("data-drawn", "1");
+        div.on("plotly_restyle", () => {
+          brushes[i] = div.data[0].dimensions.map(d => d.constraintrange || null);
+          showBrush(i);
+          drawFront(i);
+        });
+      });
+  }
+  function parallelConfig() {
+    return { displaylogo: false, plotGlPixelRatio: Math.min(2, Math.max(1, window.devicePixelRatio || 1)) };
+  }
+  function parallelKeys(study) {
+    const d = study.data;
+    return d.objectives.map((_, j) => "F:" + j).concat(d.variables.map((_, j) => "X:" + j));
+  }
+  function parallelTraces(i) {
+    const study = data.studies[i], keys = parallelKeys(study);
+    const dims = keys.map((k, j) => Object.assign({ label: name(study, k), values: column(study, k) },
+                                                  brushes[i][j] ? { constraintrange: brushes[i][j] } : {}));
+    const line = colouring(study, document.getElementById("c-" + i).value);
+    delete line.colorbar;
+    return [{ type: "parcoords", dimensions: dims, line: line }];
   }
   const parallelWatch = "IntersectionObserver" in window ? new IntersectionObserver(entries => {
     for (const e of entries) {
@@ -252,6 +298,9 @@ SCRIPT = r"""
     for (const id of ["x-", "y-", "c-", "d3-"]) {
       const e = document.getElementById(id + i); if (e) e.addEventListener("change", () => drawFront(i));
     }
+    document.getElementById("c-" + i).addEventListener("change", () => {
+      if (parallelLive.includes(i)) Plotly.react("parallel-" + i, parallelTraces(i), { margin: { t: 40 } }, parallelConfig());
+    });
     if (sig) sig.addEventListener("change", () => drawSignals(i));
     api.studies.push({ label: study.label, points: d.rows, front: "front-" + i, parallel: "parallel-" + i });
     parallelButton(i);
@@ -303,7 +352,8 @@ def _section(i: int, study) -> str:
         f"<label>colour <select id='c-{i}'></select></label>{three}</div>",
         f"<div class='row'><div id='front-{i}' class='plot'></div>"
         f"<div id='design-{i}' class='design'></div></div>",
-        f"<h3>Objectives and variables</h3><div id='parallel-{i}' class='wide'></div>",
+        f"<h3>Objectives and variables <span id='brush-{i}' class='note'></span></h3>"
+        f"<div id='parallel-{i}' class='wide'></div>",
     ]
     if d["signals"]["signals"]:
         parts.append(
@@ -344,7 +394,8 @@ def render(studies, title: str) -> str:
             f"<title>{e(title)}</title><style>{STYLE}</style></head><body>",
             f"<h1>{e(title)}</h1>",
             "<p class='note'>Click a design to see its row; drag along an axis of the "
-            "parallel coordinates to brush. Written by suspopt report; it needs no network.</p>",
+            "parallel coordinates to select those designs in the front. Written by suspopt "
+            "report; it needs no network.</p>",
             *(_section(i, s) for i, s in enumerate(studies)),
             f"<script type='application/json' id='suspopt-data'>{_json(payload)}</script>",
             f"<script>{_plotly_js()}</script>",
