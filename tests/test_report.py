@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import shlex
 import shutil
 import time
 from pathlib import Path
@@ -236,7 +237,7 @@ def browser():
 @pytest.mark.browser
 @pytest.mark.slow
 @pytest.mark.parametrize("which", [*CHAPTERS, "robust"])
-def test_the_report_in_a_real_browser(files, chapters, browser, tmp_path, which):
+def test_the_report_in_a_real_browser(files, chapters, browser, tmp_path, monkeypatch, which):
     """In headless Chromium: the plots render, the console has no error, the front has one
     point per design, a click shows the design's row, and the page asks the network for
     nothing. A screenshot is kept in ``$SUSPOPT_ARTEFACTS`` (default: the test's folder):
@@ -282,6 +283,18 @@ def test_the_report_in_a_real_browser(files, chapters, browser, tmp_path, which)
         " return [box.getAttribute('data-row'), box.textContent, window.suspoptReport.selected.row]"
     )
     assert shown[0] == str(row) and f"row {row}" in shown[1] and shown[2] == row
+    onward = browser.execute_script(  # the commands that take the design on, run as shown
+        "return [...document.querySelectorAll('#design-0 .onward code')].map(c => c.textContent)"
+    )
+    assert [shlex.split(c)[:2] for c in onward] == [["suspopt", "export"], ["suspopt", "simulate"]]
+    monkeypatch.chdir(tmp_path)
+    for command in onward if which == "ch5" else onward[:1]:  # (one simulation is enough)
+        res = _invoke(*shlex.split(command)[1:])
+        assert res.exit_code == 0, (command, res.output)
+    exported = (tmp_path / f"design_{row}.yaml").read_text().splitlines()[0]
+    assert exported.startswith(f"# Design '{row}' (row {row} of /")
+    assert exported.endswith(f" of {shlex.split(onward[0])[2]}")
+    assert which != "ch5" or (tmp_path / f"design_{row}.h5").exists()
     requests = [
         json.loads(entry["message"])["message"]["params"]["request"]["url"]
         for entry in browser.get_log("performance")
@@ -351,3 +364,16 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
         f2 = h5["pareto/F"][:, 1]
     line = browser.execute_script("return document.getElementById('parallel-0').data[0].line")
     assert line["color"] == f2.tolist() and line["colorscale"] == "Viridis"
+
+
+def test_the_commands_shown_for_a_design_name_its_file_as_a_shell_reads_it(files, tmp_path):
+    """The page shows, for the clicked design, the commands that take it on (``export``,
+    ``simulate``) with the file's path as given; quoted, a name with spaces, quotes or ``$(...)``
+    reads back as that name and runs nothing."""
+    odd = tmp_path / "my 'front' $(touch pwned).h5"
+    shutil.copyfile(files["front"], odd)
+    page = tmp_path / "odd.html"
+    assert _invoke("report", odd, "-o", page).exit_code == 0
+    source = _payload(page.read_text())["studies"][0]["data"]["source"]
+    assert shlex.split(f"suspopt export {source} --pick 0") == [
+        "suspopt", "export", str(odd), "--pick", "0"]  # fmt: skip

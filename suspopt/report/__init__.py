@@ -14,7 +14,8 @@ browser and makes no network request. Per study:
   and counts them. It is drawn when it comes on screen, at most three at a time (a browser
   keeps about 16 WebGL contexts per page and each takes three: :data:`.page.SCRIPT`);
 - hover and click on a design: its row, objectives with units, variables, constraint
-  margins, in the panel beside the plot;
+  margins, in the panel beside the plot, and the ``suspopt export`` and ``simulate``
+  commands that take it on (the file's path as given, quoted for a POSIX shell);
 - the picks' (and ``with_signals`` rows') time histories and power spectral densities
   [unit²/Hz], simulated when the report is built (from each design's own config, in one
   batch per config), thinned to at most :data:`MAX_SAMPLES` samples per signal (the page
@@ -32,6 +33,7 @@ are shown as text. The page's JavaScript API ``window.suspoptReport`` (``studies
 
 from __future__ import annotations
 
+import shlex
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -100,6 +102,7 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
         "F": _list(table.F),
         "X": _list(table.X),
         "picks": table.picks,
+        "source": shlex.quote(str(path)),  # (as given, for the commands that take a row on)
         "provenance": attrs,
         **extra,
     }

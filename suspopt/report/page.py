@@ -27,6 +27,8 @@ h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.6em; }
 .design table { border-collapse: collapse; } .design td { padding: 1px 6px; }
 .note { color: #666; font-size: 0.85em; }
 pre { background: #f6f6f6; padding: 0.6em; max-height: 24em; overflow: auto; }
+.onward code { display: block; user-select: all; background: #f6f6f6; padding: 2px 4px;
+  margin: 2px 0; font-size: 0.95em; overflow-wrap: anywhere; }
 """
 
 SCRIPT = r"""
@@ -77,6 +79,11 @@ SCRIPT = r"""
     if (d.G) d.constraints.forEach((n, j) => add("g: " + n, d.G[row][j], d.constraint_units[j]));
     if (d.k_eps) add("k-ε level", d.k_eps[row], "1");
     if (d.case) add("case " + d.case[row], null, "");
+    const onward = el("div", null, box);  // (paths as given to suspopt report)
+    onward.className = "onward";
+    el("div", "take it on (from where the report was made):", onward);
+    el("code", "suspopt export " + d.source + " --pick " + row + " -o design_" + row + ".yaml", onward);
+    el("code", "suspopt simulate " + d.source + " --pick " + row + " -o design_" + row + ".h5 --plot design_" + row + ".png", onward);
     api.selected = { study: i, row: row };
     box.setAttribute("data-row", String(row));
   }
