@@ -27,7 +27,7 @@ h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.6em; }
 .design table { border-collapse: collapse; } .design td { padding: 1px 6px; }
 .note { color: #666; font-size: 0.85em; }
 pre { background: #f6f6f6; padding: 0.6em; max-height: 24em; overflow: auto; }
-.onward code { display: block; user-select: all; background: #f6f6f6; padding: 2px 4px;
+.onward { margin-top: 0.6em; } .onward code { display: block; user-select: all; background: #f6f6f6; padding: 2px 4px;
   margin: 2px 0; font-size: 0.95em; overflow-wrap: anywhere; }
 """
 
