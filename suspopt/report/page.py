@@ -118,8 +118,8 @@ SCRIPT = r"""
   // Brushing: the ranges dragged along the parallel coordinates' axes (kept while a plot is
   // freed), and the rows inside all of them, which the front shows as selected.
   const brushes = data.studies.map(() => []);
-  function inside(value, range) {
-    return (Array.isArray(range[0]) ? range : [range]).some(r => value >= r[0] && value <= r[1]);
+  function inside(value, range) {  // (a value not finite, null in the data, is in no range)
+    return value !== null && (Array.isArray(range[0]) ? range : [range]).some(r => value >= r[0] && value <= r[1]);
   }
   function brushed(i) {
     const study = data.studies[i], keys = parallelKeys(study);
