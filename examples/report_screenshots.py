@@ -1,13 +1,15 @@
 """Each report page drawn in headless Chromium (Debian's chromium and chromium-driver, and
 selenium): waits until its plots have rendered, checks that the console has no error and
 that the page asked the network for nothing, and writes a screenshot beside it
-(``PAGE.png``). Run: ``python examples/report_screenshots.py PAGE.html ... [--crop
-SELECTOR=OUT.png ...]`` (``--crop``: also the element the CSS selector finds in the first
-page, e.g. ``#front-0`` for the README's pictures); exit 1 with the page and the problem on
-the first that fails."""
+(``PAGE.png``). Run: ``python examples/report_screenshots.py PAGE.html ... [--brush STUDY:AXIS:LO:HI ...]
+[--crop SELECTOR=OUT.png ...]`` (``--crop``: also the element the CSS selector finds in the
+first page, e.g. ``#front-0`` for the README's pictures; ``--brush``: first, on the first
+page, the range LO..HI brushed along axis AXIS (0: the first objective) of study STUDY's
+parallel coordinates); exit 1 with the page and the problem on the first that fails."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import shutil
 import sys
@@ -49,9 +51,31 @@ def _settle(browser, deadline: float) -> bool:
     return True
 
 
-def check(page: Path, crops: dict[str, str] | None = None) -> str | None:
+def _brush(browser, study: int, axis: int, lo: float, hi: float) -> bool:
+    """Brush ``lo..hi`` along ``axis`` of ``study``'s parallel coordinates (drawn first)."""
+    div = f"document.getElementById('parallel-{study}')"
+    browser.execute_script(f"{div}.scrollIntoView({{block: 'center'}})")
+    deadline = time.monotonic() + 60
+    while not browser.execute_script(f"return {div}.hasAttribute('data-drawn')"):
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.1)
+    browser.execute_script(
+        f"Plotly.restyle({div}, {{['dimensions[' + arguments[0] + '].constraintrange']:"
+        " [[arguments[1], arguments[2]]]})",
+        axis,
+        lo,
+        hi,
+    )
+    return True
+
+
+def check(
+    page: Path, crops: dict[str, str] | None = None, brushes: list[str] | None = None
+) -> str | None:
     """The problem with ``page`` in the browser, or None; its screenshot is written, and
-    each ``crops`` element (CSS selector -> PNG path)."""
+    each ``crops`` element (CSS selector -> PNG path), after the ``brushes``
+    (``STUDY:AXIS:LO:HI``)."""
     browser = _browser()
     try:
         browser.get(page.resolve().as_uri())
@@ -73,6 +97,10 @@ def check(page: Path, crops: dict[str, str] | None = None) -> str | None:
         if any(url != page.resolve().as_uri() for url in urls):
             return f"network requests: {urls[:3]}"
         browser.save_screenshot(str(page.with_suffix(".png")))
+        for brush in brushes or ():
+            study, axis, lo, hi = brush.split(":")
+            if not _brush(browser, int(study), int(axis), float(lo), float(hi)):
+                return f"--brush {brush}: the parallel coordinates did not draw in 60 s"
         for selector, target in (crops or {}).items():
             element = browser.find_element(By.CSS_SELECTOR, selector)
             browser.execute_script("arguments[0].scrollIntoView()", element)
@@ -85,13 +113,14 @@ def check(page: Path, crops: dict[str, str] | None = None) -> str | None:
 
 
 def main() -> None:
-    args = sys.argv[1:]
-    crops = (
-        dict(a.split("=", 1) for a in args[args.index("--crop") + 1 :]) if "--crop" in args else {}
-    )
-    pages = args[: args.index("--crop")] if "--crop" in args else args
-    for i, name in enumerate(pages):
-        problem = check(Path(name), crops if i == 0 else None)
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("pages", nargs="+", metavar="PAGE.html")
+    parser.add_argument("--crop", nargs="*", default=[], metavar="SELECTOR=OUT.png")
+    parser.add_argument("--brush", action="append", default=[], metavar="STUDY:AXIS:LO:HI")
+    args = parser.parse_args()
+    crops = dict(a.split("=", 1) for a in args.crop)
+    for i, name in enumerate(args.pages):
+        problem = check(Path(name), crops if i == 0 else None, args.brush if i == 0 else None)
         if problem:
             sys.exit(f"{name}: {problem}")
         print(
