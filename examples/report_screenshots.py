@@ -52,14 +52,21 @@ def _settle(browser, deadline: float) -> bool:
 
 
 def _brush(browser, study: int, axis: int, lo: float, hi: float) -> bool:
-    """Brush ``lo..hi`` along ``axis`` of ``study``'s parallel coordinates (drawn first)."""
+    """Brush ``lo..hi`` along ``axis`` of ``study``'s parallel coordinates (drawn first);
+    False if the page has no such study or axis, or the plot does not draw in 60 s."""
     div = f"document.getElementById('parallel-{study}')"
+    if not browser.execute_script(
+        f"return {div} !== null && arguments[0] < window.suspoptReport.studies.length", study
+    ):
+        return False
     browser.execute_script(f"{div}.scrollIntoView({{block: 'center'}})")
     deadline = time.monotonic() + 60
     while not browser.execute_script(f"return {div}.hasAttribute('data-drawn')"):
         if time.monotonic() > deadline:
             return False
         time.sleep(0.1)
+    if axis >= browser.execute_script(f"return {div}.data[0].dimensions.length"):
+        return False
     browser.execute_script(
         f"Plotly.restyle({div}, {{['dimensions[' + arguments[0] + '].constraintrange']:"
         " [[arguments[1], arguments[2]]]})",
@@ -100,7 +107,7 @@ def check(
         for brush in brushes or ():
             study, axis, lo, hi = brush.split(":")
             if not _brush(browser, int(study), int(axis), float(lo), float(hi)):
-                return f"--brush {brush}: the parallel coordinates did not draw in 60 s"
+                return f"--brush {brush}: no such study or axis, or its plot did not draw in 60 s"
         for selector, target in (crops or {}).items():
             element = browser.find_element(By.CSS_SELECTOR, selector)
             browser.execute_script("arguments[0].scrollIntoView()", element)
@@ -112,11 +119,26 @@ def check(
     return None
 
 
+def _brush_arg(text: str) -> str:
+    """``STUDY:AXIS:LO:HI`` as ``--brush`` takes it (argparse's one-line error otherwise)."""
+    parts = text.split(":")
+    try:
+        ok = len(parts) == 4 and int(parts[0]) >= 0 and int(parts[1]) >= 0
+        ok = ok and float(parts[2]) <= float(parts[3])
+    except ValueError:
+        ok = False
+    if not ok:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected STUDY:AXIS:LO:HI, LO <= HI")
+    return text
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("pages", nargs="+", metavar="PAGE.html")
     parser.add_argument("--crop", nargs="*", default=[], metavar="SELECTOR=OUT.png")
-    parser.add_argument("--brush", action="append", default=[], metavar="STUDY:AXIS:LO:HI")
+    parser.add_argument(
+        "--brush", action="append", default=[], metavar="STUDY:AXIS:LO:HI", type=_brush_arg
+    )
     args = parser.parse_args()
     crops = dict(a.split("=", 1) for a in args.crop)
     for i, name in enumerate(args.pages):
