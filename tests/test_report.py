@@ -309,14 +309,15 @@ def test_the_report_in_a_real_browser(files, chapters, browser, tmp_path, monkey
 @pytest.mark.browser
 @pytest.mark.slow
 def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
-    files, chapters, browser, tmp_path
+    files, chapters, browser, tmp_path, monkeypatch
 ):
     """Six studies: their parallel-coordinates plots (three WebGL contexts each) would hold
     18 contexts, over the 16 Chromium keeps, which loses the oldest plots' lines. Scrolled
     through, each plot on screen is drawn with one line per design on live contexts, at most
     three are drawn at once, the console never reports a lost context; scrolled back, the
     first is drawn again, with the range brushed on it before it was freed: the designs in
-    the range are the front's selected points. Its lines take the front's colour."""
+    the range are the front's selected points, and the command shown simulates them. Its
+    lines take the front's colour."""
     folder = chapters["ch6"].parent
     sources = [files["front"], files["kesort"], files["roads"], files["robust"],
                folder / "ch6_part_b.h5", folder / "ch8_pareto_ps_class_a.h5"]  # fmt: skip
@@ -356,6 +357,19 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
     )
     assert kept in (brush, [brush]) and selected == inside
     assert note == f"{len(inside)} of {len(f1)} designs in the brushed ranges"
+    command = browser.execute_script(  # the brushed designs in one batch, run as shown
+        "return document.querySelector('#brush-command-0 code').textContent"
+    )
+    monkeypatch.chdir(tmp_path)
+    args = shlex.split(command)
+    assert args[:2] == ["suspopt", "simulate"] and args[3:5] == [
+        "--pick",
+        ",".join(map(str, inside)),
+    ]
+    res = _invoke(*args[1:])
+    assert res.exit_code == 0, (command, res.output)
+    with h5py.File(tmp_path / "brushed.h5") as h5:
+        assert h5["designs/row"][:].tolist() == inside
     browser.execute_script(
         "const c = document.getElementById('c-0'); c.value = 'F:1';"
         " c.dispatchEvent(new Event('change'))"

@@ -128,9 +128,19 @@ SCRIPT = r"""
     const values = active.map(([k, r]) => [column(study, k), r]);
     return study.data.F.map((_, row) => row).filter(row => values.every(([v, r]) => inside(v[row], r)));
   }
+  const BRUSH_COMMAND_ROWS = 100;  // (the most rows the command of the brushed designs lists)
   function showBrush(i) {
     const rows = brushed(i), note = document.getElementById("brush-" + i);
+    const box = document.getElementById("brush-command-" + i);
     note.textContent = rows ? rows.length + " of " + data.studies[i].data.rows + " designs in the brushed ranges" : "";
+    box.textContent = "";
+    if (!rows || !rows.length) return;
+    if (rows.length > BRUSH_COMMAND_ROWS) {
+      el("div", "(more than " + BRUSH_COMMAND_ROWS + " designs: narrow the ranges to simulate them in one command)", box);
+      return;
+    }
+    el("div", "simulate them in one batch (from where the report was made):", box);
+    el("code", "suspopt simulate " + data.studies[i].data.source + " --pick " + rows.join(",") + " -o brushed.h5", box);
   }
 
   function drawFront(i) {
@@ -360,7 +370,7 @@ def _section(i: int, study) -> str:
         f"<div class='row'><div id='front-{i}' class='plot'></div>"
         f"<div id='design-{i}' class='design'></div></div>",
         f"<h3>Objectives and variables <span id='brush-{i}' class='note'></span></h3>"
-        f"<div id='parallel-{i}' class='wide'></div>",
+        f"<div id='brush-command-{i}' class='onward'></div><div id='parallel-{i}' class='wide'></div>",
     ]
     if d["signals"]["signals"]:
         parts.append(
