@@ -128,6 +128,26 @@ def test_simulate_writes_the_design_md_layout(tmp_path):
         assert h5["modal/frequency"].attrs["units"] == "Hz"
 
 
+def test_validate_takes_several_configs_and_gives_each_its_line(tmp_path):
+    """Each config gets one line in the order given, valid (stdout) or its first problem
+    (stderr); a bad one does not stop the rest, and the exit code is 2 if any is bad."""
+    from typer.testing import CliRunner
+
+    from suspopt.cli import app
+
+    good = CONFIGS / "quickstart.yaml"
+    bad = write(tmp_path, BAD_INPUTS["unknown_key"][0], "bad.yaml")
+    missing = tmp_path / "none.yaml"
+    res = CliRunner().invoke(app, ["validate", str(good), str(bad), str(missing), str(good)])
+    assert res.exit_code == 2, res.output
+    assert res.stdout.splitlines() == [f"{good}: valid (half_pitch, road bump_half_sine)"] * 2
+    errors = res.stderr.splitlines()
+    assert len(errors) == 2 and errors[0].startswith(f"error: {bad}:9: vehicle.corners.F1.")
+    assert errors[1] == f"error: {missing}: no such config file"
+    res = CliRunner().invoke(app, ["validate", str(good), str(good)])
+    assert res.exit_code == 0 and res.stderr == ""
+
+
 @pytest.mark.slow
 def test_every_bundled_config_validates():
     # in-process (typer's runner): a subprocess per config costs seconds of imports each,

@@ -13,11 +13,11 @@ from ..errors import ConfigError
 from .base import (
     app,
     claim_output,
+    err,
     fail,
     force_option,
     max_memory_option,
     out,
-    read_config,
     set_memory_limit,
     verbose_info,
 )
@@ -25,22 +25,34 @@ from .base import (
 
 @app.command()
 def validate(
-    config: Path = typer.Argument(..., help="YAML config file"),
+    configs: list[Path] = typer.Argument(..., help="YAML config files", metavar="CONFIG"),
     max_memory: str | None = max_memory_option(),
 ) -> None:
-    """Check a config and report its first problem, with its line.
+    """Check configs and report each one's first problem, with its line.
 
-    What it reports is what any command would reject about the config."""
-    from ..checks import check_config
-
+    What it reports is what any command would reject about a config. Each config gets one
+    line, valid or its error; the exit code is 2 if any is not valid."""
     set_memory_limit(max_memory)
+    problems = 0
+    for config in configs:
+        try:
+            _validate_one(config)
+        except ConfigError as exc:
+            problems += 1
+            err.print("error: " + " ".join(str(exc).split()), soft_wrap=True)
+    if problems:
+        raise typer.Exit(code=2)
+
+
+def _validate_one(config: Path) -> None:
+    """Check one config (ConfigError for its first problem) and print that it is valid."""
+    from ..checks import check_config
+    from ..config import load_config
+
     started = time.perf_counter()
-    cfg = read_config(config)
+    cfg = load_config(config)
     verbose_info(f"{config}: read and typed in {time.perf_counter() - started:.3g} s")
-    try:
-        check_config(cfg)
-    except ConfigError as exc:
-        fail(str(exc))
+    check_config(cfg)
     verbose_info(
         f"checked the run (steps, road, RK4 stability, memory"
         f"{', the optimisation' if cfg.design_variables else ''}) in "
