@@ -1185,7 +1185,7 @@ def test_numpy_warnings_are_one_line_each():
         "    for _ in range(3):\n"
         "        np.log(np.zeros(2))\n"
         "    raise SystemExit(0)\n"
-        "cli.read_config = noisy\n"
+        "cli._validate_one = noisy\n"
         "raise SystemExit(main(['validate', 'x.yaml']))\n"
     )
     proc = subprocess.run(
