@@ -28,7 +28,9 @@ browser and makes no network request. Per study:
 
 Nothing read from a file runs as code: the data go into the page as JSON (``<`` escaped) and
 are shown as text. The page's JavaScript API ``window.suspoptReport`` (``studies[i].points``,
-``select(i, row)``, ``selected``) is what the browser test drives.
+``.front`` and ``.parallel`` (plot ids), ``select(i, row)``, ``selected``) and the attributes
+``data-rendered`` (body) and ``data-drawn`` (a parallel-coordinates plot) are what the
+browser test drives.
 """
 
 from __future__ import annotations
