@@ -31,8 +31,8 @@ def _invoke(*args):
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory) -> dict[str, Path]:
-    """A seat front (spectral, fast), its kesort file and its pseudo-fronts on class B, and a
-    robust front; each written by the commands."""
+    """A seat front (spectral, fast), its kesort file and its pseudo-fronts on class B, a
+    robust front, and a front of three objectives; each written by the commands."""
     folder = tmp_path_factory.mktemp("report")
     text = template_text("spectral").replace("population: 40 ", "population: 12 ")
     text = text.replace("generations: 25 ", "generations: 3 ")
@@ -51,6 +51,10 @@ def files(tmp_path_factory) -> dict[str, Path]:
     (folder / "robust.yaml").write_text(robust.replace("generations: 15 ", "generations: 2 "))
     out["robust"] = folder / "robust.h5"
     assert _invoke("optimise", folder / "robust.yaml", "-o", out["robust"]).exit_code == 0
+    three = template_text("kesort").replace("population: 40 ", "population: 16 ")
+    (folder / "three.yaml").write_text(three.replace("generations: 10 ", "generations: 5 "))
+    out["three"] = folder / "three.h5"  # (three objectives: a 3D front)
+    assert _invoke("optimise", folder / "three.yaml", "-o", out["three"]).exit_code == 0
     return out
 
 
@@ -320,7 +324,7 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
     lines take the front's colour."""
     folder = chapters["ch6"].parent
     sources = [files["front"], files["kesort"], files["roads"], files["robust"],
-               folder / "ch6_part_b.h5", folder / "ch8_pareto_ps_class_a.h5"]  # fmt: skip
+               files["three"], folder / "ch8_pareto_ps_class_a.h5"]  # fmt: skip
     page = tmp_path / "many.html"
     assert _invoke("report", *sources, "-o", page).exit_code == 0
     with h5py.File(files["front"]) as h5:
@@ -328,6 +332,10 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
     brush = [float(f1.min()), float(sorted(f1)[len(f1) // 2])]
     inside = [r for r, v in enumerate(f1) if brush[0] <= v <= brush[1]]
     assert 0 < len(inside) < len(f1)
+    with h5py.File(files["three"]) as h5:  # three objectives: a 3D front
+        F3 = h5["pareto/F"][:]
+    brush3 = [float(F3[:, 0].min()), float(sorted(F3[:, 0])[len(F3) // 2])]
+    inside3 = [r for r, v in enumerate(F3[:, 0]) if brush3[0] <= v <= brush3[1]]
     browser.get_log("browser")
     browser.get(page.resolve().as_uri())
     _wait(browser, "return document.body.getAttribute('data-rendered')", "the plots drew")
@@ -344,9 +352,10 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
         assert lines == points and lost == [False, False, False], (i, lines, points, lost)
         drawn = browser.execute_script("return document.querySelectorAll('[data-drawn]').length")
         assert 1 <= drawn <= 3
-        if k == 0:  # brushing f1 of the first study
+        if i in (0, 4) and k < len(sources):  # brushing f1 of the first and the 3D study
             browser.execute_script(
-                f"Plotly.restyle({div}, {{'dimensions[0].constraintrange': [arguments[0]]}})", brush
+                f"Plotly.restyle({div}, {{'dimensions[0].constraintrange': [arguments[0]]}})",
+                brush if i == 0 else brush3,
             )
     warnings = [e["message"] for e in browser.get_log("browser") if "WebGL" in e["message"]]
     assert not [m for m in warnings if "context" in m.lower()], warnings
@@ -378,6 +387,12 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
         f2 = h5["pareto/F"][:, 1]
     line = browser.execute_script("return document.getElementById('parallel-0').data[0].line")
     assert line["color"] == f2.tolist() and line["colorscale"] == "Viridis"
+    shown = browser.execute_script(  # in 3D: the brushed designs, and the rest in grey
+        "document.getElementById('d3-4').click();"
+        " return document.getElementById('front-4').data.map(t => [t.type, t.customdata])"
+    )
+    outside = [r for r in range(len(F3)) if r not in inside3]
+    assert shown == [["scatter3d", inside3]] + ([["scatter3d", outside]] if outside else [])
 
 
 def test_the_commands_shown_for_a_design_name_its_file_as_a_shell_reads_it(files, tmp_path):

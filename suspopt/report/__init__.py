@@ -10,7 +10,7 @@ browser and makes no network request. Per study:
   drop-downs, in 3D for three objectives; colour by feasibility, k-ε level (kesort), case,
   or any objective or variable; the picks (edges, knee, the k-ε optimum) marked;
 - a parallel-coordinates view of the objectives and variables, coloured as the front;
-  brushing ranges along its axes selects the designs inside all of them in the (2D) front,
+  brushing ranges along its axes selects the designs inside all of them in the front,
   counts them and shows the ``suspopt simulate`` of them (up to 100). It is drawn when it comes on screen, at most three at a time (a browser
   keeps about 16 WebGL contexts per page and each takes three: :data:`.page.SCRIPT`);
 - hover and click on a design: its row, objectives with units, variables, constraint

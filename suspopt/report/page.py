@@ -154,10 +154,19 @@ SCRIPT = r"""
     const traces = [];
     const use3d = three && three.checked;
     const chosen = brushed(i);
-    if (use3d) {
-      traces.push({ type: "scatter3d", mode: "markers", name: "designs", x: column(study, "F:0"),
-        y: column(study, "F:1"), z: column(study, "F:2"), customdata: rows, text: hover,
-        hoverinfo: "text", marker: Object.assign({}, marker, { size: 4 }) });
+    if (use3d) {  // (scatter3d has no selected points: the brushed rows and the rest as two traces)
+      const split = chosen ? [chosen, rows.filter(r => !chosen.includes(r))] : [rows, []];
+      const pick = (values, subset) => subset.map(r => values[r]);
+      const xyz = subset => ({ x: pick(column(study, "F:0"), subset), y: pick(column(study, "F:1"), subset),
+                               z: pick(column(study, "F:2"), subset), customdata: subset,
+                               text: pick(hover, subset), hoverinfo: "text" });
+      const finite = marker.color.filter(v => v !== null);  // (the colour scale of every design)
+      const range = marker.cmin === undefined && finite.length
+        ? { cmin: finite.reduce((a, b) => Math.min(a, b)), cmax: finite.reduce((a, b) => Math.max(a, b)) } : {};
+      traces.push(Object.assign({ type: "scatter3d", mode: "markers", name: "designs" }, xyz(split[0]),
+        { marker: Object.assign({}, marker, range, { size: 4, color: pick(marker.color, split[0]) }) }));
+      if (split[1].length) traces.push(Object.assign({ type: "scatter3d", mode: "markers",
+        name: "outside the brushed ranges" }, xyz(split[1]), { marker: { size: 3, color: "#bbb", opacity: 0.3 } }));
     } else {
       traces.push({ type: "scatter",
         mode: "markers", name: "designs", x: column(study, x), y: column(study, y), customdata: rows,
