@@ -189,7 +189,7 @@ SCRIPT = r"""
     const layout = use3d ? { scene: { xaxis: { title: { text: label(study, "F:0") } },
                                       yaxis: { title: { text: label(study, "F:1") } },
                                       zaxis: { title: { text: label(study, "F:2") } } },
-                             margin: { t: 20 } }
+                             margin: { t: 20 }, legend: { orientation: "h", y: -0.05 } }
                          : { xaxis: { title: { text: label(study, x) } }, yaxis: { title: { text: label(study, y) } },
                              margin: { t: 20 }, legend: { orientation: "h", y: -0.18 } };
     const div = document.getElementById("front-" + i);
