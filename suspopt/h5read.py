@@ -291,11 +291,13 @@ class H5Reader:
 
         try:
             top = {k for k, v in self.file.items() if isinstance(v, h5py.Group)}
-            analysis = self.file.attrs.get("analysis")
+            analysis, source = self.file.attrs.get("analysis"), self.file.attrs.get("source")
         except (OSError, RuntimeError, KeyError, ValueError, TypeError):
-            top, analysis = set(), None
+            top, analysis, source = set(), None, None
         if isinstance(analysis, str) and analysis.isidentifier():
-            return f"; the file holds the results of suspopt analyse {analysis}"
+            shown = isinstance(source, str) and source.isprintable() and len(source) <= 300
+            made_from = f" of {source}" if shown else ""
+            return f"; the file holds the results of suspopt analyse {analysis}{made_from}"
         for group, what in _HOLDS:
             if group in top:
                 return f"; the file holds {what}"

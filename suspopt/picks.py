@@ -122,8 +122,9 @@ def read_table(path: str | Path) -> DesignTable:
             table = "designs"
         else:
             raise ConfigError(
-                f"{path}: holds no designs to pick (/pareto, /kesort or "
-                f"/designs): give a file of suspopt optimise, kesort or analyse"
+                f"{path}: holds no designs to pick (/pareto, /kesort or /designs){h5._holds()}:"
+                f" give a file of suspopt optimise, kesort or analyse roads, masses,"
+                f" controllers or transmissibility (of a Pareto file)"
             )
         X = h5.array(f"{table}/X", ndim=2)
         F = h5.array(f"{table}/F", ndim=2)

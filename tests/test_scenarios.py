@@ -330,6 +330,15 @@ def test_simulate_a_pick_under_one_scenario(tmp_path):
         rows = h5["scenarios/row"][...]
         assert np.array_equal(h5["scenarios/F"][...], src["pareto/scenarios/F"][...][rows])
         assert list(h5["scenarios/F"].attrs["over_scenarios"]) == ["max", "max"]
+    for command in (  # it holds no design set: each command says what it is and made from
+        ["report", str(report), "-o", str(tmp_path / "spread.html")],
+        ["export", str(report), "--pick", "knee", "-o", str(tmp_path / "knee.yaml")],
+        ["simulate", str(report), "--pick", "knee"],
+        ["kesort", str(report)],
+    ):
+        res = runner.invoke(app, command)
+        assert res.exit_code == 2 and len(res.output.strip().splitlines()) == 1, res.output
+        assert f"holds the results of suspopt analyse scenarios of {front}" in res.output
     plain_front = tmp_path / "plain.h5"
     text = template_text("spectral").replace("population: 40 ", "population: 6 ")
     text = text.replace("generations: 25 ", "generations: 1 ")

@@ -16,7 +16,8 @@ from .base import app, out
 @app.command()
 def report(
     sources: list[Path] = typer.Argument(
-        ..., help="result files of optimise, kesort or analyse roads|masses|controllers|scenarios"
+        ...,
+        help="result files of optimise, kesort or analyse roads|masses|controllers|transmissibility",
     ),
     output: Path = typer.Option(..., "-o", "--output", help="the HTML file to write"),
     with_signals: list[str] = typer.Option(

@@ -1,7 +1,8 @@
 """``suspopt report FILE.h5 ... -o study.html``: an interactive Pareto explorer in one file.
 
-:func:`build_report` reads the result files of ``suspopt optimise``, ``kesort`` and
-``analyse roads|masses|controllers|scenarios`` (each a *study*: :func:`collect`) and writes
+:func:`build_report` reads the result files of ``suspopt optimise``, ``kesort``, ``analyse
+roads|masses|controllers`` and ``analyse transmissibility`` of a Pareto file, the files that
+hold a design table (:func:`suspopt.picks.read_table`; each a *study*: :func:`collect`), and writes
 one self-contained HTML page (:mod:`.page`): every script and style inline, plotly.js
 included (the optional extra ``pip install 'suspopt[report]'``), so it opens offline in any
 browser and makes no network request. Per study:
