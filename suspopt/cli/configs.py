@@ -114,7 +114,10 @@ def init(
 
 @app.command()
 def export(
-    source: Path = typer.Argument(..., help="result file of optimise, kesort or analyse"),
+    source: Path = typer.Argument(
+        ...,
+        help="result file of optimise, kesort or analyse roads|masses|controllers|transmissibility",
+    ),
     pick: list[str] = typer.Option(
         [],
         "--pick",

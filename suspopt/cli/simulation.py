@@ -74,7 +74,9 @@ _PICK_HELP = (
 @base.run_options
 def simulate(
     source: Path = typer.Argument(
-        ..., help="YAML config, or a result file of optimise, kesort or analyse with --pick"
+        ...,
+        help="YAML config, or with --pick a result file of optimise, kesort or analyse"
+        " roads|masses|controllers|transmissibility",
     ),
     output: Path | None = typer.Option(None, "-o", "--output", help="HDF5 file to write"),
     pick: list[str] = typer.Option([], "--pick", help=_PICK_HELP),
