@@ -228,7 +228,7 @@ SCRIPT = r"""
     parallelLive.push(i);
     const div = document.getElementById("parallel-" + i);
     div.textContent = "";
-    return Plotly.newPlot(div, parallelTraces(i), { margin: { t: 40 } }, parallelConfig())
+    return plotParallel(i)
       .then(() => {
         if (!parallelLive.includes(i)) return;
         div.setAttribute("data-drawn", "1");
@@ -239,8 +239,9 @@ SCRIPT = r"""
         });
       });
   }
-  function parallelConfig() {
-    return { displaylogo: false, plotGlPixelRatio: Math.min(2, Math.max(1, window.devicePixelRatio || 1)) };
+  function plotParallel(i) {  // (the first drawing, and a new colour)
+    return Plotly.react("parallel-" + i, parallelTraces(i), { margin: { t: 40 } },
+      { displaylogo: false, plotGlPixelRatio: Math.min(2, Math.max(1, window.devicePixelRatio || 1)) });
   }
   function parallelKeys(study) {
     const d = study.data;
@@ -325,7 +326,7 @@ SCRIPT = r"""
       const e = document.getElementById(id + i); if (e) e.addEventListener("change", () => drawFront(i));
     }
     document.getElementById("c-" + i).addEventListener("change", () => {
-      if (parallelLive.includes(i)) Plotly.react("parallel-" + i, parallelTraces(i), { margin: { t: 40 } }, parallelConfig());
+      if (parallelLive.includes(i)) plotParallel(i);
     });
     if (sig) sig.addEventListener("change", () => drawSignals(i));
     api.studies.push({ label: study.label, points: d.rows, front: "front-" + i, parallel: "parallel-" + i });
