@@ -508,7 +508,8 @@ def write_simulation(
     ``/time (T,)`` [s] and ``/design (P,)`` (row numbers) are the dimension scales ``time``
     and ``design``; ``/signals/<name> (design, time)``, ``/metrics/<name> (design,)``,
     ``/diverged_at (design,)`` [s] (NaN where the design did not diverge), ``/designs/X
-    (design, variable)`` with attr ``names`` (also the scale ``/designs/variable``) when design
+    (design, variable)`` with attrs ``names`` (the parameters' dotted paths; also the scale
+    ``/designs/variable``) and ``units`` (each one's unit, from its config field) when design
     parameters were given, ``/modal/frequency (design, mode)`` [Hz] with attr ``dominant``
     (design 0's DOF of most energy per mode), ``/modal/label (design, mode)`` (what each mode
     is) and ``/modal/energy_share (design, mode, dof)`` (each DOF's share of each mode's
@@ -536,12 +537,14 @@ def write_simulation(
             write_dataset(met, name, np.asarray(value), result.metric_units[name], dims=("design",))
         write_dataset(h5, "diverged_at", result.diverged_at, "s", dims=("design",))
         if result.designs:
+            from .params import field_unit
+
             X = np.column_stack([result.designs[k] for k in result.designs])
             write_dataset(
                 h5.create_group("designs"),
                 "X",
                 X,
-                "SI",
+                [field_unit(result.config, k) for k in result.designs],
                 dims=("design", "variable"),
                 names=list(result.designs),
             )

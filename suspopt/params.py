@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import difflib
 import functools
+import re
 from collections.abc import Mapping
 from typing import Any, get_args
 
@@ -18,7 +19,7 @@ from .config import Config, ConfigError
 from .config.loader import require_config
 from .files import listed
 
-__all__ = ["ParamView", "numeric_paths", "field_range", "one_per_run", "ONE_PER_RUN"]
+__all__ = ["ParamView", "numeric_paths", "field_range", "field_unit", "one_per_run", "ONE_PER_RUN"]
 
 #: Config sections and fields that are one per run: the simulator never reads them per design.
 ONE_PER_RUN = {
@@ -77,14 +78,32 @@ def _limits(model: type, name: str) -> tuple[float, bool, float, bool]:
     return low, low_closed, high, high_closed
 
 
-def field_range(cfg: Config, path: str) -> tuple[float, bool, float, bool]:
-    """The range a numeric config field accepts, ``(low, low_closed, high, high_closed)``
-    (infinite where it has no bound)."""
+def _section(cfg: Config, path: str) -> tuple[Any, str]:
+    """The config section holding the field at the dotted ``path``, and the field's name."""
     node: Any = cfg
     parts = path.split(".")
     for part in parts[:-1]:
         node = node[part] if isinstance(node, dict) else getattr(node, part)
-    return _limits(type(node), parts[-1])
+    return node, parts[-1]
+
+
+def field_range(cfg: Config, path: str) -> tuple[float, bool, float, bool]:
+    """The range a numeric config field accepts, ``(low, low_closed, high, high_closed)``
+    (infinite where it has no bound)."""
+    node, name = _section(cfg, path)
+    return _limits(type(node), name)
+
+
+_UNIT = re.compile(r"\[([^\],]+)\]")
+
+
+def field_unit(cfg: Config, path: str) -> str:
+    """The SI unit of the numeric config field at ``path``, read from its description
+    (``... [N/m]``: the last bracket); "SI" where the description names none."""
+    node, name = _section(cfg, path)
+    info = type(node).model_fields.get(name)
+    found = _UNIT.findall(info.description or "") if info is not None else []
+    return found[-1] if found else "SI"
 
 
 def _check_range(cfg: Config, path: str, values: np.ndarray) -> None:

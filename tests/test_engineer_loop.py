@@ -23,6 +23,28 @@ def cli(capsys, *args) -> tuple[int, str, str]:
     return code, captured.out, captured.err
 
 
+def printed_table(stdout: str, title: str) -> tuple[list[str], dict[str, list[str]]]:
+    """The columns (after quantity and unit) and {quantity: [unit, *values]} of the table
+    whose title holds ``title``, as printed, its parts (a table wider than the terminal)
+    joined."""
+    heads: list[str] = []
+    rows: dict[str, list[str]] = {}
+    part = None
+    for line in stdout.splitlines():
+        if title in line and not line.startswith(("┃", "│")):
+            part = []
+        elif part is not None and line.startswith(("┃", "│")):
+            cells = [c.strip() for c in line.strip("┃│").split("┃" if "┃" in line else "│")]
+            if line.startswith("┃"):
+                part = cells[2:]
+                heads += part
+            else:
+                rows.setdefault(cells[0], [cells[1]]).extend(cells[2:])
+        elif part is not None and line.startswith("└"):
+            part = None
+    return heads, rows
+
+
 @pytest.fixture(scope="module")
 def kesort_file(tmp_path_factory):
     """A kesort file of a tiny Ch. 7 SH-2 front (main f1-f2, supplementary f3-f6)."""
@@ -38,9 +60,13 @@ def kesort_file(tmp_path_factory):
 @pytest.mark.slow
 def test_a_kesort_knee_re_simulated_gives_its_stored_objectives(kesort_file, tmp_path, capsys):
     _, ke = kesort_file
-    out = tmp_path / "knee.h5"
-    code, stdout, err = cli(capsys, "simulate", ke, "--pick", "knee,chosen", "-o", out)
+    out, figure = tmp_path / "knee.h5", tmp_path / "knee.svg"
+    code, stdout, err = cli(
+        capsys, "simulate", ke, "--pick", "knee,chosen", "-o", out, "--plot", figure
+    )
     assert code == 0, err
+    legend = figure.read_text()  # (the picks name the curves)
+    assert re.search(r"\bknee F1\.[\w.]+=", legend) and re.search(r"\bchosen F1\.[\w.]+=", legend)
     with h5py.File(ke) as h5:
         rows = [int(h5["kesort/picks/knee"][()]), int(h5["kesort/chosen"][()])]
         stored = h5["kesort/F"][rows]
@@ -53,7 +79,17 @@ def test_a_kesort_knee_re_simulated_gives_its_stored_objectives(kesort_file, tmp
         assert list(F.attrs["names"]) == names  # main then supplementary
         np.testing.assert_allclose(F[()], stored, rtol=1e-9)
         assert h5["designs/X"].shape == (2, 6) and (F[()] < 1e10).all()
-    assert "knee" in stdout and "chosen" in stdout
+        X = h5["designs/X"]
+        units = list(X.attrs["units"].astype(str))
+        X, paths = X[()], list(X.attrs["names"].astype(str))
+    with h5py.File(ke) as h5:
+        variables = list(h5["kesort/X"].attrs["names"].astype(str))
+        assert list(h5["kesort/X"].attrs["units"].astype(str)) == units  # (from the config)
+    heads, rows = printed_table(stdout, " - key results")
+    assert heads == ["knee", "chosen"]  # each column is the pick it shows
+    for j, (name, unit) in enumerate(zip(variables, units)):  # each pick's variables on top
+        assert rows[name] == [unit, *(f"{x:.4g}" for x in X[:, j])], (name, paths[j])
+    assert list(rows)[: len(variables)] == variables and "peak body heave" in rows
 
 
 def test_an_exported_design_validates_and_gives_its_objectives(kesort_file, tmp_path, capsys):
@@ -164,7 +200,7 @@ def test_a_sweep_of_3_by_4_values_is_one_batch_of_12_named_designs(tmp_path, cap
         lambda cfg, prepared, *a: batches.append(prepared.pv.P) or real(cfg, prepared, *a),
     )
     out = tmp_path / "sweep.h5"
-    code, _, err = cli(
+    code, stdout, err = cli(
         capsys,
         "simulate",
         CONFIGS / "quickstart.yaml",
@@ -188,7 +224,16 @@ def test_a_sweep_of_3_by_4_values_is_one_batch_of_12_named_designs(tmp_path, cap
         ]
         np.testing.assert_array_equal(X[:, 0], np.repeat([1000.0, 2500.0, 4000.0], 4))
         np.testing.assert_array_equal(X[:, 1], np.tile([4e4, 5e4, 6e4, 7e4], 3))
+        assert list(X.attrs["units"].astype(str)) == ["N s/m", "N/m"]  # (not "SI")
         assert h5["signals/body.heave"].shape == (12, 1001)  # --set: 1 s
+        peak = 1e3 * h5["signals/body.heave"][()].max(axis=1)
+        X = X[()]
+    heads, rows = printed_table(stdout, " - key results (5 of 12 designs, evenly spaced by index)")
+    shown = [int(h.removeprefix("design ")) for h in heads]
+    assert len(set(shown)) == 5 and shown == sorted(shown) and shown[0] == 0 and shown[-1] == 11
+    for j, path in enumerate(["vehicle.corners.F1.damper.c", "vehicle.corners.R1.spring.linear"]):
+        assert rows[path] == [["N s/m", "N/m"][j], *(f"{X[p, j]:.4g}" for p in shown)]
+    assert rows["peak body heave"] == ["mm", *(f"{peak[p]:.4g}" for p in shown)]
     code, _, err = cli(
         capsys,
         "simulate",

@@ -212,8 +212,15 @@ def test_more_designs_than_fit_are_thinned_evenly_and_the_title_says_so(tmp_path
     assert plots.chosen_designs(5, None) == ([0, 1, 2, 3, 4], "")
     path = plots.plot_simulation(res, tmp_path / "many.svg", signals=["body.heave_acc"])
     text = path.read_text()
-    assert "8 of 20 designs drawn" in text and "#19 damper.c=8000" in text
-    assert "#1 damper.c" not in text
+    assert "8 of 20 designs drawn" in text and "#19 F1.damper.c=8000" in text  # (its corner)
+    assert "#1 F1.damper.c" not in text
+    names = [f"pick {i}" for i in range(20)]  # (the picks of simulate --pick)
+    path = plots.plot_simulation(res, tmp_path / "named.svg", "body.heave_acc", design_names=names)
+    assert "pick 19 F1.damper.c=8000" in path.read_text() and "#19" not in path.read_text()
+    for wrong in (names[:19], [*names[:19], 3], "pick"):
+        with pytest.raises(ValueError, match=r"design_names: give one text per design \(20\)"):
+            plots.plot_simulation(res, tmp_path / "wrong.svg", design_names=wrong)
+    assert not (tmp_path / "wrong.svg").exists()
 
 
 def test_a_signal_every_design_shares_is_one_curve_and_one_design_has_no_legend():
@@ -254,6 +261,10 @@ def test_design_labels_show_what_varies_and_where_a_design_diverged():
         "#1 F1.spring.linear=2e+04, R1.spring.linear=3e+04 (diverged at 1.25 s)",
     ]
     assert plots.design_labels({}, [0], 1, np.array([np.nan])) == ["design"]
+    assert plots.design_labels({}, [0], 1, np.array([np.nan]), ["knee"]) == ["knee"]
+    assert plots.design_labels(designs, [1], 2, np.array([np.nan, np.nan]), ["a", "b"]) == [
+        "b F1.spring.linear=2e+04, R1.spring.linear=3e+04"
+    ]
 
 
 # --- optimise ------------------------------------------------------------------------------

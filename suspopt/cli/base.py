@@ -359,8 +359,8 @@ def show_table(table: Table, keys: int = 1) -> None:
         part = new_table(f"{title} ({i} of {len(groups)})" if title else None)
         for j in key + group:
             part.add_column(table.columns[j].header, justify=table.columns[j].justify)
-        for row in table.cells:
-            part.add_row(*(row[j] for j in key + group))
+        for row, kept in zip(table.cells, table.rows):  # (and where a section ends)
+            part.add_row(*(row[j] for j in key + group), end_section=kept.end_section)
         out.print(part)
 
 

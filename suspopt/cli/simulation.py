@@ -16,23 +16,58 @@ if TYPE_CHECKING:
     from rich.table import Table
 
 
-def _summary_table(result) -> Table:
-    """Peak and RMS body acceleration, max travel and tyre deflection per corner."""
-    import numpy as np
+#: The most designs the tables of ``simulate`` show, evenly spaced over a larger batch.
+TABLE_DESIGNS = 5
 
-    P = min(result.P, 5)
-    table = base.new_table(
-        f"{result.model.preset} - key results"
-        + (f" (first {P} of {result.P} designs)" if result.P > P else "")
-    )
+
+def _columns(result, picked, title: str) -> tuple[Table, list[int]]:
+    """A table titled ``title`` with a column per design shown (each pick's name, ``design
+    i`` in a batch, ``value`` alone; at most :data:`TABLE_DESIGNS`, evenly spaced by index,
+    which the title says), and the designs' indices."""
+    from ..plots.runs import evenly_spaced
+
+    shown = evenly_spaced(result.P, TABLE_DESIGNS)
+    if len(shown) < result.P:
+        title += f" ({len(shown)} of {result.P} designs, evenly spaced by index)"
+    table = base.new_table(title)
     table.add_column("quantity")
     table.add_column("unit")
-    for p in range(P):
-        table.add_column(f"design {p}" if result.P > 1 else "value", justify="right")
+    for p in shown:
+        head = (
+            picked.names[p] if picked is not None else "value" if result.P == 1 else f"design {p}"
+        )
+        table.add_column(head, justify="right")
+    return table, shown
+
+
+def _design_rows(table, result, picked, shown: list[int]) -> None:
+    """The designs' own values, above their results: every design variable of the picks, or
+    the parameters that differ between the designs of a batch (``--sweep``)."""
+    from ..params import field_unit
+    from ..plots.runs import varying_parameters
+
+    if picked is not None:
+        paths, names, units = picked.paths, picked.var_names, picked.var_units
+    else:  # (by their paths as given to --sweep)
+        paths = names = varying_parameters(result.designs, result.P)
+        units = [field_unit(result.config, path) for path in paths]
+    for path, name, unit in zip(paths, names, units):
+        table.add_row(name, unit, *(f"{result.designs[path][p]:.4g}" for p in shown))
+    if paths:
+        table.add_section()
+
+
+def _summary_table(result, picked=None) -> Table:
+    """The designs' own values (:func:`_design_rows`), then peak and RMS body acceleration,
+    max travel and tyre deflection per corner."""
+    import numpy as np
+
+    table, shown = _columns(result, picked, f"{result.model.preset} - key results")
+    _design_rows(table, result, picked, shown)
     sig = result.signals
 
     def row(label, unit, values):
-        table.add_row(label, unit, *(f"{v:.4g}" for v in values[:P]))
+        table.add_row(label, unit, *(f"{values[p]:.4g}" for p in shown))
 
     heave, acc = sig["body.heave"], sig["body.heave_acc"]
     row("peak body heave", "mm", 1e3 * np.max(heave, axis=-1))
@@ -51,16 +86,12 @@ def _summary_table(result) -> Table:
     return table
 
 
-def _metrics_table(result) -> Table:
-    """The config's metrics (``metrics:`` section), one row each."""
-    P = min(result.P, 5)
-    table = base.new_table("metrics")
-    table.add_column("metric")
-    table.add_column("unit")
-    for p in range(P):
-        table.add_column(f"design {p}" if result.P > 1 else "value", justify="right")
+def _metrics_table(result, picked=None) -> Table:
+    """The config's metrics (``metrics:`` section), one row each, for the designs of
+    :func:`_summary_table`."""
+    table, shown = _columns(result, picked, "metrics")
     for name, values in result.metrics.items():
-        table.add_row(name, result.metric_units[name], *(f"{v:.4g}" for v in values[:P]))
+        table.add_row(name, result.metric_units[name], *(f"{values[p]:.4g}" for p in shown))
     return table
 
 
@@ -272,9 +303,9 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
             f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
             f"try a smaller simulation.dt"
         )
-    base.show_table(_summary_table(result), keys=2)
+    base.show_table(_summary_table(result, picked), keys=2)
     if result.metrics:
-        base.show_table(_metrics_table(result), keys=2)
+        base.show_table(_metrics_table(result, picked), keys=2)
     extra = None
     if picked is not None:
         objectives = _pick_objectives(picked, cfg, result, params)
@@ -295,7 +326,7 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
     if plot is not None:
         from ..plots import plot_simulation
 
-        plot_simulation(result, plot)
+        plot_simulation(result, plot, design_names=None if picked is None else picked.names)
         out.print(f"wrote {plot}")
 
 

@@ -21,7 +21,6 @@ objective set to :data:`PENALTY` and the last constraint, ``simulation_failed``,
 from __future__ import annotations
 
 import difflib
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -35,7 +34,7 @@ from ..config.loader import require_config
 from ..config.optimise import DesignVariable, Objective
 from ..config.scenarios import CONSTRAINT_DEFAULT, OBJECTIVE_DEFAULT
 from ..control.controller import build_controller
-from ..params import ParamView, numeric_paths, one_per_run
+from ..params import ParamView, field_unit, numeric_paths, one_per_run
 from ..seat import CONSTRAINT_UNITS, build_attachments, seat_constraints, seat_static_deflection
 from ..simulate import signal_table
 from ..specs import evaluate_spec, metric_unit, spec_signals
@@ -114,7 +113,7 @@ class Problem(_PymooProblem):
         lower = np.array([v.lower for v in self.variables], dtype=float)
         upper = np.array([v.upper for v in self.variables], dtype=float)
         self.var_names = [v.label for v in self.variables]
-        self.var_units = [_field_unit(cfg, v.path) for v in self.variables]
+        self.var_units = [field_unit(cfg, v.path) for v in self.variables]
         self.obj_names = [n for t in self._objectives for n in t.names]
         self.obj_units = [u for t in self._objectives for u in t.units]
         self.supplementary_names = [n for t in self._supplementary for n in t.names]
@@ -579,17 +578,3 @@ def _compile(
         (unit,) * len(signals),
         signals=tuple(signals),
     )
-
-
-_UNIT = re.compile(r"\[([^\],]+)\]")
-
-
-def _field_unit(cfg: Config, path: str) -> str:
-    """SI unit of a config field, read from its description (``[N/m]``); "SI" if none."""
-    node = cfg
-    parts = path.split(".")
-    for part in parts[:-1]:
-        node = node[part] if isinstance(node, dict) else getattr(node, part)
-    info = type(node).model_fields.get(parts[-1])
-    found = _UNIT.findall(info.description or "") if info is not None else []
-    return found[-1] if found else "SI"

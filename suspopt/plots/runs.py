@@ -155,31 +155,43 @@ def simulation_figure(
     return fig
 
 
-def _short_names(paths: Sequence[str]) -> list[str]:
-    """The shortest tails (two components at least) of dotted ``paths`` that tell them
-    apart: ``vehicle.corners.F1.damper.c`` -> ``damper.c`` or ``F1.damper.c``."""
+def short_names(paths: Sequence[str]) -> list[str]:
+    """The shortest tails of dotted ``paths`` that tell them apart, each of two components
+    at least and holding its corner: ``vehicle.corners.F1.damper.c`` -> ``F1.damper.c``,
+    ``vehicle.body.mass`` -> ``body.mass``."""
     parts = [p.split(".") for p in paths]
+    least = [max(2, len(p) - p.index("corners") - 1) if "corners" in p[:-1] else 2 for p in parts]
     for k in range(2, max((len(p) for p in parts), default=2) + 1):
-        tails = [".".join(p[-k:]) for p in parts]
+        tails = [".".join(p[-max(k, n) :]) for p, n in zip(parts, least)]
         if len(set(tails)) == len(tails):
             return tails
     return list(paths)
 
 
-def design_labels(
-    designs: Mapping[str, np.ndarray], chosen: Sequence[int], P: int, diverged_at: np.ndarray
-) -> list[str]:
-    """``#i`` and the parameters that vary over the P designs (three at most), and where a
-    design diverged."""
-    varying = [
+def varying_parameters(designs: Mapping[str, np.ndarray], P: int) -> list[str]:
+    """The parameters of ``designs`` (dotted path -> (P,) values) whose values differ
+    between the P designs, in their order."""
+    return [
         k
         for k, v in designs.items()
         if np.size(v) == P and P > 1 and np.ptp(np.asarray(v, dtype=float)) > 0
     ]
-    short = _short_names(varying)
+
+
+def design_labels(
+    designs: Mapping[str, np.ndarray],
+    chosen: Sequence[int],
+    P: int,
+    diverged_at: np.ndarray,
+    names: Sequence[str] | None = None,
+) -> list[str]:
+    """Each chosen design's name (``names[i]``, e.g. the pick it came from; default ``#i``),
+    the parameters that vary over the P designs (three at most), and where it diverged."""
+    varying = varying_parameters(designs, P)
+    short = short_names(varying)
     labels = []
     for i in chosen:
-        label = "design" if P == 1 else f"#{i}"
+        label = str(names[i]) if names is not None else "design" if P == 1 else f"#{i}"
         values = [
             f"{s}={float(np.asarray(designs[k])[i]):.4g}" for s, k in zip(short[:3], varying[:3])
         ]
@@ -203,12 +215,20 @@ def default_signals(result) -> list[str]:
     return out
 
 
+def evenly_spaced(P: int, most: int) -> list[int]:
+    """At most ``most`` of the design indices 0 to P - 1, evenly spaced by index, the first
+    and the last included (all of them when there are no more than ``most``)."""
+    if P <= most or most < 2:
+        return list(range(min(P, most)))
+    return sorted({int(round(x)) for x in np.linspace(0, P - 1, most)})
+
+
 def chosen_designs(P: int, designs: Sequence[int] | None) -> tuple[list[int], str]:
     """The design indices to draw and a note when they are not all of them."""
     if designs is None:
         if P <= MAX_DESIGNS:
             return list(range(P)), ""
-        chosen = sorted({int(round(x)) for x in np.linspace(0, P - 1, MAX_DESIGNS)})
+        chosen = evenly_spaced(P, MAX_DESIGNS)
         return chosen, (
             f"{len(chosen)} of {P} designs drawn (evenly spaced by index; at "
             f"most {MAX_DESIGNS} on one figure)"
@@ -237,12 +257,15 @@ def plot_simulation(
     path: str | Path,
     signals: Sequence[str] | None = None,
     designs: Sequence[int] | None = None,
+    design_names: Sequence[str] | None = None,
 ) -> Path:
     """Draw a :class:`suspopt.simulate.Result` (:func:`simulation_figure`) to ``path`` (.png
     or .svg): ``signals`` (default :func:`default_signals`) of the ``designs`` (indices;
     default every design, or :data:`MAX_DESIGNS` of them evenly spaced by index when there
-    are more, which the title says). ValueError for an unknown signal, a design out of range,
-    more than :data:`MAX_DESIGNS` designs, or no matplotlib."""
+    are more, which the title says). ``design_names`` (one per design of the result, e.g. the
+    picks they came from) name the designs in the legend instead of ``#i``. ValueError for
+    an unknown signal, a design out of range, more than :data:`MAX_DESIGNS` designs, design
+    names that are not one text per design, or no matplotlib."""
     import difflib
 
     from ..errors import require
@@ -259,8 +282,14 @@ def plot_simulation(
                 + (f"; did you mean {', '.join(close)}?" if close else "")
             )
     P = result.P
+    if design_names is not None:
+        design_names = listed(design_names)
+        if len(design_names) != P or not all(isinstance(n, str) for n in design_names):
+            raise ValueError(
+                f"design_names: give one text per design ({P}); got {design_names!r:.200}"
+            )
     chosen, note = chosen_designs(P, designs)
-    labels = design_labels(result.designs, chosen, P, np.asarray(result.diverged_at))
+    labels = design_labels(result.designs, chosen, P, np.asarray(result.diverged_at), design_names)
     cfg = result.config
     source = cfg.source.name if getattr(cfg, "source", None) else "simulation"
     title = f"{source}: road {cfg.road.kind}, {P} design{'s' if P > 1 else ''}" + (
