@@ -520,3 +520,83 @@ def test_a_budget_smaller_than_one_step_still_writes_a_result(tmp_path, optimise
         best = h5["history/best"]
         assert best.ndim == 2 and best.shape[1] == len(best.attrs["names"])
         assert len(h5["history/generation"]) == best.shape[0]
+
+
+# --- designs at the bounds of their search --------------------------------------------------
+
+
+def test_a_value_within_one_percent_of_its_search_range_is_at_the_bound():
+    from suspopt.config.optimise import DesignVariable
+    from suspopt.optimise.bounds import at_bounds, bounds_note
+
+    variables = [
+        DesignVariable(name="c", path="vehicle.corners.F1.damper.c", lower=0.0, upper=100.0),
+        DesignVariable(
+            name="k", path="vehicle.corners.F1.spring.cubic", lower=1.0, upper=1e4, scale="log"
+        ),
+    ]
+    X = np.array(
+        [
+            [0.0, 1.0],  # on both lower bounds (log10: 0 of 0..4)
+            [0.9, 10**0.03],  # 0.9 % and 0.75 % of the range: at them
+            [1.5, 10**0.08],  # 1.5 % and 2 %: between
+            [99.5, 10**3.97],  # 99.5 % and 99.25 %: at the upper bounds
+            [-5.0, 1e5],  # beyond the bounds
+            [np.nan, 100.0],  # NaN, and half way on the log scale (1e4 / 2 is at 92.5 %)
+        ]
+    )
+    assert at_bounds(variables, X).tolist() == [
+        [-1, -1],
+        [-1, -1],
+        [0, 0],
+        [1, 1],
+        [-1, 1],
+        [0, 0],
+    ]
+    assert at_bounds(variables, [[50.0, 5e3]]).tolist() == [[0, 0]]  # (log: 92.5 %)
+    assert at_bounds(variables, [[50.0, 5e3]], share=0.1).tolist() == [[0, 1]]
+    note = bounds_note(["c", "k"], variables, X)
+    assert note.startswith(
+        "at a bound (within 1 % of its range): c lower in 3 of 6 designs, c upper in 1 of 6 "
+        "designs, k lower in 2 of 6 designs, k upper in 2 of 6 designs; the front may reach"
+    )
+    assert bounds_note(["c", "k"], variables, X[2:3]) is None
+    one = bounds_note(["c", "k"], variables, X[3:4])
+    assert one.startswith("at a bound (within 1 % of its range): c upper, k upper; the optimum")
+    with pytest.raises(ValueError, match="X: \\(3,\\) columns for 2 design variables"):
+        at_bounds(variables, np.zeros((2, 3)))
+
+
+@pytest.mark.slow
+def test_optimise_and_kesort_name_the_variables_the_optimum_has_at_a_bound(tmp_path, capsys):
+    """SLSQP on the tiny half car, softer and less damped for less body acceleration: the
+    optimum stops at the lower bounds of the damper and the Duffing term, inside the spring's
+    range. ``optimise`` and ``kesort`` say which, as the file's values give them."""
+    from suspopt._entry import main
+
+    config = tmp_path / "case.yaml"
+    config.write_text(
+        TINY.replace("    - {name: f3, metric: var, signal: tyre_deflection, reduce: mean}\n", "")
+        .replace("  - {name: ratio, metric: spring_usage, min: 0.1, max: 0.3}\n", "")
+        .replace(
+            "{algorithm: nsga2, population: 8, generations: 4, seed: 1}",
+            "{algorithm: gradient, max_evaluations: 200, seed: 1}",
+        )
+    )
+    out = tmp_path / "best.h5"
+    assert main(["optimise", str(config), "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    cfg = suspopt.load_config(config)
+    with h5py.File(out) as h5:
+        (x,) = h5["pareto/X"][()]
+    at = []
+    for v, value in zip(cfg.design_variables, x):
+        scale = np.log10 if v.scale == "log" else (lambda a: a)
+        position = (scale(value) - scale(v.lower)) / (scale(v.upper) - scale(v.lower))
+        at += [f"{v.name} lower"] * bool(position <= 0.01)
+        at += [f"{v.name} upper"] * bool(position >= 0.99)
+    assert 0 < len(at) < len(x)  # (the run has both: the note can name too many or too few)
+    note = f"at a bound (within 1 % of its range): {', '.join(at)}; the optimum may lie beyond"
+    assert f"note: {note}" in " ".join(printed.split())
+    assert main(["kesort", str(out)]) == 0
+    assert f"note: the k-ε optimum is {note}" in " ".join(capsys.readouterr().out.split())

@@ -175,6 +175,11 @@ def _optimise(
         err.print("the first generation had not completed: nothing written")
         raise typer.Exit(code=130) from None
     base.show_table(_optimum_table(result))
+    from ..optimise.bounds import bounds_note
+
+    note = bounds_note(result.var_names, cfg.design_variables, result.X)
+    if note is not None:
+        out.print(f"note: {note}", soft_wrap=True)
     if result.weights is not None:
         out.print(
             "weighted sum (Eq 5.7): "

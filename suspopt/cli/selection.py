@@ -76,6 +76,20 @@ def _kesort_tables(sel) -> list[Table]:
     return [table, picks]
 
 
+def _optimum_bounds_note(sel) -> str | None:
+    """Which design variables of the k-ε optimum lie at a bound of its own set's config
+    (:func:`suspopt.optimise.bounds.bounds_note`), or None (none does, or the config's
+    design variables are not the set's)."""
+    from ..optimise.bounds import bounds_note
+
+    design_set = sel.sets[int(sel.source[sel.chosen])]
+    variables = design_set.config.design_variables
+    if [v.label for v in variables] != list(design_set.var_names):
+        return None
+    row = int(sel.row[sel.chosen])
+    return bounds_note(design_set.var_names, variables, design_set.X[[row]])
+
+
 def _threshold_line(sort, label: str) -> str:
     if sort.P is None:
         how = "absolute ε"
@@ -187,6 +201,9 @@ def _kesort(
     )
     for note in selection.notes:
         out.print(f"note: {note}")
+    bounds = _optimum_bounds_note(selection)
+    if bounds is not None:
+        out.print(f"note: the k-ε optimum is {bounds}", soft_wrap=True)
     for path in (output, plot):
         if path is not None:
             out.print(f"wrote {path}")
