@@ -13,11 +13,14 @@ import time
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pytest
 from conftest import CONFIGS, tiny
 from typer.testing import CliRunner
 
+import suspopt
 from suspopt.cli import app
+from suspopt.report import collect
 from suspopt.templates import template_text
 
 pytest.importorskip("plotly")
@@ -135,6 +138,26 @@ def test_the_page_holds_every_design_and_nothing_from_a_file_as_markup(files, tm
     ) == len(tr["rows"])
     assert len(front["signals"]["time"]) <= 1000
     assert page.stat().st_size < 10 << 20
+    seat = suspopt.load_config(files["front"].with_name("seat.yaml")).design_variables
+    robust = collect(files["robust"]).data  # (a design at a bound: the others have none)
+    both = suspopt.load_config(files["robust"].with_name("robust.yaml")).design_variables
+    for study, variables in [(front, seat), (kesort, seat), (roads, seat), (robust, both)]:
+        bounds = [[v.lower for v in variables], [v.upper for v in variables]]
+        assert study["variable_bounds"] == bounds  # each variable's search range
+        assert study["at_bound"] == at_bound(variables, study["X"])
+    assert "-" in "".join(robust["at_bound"]) or "+" in "".join(robust["at_bound"])
+
+
+def at_bound(variables, X) -> list[str]:
+    """Per variable, a character per design of ``X``: ``-`` within 1 % of the variable's
+    search range (of log10 for a log scale) of the lower bound, ``+`` of the upper, ``.``
+    neither."""
+    out = []
+    for j, v in enumerate(variables):
+        f = np.log10 if v.scale == "log" else float
+        where = [(f(row[j]) - f(v.lower)) / (f(v.upper) - f(v.lower)) for row in X]
+        out.append("".join("-" if w <= 0.01 else "+" if w >= 0.99 else "." for w in where))
+    return out
 
 
 @pytest.mark.parametrize(
@@ -287,6 +310,27 @@ def test_the_report_in_a_real_browser(files, chapters, browser, tmp_path, monkey
         " return [box.getAttribute('data-row'), box.textContent, window.suspoptReport.selected.row]"
     )
     assert shown[0] == str(row) and f"row {row}" in shown[1] and shown[2] == row
+    study = _payload(page.read_text())["studies"][0]["data"]
+    lower, upper = study["variable_bounds"]
+    ranges = browser.execute_script(  # a variable's axis spans its search range
+        "return document.getElementById('parallel-0').data[0].dimensions.map(d => d.range)"
+    )[len(study["objectives"]) :]
+    for j, (lo, hi) in enumerate(zip(lower, upper)):
+        values = [r[j] for r in study["X"] if r[j] is not None]
+        assert ranges[j] == pytest.approx([min(lo, *values), max(hi, *values)], rel=1e-12)
+    bounded = [r for r in range(N) if any(sides[r] != "." for sides in study["at_bound"])]
+    for r in {row, *bounded[:2]}:  # the panel says which values lie at a bound
+        browser.execute_script("window.suspoptReport.select(0, arguments[0])", r)
+        notes = browser.execute_script(
+            "return [...document.querySelectorAll('#design-0 tr')]"
+            ".map(tr => [tr.cells[0].textContent, tr.cells.length > 3 ? tr.cells[3].textContent : ''])"
+        )
+        said = {"-": "at lower bound", "+": "at upper bound", ".": ""}
+        expected = [said[sides[r]] for sides in study["at_bound"]]
+        assert [dict(notes)[name] for name in study["variables"]] == expected
+        assert all(note == "" for name, note in notes if name not in study["variables"])
+    assert which != "robust" or bounded  # (one page at least shows the note)
+    browser.execute_script("window.suspoptReport.select(0, arguments[0])", row)
     onward = browser.execute_script(  # the commands that take the design on, run as shown
         "return [...document.querySelectorAll('#design-0 .onward code')].map(c => c.textContent)"
     )

@@ -14,12 +14,16 @@ on a bound exactly (a GA's offspring approach it), so 1 % of the range counts as
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..config.optimise import DesignVariable
 
-__all__ = ["AT_BOUND", "at_bounds", "bounds_note"]
+if TYPE_CHECKING:
+    from ..picks import DesignTable
+
+__all__ = ["AT_BOUND", "at_bounds", "bounds_note", "table_bounds"]
 
 #: The share of a design variable's search range within which a value is at the bound.
 AT_BOUND = 0.01
@@ -72,3 +76,28 @@ def bounds_note(
         f"at a bound (within {100 * share:g} % of its range): {', '.join(found)}; {beyond}:"
         f" widen the bounds in design_variables if the design allows"
     )
+
+
+def table_bounds(table: DesignTable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(lower (n,), upper (n,), at (N, n))`` of the design table of a result file
+    (:func:`suspopt.picks.read_table`): each variable's search range from the configs the
+    file stored (the widest over the sets of a kesort file; NaN for a variable none of them
+    has), and :func:`at_bounds` of each design against its own config's variables (0 where
+    its config lacks the variable). ConfigError when a stored config does not load."""
+    from ..config.loader import load_config_text
+
+    n = len(table.var_names)
+    lower, upper = np.full(n, np.nan), np.full(n, np.nan)
+    at = np.zeros(table.X.shape, dtype=np.int8)
+    for c, text in enumerate(table.configs):
+        cfg = load_config_text(text, table.path.with_name(f"{table.path.name}:config"))
+        mine = {v.label: v for v in cfg.design_variables}
+        columns = np.array([j for j, name in enumerate(table.var_names) if name in mine], int)
+        if not columns.size:
+            continue
+        variables = [mine[table.var_names[j]] for j in columns]
+        lower[columns] = np.fmin(lower[columns], [v.lower for v in variables])
+        upper[columns] = np.fmax(upper[columns], [v.upper for v in variables])
+        rows = np.flatnonzero(table.config_of == c)
+        at[np.ix_(rows, columns)] = at_bounds(variables, table.X[np.ix_(rows, columns)])
+    return lower, upper, at

@@ -10,12 +10,13 @@ browser and makes no network request. Per study:
 - the front as a scatter of any two columns (objectives or design variables) chosen from
   drop-downs, in 3D for three objectives; colour by feasibility, k-ε level (kesort), case,
   or any objective or variable; the picks (edges, knee, the k-ε optimum) marked;
-- a parallel-coordinates view of the objectives and variables, coloured as the front;
+- a parallel-coordinates view of the objectives and variables, coloured as the front, each
+  variable's axis spanning its search range (:func:`_search_bounds`);
   brushing ranges along its axes selects the designs inside all of them in the front,
   counts them and shows the ``suspopt simulate`` of them (up to 100). It is drawn when it comes on screen, at most three at a time (a browser
   keeps about 16 WebGL contexts per page and each takes three: :data:`.page.SCRIPT`);
-- hover and click on a design: its row, objectives with units, variables, constraint
-  margins, in the panel beside the plot, and the ``suspopt export`` and ``simulate``
+- hover and click on a design: its row, objectives with units, variables (those at a
+  bound marked), constraint margins, in the panel beside the plot, and the ``suspopt export`` and ``simulate``
   commands that take it on (the file's path as given, quoted for a POSIX shell);
 - the picks' (and ``with_signals`` rows') time histories and power spectral densities
   [unit²/Hz], simulated when the report is built (from each design's own config, in one
@@ -110,6 +111,7 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
         **extra,
     }
     study = Study(path.name, kind, data)
+    _search_bounds(table, data, study.notes)
     rows = sorted(
         set(table.picks.values()) | {table.resolve(r, "--with-signals") for r in with_signals}
     )
@@ -119,6 +121,26 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
         )
     data["signals"] = _signals(path, table, rows, study.notes)
     return study
+
+
+def _search_bounds(table, data: dict[str, Any], notes: list[str]) -> None:
+    """The design variables' search ranges (``variable_bounds``: lower and upper, None where
+    unknown) and which designs lie at a bound (:func:`suspopt.optimise.bounds.table_bounds`):
+    ``at_bound``, one text per variable of one character per design, ``-`` at the lower
+    bound, ``+`` at the upper, ``.`` neither (N bytes a variable, where lists of numbers
+    would take a 20,000-design page past its size limit). A stored config that does not
+    load leaves them out, with a note."""
+    from ..optimise.bounds import table_bounds
+
+    try:
+        lower, upper, at = table_bounds(table)
+    except ConfigError as exc:
+        notes.append(f"the design variables' bounds are not shown: {exc}")
+        return
+    data["variable_bounds"] = [_list(lower), _list(upper)]
+    data["at_bound"] = [
+        "".join({-1: "-", 0: ".", 1: "+"}[side] for side in column) for column in at.T
+    ]
 
 
 def _extras(h5, table) -> dict[str, Any]:

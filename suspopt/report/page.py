@@ -23,8 +23,9 @@ h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.6em; }
 .controls label { margin-right: 1em; font-size: 0.9em; }
 .row { display: flex; flex-wrap: wrap; gap: 1em; }
 .plot { width: 720px; height: 480px; } .wide { width: 1100px; height: 420px; }
-.design { min-width: 300px; max-width: 380px; font-size: 0.85em; }
+.design { min-width: 300px; max-width: 460px; font-size: 0.85em; }
 .design table { border-collapse: collapse; } .design td { padding: 1px 6px; }
+.design td.note { white-space: nowrap; }
 .note { color: #666; font-size: 0.85em; }
 pre { background: #f6f6f6; padding: 0.6em; max-height: 24em; overflow: auto; }
 .onward { margin-top: 0.6em; } .onward code { display: block; user-select: all; background: #f6f6f6; padding: 2px 4px;
@@ -71,11 +72,14 @@ SCRIPT = r"""
     const picks = Object.entries(d.picks).filter(([, r]) => r === row).map(([n]) => n);
     if (picks.length) el("div", "pick: " + picks.join(", "), box);
     const t = el("table", null, box);
-    function add(name, value, unit) {
+    function add(name, value, unit, note) {
       const tr = el("tr", null, t); el("td", name, tr); el("td", fmt(value), tr); el("td", unit, tr);
+      if (note) el("td", note, tr).className = "note";
     }
+    const side = { "-": "at lower bound", "+": "at upper bound" };
     d.objectives.forEach((n, j) => add(n, d.F[row][j], d.objective_units[j]));
-    d.variables.forEach((n, j) => add(n, d.X[row][j], d.variable_units[j]));
+    d.variables.forEach((n, j) => add(n, d.X[row][j], d.variable_units[j],
+                                      d.at_bound && side[d.at_bound[j][row]]));
     if (d.G) d.constraints.forEach((n, j) => add("g: " + n, d.G[row][j], d.constraint_units[j]));
     if (d.k_eps) add("k-ε level", d.k_eps[row], "1");
     if (d.case) add("case " + d.case[row], null, "");
@@ -250,10 +254,17 @@ SCRIPT = r"""
   function parallelTraces(i) {
     const study = data.studies[i], keys = parallelKeys(study);
     const dims = keys.map((k, j) => Object.assign({ label: name(study, k), values: column(study, k) },
+                                                  searchRange(study, k),
                                                   brushes[i][j] ? { constraintrange: brushes[i][j] } : {}));
     const line = colouring(study, document.getElementById("c-" + i).value);
     delete line.colorbar;
     return [{ type: "parcoords", dimensions: dims, line: line }];
+  }
+  function searchRange(study, key) {  // a variable's axis spans its bounds (and its values)
+    const d = study.data, [kind, j] = key.split(":"), b = d.variable_bounds;
+    if (kind !== "X" || !b || b[0][j] === null || b[1][j] === null) return {};
+    const v = column(study, key).filter(x => x !== null);
+    return { range: [v.reduce((a, x) => Math.min(a, x), b[0][j]), v.reduce((a, x) => Math.max(a, x), b[1][j])] };
   }
   const parallelWatch = "IntersectionObserver" in window ? new IntersectionObserver(entries => {
     for (const e of entries) {
