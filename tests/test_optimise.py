@@ -22,6 +22,7 @@ from suspopt.optimise import (
     PENALTY,
     Gradient,
     Hybrid,
+    Problem,
     PymooOptimiser,
     WeightedSum,
     balanced_weights,
@@ -431,7 +432,11 @@ def test_resume_equals_an_uninterrupted_run(tmp_path, variant):
     for other in (again, resumed):
         for key in ("X", "F", "G"):
             np.testing.assert_array_equal(getattr(whole, key), getattr(other, key))
+            np.testing.assert_array_equal(  # (and the config's own design, evaluated at the end)
+                getattr(whole.baseline, key), getattr(other.baseline, key)
+            )
         np.testing.assert_array_equal(whole.history["evaluations"], other.history["evaluations"])
+    assert part.baseline is None  # (an interrupted run spends no more time)
     if variant == "hybrid_weighted":
         assert whole.F.shape == (1, 2) and whole.weights.shape == (2,)
     with pytest.raises(ConfigError, match="another config"):
@@ -466,6 +471,27 @@ def test_cli_optimise_writes_the_design_md_layout(tmp_path):
         assert checkpoint["G"].shape == (16, 6)
         assert list(checkpoint["X"].attrs["units"])[2] == "log10(N/m^3)"
         assert "state" not in checkpoint
+        own = {k: h5[f"baseline/{k}"][()] for k in "XFG"}  # the config's own design
+        assert list(h5["baseline/F"].attrs["names"]) == list(F.attrs["names"])
+        front = {k: h5[f"pareto/{k}"][()] for k in "FG"}
+    # the config as written, simulated on its own: its objectives are the baseline's
+    cfg = suspopt.load_config(config)
+    np.testing.assert_allclose(own["X"], [[5.0e4, 3000.0, 1.0e7]], rtol=1e-12)
+    values = Problem.from_config(cfg).values(suspopt.simulate(cfg), {}, 1)
+    np.testing.assert_allclose(own["F"], values[0], rtol=1e-9)
+    np.testing.assert_allclose(own["G"], values[1], rtol=1e-9, atol=1e-12)
+    feasible = "feasible" if (own["G"] <= 0).all() else "infeasible"
+    if N == 1:  # each objective's change from the config's design
+        changes = [f"{n} {100 * (a - b) / abs(b):+.3g} %" for n, a, b in
+                   zip(["f1", "f3"], front["F"][0], own["F"][0])]  # fmt: skip
+        line = f"against the config's own design ({feasible}): {', '.join(changes)}"
+    else:  # the front's designs that dominate it
+        dominate = ((front["G"] <= 0).all(1) & (front["F"] <= own["F"]).all(1)
+                    & (front["F"] < own["F"]).any(1)).sum()  # fmt: skip
+        names = ", ".join(f"{n} = {v:.4g} {u}" for n, v, u in zip(["f1", "f3"], own["F"][0],
+                                                                 ["(m/s^2)^2", "m^2"]))  # fmt: skip
+        line = f"the config's own design: {names} ({feasible}); {dominate} of the {N} designs"
+    assert line in " ".join(proc.stdout.split())
 
 
 @pytest.mark.parametrize(
@@ -596,7 +622,37 @@ def test_optimise_and_kesort_name_the_variables_the_optimum_has_at_a_bound(tmp_p
         at += [f"{v.name} lower"] * bool(position <= 0.01)
         at += [f"{v.name} upper"] * bool(position >= 0.99)
     assert 0 < len(at) < len(x)  # (the run has both: the note can name too many or too few)
+    with h5py.File(out) as h5:  # and against the config's own design, beside the optimum
+        F, own = h5["pareto/F"][0, 0], h5["baseline/F"][0, 0]
+    change = f"{100 * (F - own) / abs(own):+.3g}"
+    assert f"against the config's own design (feasible): f1 {change} %" in printed
+    assert "config's design" in printed and float(change) < 0
     note = f"at a bound (within 1 % of its range): {', '.join(at)}; the optimum may lie beyond"
     assert f"note: {note}" in " ".join(printed.split())
     assert main(["kesort", str(out)]) == 0
     assert f"note: the k-ε optimum is {note}" in " ".join(capsys.readouterr().out.split())
+
+
+def test_the_front_is_set_against_the_configs_own_design():
+    """The designs of a front that dominate the config's design: feasible, no objective
+    worse, one better (a design equal to it, or infeasible, does not)."""
+    from types import SimpleNamespace
+
+    from suspopt.cli.optimisation import _baseline_line
+    from suspopt.optimise import Solutions
+
+    own = Solutions(np.zeros((1, 1)), np.array([[1.0, 1.0]]), np.array([[-1.0]]))
+    F = np.array([[0.5, 1.0], [1.0, 1.0], [0.2, 0.2], [0.5, 2.0], [0.9, 0.9]])
+    G = np.array([[-1.0], [-1.0], [0.5], [-1.0], [0.0]])
+    result = SimpleNamespace(X=np.zeros((5, 1)), F=F, G=G, obj_names=["a", "b"],
+                             obj_units=["m", "s"], baseline=own)  # fmt: skip
+    assert _baseline_line(result) == (
+        "the config's own design: a = 1 m, b = 1 s (feasible); 2 of the 5 designs dominate "
+        "it (feasible, no objective worse, one better)"
+    )
+    result.baseline = Solutions(own.X, np.array([[PENALTY, PENALTY]]), np.array([[1.0]]))
+    assert _baseline_line(result) == (
+        "the config's own design failed to simulate (diverged or gave NaN)"
+    )
+    result.baseline = None
+    assert _baseline_line(result) is None

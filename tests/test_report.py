@@ -146,6 +146,9 @@ def test_the_page_holds_every_design_and_nothing_from_a_file_as_markup(files, tm
         assert study["variable_bounds"] == bounds  # each variable's search range
         assert study["at_bound"] == at_bound(variables, study["X"])
     assert "-" in "".join(robust["at_bound"]) or "+" in "".join(robust["at_bound"])
+    with h5py.File(files["front"]) as h5:  # the config's own design, where the file has it
+        own = {k: h5[f"baseline/{k}"][0].tolist() for k in "FX"}
+    assert front["baseline"] == own and "baseline" not in kesort and "baseline" not in roads
 
 
 def at_bound(variables, X) -> list[str]:
@@ -330,6 +333,17 @@ def test_the_report_in_a_real_browser(files, chapters, browser, tmp_path, monkey
         assert [dict(notes)[name] for name in study["variables"]] == expected
         assert all(note == "" for name, note in notes if name not in study["variables"])
     assert which != "robust" or bounded  # (one page at least shows the note)
+    if "baseline" in study:  # the config's own design on the front, at its values
+        trace = browser.execute_script(
+            "const t = document.getElementById('front-0').data"
+            '.find(t => t.name === "the config\'s design"); return t && [t.x, t.y]'
+        )
+        x, y = (browser.execute_script(f"return document.getElementById('{a}-0').value")
+                for a in "xy")  # fmt: skip
+        at = {f"F:{j}": v for j, v in enumerate(study["baseline"]["F"])}
+        at.update({f"X:{j}": v for j, v in enumerate(study["baseline"]["X"])})
+        assert trace == [[at[x]], [at[y]]]
+    assert which != "ch5" or "baseline" in study
     browser.execute_script("window.suspoptReport.select(0, arguments[0])", row)
     onward = browser.execute_script(  # the commands that take the design on, run as shown
         "return [...document.querySelectorAll('#design-0 .onward code')].map(c => c.textContent)"
@@ -432,11 +446,15 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
     line = browser.execute_script("return document.getElementById('parallel-0').data[0].line")
     assert line["color"] == f2.tolist() and line["colorscale"] == "Viridis"
     shown = browser.execute_script(  # in 3D: the brushed designs, and the rest in grey
-        "document.getElementById('d3-4').click();"
-        " return document.getElementById('front-4').data.map(t => [t.type, t.customdata])"
+        "document.getElementById('d3-4').click(); return document.getElementById('front-4')"
+        '.data.map(t => [t.type, t.customdata || null, t.name === "the config\'s design" ? t.z : null])'
     )
     outside = [r for r in range(len(F3)) if r not in inside3]
-    assert shown == [["scatter3d", inside3]] + ([["scatter3d", outside]] if outside else [])
+    with h5py.File(files["three"]) as h5:  # and the config's own design, where it started
+        own = h5["baseline/F"][0, 2]
+    assert shown == [["scatter3d", inside3, None]] + (
+        [["scatter3d", outside, None]] if outside else []
+    ) + [["scatter3d", None, [own]]]
 
 
 def test_the_commands_shown_for_a_design_name_its_file_as_a_shell_reads_it(files, tmp_path):

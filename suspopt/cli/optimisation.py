@@ -31,6 +31,38 @@ def _progress_line(p) -> str:
     )
 
 
+def _baseline_line(result) -> str | None:
+    """How the optimum stands against the config's own design (``result.baseline``): each
+    objective's change for one optimum; the design's objectives and how many designs of a
+    front dominate it (feasible, no objective worse, one better)."""
+    import numpy as np
+
+    from ..optimise.problem import PENALTY
+
+    own = result.baseline
+    if own is None:
+        return None
+    if (own.F >= PENALTY).any():
+        return "the config's own design failed to simulate (diverged or gave NaN)"
+    feasible = "feasible" if own.feasible[0] else "infeasible"
+    if len(result.X) == 1:
+        change = [
+            f"{name} {100 * (new - old) / abs(old):+.3g} %"
+            for name, new, old in zip(result.obj_names, result.F[0], own.F[0])
+            if old != 0 and np.isfinite(old)
+        ]
+        return f"against the config's own design ({feasible}): " + ", ".join(change)
+    ok = (result.G <= 0).all(axis=1)
+    better = ok & (result.F <= own.F).all(axis=1) & (result.F < own.F).any(axis=1)
+    values = ", ".join(
+        f"{n} = {v:.4g} {u}" for n, v, u in zip(result.obj_names, own.F[0], result.obj_units)
+    )
+    return (
+        f"the config's own design: {values} ({feasible}); {int(better.sum())} of the "
+        f"{len(result.X)} designs dominate it (feasible, no objective worse, one better)"
+    )
+
+
 def _optimum_table(result, rows: int = 12) -> Table:
     """The best design (one column), or up to ``rows`` designs spread along the Pareto front
     (one row each)."""
@@ -44,11 +76,17 @@ def _optimum_table(result, rows: int = 12) -> Table:
     suffix = "" if result.status == "finished" else " (interrupted)"
     if N == 1:
         table = base.new_table("best design" + suffix)
-        for col in ("quantity", "unit", "value"):
-            table.add_column(col, justify="right" if col == "value" else "left")
-        for name, unit, value in zip(names, units, values[0]):
-            table.add_row(name, unit, f"{value:.5g}")
-        table.add_row("feasible", "", feasible[0])
+        table.add_column("quantity")
+        table.add_column("unit")
+        table.add_column("value", justify="right")
+        own = result.baseline  # (the design the run started from, beside it)
+        if own is not None:
+            table.add_column("config's design", justify="right")
+        for j, (name, unit, value) in enumerate(zip(names, units, values[0])):
+            start = [] if own is None else [f"{np.hstack([own.F, own.X])[0, j]:.5g}"]
+            table.add_row(name, unit, f"{value:.5g}", *start)
+        start = [] if own is None else ["yes" if own.feasible[0] else "no"]
+        table.add_row("feasible", "", feasible[0], *start)
         return table
     pick = np.unique(np.linspace(0, N - 1, min(rows, N)).round().astype(int))
     table = base.new_table(f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
@@ -175,6 +213,9 @@ def _optimise(
         err.print("the first generation had not completed: nothing written")
         raise typer.Exit(code=130) from None
     base.show_table(_optimum_table(result))
+    line = _baseline_line(result)
+    if line is not None:
+        out.print(line, soft_wrap=True)
     from ..optimise.bounds import bounds_note
 
     note = bounds_note(result.var_names, cfg.design_variables, result.X)

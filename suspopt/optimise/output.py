@@ -44,6 +44,15 @@ def write_pareto(h5, problem: Problem, optimum, weights) -> None:
         write_scenarios(pareto, problem, optimum.X)
 
 
+def write_baseline(h5, problem: Problem, baseline) -> None:
+    """``/baseline/X, F, G`` (one row each, as ``/pareto``'s): the config's own design
+    (:func:`suspopt.optimise.run.config_design`), evaluated as the run's designs are."""
+    group = h5.create_group("baseline")
+    values = {"X": baseline.X, "F": baseline.F, "G": baseline.G}
+    for key, _, units, dim, names in _tables(problem, problem.var_units):
+        write_dataset(group, key, values[key], units, dims=("design", dim), names=names)
+
+
 def write_scenarios(pareto, problem: Problem, X) -> None:
     """``/pareto/scenarios``: the objectives ``F (N, S, m)`` and constraint margins
     ``G (N, S, k)`` of the designs ``X`` (physical values) under each scenario, the scenarios'

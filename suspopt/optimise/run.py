@@ -31,6 +31,10 @@ HDF5 layout (the public contract, docs/architecture.md#public-contract), every d
   the file (no simulation), checks that it asks for exactly the stored designs and arrives at
   the stored history, then goes on; so it continues bit for bit, and nothing read from the
   file is ever executed (there is no pickle).
+- ``/baseline/X, F, G`` (one row each, names and units as ``/pareto``'s): the config's
+  own design (the values its design variables' fields hold), evaluated once when the run
+  ends (not when interrupted), outside the budget: where the optimum stands against the
+  design it started from. Absent where a design variable's field holds no value.
 - dimensions (:func:`suspopt.io.write_dataset`): ``/pareto/{design, variable, objective,
   constraint}`` (row numbers; the names of the columns of X, F, G), ``/history/generation``
   and ``/history/objective`` (the columns of ``best``), ``/checkpoint/{evaluation, variable,
@@ -58,8 +62,15 @@ from ..config.optimise import ALGORITHMS
 from ..config.optimise import Hybrid as HybridSettings
 from ..config.optimise import Optimiser as OptimiserSettings
 from ..io import atomic_h5, check_not_input, config_inputs
+from ..params import numeric_paths
 from . import algorithms
-from .output import read_checkpoint, write_checkpoint, write_history, write_pareto
+from .output import (
+    read_checkpoint,
+    write_baseline,
+    write_checkpoint,
+    write_history,
+    write_pareto,
+)
 from .problem import PENALTY, Problem
 
 __all__ = ["optimise", "build_optimiser", "Progress", "OptimisationResult"]
@@ -109,6 +120,7 @@ class OptimisationResult:
     status: str
     path: Path
     weights: np.ndarray | None = None
+    baseline: algorithms.Solutions | None = None
 
 
 class _Recorder(_PymooProblem):
@@ -232,7 +244,21 @@ def optimise(
         snapshot = _snapshot(run, problem)
     if status == "finished" and (snapshot.optimum.F >= PENALTY).all():
         status = "failed"  # every design of the optimum failed to simulate
-    return _write(output, cfg, problem, snapshot, run, status, command)
+    baseline = config_design(problem) if status != "interrupted" else None
+    return _write(output, cfg, problem, snapshot, run, status, command, baseline)
+
+
+def config_design(problem: Problem) -> algorithms.Solutions | None:
+    """The config's own design (the values its design variables' fields hold: the design
+    the engineer starts from), evaluated as the run's designs are: X physical (1, n), F
+    (1, m), G (1, k); None when a field holds no value. Not counted in the run's budget."""
+    values = numeric_paths(problem.cfg)
+    if any(v.path not in values for v in problem.variables):
+        return None
+    X = np.array([[values[v.path] for v in problem.variables]])
+    with np.errstate(divide="ignore"):  # (0 on a log scale: log10 gives -inf, 10**-inf 0)
+        F, G = problem.evaluate(problem.to_search(X), return_values_of=["F", "G"])
+    return algorithms.Solutions(problem.to_physical(problem.to_search(X)), F, G)
 
 
 def settings(cfg: Config) -> OptimiserSettings:
@@ -510,6 +536,7 @@ def _write(
     run: _Run,
     status: str,
     command: str | None,
+    baseline: algorithms.Solutions | None = None,
 ) -> OptimisationResult:
     weights, run_batches = run.weights, run.recorder.batches
     opt = settings(cfg)
@@ -526,6 +553,8 @@ def _write(
         write_pareto(h5, problem, snap.optimum, weights)
         write_history(h5, snap.history, best_names, best_units)
         write_checkpoint(h5, problem, run_batches[: snap.batches], snap.generation)
+        if baseline is not None:
+            write_baseline(h5, problem, baseline)
     o = snap.optimum
     return OptimisationResult(
         status=status,
@@ -540,4 +569,5 @@ def _write(
         G=o.G,
         constraint_names=problem.constraint_names,
         history=snap.history,
+        baseline=baseline,
     )

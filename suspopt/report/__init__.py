@@ -9,7 +9,8 @@ browser and makes no network request. Per study:
 
 - the front as a scatter of any two columns (objectives or design variables) chosen from
   drop-downs, in 3D for three objectives; colour by feasibility, k-ε level (kesort), case,
-  or any objective or variable; the picks (edges, knee, the k-ε optimum) marked;
+  or any objective or variable; the picks (edges, knee, the k-ε optimum) marked, and the
+  config's own design (``/baseline`` of an optimise file) where the file has it;
 - a parallel-coordinates view of the objectives and variables, coloured as the front, each
   variable's axis spanning its search range (:func:`_search_bounds`);
   brushing ranges along its axes selects the designs inside all of them in the front,
@@ -156,6 +157,11 @@ def _extras(h5, table) -> dict[str, Any]:
             out["constraints"] = h5.labels("pareto/G", "names", G.shape[1])
             out["constraint_units"] = h5.labels("pareto/G", "units", G.shape[1])
             out["feasible"] = (G <= 0).all(axis=1).tolist()
+    if group == "pareto" and h5._node("baseline/F") is not None:  # (the config's design)
+        F0 = h5.array("baseline/F", ndim=2, columns=table.F.shape[1])
+        X0 = h5.array("baseline/X", ndim=2, columns=table.X.shape[1])
+        if len(F0) == len(X0) == 1:
+            out["baseline"] = {"F": _list(F0[0]), "X": _list(X0[0])}
     if group == "kesort":
         out["k_eps"] = _list(h5.array("kesort/k_eps", ndim=1))
         out["feasible"] = [bool(v) for v in h5.array("kesort/feasible", ndim=1)]

@@ -147,6 +147,12 @@ SCRIPT = r"""
     el("code", "suspopt simulate " + data.studies[i].data.source + " --pick " + rows.join(",") + " -o brushed.h5", box);
   }
 
+  function baselineTrace(d, x, y) {  // the config's own design: where the run started
+    const at = key => { const [kind, j] = key.split(":"); return (kind === "F" ? d.baseline.F : d.baseline.X)[Number(j)]; };
+    return { type: "scatter", mode: "markers+text", name: "the config's design", x: [at(x)], y: [at(y)],
+             text: ["config"], textposition: "bottom center", hoverinfo: "text+x+y",
+             marker: { symbol: "diamond-open", size: 12, color: "#000", line: { width: 2 } } };
+  }
   function drawFront(i) {
     const study = data.studies[i], d = study.data;
     const x = document.getElementById("x-" + i).value, y = document.getElementById("y-" + i).value;
@@ -171,6 +177,8 @@ SCRIPT = r"""
         { marker: Object.assign({}, marker, range, { size: 4, color: pick(marker.color, split[0]) }) }));
       if (split[1].length) traces.push(Object.assign({ type: "scatter3d", mode: "markers",
         name: "outside the brushed ranges" }, xyz(split[1]), { marker: { size: 3, color: "#bbb", opacity: 0.3 } }));
+      if (d.baseline) traces.push(Object.assign(baselineTrace(d, "F:0", "F:1"),
+        { type: "scatter3d", z: [d.baseline.F[2]], marker: { symbol: "diamond-open", size: 6, color: "#000" } }));
     } else {
       traces.push({ type: "scatter",
         mode: "markers", name: "designs", x: column(study, x), y: column(study, y), customdata: rows,
@@ -180,6 +188,7 @@ SCRIPT = r"""
       traces.push({ type: "scatter", mode: "markers+text", name: "picks", x: pr.map(r => column(study, x)[r]),
         y: pr.map(r => column(study, y)[r]), text: names, textposition: "top center", customdata: pr,
         hoverinfo: "text", marker: { symbol: "x", size: 12, color: "#d62728" } });
+      if (d.baseline) traces.push(baselineTrace(d, x, y));
       for (const p of d.pseudo || []) {
         if (!x.startsWith("F:") || !y.startsWith("F:")) break;
         const jx = Number(x.slice(2)), jy = Number(y.slice(2)), lx = [], ly = [];
