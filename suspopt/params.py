@@ -193,9 +193,29 @@ def _split(item: str, option: str) -> tuple[str, str]:
     return path.strip(), value.strip()
 
 
-def _numeric_path(cfg: Config, path: str, option: str) -> None:
+def _numeric_type(annotation: Any) -> bool:
+    """Whether a field's ``annotation`` admits a number (int or float, not bool), through
+    ``Optional`` and ``Annotated``."""
+    return annotation in (int, float) or any(_numeric_type(a) for a in get_args(annotation))
+
+
+def _unset_numeric(cfg: Config, path: str) -> bool:
+    """Whether ``path`` is a numeric field of an existing section that the config leaves
+    unset (``optimiser.generations`` of a run budgeted by evaluations): ``--set`` gives it a
+    value, as writing it in the YAML would."""
+    try:
+        node, name = _section(cfg, path)
+    except (AttributeError, KeyError, TypeError):
+        return False
+    info = getattr(type(node), "model_fields", {}).get(name)
+    return info is not None and getattr(node, name) is None and _numeric_type(info.annotation)
+
+
+def _numeric_path(cfg: Config, path: str, option: str, unset: bool = False) -> None:
+    """ConfigError unless ``path`` is a numeric field of ``cfg`` (or, with ``unset``, one it
+    leaves unset), naming the closest ones."""
     paths = numeric_paths(cfg)
-    if path not in paths:
+    if path not in paths and not (unset and _unset_numeric(cfg, path)):
         close = difflib.get_close_matches(path, list(paths), n=3)
         raise ConfigError(
             f"{option} {path}: not a numeric field of this config"
@@ -212,7 +232,7 @@ def apply_sets(cfg: Config, items: list[str]) -> Config:
     values = {}
     for item in listed(items):  # (one PATH=VALUE as a string: not letter by letter)
         path, text = _split(item, "--set")
-        _numeric_path(cfg, path, "--set")
+        _numeric_path(cfg, path, "--set", unset=True)
         try:
             value, _ = parse_yaml(text)
         except YamlError:

@@ -656,3 +656,32 @@ def test_the_front_is_set_against_the_configs_own_design():
     )
     result.baseline = None
     assert _baseline_line(result) is None
+
+
+def test_optimise_takes_set_and_its_resume_needs_the_same(tmp_path, capsys):
+    """``--set`` edits the config before the run as ``simulate``'s does, a field the config
+    leaves unset included (a budget by evaluations given generations); the file records the
+    edited config, so ``--resume`` takes the same ``--set`` (the hint says it) and refuses
+    the run without it."""
+    from suspopt._entry import main
+    from suspopt.cli.optimisation import _again
+
+    config = tmp_path / "case.yaml"
+    config.write_text(TINY.replace("generations: 4, seed: 1}", "max_evaluations: 40, seed: 1}"))
+    out = tmp_path / "front.h5"
+    sets = ["--set", "optimiser.generations=2", "--set", "road.speed=20"]
+    assert main(["optimise", str(config), "-o", str(out), *sets]) == 0, capsys.readouterr().err
+    with h5py.File(out) as h5:
+        assert h5["history/evaluations"][()].tolist() == [8, 16]  # (2 generations, not 5)
+        recorded = load_config_text(h5.attrs["config"])
+    assert recorded.optimiser.generations == 2 and recorded.road.speed == 20
+    assert main(["optimise", str(config), "-o", str(out), *sets, "--resume"]) == 0
+    capsys.readouterr()
+    assert main(["optimise", str(config), "-o", str(out), "--resume"]) == 2
+    assert "another config" in capsys.readouterr().err
+    assert main(["optimise", str(config), "-o", str(out), "--set", "optimiser.generationz=2"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: --set optimiser.generationz: not a numeric field of this")
+    assert len(err.splitlines()) == 1
+    hint = _again(Path("my study.yaml"), Path("o.h5"), ["road.speed=25"])
+    assert hint == "suspopt optimise 'my study.yaml' -o o.h5 --set road.speed=25 --resume"

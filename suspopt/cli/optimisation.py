@@ -111,6 +111,12 @@ def optimise(
         "the current folder), rewritten after the first generation and then at most every 2 s",
     ),
     resume: bool = typer.Option(False, "--resume", help="continue from the checkpoint in OUT.h5"),
+    set_: list[str] = typer.Option(
+        [],
+        "--set",
+        help="PATH=VALUE: override a numeric field of the config (optimiser.generations=50,"
+        " road.speed=25); repeatable; give the same with --resume",
+    ),
     plot: Path | None = base.plot_option(
         "the front (or the best value) and the history per generation"
     ),
@@ -131,7 +137,7 @@ def optimise(
         except ValueError as exc:
             base.fail(str(exc))
     with run.outputs(output, plot, execute=False, inputs=[("the config", config)]):
-        _optimise(config, output, resume, plot, run)
+        _optimise(config, output, resume, plot, run, set_)
 
 
 def _scenarios_line(cfg, output: Path) -> None:
@@ -175,9 +181,17 @@ def _progress(cfg):
     return bar, report, chunk_done
 
 
-def _resume_hint(config: Path, output: Path, kept: str, then: str) -> str:
+def _again(config: Path, output: Path, sets: list[str]) -> str:
+    """The command that continues the run: its config, output and ``--set`` items."""
+    import shlex
+
+    edits = [word for item in sets for word in ("--set", item)]
+    return shlex.join(["suspopt", "optimise", str(config), "-o", str(output), *edits, "--resume"])
+
+
+def _resume_hint(config: Path, output: Path, kept: str, then: str, sets: list[str]) -> str:
     """What to do when a run stops early, its output holding what it ``kept``."""
-    return f"; {output} keeps {kept}: {then} with suspopt optimise {config} -o {output} --resume"
+    return f"; {output} keeps {kept}: {then} with {_again(config, output, sets)}"
 
 
 def _optimise(
@@ -186,25 +200,29 @@ def _optimise(
     resume: bool,
     plot: Path | None,
     options: base.RunOptions,
+    sets: list[str],
 ) -> None:
     from ..checks import check_config
     from ..io import WriteError
     from ..optimise import optimise as run
+    from ..params import apply_sets
 
-    cfg = base.read_config(config)
     try:
+        cfg = apply_sets(base.read_config(config), sets)
         check_config(cfg)
     except ConfigError as exc:
         base.fail(str(exc))
     bar, report, chunk_done = _progress(cfg)
     try:
-        lost = _resume_hint(config, output, "the last generation's checkpoint", "continue")
+        lost = _resume_hint(config, output, "the last generation's checkpoint", "continue", sets)
         with bar, options.executing(progress=chunk_done, lost_hint=lost + " (on any executor)"):
             result = run(cfg, output, resume=resume, callback=report, command=base.command_line())
     except WriteError as exc:  # (a full disk: the file holds the last generation it took)
         hint = "make room, then continue"
         kept = (
-            _resume_hint(config, output, "an earlier checkpoint", hint) if output.exists() else ""
+            _resume_hint(config, output, "an earlier checkpoint", hint, sets)
+            if output.exists()
+            else ""
         )
         base.fail(f"{exc}{kept}")
     except ConfigError as exc:
@@ -231,7 +249,7 @@ def _optimise(
     if result.status == "interrupted":
         err.print(
             f"wrote the designs found so far to {output}; continue with "
-            f"suspopt optimise {config} -o {output} --resume",
+            f"{_again(config, output, sets)}",
             soft_wrap=True,
         )
         raise typer.Exit(code=130)
