@@ -685,3 +685,35 @@ def test_optimise_takes_set_and_its_resume_needs_the_same(tmp_path, capsys):
     assert len(err.splitlines()) == 1
     hint = _again(Path("my study.yaml"), Path("o.h5"), ["road.speed=25"])
     assert hint == "suspopt optimise 'my study.yaml' -o o.h5 --set road.speed=25 --resume"
+
+
+@pytest.mark.slow
+def test_a_run_resumed_with_a_longer_budget_goes_on_to_the_longer_runs_result(tmp_path, capsys):
+    """A finished run of 2 generations, resumed with ``--set optimiser.generations=4``, goes
+    on from its checkpoint to the bits of a 4-generation run; a budget below what the file
+    holds, or any other change, is refused in one line."""
+    from suspopt._entry import main
+
+    config = tmp_path / "case.yaml"
+    config.write_text(TINY.replace("generations: 4", "generations: 2"))
+    short, whole = tmp_path / "short.h5", tmp_path / "whole.h5"
+    more = ["--set", "optimiser.generations=4"]
+    assert main(["optimise", str(config), "-o", str(short)]) == 0
+    assert main(["optimise", str(config), "-o", str(whole), *more]) == 0
+    assert main(["optimise", str(config), "-o", str(short), *more, "--resume"]) == 0
+    with h5py.File(short) as a, h5py.File(whole) as b:
+        assert a.attrs["generations"] == b.attrs["generations"] == 4
+        for key in ("pareto/X", "pareto/F", "pareto/G", "history/evaluations", "checkpoint/X"):
+            np.testing.assert_array_equal(a[key][()], b[key][()])
+        assert a.attrs["config"] == b.attrs["config"]  # (the longer budget's, recorded)
+    capsys.readouterr()
+    for edit, needle in (
+        (
+            ["--set", "optimiser.generations=3"],
+            "holds 4 generations and optimiser.generations is 3",
+        ),
+        (["--set", "road.speed=12"], "another config (it differs in more than optimiser."),
+    ):
+        assert main(["optimise", str(config), "-o", str(short), *more, *edit, "--resume"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert needle in err and len(err.splitlines()) == 1, err

@@ -108,7 +108,9 @@ def write_checkpoint(h5, problem: Problem, batches: list, generations: int) -> N
 
 def read_checkpoint(output: Path, cfg: Config, problem: Problem):
     """The stored batches ``[(X, F, G), ...]``, generations and history of ``output``;
-    ConfigError naming the file and the dataset for anything missing or malformed."""
+    ConfigError naming the file and the dataset for anything missing or malformed, for a
+    file of another config (one that differs in more than the budget, :data:`BUDGET`), or
+    for a budget that ends before the checkpoint does."""
     from ..h5read import H5Reader
 
     where = f"--resume: {output}"
@@ -119,10 +121,12 @@ def read_checkpoint(output: Path, cfg: Config, problem: Problem):
     if missing:
         raise ConfigError(f"{where}: does not exist (run without --resume to start)")
     with H5Reader(output, where) as h5:
-        if h5.text_attr("config") != cfg.text:
+        stored = h5.text_attr("config")
+        if stored != cfg.text and not _same_but_budget(stored, cfg):
             raise ConfigError(
-                f"{where}: was written for another config (its YAML text "
-                f"differs); use the same config or run without --resume"
+                f"{where}: was written for another config (it differs in more than "
+                f"optimiser.generations and max_evaluations); use the same config or run "
+                f"without --resume"
             )
         if "checkpoint/state" in h5.file:
             raise ConfigError(
@@ -156,6 +160,42 @@ def read_checkpoint(output: Path, cfg: Config, problem: Problem):
             f"{where}: /history/time: {len(history['time'])} generations, the "
             f"checkpoint {generations}"
         )
+    _check_budget(where, cfg, generations, int(sizes.sum()))
     edges = np.concatenate([[0], np.cumsum(sizes)])
     batches = [(X[a:b], F[a:b], G[a:b]) for a, b in zip(edges[:-1], edges[1:])]
     return batches, generations, history
+
+
+#: The optimiser's fields a ``--resume`` may change: how long the run goes on, not how.
+BUDGET = ("generations", "max_evaluations")
+
+
+def _same_but_budget(stored: str, cfg: Config) -> bool:
+    """Whether the config text ``stored`` (a checkpoint's) is ``cfg`` but for the budget
+    (:data:`BUDGET`): a run resumed with a longer budget goes on from where it stopped."""
+    from ..config.loader import load_config_text
+
+    try:
+        before = load_config_text(stored, cfg.source)
+    except ConfigError:
+        return False
+    if before.optimiser is None or cfg.optimiser is None:
+        return False
+    skip = {"optimiser": set(BUDGET)}
+    return before.model_dump(exclude=skip) == cfg.model_dump(exclude=skip)
+
+
+def _check_budget(where: str, cfg: Config, generations: int, evaluations: int) -> None:
+    """ConfigError when the config's budget ends before the checkpoint does (a resumed run
+    cannot end earlier than the run it continues)."""
+    opt = cfg.optimiser
+    assert opt is not None
+    for field, budget, done in (
+        ("generations", opt.generations, generations),
+        ("max_evaluations", opt.max_evaluations, evaluations),
+    ):
+        if budget is not None and budget < done:
+            raise ConfigError(
+                f"{where}: the file holds {done} {field.replace('max_', '')} and "
+                f"optimiser.{field} is {budget}: give a budget of at least that to go on"
+            )

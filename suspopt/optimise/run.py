@@ -203,7 +203,9 @@ def optimise(
     """Optimise ``cfg`` and write ``output`` (HDF5, layout in the module docstring).
 
     ``resume`` continues from the checkpoint in ``output``, which must have been written for
-    the same config text. Raises ConfigError for bad input before any simulation, and
+    the same config text, or for one that differs only in the budget
+    (``optimiser.generations``, ``max_evaluations``; :func:`.output.read_checkpoint`): a
+    finished run resumed with a longer budget goes on to the longer run's result. Raises ConfigError for bad input before any simulation, and
     KeyboardInterrupt only when interrupted before the first generation completed.
     """
     output = Path(output)
