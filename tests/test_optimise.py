@@ -717,3 +717,14 @@ def test_a_run_resumed_with_a_longer_budget_goes_on_to_the_longer_runs_result(tm
         assert main(["optimise", str(config), "-o", str(short), *more, *edit, "--resume"]) == 2
         err = capsys.readouterr().err.strip()
         assert needle in err and len(err.splitlines()) == 1, err
+
+
+def test_a_config_value_outside_the_log_search_has_no_baseline(tmp_path):
+    """A linear spring (k_nl = 0) where k_nl is searched on a log scale: the config's own
+    design is no point of the search, so the file has no /baseline (and the run its optimum)."""
+    result = optimise(tiny(**{"cubic: 1.0e7}": "cubic: 0}"}), tmp_path / "out.h5")
+    assert result.baseline is None and result.status == "finished"
+    with h5py.File(tmp_path / "out.h5") as h5:
+        assert "baseline" not in h5 and len(h5["pareto/X"]) >= 1
+    whole = optimise(tiny(), tmp_path / "whole.h5")
+    assert whole.baseline is not None and whole.baseline.X.shape == (1, 3)

@@ -205,8 +205,9 @@ def optimise(
     ``resume`` continues from the checkpoint in ``output``, which must have been written for
     the same config text, or for one that differs only in the budget
     (``optimiser.generations``, ``max_evaluations``; :func:`.output.read_checkpoint`): a
-    finished run resumed with a longer budget goes on to the longer run's result. Raises ConfigError for bad input before any simulation, and
-    KeyboardInterrupt only when interrupted before the first generation completed.
+    finished run resumed with a longer budget goes on to the longer run's result. Raises
+    ConfigError for bad input before any simulation, and KeyboardInterrupt only when
+    interrupted before the first generation completed.
     """
     output = Path(output)
     check_not_input(output, config_inputs(cfg))  # (before any simulation, not at a write)
@@ -253,14 +254,17 @@ def optimise(
 def config_design(problem: Problem) -> algorithms.Solutions | None:
     """The config's own design (the values its design variables' fields hold: the design
     the engineer starts from), evaluated as the run's designs are: X physical (1, n), F
-    (1, m), G (1, k); None when a field holds no value. Not counted in the run's budget."""
+    (1, m), G (1, k); None when a field holds no value, or one of ``scale: log`` holds a
+    value <= 0 (no point of the search). Not counted in the run's budget."""
     values = numeric_paths(problem.cfg)
     if any(v.path not in values for v in problem.variables):
         return None
-    X = np.array([[values[v.path] for v in problem.variables]])
-    with np.errstate(divide="ignore"):  # (0 on a log scale: log10 gives -inf, 10**-inf 0)
-        F, G = problem.evaluate(problem.to_search(X), return_values_of=["F", "G"])
-    return algorithms.Solutions(problem.to_physical(problem.to_search(X)), F, G)
+    own = np.array([[values[v.path] for v in problem.variables]])
+    if any(v.scale == "log" and x <= 0 for v, x in zip(problem.variables, own[0])):
+        return None
+    X = problem.to_search(own)
+    F, G = problem.evaluate(X, return_values_of=["F", "G"])
+    return algorithms.Solutions(problem.to_physical(X), F, G)
 
 
 def settings(cfg: Config) -> OptimiserSettings:
