@@ -6,7 +6,8 @@ A *design table* is the table of designs a result file holds, with their variabl
 - ``suspopt optimise`` output: ``/pareto`` (the optimum or the Pareto set);
 - ``suspopt kesort`` output: ``/kesort`` (the pooled sets; each design keeps the config of
   its set, ``/kesort/sets/config``);
-- ``suspopt analyse roads|masses|controllers`` output: ``/pareto`` (the stored front);
+- ``suspopt analyse roads|masses|controllers|tolerances`` output: ``/pareto`` (the stored
+  front);
 - ``suspopt analyse transmissibility`` of a front: ``/designs`` (its edges and knee).
 
 A *pick* names one row of it: ``knee``, ``best_<objective>`` (the edges of the front,
@@ -124,7 +125,7 @@ def read_table(path: str | Path) -> DesignTable:
             raise ConfigError(
                 f"{path}: holds no designs to pick (/pareto, /kesort or /designs){h5._holds()}:"
                 f" give a file of suspopt optimise, kesort or analyse roads, masses,"
-                f" controllers or transmissibility (of a Pareto file)"
+                f" controllers, tolerances or transmissibility (of a Pareto file)"
             )
         X = h5.array(f"{table}/X", ndim=2)
         F = h5.array(f"{table}/F", ndim=2)

@@ -14,6 +14,7 @@ them and which keyword options it accepts (the CLI passes only those).
 | ``roads``, ``masses``, ``controllers`` | a Pareto file (Sec 8.4.2-8.4.3, Ch. 7) | :mod:`.pseudo` |
 | ``transmissibility`` | a config with a seat (Eq 2.86, Fig. 8.26) | :mod:`.transmissibility` |
 | ``scenarios`` | a robust optimisation's Pareto file | :mod:`.scenarios` |
+| ``tolerances`` | a Pareto file (each design variable off by ±t %) | :mod:`.tolerances` |
 """
 
 from __future__ import annotations
@@ -72,6 +73,8 @@ SUMMARIES = {
     "transmissibility": "seat-to-head and seat transmissibility of a config or of a front's "
     "edges and knee (Eq 2.86, Fig. 8.26)",
     "scenarios": "a robust front's picks under each of its scenarios (no simulation)",
+    "tolerances": "a Pareto file's designs with each design variable off by ±t % in turn "
+    "(as built: manufacturing tolerances)",
     "cdf-sensitivity": "the C_max share of an adaptive CDF threshold swept from 20 to 70 % "
     "(Figs. 4.7, 4.10)",
 }
@@ -84,6 +87,7 @@ def analysis_kinds() -> dict[str, Kind]:
         models,  # noqa: F401  (registers models)
         pseudo,  # noqa: F401  (registers roads, masses, controllers)
         scenarios,  # noqa: F401  (registers scenarios)
+        tolerances,  # noqa: F401  (registers tolerances)
         transmissibility,  # noqa: F401  (registers transmissibility)
     )
 

@@ -82,6 +82,7 @@ __all__ = [
     "run_roads",
     "run_masses",
     "run_controllers",
+    "run_variants",
 ]
 
 #: Passenger changes of Sec 8.4.3 [kg]: 20 kg lighter and heavier.
@@ -355,8 +356,8 @@ def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Vari
 
 
 #: The changes a pseudo front is evaluated under (``analyse roads``, ``masses``,
-#: ``controllers``).
-PSEUDO_KINDS = ("roads", "masses", "controllers")
+#: ``controllers``, and ``tolerances``: :mod:`.tolerances`).
+PSEUDO_KINDS = ("roads", "masses", "controllers", "tolerances")
 
 
 def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> PseudoFronts:
@@ -505,14 +506,16 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
     return Report(title=title, columns=columns, rows=rows, notes=notes)
 
 
-def _run(
+def run_variants(
     kind: str,
     source: Path,
     output: Path | None,
     plot: Path | None,
     variants: Callable[[ParetoSet], list[Variant]],
     what: str,
-) -> Report:
+) -> tuple[Report, list[Variant]]:
+    """The analysis ``kind`` of the Pareto file ``source`` under the ``variants`` made of
+    it: written, drawn, and its report (and the variants, for more notes)."""
     if plot is not None:
         plots.check_path(plot)
     pareto = read_pareto(source)
@@ -522,7 +525,7 @@ def _run(
         write_pseudo_fronts(output, fronts)
     if plot is not None:
         plot_pseudo_fronts(fronts, plot, title)
-    return _report(fronts, title)
+    return _report(fronts, title), fronts.variants
 
 
 def run_roads(
@@ -530,7 +533,7 @@ def run_roads(
 ) -> Report:
     """``suspopt analyse roads PARETO.h5 --road B --road C`` (Sec 8.4.2, Table 8.12)."""
     variants = partial(road_variants, roads=road)
-    return _run("roads", source, output, plot, variants, "on other roads (Sec 8.4.2)")
+    return run_variants("roads", source, output, plot, variants, "on other roads (Sec 8.4.2)")[0]
 
 
 def run_masses(
@@ -542,7 +545,8 @@ def run_masses(
     """``suspopt analyse masses PARETO.h5 [--mass-change -20 --mass-change 20]`` (Sec 8.4.3,
     Table 8.13)."""
     variants = partial(mass_variants, changes=mass_change)
-    return _run("masses", source, output, plot, variants, "with other passengers (Sec 8.4.3)")
+    what = "with other passengers (Sec 8.4.3)"
+    return run_variants("masses", source, output, plot, variants, what)[0]
 
 
 def run_controllers(
@@ -550,7 +554,8 @@ def run_controllers(
 ) -> Report:
     """``suspopt analyse controllers PARETO.h5 --with OTHER.yaml`` (Sec 7.3, Fig. 7.4b)."""
     variants = partial(controller_variants, sources=with_)
-    return _run("controllers", source, output, plot, variants, "with other controllers (Fig. 7.4b)")
+    what = "with other controllers (Fig. 7.4b)"
+    return run_variants("controllers", source, output, plot, variants, what)[0]
 
 
 KINDS["roads"] = Kind(run_roads, options=("road",))

@@ -15,6 +15,7 @@ _ANALYSE_OPTIONS = {
     "road": "--road",
     "with_": "--with",
     "mass_change": "--mass-change",
+    "tolerance": "--tolerance",
 }
 
 
@@ -85,13 +86,18 @@ def analyse(
         "--mass-change",
         help="masses: change of the load on the seat, in kg; repeatable (default -20 and +20)",
     ),
+    tolerance: float | None = typer.Option(
+        None,
+        "--tolerance",
+        help="tolerances: how far each design variable is off, in % of its value (default 10)",
+    ),
     *,
     run: base.RunOptions,
 ) -> None:
     """Run an analysis of configs or of a Pareto file and print its table.
 
-    The kinds: models, roads, masses, controllers, transmissibility, scenarios and
-    cdf-sensitivity (see KIND below)."""
+    The kinds: models, roads, masses, controllers, tolerances, transmissibility, scenarios
+    and cdf-sensitivity (see KIND below)."""
     from ..plots import check_path
 
     given = {
@@ -99,6 +105,7 @@ def analyse(
         "road": road or None,
         "with_": with_ or None,
         "mass_change": mass_change or None,
+        "tolerance": tolerance,
     }
     spec, options = _checked(kind, sources, given)
     try:

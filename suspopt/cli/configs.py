@@ -116,7 +116,8 @@ def init(
 def export(
     source: Path = typer.Argument(
         ...,
-        help="result file of optimise, kesort or analyse roads|masses|controllers|transmissibility",
+        help="result file of optimise, kesort or analyse"
+        " roads|masses|controllers|tolerances|transmissibility",
     ),
     pick: list[str] = typer.Option(
         [],

@@ -17,7 +17,8 @@ from .base import app, out
 def report(
     sources: list[Path] = typer.Argument(
         ...,
-        help="result files of optimise, kesort or analyse roads|masses|controllers|transmissibility",
+        help="result files of optimise, kesort or analyse"
+        " roads|masses|controllers|tolerances|transmissibility",
     ),
     output: Path = typer.Option(..., "-o", "--output", help="the HTML file to write"),
     with_signals: list[str] = typer.Option(

@@ -1,7 +1,7 @@
 """``suspopt report FILE.h5 ... -o study.html``: an interactive Pareto explorer in one file.
 
 :func:`build_report` reads the result files of ``suspopt optimise``, ``kesort``, ``analyse
-roads|masses|controllers`` and ``analyse transmissibility`` of a Pareto file, the files that
+roads|masses|controllers|tolerances`` and ``analyse transmissibility`` of a Pareto file, the files that
 hold a design table (:func:`suspopt.picks.read_table`; each a *study*: :func:`collect`), and writes
 one self-contained HTML page (:mod:`.page`): every script and style inline, plotly.js
 included (the optional extra ``pip install 'suspopt[report]'``), so it opens offline in any
@@ -24,7 +24,7 @@ browser and makes no network request. Per study:
   batch per config), thinned to at most :data:`MAX_SAMPLES` samples per signal (the page
   says when); where there is a seat, their transmissibility from the floor to the seat and
   to the head (STHT, Eq 2.86) of the seat linearised about its static equilibrium;
-- pseudo-fronts (``analyse roads|masses|controllers``): each changed front over the stored
+- pseudo-fronts (``analyse roads|masses|controllers|tolerances``): each changed front over the stored
   one, with a line from each design to its moved point;
 - the history per generation (best value, hypervolume, feasible share) and the run's
   provenance (config, seeds, version, command) in a collapsible section.

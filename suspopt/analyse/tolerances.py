@@ -1,0 +1,116 @@
+"""``suspopt analyse tolerances PARETO.h5 [--tolerance 10]``: a front's designs as built.
+
+A design leaves the drawing office as numbers and the factory as parts: a spring within its
+rate tolerance, a damper within its force band. This analysis shows what that does to the
+objectives: each design variable in turn is off by ``-t`` and ``+t`` % of every design's own
+value (one at a time, the others as designed), and the whole front is evaluated again under
+each of those ``2 n`` changes, one batch each: pseudo-fronts (:mod:`.pseudo`), with the same
+HDF5 layout, table and figure as ``analyse roads``. The thesis has no such analysis; it is
+ours, in the form of its pseudo-fronts (Sec 8.4).
+
+A value the change would take outside what its config field accepts (a ratio above 1) is
+held at the field's limit, and the report says for how many designs. ``--tolerance`` is in %
+of the value, for a variable on a log scale too; an integer variable is rounded as the
+optimiser rounds it. Each variant's ``/pseudo/<label>`` has the attributes ``variable``,
+``tolerance`` [%] (signed) and ``X`` (the changed designs).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+
+from ..config import ConfigError
+from ..files import listed
+from ..params import field_range
+from ..selection import ParetoSet
+from . import KINDS, Kind, Report
+from .pseudo import Variant, run_variants
+
+__all__ = ["TOLERANCE", "tolerance_variants", "run_tolerances"]
+
+#: The default tolerance [%]: a spring's or a damper's usual rate band.
+TOLERANCE = 10.0
+
+
+def _inside(values: np.ndarray, limits: tuple[float, bool, float, bool]) -> np.ndarray:
+    """``values`` held within a field's range ``(low, low_closed, high, high_closed)`` (an
+    open end: the nearest float inside it)."""
+    low, low_closed, high, high_closed = limits
+    low = low if low_closed else np.nextafter(low, np.inf)
+    high = high if high_closed else np.nextafter(high, -np.inf)
+    return np.clip(values, low, high)
+
+
+def tolerance_variants(pareto: ParetoSet, tolerance: float = TOLERANCE) -> list[Variant]:
+    """Two variants per design variable: its value in every design times ``1 - t/100`` and
+    ``1 + t/100`` (``t`` = ``tolerance`` [%], above 0 and below 100), the stored config."""
+    values = listed(tolerance)
+    if len(values) != 1:
+        raise ConfigError(f"--tolerance: give one tolerance in %, got {len(values)}")
+    try:
+        t = float(values[0])
+    except (TypeError, ValueError):
+        raise ConfigError(f"--tolerance {values[0]!r}: give a number of %") from None
+    if not (0.0 < t < 100.0 and math.isfinite(t)):
+        raise ConfigError(f"--tolerance {t:g}: give a tolerance above 0 and below 100 %")
+    cfg = pareto.config()
+    path_of = {v.label: v.path for v in cfg.design_variables}
+    missing = [name for name in pareto.var_names if name not in path_of]
+    if missing:
+        raise ConfigError(
+            f"{pareto.path}: /pareto/X holds {', '.join(missing)}, which the stored config's "
+            f"design_variables do not have"
+        )
+    variants = []
+    for j, name in enumerate(pareto.var_names):
+        limits = field_range(cfg, path_of[name])
+        for sign in (-1.0, 1.0):
+            X = pareto.X.copy()
+            X[:, j] = _inside(X[:, j] * (1.0 + sign * t / 100.0), limits)
+            held = int(np.sum(X[:, j] != pareto.X[:, j] * (1.0 + sign * t / 100.0)))
+            variants.append(
+                Variant(
+                    f"{name} {sign * t:+g} %",
+                    cfg,
+                    X,
+                    attrs={"variable": name, "tolerance": sign * t, "held_at_limit": held},
+                )
+            )
+    return variants
+
+
+def _held_notes(variants: Sequence[Variant]) -> list[str]:
+    """What the report says of the values held at their field's limit."""
+    return [
+        f"{v.label}: {v.attrs['held_at_limit']} design(s) held at the field's limit"
+        for v in variants
+        if v.attrs["held_at_limit"]
+    ]
+
+
+def run_tolerances(
+    source: Path,
+    output: Path | None = None,
+    plot: Path | None = None,
+    tolerance: float = TOLERANCE,
+) -> Report:
+    """``suspopt analyse tolerances PARETO.h5 [--tolerance 10]`` (module docstring)."""
+    variants = partial(tolerance_variants, tolerance=tolerance)
+    report, made = run_variants(
+        "tolerances",
+        Path(source),
+        output,
+        plot,
+        variants,
+        "with each variable off by its tolerance",
+    )
+    report.notes += _held_notes(made)
+    return report
+
+
+KINDS["tolerances"] = Kind(run_tolerances, options=("tolerance",))

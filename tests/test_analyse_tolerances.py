@@ -1,0 +1,85 @@
+"""``analyse tolerances``: a front's designs with each design variable off by ±t % in turn."""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+from conftest import optimised_front
+from typer.testing import CliRunner
+
+from suspopt.analyse.pseudo import Variant
+from suspopt.analyse.tolerances import _held_notes, _inside
+from suspopt.cli import app
+
+pytestmark = pytest.mark.cli
+
+
+def _invoke(*args):
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def ps_front(tmp_path_factory):
+    """A tiny front of the Ch. 8 PS seat (K_v, C_v; RC_se, X_ST)."""
+    return optimised_front(tmp_path_factory.mktemp("tol"), "ch8/pareto_ps_class_a", 1.5)[1]
+
+
+@pytest.mark.slow
+def test_each_variable_off_by_its_tolerance_moves_the_static_deflection_as_m_g_over_k(
+    ps_front, tmp_path
+):
+    """Each variable in turn times 0.9 and 1.1, the others as designed. The PS seat's static
+    deflection is m g / K_v (Eq 8.2), so K_v off by -10 % and +10 % moves X_ST of every
+    design by 1/0.9 - 1 and 1/1.1 - 1, and C_v leaves it where it was."""
+    out = tmp_path / "tol.h5"
+    res = _invoke("analyse", "tolerances", ps_front, "-o", out, "--tolerance", "10")
+    assert res.exit_code == 0, res.output
+    with h5py.File(ps_front) as h5:
+        X = h5["pareto/X"][()]
+        names = list(h5["pareto/X"].attrs["names"].astype(str))
+        objectives = list(h5["pareto/F"].attrs["names"].astype(str))
+    assert names == ["K_v", "C_v"] and objectives == ["RC_se", "X_ST"]
+    with h5py.File(out) as h5:
+        assert h5.attrs["analysis"] == "tolerances"
+        labels = list(h5["pseudo"].attrs["labels"].astype(str))
+        assert labels == ["K_v -10 %", "K_v +10 %", "C_v -10 %", "C_v +10 %"]
+        for label, (j, factor) in zip(labels, [(0, 0.9), (0, 1.1), (1, 0.9), (1, 1.1)]):
+            g = h5["pseudo"][label]
+            assert g.attrs["variable"] == names[j]
+            assert g.attrs["tolerance"] == pytest.approx(100 * (factor - 1))
+            changed = X.copy()
+            changed[:, j] *= factor
+            np.testing.assert_array_equal(g["X"][()], changed)
+            change = g["change"][()]
+            x_st = 100 * (1 / factor - 1) if j == 0 else 0.0
+            np.testing.assert_allclose(change[:, 1], x_st, atol=1e-9)
+            assert (g["failed"][()] == 0).all()
+        assert np.abs(h5["pseudo/C_v +10 %/change"][:, 0]).max() > 0.01  # (damping: comfort)
+    assert "K_v +10 %: " in res.output and "X_ST -9.1 to -9.1 %" in res.output
+
+
+@pytest.mark.parametrize("value", ["0", "100", "-5", "nan", "inf"])
+def test_a_tolerance_out_of_range_is_one_line(ps_front, tmp_path, value):
+    out = tmp_path / "tol.h5"
+    res = _invoke("analyse", "tolerances", ps_front, "-o", out, "--tolerance", value)
+    assert res.exit_code == 2 and not out.exists()
+    assert res.output.strip().startswith("error: --tolerance ")
+    assert len(res.output.strip().splitlines()) == 1
+
+
+def test_tolerance_is_an_option_of_tolerances_alone(ps_front):
+    res = _invoke("analyse", "roads", ps_front, "--road", "B", "--tolerance", "5")
+    assert res.exit_code == 2 and "analyse roads does not take --tolerance" in res.output
+
+
+def test_a_value_off_its_fields_range_is_held_at_the_limit_and_said():
+    closed, open_top = (0.0, True, 1.0, True), (0.0, True, 1.0, False)
+    np.testing.assert_array_equal(_inside(np.array([-0.1, 0.5, 1.1]), closed), [0.0, 0.5, 1.0])
+    top = _inside(np.array([1.1]), open_top)[0]
+    assert top < 1.0 and top == np.nextafter(1.0, 0.0)
+    held = [
+        Variant("a +10 %", None, attrs={"held_at_limit": 3}),  # type: ignore[arg-type]
+        Variant("a -10 %", None, attrs={"held_at_limit": 0}),  # type: ignore[arg-type]
+    ]
+    assert _held_notes(held) == ["a +10 %: 3 design(s) held at the field's limit"]
