@@ -343,6 +343,19 @@ def test_the_report_in_a_real_browser(files, chapters, browser, tmp_path, monkey
         at = {f"F:{j}": v for j, v in enumerate(study["baseline"]["F"])}
         at.update({f"X:{j}": v for j, v in enumerate(study["baseline"]["X"])})
         assert trace == [[at[x]], [at[y]]]
+        browser.execute_script(  # clicked, the panel shows its values
+            "document.getElementById('front-0').emit('plotly_click', {points: [{customdata: 'config'}]})"
+        )
+        panel = browser.execute_script(
+            "const box = document.getElementById('design-0'); return [box.getAttribute('data-row'),"
+            " box.querySelector('h3').textContent, [...box.querySelectorAll('tr')]"
+            ".map(tr => [tr.cells[0].textContent, Number(tr.cells[1].textContent)])]"
+        )
+        assert panel[:2] == ["config", "the config's design"]
+        shown = dict(panel[2])
+        names = study["objectives"] + study["variables"]
+        values = study["baseline"]["F"] + study["baseline"]["X"]
+        assert [shown[n] for n in names] == pytest.approx(values, rel=1e-4)
     assert which != "ch5" or "baseline" in study
     browser.execute_script("window.suspoptReport.select(0, arguments[0])", row)
     onward = browser.execute_script(  # the commands that take the design on, run as shown

@@ -31,7 +31,8 @@ browser and makes no network request. Per study:
 
 Nothing read from a file runs as code: the data go into the page as JSON (``<`` escaped) and
 are shown as text. The page's JavaScript API ``window.suspoptReport`` (``studies[i].points``,
-``.front`` and ``.parallel`` (plot ids), ``select(i, row)``, ``selected``) and the attributes
+``.front`` and ``.parallel`` (plot ids), ``select(i, row)`` (``row`` a row number, or
+``"config"``: the config's own design), ``selected``) and the attributes
 ``data-rendered`` (body) and ``data-drawn`` (a parallel-coordinates plot) are what the
 browser test drives.
 """
@@ -162,6 +163,9 @@ def _extras(h5, table) -> dict[str, Any]:
         X0 = h5.array("baseline/X", ndim=2, columns=table.X.shape[1])
         if len(F0) == len(X0) == 1:
             out["baseline"] = {"F": _list(F0[0]), "X": _list(X0[0])}
+            if "G" in out and h5._node("baseline/G") is not None:
+                G0 = h5.array("baseline/G", ndim=2, columns=len(out["constraints"]))
+                out["baseline"]["G"] = _list(G0[0]) if len(G0) == 1 else None
     if group == "kesort":
         out["k_eps"] = _list(h5.array("kesort/k_eps", ndim=1))
         out["feasible"] = [bool(v) for v in h5.array("kesort/feasible", ndim=1)]

@@ -67,6 +67,7 @@ SCRIPT = r"""
 
   function showDesign(i, row) {
     const study = data.studies[i], d = study.data, box = document.getElementById("design-" + i);
+    if (row === "config") return showBaseline(i, d, box);
     box.textContent = "";
     el("h3", "row " + row, box);
     const picks = Object.entries(d.picks).filter(([, r]) => r === row).map(([n]) => n);
@@ -92,6 +93,20 @@ SCRIPT = r"""
     box.setAttribute("data-row", String(row));
   }
   api.select = showDesign;
+  function showBaseline(i, d, box) {  // the config's own design (an optimise file's /baseline)
+    box.textContent = "";
+    el("h3", "the config's design", box);
+    el("div", "the design the run started from: its config's own values", box).className = "note";
+    const t = el("table", null, box), b = d.baseline;
+    function add(name, value, unit) {
+      const tr = el("tr", null, t); el("td", name, tr); el("td", fmt(value), tr); el("td", unit, tr);
+    }
+    d.objectives.forEach((n, j) => add(n, b.F[j], d.objective_units[j]));
+    d.variables.forEach((n, j) => add(n, b.X[j], d.variable_units[j]));
+    if (b.G) d.constraints.forEach((n, j) => add("g: " + n, b.G[j], d.constraint_units[j]));
+    api.selected = { study: i, row: "config" };
+    box.setAttribute("data-row", "config");
+  }
 
   function colours(study) {
     const d = study.data, out = [];
@@ -150,7 +165,7 @@ SCRIPT = r"""
   function baselineTrace(d, x, y) {  // the config's own design: where the run started
     const at = key => { const [kind, j] = key.split(":"); return (kind === "F" ? d.baseline.F : d.baseline.X)[Number(j)]; };
     return { type: "scatter", mode: "markers+text", name: "the config's design", x: [at(x)], y: [at(y)],
-             text: ["config"], textposition: "bottom center", hoverinfo: "text+x+y",
+             text: ["config"], textposition: "bottom center", hoverinfo: "text+x+y", customdata: ["config"],
              marker: { symbol: "diamond-open", size: 12, color: "#000", line: { width: 2 } } };
   }
   function drawFront(i) {
