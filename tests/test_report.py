@@ -147,7 +147,7 @@ def test_the_page_holds_every_design_and_nothing_from_a_file_as_markup(files, tm
         assert study["at_bound"] == at_bound(variables, study["X"])
     assert "-" in "".join(robust["at_bound"]) or "+" in "".join(robust["at_bound"])
     with h5py.File(files["front"]) as h5:  # the config's own design, where the file has it
-        own = {k: h5[f"baseline/{k}"][0].tolist() for k in "FX"}
+        own = {k: h5[f"baseline/{k}"][0].tolist() for k in "FXG"}
     assert front["baseline"] == own and "baseline" not in kesort and "baseline" not in roads
 
 
@@ -467,7 +467,7 @@ def test_a_page_of_many_studies_keeps_every_parallel_plot_it_shows(
         own = h5["baseline/F"][0, 2]
     assert shown == [["scatter3d", inside3, None]] + (
         [["scatter3d", outside, None]] if outside else []
-    ) + [["scatter3d", None, [own]]]
+    ) + [["scatter3d", ["config"], [own]]]
 
 
 def test_the_commands_shown_for_a_design_name_its_file_as_a_shell_reads_it(files, tmp_path):
