@@ -12,7 +12,8 @@ A value the change would take outside what its config field accepts (a ratio abo
 held at the field's limit, and the report says for how many designs. ``--tolerance`` is in %
 of the value, for a variable on a log scale too; an integer variable is rounded as the
 optimiser rounds it. Each variant's ``/pseudo/<label>`` has the attributes ``variable``,
-``tolerance`` [%] (signed) and ``X`` (the changed designs).
+``tolerance`` [%] (signed) and ``held_at_limit`` (how many designs), and the dataset ``X``
+(the changed designs).
 """
 
 from __future__ import annotations
@@ -46,13 +47,16 @@ def _inside(values: np.ndarray, limits: tuple[float, bool, float, bool]) -> np.n
     return np.clip(values, low, high)
 
 
-def tolerance_variants(pareto: ParetoSet, tolerance: float = TOLERANCE) -> list[Variant]:
+def tolerance_variants(pareto: ParetoSet, tolerance: float | None = TOLERANCE) -> list[Variant]:
     """Two variants per design variable: its value in every design times ``1 - t/100`` and
-    ``1 + t/100`` (``t`` = ``tolerance`` [%], above 0 and below 100), the stored config."""
-    values = listed(tolerance)
+    ``1 + t/100`` (``t`` = ``tolerance`` [%], above 0 and below 100; None: :data:`TOLERANCE`),
+    the stored config."""
+    values = listed(TOLERANCE if tolerance is None else tolerance)
     if len(values) != 1:
         raise ConfigError(f"--tolerance: give one tolerance in %, got {len(values)}")
     try:
+        if isinstance(values[0], bool):
+            raise TypeError
         t = float(values[0])
     except (TypeError, ValueError):
         raise ConfigError(f"--tolerance {values[0]!r}: give a number of %") from None
@@ -97,7 +101,7 @@ def run_tolerances(
     source: Path,
     output: Path | None = None,
     plot: Path | None = None,
-    tolerance: float = TOLERANCE,
+    tolerance: float | None = TOLERANCE,
 ) -> Report:
     """``suspopt analyse tolerances PARETO.h5 [--tolerance 10]`` (module docstring)."""
     variants = partial(tolerance_variants, tolerance=tolerance)
@@ -107,7 +111,7 @@ def run_tolerances(
         output,
         plot,
         variants,
-        "with each variable off by its tolerance",
+        "with each design variable off by its tolerance in turn",
     )
     report.notes += _held_notes(made)
     return report
