@@ -630,7 +630,13 @@ def test_optimise_and_kesort_name_the_variables_the_optimum_has_at_a_bound(tmp_p
     note = f"at a bound (within 1 % of its range): {', '.join(at)}; the optimum may lie beyond"
     assert f"note: {note}" in " ".join(printed.split())
     assert main(["kesort", str(out)]) == 0
-    assert f"note: the k-ε optimum is {note}" in " ".join(capsys.readouterr().out.split())
+    printed = " ".join(capsys.readouterr().out.split())
+    assert f"note: the k-ε optimum is {note}" in printed
+    assert f"the k-ε optimum against the config's own design (feasible): f1 {change} %" in printed
+    other = tmp_path / "other.yaml"  # (evaluated under another config: no baseline of its own)
+    other.write_text(config.read_text().replace("speed: 11.111", "speed: 12.0"))
+    assert main(["kesort", str(out), "--config", str(other), "--keep-infeasible"]) == 0
+    assert "config's own design" not in capsys.readouterr().out
 
 
 def test_the_front_is_set_against_the_configs_own_design():

@@ -329,6 +329,21 @@ def _folding_table() -> type:
     return FoldingTable
 
 
+def against_baseline(names, values, baseline, feasible: bool) -> str:
+    """``against the config's own design (feasible): f1 -13.4 %, ...``: each objective of
+    ``names`` in ``values`` as a change from ``baseline`` (one where that is 0 or not
+    finite left out), the config's design ``feasible`` or not."""
+    import math
+
+    changes = [
+        f"{name} {100 * (new - old) / abs(old):+.3g} %"
+        for name, new, old in zip(names, values, baseline)
+        if old != 0 and math.isfinite(old)
+    ]
+    state = "feasible" if feasible else "infeasible"
+    return f"against the config's own design ({state}): " + ", ".join(changes)
+
+
 def show_table(table: Table, keys: int = 1) -> None:
     """Print ``table``; when it is wider than the terminal (a CI log's 80 columns), as several
     tables of the columns that fit, each with the first ``keys`` columns again, so that no

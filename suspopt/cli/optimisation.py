@@ -35,7 +35,6 @@ def _baseline_line(result) -> str | None:
     """How the optimum stands against the config's own design (``result.baseline``): each
     objective's change for one optimum; the design's objectives and how many designs of a
     front dominate it (feasible, no objective worse, one better)."""
-    import numpy as np
 
     from ..optimise.problem import PENALTY
 
@@ -44,14 +43,9 @@ def _baseline_line(result) -> str | None:
         return None
     if (own.F >= PENALTY).any():
         return "the config's own design failed to simulate (diverged or gave NaN)"
-    feasible = "feasible" if own.feasible[0] else "infeasible"
     if len(result.X) == 1:
-        change = [
-            f"{name} {100 * (new - old) / abs(old):+.3g} %"
-            for name, new, old in zip(result.obj_names, result.F[0], own.F[0])
-            if old != 0 and np.isfinite(old)
-        ]
-        return f"against the config's own design ({feasible}): " + ", ".join(change)
+        return base.against_baseline(result.obj_names, result.F[0], own.F[0], own.feasible[0])
+    feasible = "feasible" if own.feasible[0] else "infeasible"
     ok = (result.G <= 0).all(axis=1)
     better = ok & (result.F <= own.F).all(axis=1) & (result.F < own.F).any(axis=1)
     values = ", ".join(

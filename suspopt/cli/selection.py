@@ -90,6 +90,30 @@ def _optimum_bounds_note(sel) -> str | None:
     return bounds_note(design_set.var_names, variables, design_set.X[[row]])
 
 
+def _optimum_against_baseline(sel) -> str | None:
+    """The k-ε optimum against the config's own design of its set (``/baseline`` of an
+    optimise file), or None: the file has none, or the set was evaluated under another
+    config (``--config``), to which the file's baseline does not belong."""
+    from ..h5read import H5Reader
+
+    design_set = sel.sets[int(sel.source[sel.chosen])]
+    with H5Reader(design_set.source) as h5:
+        if h5._node("baseline/F") is None or h5.text_attr("config") != design_set.config.text:
+            return None
+        F = h5.array("baseline/F", ndim=2)
+        G = h5.array("baseline/G", ndim=2)
+        names = h5.labels("baseline/F", "names", F.shape[1])
+    if len(F) != 1 or len(G) != 1:
+        return None
+    mine = [j for j, name in enumerate(sel.names) if name in names]
+    return base.against_baseline(
+        [sel.names[j] for j in mine],
+        sel.F[sel.chosen, mine],
+        [F[0, names.index(sel.names[j])] for j in mine],
+        bool((G <= 0).all()),
+    )
+
+
 def _threshold_line(sort, label: str) -> str:
     if sort.P is None:
         how = "absolute ε"
@@ -201,6 +225,9 @@ def _kesort(
     )
     for note in selection.notes:
         out.print(f"note: {note}")
+    against = _optimum_against_baseline(selection)
+    if against is not None:
+        out.print(f"the k-ε optimum {against}", soft_wrap=True)
     bounds = _optimum_bounds_note(selection)
     if bounds is not None:
         out.print(f"note: the k-ε optimum is {bounds}", soft_wrap=True)
