@@ -227,12 +227,12 @@ def _optimise(
     base.show_table(_optimum_table(result))
     line = _baseline_line(result)
     if line is not None:
-        out.print(line, soft_wrap=True)
+        out.print(line)
     from ..optimise.bounds import bounds_note
 
     note = bounds_note(result.var_names, cfg.design_variables, result.X)
     if note is not None:
-        out.print(f"note: {note}", soft_wrap=True)
+        out.print(f"note: {note}")
     if result.weights is not None:
         out.print(
             "weighted sum (Eq 5.7): "

@@ -227,10 +227,10 @@ def _kesort(
         out.print(f"note: {note}")
     against = _optimum_against_baseline(selection)
     if against is not None:
-        out.print(f"the k-ε optimum {against}", soft_wrap=True)
+        out.print(f"the k-ε optimum {against}")
     bounds = _optimum_bounds_note(selection)
     if bounds is not None:
-        out.print(f"note: the k-ε optimum is {bounds}", soft_wrap=True)
+        out.print(f"note: the k-ε optimum is {bounds}")
     for path in (output, plot):
         if path is not None:
             out.print(f"wrote {path}")
