@@ -1383,6 +1383,49 @@ def h5_variants() -> list[tuple[str, object, str | None]]:
         ("config_dt_1e-300", _root_config(_set_config(("simulation", "dt"), 1e-300)), "config"),
         ("config_n_waves_1e12", _root_config(_set_config(("road", "n_waves"), 10**12)), "config"),
         ("config_no_seat", _root_config(_edit_config(lambda d: d.pop("seat"))), "config"),
+        # the config's own design (/baseline), which kesort and report read
+        (
+            "baseline_F_text",
+            _copy_edit(
+                lambda h5: (
+                    h5["baseline"].__delitem__("F"),
+                    h5["baseline"].create_dataset("F", data=b"abc"),
+                )
+            ),
+            "/baseline/F",
+        ),
+        (
+            "baseline_F_3d",
+            _copy_edit(
+                lambda h5: (
+                    h5["baseline"].__delitem__("F"),
+                    h5["baseline"].create_dataset("F", data=np.zeros((1, 1, 1))),
+                )
+            ),
+            "/baseline/F",
+        ),
+        (
+            "baseline_names_missing",
+            _copy_edit(lambda h5: h5["baseline/F"].attrs.__delitem__("names")),
+            "/baseline/F",
+        ),
+        (
+            "baseline_G_missing",
+            _copy_edit(lambda h5: h5["baseline"].__delitem__("G")),
+            "/baseline/G",
+        ),
+        (
+            "baseline_F_nan",
+            _copy_edit(lambda h5: h5["baseline/F"].__setitem__((0, 0), np.nan)),
+            None,
+        ),
+        (
+            "baseline_a_dataset",
+            _copy_edit(
+                lambda h5: (h5.__delitem__("baseline"), h5.create_dataset("baseline", data=1.0))
+            ),
+            None,
+        ),
     ]
     return out
 

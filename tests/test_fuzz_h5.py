@@ -6,7 +6,8 @@ empty, a directory, a FIFO, a symlink to /dev/zero; no ``/pareto``; each of ``/p
 ``F``, ``G`` deleted or replaced by text, by the wrong shape (1-D, 3-D, zero rows), by
 NaN/inf, by a chunked dataset of 10^12 rows with nothing written; ``names``/``units``
 attributes missing or of the wrong length; names that do not match the stored config; the root
-``config`` attribute missing, not UTF-8, a YAML error, an alias bomb, another config; plus
+``config`` attribute missing, not UTF-8, a YAML error, an alias bomb, another config;
+``/baseline`` (the config's own design) as text, 3-D, without names or G, NaN, a dataset; plus
 seeded random byte flips (``SUSPOPT_FUZZ_H5_CASES``, default 48). ``kesort``, ``analyse
 roads --road B``, ``analyse masses`` and ``analyse transmissibility`` run on each, in-process
 in a worker capped at 2 GB with a 3 s SIGALRM per command (:mod:`fuzz_harness`). Each must
