@@ -123,6 +123,17 @@ def plot_option(what: str):
     return typer.Option(None, "--plot", help=f"figure of {what} (.png or .svg)")
 
 
+def set_option(then: str = ""):
+    """``--set PATH=VALUE``: a numeric field of the config changed before it is checked
+    (:func:`suspopt.params.apply_sets`); ``then``: what else the command says of it."""
+    return typer.Option(
+        [],
+        "--set",
+        help="PATH=VALUE: override a numeric field of the config (road.speed=25); repeatable"
+        + then,
+    )
+
+
 def max_memory_option():
     """``--max-memory SIZE``: the most memory a run may take."""
     return typer.Option(None, "--max-memory", help=MEMORY_HELP)

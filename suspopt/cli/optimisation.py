@@ -105,11 +105,8 @@ def optimise(
         "the current folder), rewritten after the first generation and then at most every 2 s",
     ),
     resume: bool = typer.Option(False, "--resume", help="continue from the checkpoint in OUT.h5"),
-    set_: list[str] = typer.Option(
-        [],
-        "--set",
-        help="PATH=VALUE: override a numeric field of the config (optimiser.generations=50,"
-        " road.speed=25); repeatable; give the same with --resume",
+    set_: list[str] = base.set_option(
+        "; give the same with --resume, or a longer budget (optimiser.generations=50)"
     ),
     plot: Path | None = base.plot_option(
         "the front (or the best value) and the history per generation"

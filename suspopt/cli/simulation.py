@@ -111,9 +111,7 @@ def simulate(
     ),
     output: Path | None = typer.Option(None, "-o", "--output", help="HDF5 file to write"),
     pick: list[str] = typer.Option([], "--pick", help=_PICK_HELP),
-    set_: list[str] = typer.Option(
-        [], "--set", help="PATH=VALUE: override a numeric field of the config; repeatable"
-    ),
+    set_: list[str] = base.set_option(),
     sweep_: list[str] = typer.Option(
         [],
         "--sweep",
