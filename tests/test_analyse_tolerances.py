@@ -56,7 +56,14 @@ def test_each_variable_off_by_its_tolerance_moves_the_static_deflection_as_m_g_o
             np.testing.assert_allclose(change[:, 1], x_st, atol=1e-9)
             assert (g["failed"][()] == 0).all()
         assert np.abs(h5["pseudo/C_v +10 %/change"][:, 0]).max() > 0.01  # (damping: comfort)
+        changes = np.array([h5["pseudo"][label]["change"][:, 0] for label in labels])
     assert "K_v +10 %: " in res.output and "X_ST -9.1 to -9.1 %" in res.output
+    i, row = np.unravel_index(np.argmax(np.abs(changes)), changes.shape)  # the worst for RC_se
+    said = " ".join(res.output.split())
+    assert (
+        f"largest change of each objective: RC_se {changes[i, row]:+.3g} % ({labels[i]}, " in said
+    )
+    assert "; X_ST +11.1 % (K_v -10 %, design " in said
 
 
 @pytest.mark.parametrize("value", ["0", "100", "-5", "nan", "inf"])

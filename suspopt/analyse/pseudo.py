@@ -513,9 +513,9 @@ def run_variants(
     plot: Path | None,
     variants: Callable[[ParetoSet], list[Variant]],
     what: str,
-) -> tuple[Report, list[Variant]]:
+) -> tuple[Report, PseudoFronts]:
     """The analysis ``kind`` of the Pareto file ``source`` under the ``variants`` made of
-    it: written, drawn, and its report (and the variants, for more notes)."""
+    it: written, drawn, and its report (and the fronts, for more notes)."""
     if plot is not None:
         plots.check_path(plot)
     pareto = read_pareto(source)
@@ -525,7 +525,7 @@ def run_variants(
         write_pseudo_fronts(output, fronts)
     if plot is not None:
         plot_pseudo_fronts(fronts, plot, title)
-    return _report(fronts, title), fronts.variants
+    return _report(fronts, title), fronts
 
 
 def run_roads(

@@ -5,7 +5,8 @@ rate tolerance, a damper within its force band. This analysis shows what that do
 objectives: each design variable in turn is off by ``-t`` and ``+t`` % of every design's own
 value (one at a time, the others as designed), and the whole front is evaluated again under
 each of those ``2 n`` changes, one batch each: pseudo-fronts (:mod:`.pseudo`), with the same
-HDF5 layout, table and figure as ``analyse roads``. The thesis has no such analysis; it is
+HDF5 layout, table and figure as ``analyse roads``, and a last note of the largest change
+of each objective and where it came from. The thesis has no such analysis; it is
 ours, in the form of its pseudo-fronts (Sec 8.4).
 
 A value the change would take outside what its config field accepts (a ratio above 1) is
@@ -30,7 +31,7 @@ from ..files import listed
 from ..params import field_range
 from ..selection import ParetoSet
 from . import KINDS, Kind, Report
-from .pseudo import Variant, run_variants
+from .pseudo import PseudoFronts, Variant, run_variants
 
 __all__ = ["TOLERANCE", "tolerance_variants", "run_tolerances"]
 
@@ -88,6 +89,19 @@ def tolerance_variants(pareto: ParetoSet, tolerance: float | None = TOLERANCE) -
     return variants
 
 
+def _largest_changes(fronts: PseudoFronts) -> str:
+    """Each objective's largest change over every variant and design (its sign kept), and
+    where: the design variable most to watch for it."""
+    parts = []
+    for j, name in enumerate(fronts.stored.names):
+        changes = np.array([fronts.change(i)[:, j] for i in range(len(fronts.variants))])
+        if not np.isfinite(changes).any():
+            continue
+        i, row = np.unravel_index(np.nanargmax(np.abs(changes)), changes.shape)
+        parts.append(f"{name} {changes[i, row]:+.3g} % ({fronts.variants[i].label}, design {row})")
+    return "largest change of each objective: " + "; ".join(parts)
+
+
 def _held_notes(variants: Sequence[Variant]) -> list[str]:
     """What the report says of the values held at their field's limit."""
     return [
@@ -105,7 +119,7 @@ def run_tolerances(
 ) -> Report:
     """``suspopt analyse tolerances PARETO.h5 [--tolerance 10]`` (module docstring)."""
     variants = partial(tolerance_variants, tolerance=tolerance)
-    report, made = run_variants(
+    report, fronts = run_variants(
         "tolerances",
         Path(source),
         output,
@@ -113,7 +127,7 @@ def run_tolerances(
         variants,
         "with each design variable off by its tolerance in turn",
     )
-    report.notes += _held_notes(made)
+    report.notes += [_largest_changes(fronts), *_held_notes(fronts.variants)]
     return report
 
 
