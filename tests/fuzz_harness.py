@@ -2185,7 +2185,7 @@ def _compile_the_kernel() -> None:
     # an optimisation's evaluation of one design (a batch of the gradient, or the last of a
     # batched population): the streamed kernel takes other specialisations for one design
     cfg = suspopt.load_config(ROOT / "configs" / "ch5" / "case1_s1.yaml")
-    cfg.simulation.duration = 0.1
+    cfg.road.start, cfg.simulation.duration = 0.01, 0.1
     problem = suspopt.Problem.from_config(cfg)
     problem.evaluate(((problem.xl + problem.xu) / 2)[None], return_values_of=["F", "G"])
     # the streamed reductions' loops (suspopt.integrator._reductions), as an evaluation calls them
