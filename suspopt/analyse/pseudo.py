@@ -63,6 +63,7 @@ from ..config.loader import edit_config, line_of, set_path
 from ..files import Unreadable, listed, status
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..kesort import pareto_picks
+from ..plots.runs import evenly_spaced
 from ..seat import build_seat, passenger_mass_change
 from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
 from . import KINDS, Kind, Report, relative_change
@@ -462,10 +463,6 @@ def plot_pseudo_fronts(
     )
 
 
-def _spread(N: int, rows: int = _TABLE_ROWS) -> np.ndarray:
-    return np.unique(np.linspace(0, N - 1, min(rows, N)).round().astype(int))
-
-
 def _report(fronts: PseudoFronts, title: str) -> Report:
     p, m = fronts.pareto, fronts.m
     names, units = fronts.stored.names, fronts.stored.units
@@ -478,7 +475,7 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
     values = [fronts.values(i) for i in range(len(fronts.sets))]
     changes = [fronts.change(i) for i in range(len(fronts.sets))]
     rows = []
-    for k in sorted(set(_spread(len(p.X)).tolist()) | set(picked)):
+    for k in sorted(set(evenly_spaced(len(p.X), _TABLE_ROWS)) | set(picked)):
         row = [str(k), ", ".join(picked.get(k, []))] + [f"{f:.4g}" for f in p.F[k]]
         for s, value, change in zip(fronts.sets, values, changes):
             row += [

@@ -82,7 +82,9 @@ def _optimum_table(result, rows: int = 12) -> Table:
         start = [] if own is None else ["yes" if own.feasible[0] else "no"]
         table.add_row("feasible", "", feasible[0], *start)
         return table
-    pick = np.unique(np.linspace(0, N - 1, min(rows, N)).round().astype(int))
+    from ..plots.runs import evenly_spaced
+
+    pick = evenly_spaced(N, rows)
     table = base.new_table(f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
     table.add_column("#", justify="right")
     for name, unit in zip(names, units):
