@@ -2182,8 +2182,8 @@ def _compile_the_kernel() -> None:
             cfg.road.start = 0.01  # early in the short run
         cfg.simulation.duration = 0.1
         suspopt.simulate(cfg)
-    # an optimisation's evaluation of one design (a batch of the gradient, or the last of a
-    # batched population): the streamed kernel takes other specialisations for one design
+    # an optimisation's evaluation (streamed: the kernel's own reductions of the objectives);
+    # a batch of one design takes the specialisations of any other batch
     cfg = suspopt.load_config(ROOT / "configs" / "ch5" / "case1_s1.yaml")
     cfg.road.start, cfg.simulation.duration = 0.01, 0.1
     problem = suspopt.Problem.from_config(cfg)

@@ -164,6 +164,44 @@ def test_a_design_gives_the_same_bits_in_any_batch(name, lift_off):
         np.testing.assert_array_equal(alone.accelerations[:, 0], batch.accelerations[:, p])
 
 
+def _compiled_signatures() -> set[tuple[str, object]]:
+    """(function, signature) of every specialisation the kernel's compiled functions hold in
+    this process."""
+    from suspopt.integrator import _accumulate, _kernel, _reductions
+
+    return {
+        (f"{module.__name__}.{name}", sig)
+        for module in (_kernel, _accumulate, _reductions)
+        for name, f in vars(module).items()
+        if hasattr(f, "py_func") and hasattr(f, "signatures")
+        for sig in f.signatures
+    }
+
+
+@pytest.mark.parametrize("name", ["ch5/case1_s1.yaml", "ch7/sh_add_2.yaml"])
+def test_a_batch_of_one_design_takes_the_specialisations_of_a_batch_of_two(name):
+    """A batch of one design (an optimisation's baseline, a gradient step, the last batch of
+    a split population, ``simulate`` of a config) runs the compiled functions a batch of two
+    compiled, and compiles none of its own: on a fresh machine another specialisation of
+    the kernel costs about a minute. (It did: one design's coefficients were a read-only
+    view, another type to numba.) Streamed (``Problem.evaluate``, the kernel's own
+    reductions) and recorded (``simulate`` with a controller)."""
+    cfg = suspopt.load_config(CONFIGS / name)
+    cfg.simulation.engine = "compiled"
+    cfg.simulation.duration = 0.1
+    if cfg.road.kind.startswith("bump"):
+        cfg.road.start = 0.01
+    problem = suspopt.Problem.from_config(cfg)
+    X = problem.to_search(np.array([_designs(cfg, 2)[v.path] for v in problem.variables]).T)
+    for two, one in ((X, X[:1]), (X, X[1:])):
+        problem.evaluate(two, return_values_of=["F"])
+        simulate(cfg, problem.params(two))
+        before = _compiled_signatures()
+        problem.evaluate(one, return_values_of=["F"])
+        simulate(cfg, problem.params(one))
+        assert _compiled_signatures() == before
+
+
 def test_a_diverging_design_stops_at_the_same_instant_on_both_engines():
     cfg = suspopt.load_config(CONFIGS / "quickstart.yaml")
     cfg.simulation.duration, cfg.simulation.dt = 1.0, 5.0e-3  # RK4 unstable on the tyre hop

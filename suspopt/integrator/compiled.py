@@ -104,9 +104,12 @@ def unsupported(asm: Assembled, controller: Controller | None) -> str | None:
 
 
 def padded(a: np.ndarray, P: int) -> np.ndarray:
-    """``a (..., 1 | P0)`` over ``P >= P0`` designs, the last one repeated, contiguous."""
+    """``a (..., 1 | P0)`` over ``P >= P0`` designs, the last one repeated: a new, writable,
+    contiguous array whatever ``P`` is. (A read-only view of one design, as ``broadcast_to``
+    gives, would be another type to numba: every compiled function it reaches would compile
+    again for a batch of one design, about a minute on a fresh machine.)"""
     if a.shape[-1] == 1:
-        return np.ascontiguousarray(np.broadcast_to(a, a.shape[:-1] + (P,)))
+        return np.repeat(a, P, axis=-1)
     extra = np.repeat(a[..., -1:], P - a.shape[-1], axis=-1)
     return np.ascontiguousarray(np.concatenate([a, extra], axis=-1))
 

@@ -263,10 +263,8 @@ def config_design(problem: Problem) -> algorithms.Solutions | None:
     if any(v.scale == "log" and x <= 0 for v, x in zip(problem.variables, own[0])):
         return None
     X = problem.to_search(own)
-    # two copies, the first kept: a batch of one design takes other compiled specialisations
-    # of the kernel than a population does (a minute to compile on a fresh machine)
-    F, G = problem.evaluate(np.repeat(X, 2, axis=0), return_values_of=["F", "G"])
-    return algorithms.Solutions(problem.to_physical(X), F[:1], G[:1])
+    F, G = problem.evaluate(X, return_values_of=["F", "G"])
+    return algorithms.Solutions(problem.to_physical(X), F, G)
 
 
 def settings(cfg: Config) -> OptimiserSettings:
