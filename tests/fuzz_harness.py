@@ -1548,6 +1548,7 @@ OPTION_BASES = [
     ["report", "{path}/front.h5", "-o", "{out}.html"],
     ["analyse", "roads", "{path}/front.h5", "--road", "{path}/road.yaml", "-o", "{out}"],
     ["analyse", "masses", "{path}/front.h5", "-o", "{out}"],
+    ["analyse", "builds", "{path}/front.h5", "--samples", "3", "-o", "{out}"],
     ["analyse", "models", "{path}/study.yaml", "{path}/study2.yaml"],
     ["analyse", "transmissibility", "{path}/front.h5"],
     ["analyse", "scenarios", "{path}/robust.h5"],

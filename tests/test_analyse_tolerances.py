@@ -9,7 +9,7 @@ from conftest import optimised_front
 from typer.testing import CliRunner
 
 from suspopt.analyse.pseudo import Variant
-from suspopt.analyse.tolerances import _held_notes, _inside
+from suspopt.analyse.tolerances import _held_notes, inside
 from suspopt.cli import app
 
 pytestmark = pytest.mark.cli
@@ -82,8 +82,8 @@ def test_tolerance_is_an_option_of_tolerances_alone(ps_front):
 
 def test_a_value_off_its_fields_range_is_held_at_the_limit_and_said():
     closed, open_top = (0.0, True, 1.0, True), (0.0, True, 1.0, False)
-    np.testing.assert_array_equal(_inside(np.array([-0.1, 0.5, 1.1]), closed), [0.0, 0.5, 1.0])
-    top = _inside(np.array([1.1]), open_top)[0]
+    np.testing.assert_array_equal(inside(np.array([-0.1, 0.5, 1.1]), closed), [0.0, 0.5, 1.0])
+    top = inside(np.array([1.1]), open_top)[0]
     assert top < 1.0 and top == np.nextafter(1.0, 0.0)
     held = [
         Variant("a +10 %", None, attrs={"held_at_limit": 3}),  # type: ignore[arg-type]

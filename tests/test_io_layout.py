@@ -15,6 +15,8 @@ from conftest import CONFIGS, optimised_front
 
 import suspopt
 from suspopt.analyse import models, transmissibility
+from suspopt.analyse.builds import builds as draw_and_evaluate
+from suspopt.analyse.builds import write_builds
 from suspopt.analyse.pseudo import pseudo_fronts, road_variants, write_pseudo_fronts
 from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
@@ -48,6 +50,7 @@ def files(tmp_path_factory):
     roads = write_pseudo_fronts(
         d / "roads.h5", pseudo_fronts("roads", pareto, road_variants(pareto, ["B"]))
     )
+    builds = write_builds(d / "builds.h5", draw_and_evaluate(pareto, 4, 10.0, seed=1))
     transmissibility.run(front, output=d / "stht.h5")
     models.run(
         [CONFIGS / "ch3/part1a_qc_bump.yaml", CONFIGS / "ch3/part1a_hc1_bump.yaml"],
@@ -60,6 +63,7 @@ def files(tmp_path_factory):
         "roads": roads,
         "stht": d / "stht.h5",
         "models": d / "models.h5",
+        "builds": builds,
     }
 
 
@@ -99,7 +103,7 @@ def datasets(path) -> list[tuple[str, tuple, dict]]:
     return out
 
 
-@pytest.mark.parametrize("kind", ["sim", "front", "ke", "roads", "stht", "models"])
+@pytest.mark.parametrize("kind", ["sim", "front", "ke", "roads", "stht", "models", "builds"])
 @pytest.mark.slow
 def test_every_group_opens_in_xarray_with_named_dimensions(files, kind):
     """No phony_dim anywhere; the whole file is one DataTree (one length per name)."""

@@ -15,6 +15,7 @@ them and which keyword options it accepts (the CLI passes only those).
 | ``transmissibility`` | a config with a seat (Eq 2.86, Fig. 8.26) | :mod:`.transmissibility` |
 | ``scenarios`` | a robust optimisation's Pareto file | :mod:`.scenarios` |
 | ``tolerances`` | a Pareto file (each design variable off by ±t %) | :mod:`.tolerances` |
+| ``builds`` | a Pareto file (built many times, every variable off at once) | :mod:`.builds` |
 """
 
 from __future__ import annotations
@@ -75,6 +76,8 @@ SUMMARIES = {
     "scenarios": "a robust front's picks under each of its scenarios (no simulation)",
     "tolerances": "a Pareto file's designs with each design variable off by ±t % in turn "
     "(as built: manufacturing tolerances)",
+    "builds": "a Pareto file's designs built many times with every design variable off "
+    "at once within ±t % (Monte Carlo of manufacturing tolerances)",
     "cdf-sensitivity": "the C_max share of an adaptive CDF threshold swept from 20 to 70 % "
     "(Figs. 4.7, 4.10)",
 }
@@ -83,6 +86,7 @@ SUMMARIES = {
 def analysis_kinds() -> dict[str, Kind]:
     """Every available analysis kind, importing the modules that provide them."""
     from . import (
+        builds,  # noqa: F401  (registers builds)
         cdf,  # noqa: F401  (registers cdf-sensitivity)
         models,  # noqa: F401  (registers models)
         pseudo,  # noqa: F401  (registers roads, masses, controllers)

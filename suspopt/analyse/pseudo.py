@@ -390,24 +390,30 @@ def _columns(group, name: str, data, dim: str, names, units) -> None:
     write_dataset(group, name, data, list(units), dims=("design", dim), names=names)
 
 
+def write_stored_front(h5, kind: str, pareto: ParetoSet, stored: DesignSet) -> None:
+    """The root attributes ``analysis`` and ``source`` and the group ``/pareto`` of an
+    analysis of the front ``pareto`` (module docstring), ``stored`` its designs evaluated
+    under the stored config."""
+    m, names, units = pareto.F.shape[1], stored.names, stored.units
+    h5.attrs["analysis"] = kind
+    h5.attrs["source"] = str(pareto.path)
+    grp = h5.create_group("pareto")
+    _columns(grp, "X", pareto.X, "variable", pareto.var_names, pareto.var_units)
+    _columns(grp, "F", pareto.F, "objective", names[:m], units[:m])
+    write_dataset(grp, "feasible", stored.feasible.astype(np.int8), "1", dims=("design",))
+    picks = grp.create_group("picks")
+    for key, row in pareto_picks(pareto.F, pareto.obj_names).items():
+        write_dataset(picks, key, row, "1")
+    if len(names) > m:
+        _columns(grp, "S", stored.F[:, m:], "supplementary", names[m:], units[m:])
+
+
 def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts, command: str | None = None) -> Path:
     """Write ``fronts`` with the layout of the module docstring (atomically)."""
     p, m = fronts.pareto, fronts.m
     names, units = fronts.stored.names, fronts.stored.units
     with atomic_h5(path, p.config(), command, inputs=[("the input", p.path)]) as h5:
-        h5.attrs["analysis"] = fronts.kind
-        h5.attrs["source"] = str(p.path)
-        grp = h5.create_group("pareto")
-        _columns(grp, "X", p.X, "variable", p.var_names, p.var_units)
-        _columns(grp, "F", p.F, "objective", names[:m], units[:m])
-        write_dataset(
-            grp, "feasible", fronts.stored.feasible.astype(np.int8), "1", dims=("design",)
-        )
-        picks = grp.create_group("picks")
-        for key, row in fronts.picks.items():
-            write_dataset(picks, key, row, "1")
-        if len(names) > m:
-            _columns(grp, "S", fronts.reference[:, m:], "supplementary", names[m:], units[m:])
+        write_stored_front(h5, fronts.kind, p, fronts.stored)
         pseudo = h5.create_group("pseudo")
         write_attrs(pseudo, labels=[v.label for v in fronts.variants])
         for i, (variant, s) in enumerate(zip(fronts.variants, fronts.sets)):
@@ -433,7 +439,7 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts, command: str | N
     return Path(path)
 
 
-def _is_comfort(cfg: Config) -> list[bool]:
+def is_comfort(cfg: Config) -> list[bool]:
     """Which main objectives are ISO 2631-1 weighted r.m.s. accelerations (their comfort
     levels are drawn)."""
     return [spec.metric == "rms_weighted" for spec in cfg.objectives.main]
@@ -459,8 +465,18 @@ def plot_pseudo_fronts(
         curves,
         variables,
         marks=fronts.picks if marks is None else marks,
-        comfort=_is_comfort(p.config()),
+        comfort=is_comfort(p.config()),
     )
+
+
+def table_designs(N: int, picks: Mapping[str, int]) -> list[tuple[int, str]]:
+    """The rows of a table of a front of ``N`` designs: at most :data:`_TABLE_ROWS` evenly
+    spaced, and every pick; (row, the names of its picks), in order."""
+    picked: dict[int, list[str]] = {}
+    for key, row in picks.items():
+        picked.setdefault(row, []).append(key)
+    rows = sorted(set(evenly_spaced(N, _TABLE_ROWS)) | set(picked))
+    return [(k, ", ".join(picked.get(k, []))) for k in rows]
 
 
 def _report(fronts: PseudoFronts, title: str) -> Report:
@@ -469,14 +485,11 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
     columns = ["#", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
     for v in fronts.variants:
         columns += [f"{v.label}: {n} (change)" for n in names[:m]]
-    picked: dict[int, list[str]] = {}
-    for key, row in fronts.picks.items():
-        picked.setdefault(row, []).append(key)
     values = [fronts.values(i) for i in range(len(fronts.sets))]
     changes = [fronts.change(i) for i in range(len(fronts.sets))]
     rows = []
-    for k in sorted(set(evenly_spaced(len(p.X), _TABLE_ROWS)) | set(picked)):
-        row = [str(k), ", ".join(picked.get(k, []))] + [f"{f:.4g}" for f in p.F[k]]
+    for k, picks in table_designs(len(p.X), fronts.picks):
+        row = [str(k), picks] + [f"{f:.4g}" for f in p.F[k]]
         for s, value, change in zip(fronts.sets, values, changes):
             row += [
                 "failed" if s.failed[k] else f"{f:.4g} ({c:+.0f} %)"

@@ -33,13 +33,20 @@ from ..selection import ParetoSet
 from . import KINDS, Kind, Report
 from .pseudo import PseudoFronts, Variant, run_variants
 
-__all__ = ["TOLERANCE", "tolerance_variants", "run_tolerances"]
+__all__ = [
+    "TOLERANCE",
+    "checked_tolerance",
+    "inside",
+    "variable_limits",
+    "tolerance_variants",
+    "run_tolerances",
+]
 
 #: The default tolerance [%]: a spring's or a damper's usual rate band.
 TOLERANCE = 10.0
 
 
-def _inside(values: np.ndarray, limits: tuple[float, bool, float, bool]) -> np.ndarray:
+def inside(values: np.ndarray, limits: tuple[float, bool, float, bool]) -> np.ndarray:
     """``values`` held within a field's range ``(low, low_closed, high, high_closed)`` (an
     open end: the nearest float inside it)."""
     low, low_closed, high, high_closed = limits
@@ -48,10 +55,9 @@ def _inside(values: np.ndarray, limits: tuple[float, bool, float, bool]) -> np.n
     return np.clip(values, low, high)
 
 
-def tolerance_variants(pareto: ParetoSet, tolerance: float | None = TOLERANCE) -> list[Variant]:
-    """Two variants per design variable: its value in every design times ``1 - t/100`` and
-    ``1 + t/100`` (``t`` = ``tolerance`` [%], above 0 and below 100; None: :data:`TOLERANCE`),
-    the stored config."""
+def checked_tolerance(tolerance: float | None) -> float:
+    """``--tolerance`` [%] as a number above 0 and below 100 (None: :data:`TOLERANCE`);
+    ConfigError naming the option for anything else."""
     values = listed(TOLERANCE if tolerance is None else tolerance)
     if len(values) != 1:
         raise ConfigError(f"--tolerance: give one tolerance in %, got {len(values)}")
@@ -63,6 +69,13 @@ def tolerance_variants(pareto: ParetoSet, tolerance: float | None = TOLERANCE) -
         raise ConfigError(f"--tolerance {values[0]!r}: give a number of %") from None
     if not (0.0 < t < 100.0 and math.isfinite(t)):
         raise ConfigError(f"--tolerance {t:g}: give a tolerance above 0 and below 100 %")
+    return t
+
+
+def variable_limits(pareto: ParetoSet) -> list[tuple[float, bool, float, bool]]:
+    """The range each column of ``pareto.X`` may take: its config field's
+    (:func:`suspopt.params.field_range`); ConfigError where the stored config does not vary
+    a column."""
     cfg = pareto.config()
     path_of = {v.label: v.path for v in cfg.design_variables}
     missing = [name for name in pareto.var_names if name not in path_of]
@@ -71,12 +84,20 @@ def tolerance_variants(pareto: ParetoSet, tolerance: float | None = TOLERANCE) -
             f"{pareto.path}: /pareto/X holds {', '.join(missing)}, which the stored config's "
             f"design_variables do not have"
         )
+    return [field_range(cfg, path_of[name]) for name in pareto.var_names]
+
+
+def tolerance_variants(pareto: ParetoSet, tolerance: float | None = TOLERANCE) -> list[Variant]:
+    """Two variants per design variable: its value in every design times ``1 - t/100`` and
+    ``1 + t/100`` (``t`` = ``tolerance`` [%], above 0 and below 100; None: :data:`TOLERANCE`),
+    the stored config."""
+    t = checked_tolerance(tolerance)
+    cfg = pareto.config()
     variants = []
-    for j, name in enumerate(pareto.var_names):
-        limits = field_range(cfg, path_of[name])
+    for j, (name, limits) in enumerate(zip(pareto.var_names, variable_limits(pareto))):
         for sign in (-1.0, 1.0):
             X = pareto.X.copy()
-            X[:, j] = _inside(X[:, j] * (1.0 + sign * t / 100.0), limits)
+            X[:, j] = inside(X[:, j] * (1.0 + sign * t / 100.0), limits)
             held = int(np.sum(X[:, j] != pareto.X[:, j] * (1.0 + sign * t / 100.0)))
             variants.append(
                 Variant(

@@ -16,6 +16,8 @@ _ANALYSE_OPTIONS = {
     "with_": "--with",
     "mass_change": "--mass-change",
     "tolerance": "--tolerance",
+    "samples": "--samples",
+    "seed": "--seed",
 }
 
 
@@ -89,15 +91,22 @@ def analyse(
     tolerance: float | None = typer.Option(
         None,
         "--tolerance",
-        help="tolerances: how far each design variable is off, in % of its value (default 10)",
+        help="tolerances, builds: how far each design variable is off, in % of its value "
+        "(default 10)",
+    ),
+    samples: int | None = typer.Option(
+        None, "--samples", help="builds: how many builds of each design (default 100)"
+    ),
+    seed: int | None = typer.Option(
+        None, "--seed", help="builds: the seed of the draws (default the config's optimiser.seed)"
     ),
     *,
     run: base.RunOptions,
 ) -> None:
     """Run an analysis of configs or of a Pareto file and print its table.
 
-    The kinds: models, roads, masses, controllers, tolerances, transmissibility, scenarios
-    and cdf-sensitivity (see KIND below)."""
+    The kinds: models, roads, masses, controllers, tolerances, builds, transmissibility,
+    scenarios and cdf-sensitivity (see KIND below)."""
     from ..plots import check_path
 
     given = {
@@ -106,6 +115,8 @@ def analyse(
         "with_": with_ or None,
         "mass_change": mass_change or None,
         "tolerance": tolerance,
+        "samples": samples,
+        "seed": seed,
     }
     spec, options = _checked(kind, sources, given)
     try:
@@ -121,6 +132,11 @@ def analyse(
             report = spec.run(sources if spec.many else sources[0], output, plot, **options)
         except (ConfigError, FileNotFoundError, ValueError) as exc:
             base.fail(str(exc))
+    _show(report, output, plot)
+
+
+def _show(report, output: Path | None, plot: Path | None) -> None:
+    """An analysis's table and notes, and the files it wrote."""
     table = base.new_table(report.title)
     for col in report.columns:
         table.add_column(col)

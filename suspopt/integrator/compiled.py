@@ -105,13 +105,10 @@ def unsupported(asm: Assembled, controller: Controller | None) -> str | None:
 
 def padded(a: np.ndarray, P: int) -> np.ndarray:
     """``a (..., 1 | P0)`` over ``P >= P0`` designs, the last one repeated: a new, writable,
-    contiguous array whatever ``P`` is. (A read-only view of one design, as ``broadcast_to``
-    gives, would be another type to numba: every compiled function it reaches would compile
-    again for a batch of one design, about a minute on a fresh machine.)"""
-    if a.shape[-1] == 1:
-        return np.repeat(a, P, axis=-1)
+    contiguous array (a read-only view, as ``broadcast_to`` gives for one design, is another
+    numba type: the kernel compiled again for it, a minute on a fresh machine)."""
     extra = np.repeat(a[..., -1:], P - a.shape[-1], axis=-1)
-    return np.ascontiguousarray(np.concatenate([a, extra], axis=-1))
+    return np.concatenate([a, extra], axis=-1)
 
 
 def _entries(matrix: np.ndarray, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -1,0 +1,290 @@
+"""``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]``: a
+front's designs as many parts built to their tolerances at once.
+
+``analyse tolerances`` moves one design variable at a time to the edge of its band; a built
+suspension has every part off at once, by an amount nobody chose. This analysis builds each
+design of the front ``--samples`` times: every design variable of every build is its
+design's value times ``1 + u t/100``, ``u`` drawn uniformly from [-1, 1] independently for
+each variable, design and build (``t`` = ``--tolerance`` [%]). All builds of all designs are
+evaluated under the stored config in one batch (:func:`suspopt.selection.evaluate_pareto`).
+It reports, per design, the spread of each objective's change over its builds (5th to 95th
+percentile, ``100 (f_built - f_stored)/f_stored``) and the share of builds that meet every
+constraint. The thesis has no such analysis; it is ours.
+
+Choices: a uniform draw, since a tolerance band says where a part may lie and nothing of how
+often (a process's own distribution, where known, would narrow the spread); independent
+variables (two springs of one batch may well be off alike, which this does not model). A
+value the draw would take outside what its config field accepts is held at the field's
+limit, and the report says how many (as ``analyse tolerances`` does). The draws come from
+``numpy.random.default_rng(seed)``, ``seed`` = ``--seed``, by default the stored config's
+``optimiser.seed``: the same seed gives the same builds bit for bit, however the batch is
+split, since they are drawn in one call before any is evaluated. A failed simulation of a
+build (NaN objectives) counts as not feasible and is left out of the percentiles.
+
+HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text;
+``analysis = "builds"``, ``source``, ``samples``, ``tolerance`` [%] and ``seed``):
+
+- ``/pareto``: the stored front, as :mod:`.pseudo` writes it (X, F, feasible, picks, S);
+- ``/builds/X (sample, design, variable)`` the built designs (the variables' units),
+  ``F (sample, design, objective)``, ``S (sample, design, supplementary)`` (if any),
+  ``change (sample, design, objective)`` [%], ``feasible`` and ``failed (sample, design)``
+  [1];
+- ``/builds/F_p05``, ``F_median``, ``F_p95 (design, objective)``: each objective's 5th
+  percentile, median and 95th percentile over the builds; ``feasible_share (design,)`` [1].
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..config import ConfigError
+from ..io import atomic_h5, write_dataset
+from ..kesort import pareto_picks
+from ..params import MAX_SWEEP_DESIGNS
+from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
+from . import KINDS, Kind, Report, relative_change
+from .pseudo import is_comfort, table_designs, write_stored_front
+from .tolerances import TOLERANCE, checked_tolerance, inside, variable_limits
+
+__all__ = ["SAMPLES", "Builds", "draw_builds", "builds", "write_builds", "run_builds"]
+
+#: The default number of builds of each design.
+SAMPLES = 100
+#: The percentiles the report and the file give [%].
+PERCENTILES = (5.0, 50.0, 95.0)
+
+
+@dataclass(frozen=True)
+class Builds:
+    """The builds of a stored front: ``X (N, D, n)`` built designs, ``F (N, D, m + s)``
+    their main then supplementary objectives (NaN where the simulation failed),
+    ``feasible`` and ``failed (N, D)``; ``stored`` the front's designs under the stored
+    config (``names``, ``units``), ``held (n,)`` how many values of each variable were held
+    at its field's limit; ``tolerance`` [%] and ``seed`` as drawn."""
+
+    pareto: ParetoSet
+    stored: DesignSet
+    X: np.ndarray
+    F: np.ndarray
+    feasible: np.ndarray
+    failed: np.ndarray
+    held: np.ndarray
+    tolerance: float
+    seed: int
+
+    @property
+    def m(self) -> int:
+        return self.pareto.F.shape[1]
+
+    @property
+    def reference(self) -> np.ndarray:
+        """(D, m + s): the file's main objectives, then the re-simulated supplementary ones."""
+        return np.hstack([self.pareto.F, self.stored.F[:, self.m :]])
+
+    @property
+    def change(self) -> np.ndarray:
+        """(N, D, m + s) change of each objective of each build [%]."""
+        return relative_change(self.F, self.reference)
+
+    def percentiles(self, values: np.ndarray) -> np.ndarray:
+        """(3, D, ...) the :data:`PERCENTILES` of ``values (N, D, ...)`` over the builds (NaN
+        for a design all of whose builds failed)."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # (all builds failed: NaN)
+            return np.nanpercentile(values, PERCENTILES, axis=0)
+
+
+def _checked_samples(samples: int | None, designs: int) -> int:
+    """``--samples`` as a whole number from 1 on, at most :data:`MAX_SWEEP_DESIGNS` builds
+    in all."""
+    N = SAMPLES if samples is None else samples
+    if isinstance(N, bool) or not isinstance(N, (int, np.integer)) or N < 1:
+        raise ConfigError(f"--samples {N!r}: give a whole number of builds from 1 on")
+    if int(N) * designs > MAX_SWEEP_DESIGNS:
+        raise ConfigError(
+            f"--samples {N}: {int(N) * designs} builds of {designs} designs, more than "
+            f"{MAX_SWEEP_DESIGNS}; give fewer samples"
+        )
+    return int(N)
+
+
+def _checked_seed(seed: int | None, pareto: ParetoSet) -> int:
+    """``--seed``, by default the stored config's ``optimiser.seed``."""
+    if seed is None:
+        optimiser = pareto.config().optimiser
+        if optimiser is None:
+            raise ConfigError(
+                f"{pareto.path}: the stored config has no optimiser.seed: give --seed"
+            )
+        return int(optimiser.seed)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise ConfigError(f"--seed {seed!r}: give a whole number from 0 to 2**63 - 1")
+    if not 0 <= seed <= 2**63 - 1:
+        raise ConfigError(f"--seed {seed}: give a whole number from 0 to 2**63 - 1")
+    return int(seed)
+
+
+def draw_builds(
+    pareto: ParetoSet, samples: int, tolerance: float, seed: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """``samples`` builds of every design of ``pareto`` (module docstring): ``X (N, D, n)``
+    and how many values of each variable were held at its field's limit ``(n,)``."""
+    u = np.random.default_rng(seed).uniform(-1.0, 1.0, (samples,) + pareto.X.shape)
+    wanted = pareto.X * (1.0 + u * tolerance / 100.0)
+    X = np.empty_like(wanted)
+    for j, limits in enumerate(variable_limits(pareto)):  # (per variable: its field's range)
+        X[..., j] = inside(wanted[..., j], limits)
+    return X, (X != wanted).sum(axis=(0, 1))
+
+
+def builds(
+    pareto: ParetoSet,
+    samples: int | None = SAMPLES,
+    tolerance: float | None = TOLERANCE,
+    seed: int | None = None,
+) -> Builds:
+    """Draw and evaluate the builds of every design of ``pareto`` (module docstring)."""
+    t = checked_tolerance(tolerance)
+    N = _checked_samples(samples, len(pareto.X))
+    s = _checked_seed(seed, pareto)
+    X, held = draw_builds(pareto, N, t, s)
+    stored = evaluate_pareto(pareto)
+    flat = replace(pareto, X=X.reshape(-1, X.shape[-1]))
+    built = evaluate_pareto(flat, pareto.config(), "builds")  # (one batch of N D designs)
+    if built.names != stored.names:
+        raise ConfigError(f"{pareto.path}: the builds' objectives are {', '.join(built.names)}")
+    shape = X.shape[:2]
+    F = np.where(built.failed[:, None], np.nan, built.F).reshape(shape + (-1,))
+    return Builds(
+        pareto=pareto,
+        stored=stored,
+        X=X,
+        F=F,
+        feasible=built.feasible.reshape(shape),
+        failed=built.failed.reshape(shape),
+        held=held,
+        tolerance=t,
+        seed=s,
+    )
+
+
+def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Path:
+    """Write ``b`` with the layout of the module docstring (atomically)."""
+    p, m = b.pareto, b.m
+    names, units = b.stored.names, b.stored.units
+    with atomic_h5(path, p.config(), command, inputs=[("the input", p.path)]) as h5:
+        write_stored_front(h5, "builds", p, b.stored)
+        h5.attrs["samples"], h5.attrs["tolerance"], h5.attrs["seed"] = len(b.X), b.tolerance, b.seed
+        g = h5.create_group("builds")
+        three = ("sample", "design")
+        write_dataset(g, "X", b.X, list(p.var_units), three + ("variable",), names=p.var_names)
+        write_dataset(g, "F", b.F[..., :m], units[:m], three + ("objective",), names=names[:m])
+        if len(names) > m:
+            extra = names[m:]
+            write_dataset(g, "S", b.F[..., m:], units[m:], three + ("supplementary",), names=extra)
+        change = b.change[..., :m]
+        write_dataset(g, "change", change, ["%"] * m, three + ("objective",), names=names[:m])
+        write_dataset(g, "feasible", b.feasible.astype(np.int8), "1", three)
+        write_dataset(g, "failed", b.failed.astype(np.int8), "1", three)
+        for key, values in zip(("F_p05", "F_median", "F_p95"), b.percentiles(b.F[..., :m])):
+            write_dataset(g, key, values, units[:m], ("design", "objective"), names=names[:m])
+        write_dataset(g, "feasible_share", b.feasible.mean(axis=0), "1", ("design",))
+    return Path(path)
+
+
+def _spread(low: float, high: float) -> str:
+    return "failed" if math.isnan(low) else f"{low:+.1f} to {high:+.1f} %"
+
+
+def _report(b: Builds, title: str) -> Report:
+    p, m = b.pareto, b.m
+    names, units = b.stored.names, b.stored.units
+    low, _, high = b.percentiles(b.change)  # (D, m + s) each
+    share = b.feasible.mean(axis=0)
+    columns = ["#", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
+    columns += [f"{n}: 5-95 % (change)" for n in names] + ["feasible builds"]
+    picks = table_designs(len(p.X), pareto_picks(p.F, p.obj_names))
+    rows = [
+        [str(k), picked]
+        + [f"{f:.4g}" for f in p.F[k]]
+        + [_spread(lo, hi) for lo, hi in zip(low[k], high[k])]
+        + [f"{100 * share[k]:.0f} %"]
+        for k, picked in picks
+    ]
+    notes = [
+        f"{len(b.X)} builds of each of {len(p.X)} designs of {p.path.name}: every design "
+        f"variable off at once by a uniform draw within ±{b.tolerance:g} % of its value "
+        f"(seed {b.seed}); change = (f_built - f_stored)/f_stored, its 5th to 95th "
+        f"percentile over the builds",
+        *b.stored.notes,
+    ]
+    worst = [
+        f"{name} {high[k, j]:+.3g} % (design {k})"
+        for j, name in enumerate(names)
+        if np.isfinite(high[:, j]).any()
+        for k in [int(np.nanargmax(high[:, j]))]
+    ]
+    if worst:
+        notes.append("largest 95th percentile of each objective's change: " + "; ".join(worst))
+    k = int(np.argmin(share))
+    notes.append(
+        f"feasible builds: {100 * share[k]:.0f} % at the least (design {k}); "
+        f"{int((share == 1).sum())} of {len(p.X)} designs have every build feasible"
+    )
+    if b.failed.any():
+        notes.append(f"{int(b.failed.sum())} of {b.failed.size} builds failed to simulate")
+    notes += [
+        f"{name}: {int(n)} value(s) held at the field's limit"
+        for name, n in zip(p.var_names, b.held)
+        if n
+    ]
+    return Report(title=title, columns=columns, rows=rows, notes=notes)
+
+
+def plot_builds(b: Builds, path: str | Path, title: str) -> Path:
+    """The stored front with each objective's 5th and 95th percentile over the builds, and
+    the design variables along it (:func:`suspopt.plots.pareto_fronts`)."""
+    from .. import plots
+
+    p, m = b.pareto, b.m
+    low, _, high = b.percentiles(b.F[..., :m])
+    curves = [(f"optimised ({p.path.name})", p.F), ("builds: 5th percentile", low)]
+    curves.append(("builds: 95th percentile", high))
+    variables = [(n, u, p.X[:, j]) for j, (n, u) in enumerate(zip(p.var_names, p.var_units))]
+    objectives = list(zip(b.stored.names[:m], b.stored.units[:m]))
+    marks, comfort = pareto_picks(p.F, p.obj_names), is_comfort(p.config())
+    return plots.pareto_fronts(
+        path, title, objectives, curves, variables, marks=marks, comfort=comfort
+    )
+
+
+def run_builds(
+    source: Path,
+    output: Path | None = None,
+    plot: Path | None = None,
+    tolerance: float | None = TOLERANCE,
+    samples: int | None = SAMPLES,
+    seed: int | None = None,
+) -> Report:
+    """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]``
+    (module docstring)."""
+    from .. import plots
+
+    if plot is not None:
+        plots.check_path(plot)
+    pareto = read_pareto(Path(source))
+    b = builds(pareto, samples, tolerance, seed)
+    title = f"builds: {pareto.path.name} as built to ±{b.tolerance:g} %"
+    if output is not None:
+        write_builds(output, b)
+    if plot is not None:
+        plot_builds(b, plot, title)
+    return _report(b, title)
+
+
+KINDS["builds"] = Kind(run_builds, options=("tolerance", "samples", "seed"))

@@ -1,0 +1,152 @@
+"""``analyse builds``: a front's designs built many times, every design variable off at once."""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+from conftest import optimised_front
+from typer.testing import CliRunner
+
+from suspopt.analyse.builds import builds
+from suspopt.cli import app
+from suspopt.selection import read_pareto
+
+pytestmark = pytest.mark.cli
+
+
+def _invoke(*args):
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def ps_front(tmp_path_factory):
+    """A tiny front of the Ch. 8 PS seat (K_v, C_v; RC_se, X_ST), and the limit [m] on the
+    static deflection its stored config is given: 3 % below the largest of the front's
+    (the builds are evaluated under the stored config, so some of that design's are
+    feasible, and the rest not)."""
+    folder = tmp_path_factory.mktemp("builds")
+    front = optimised_front(folder, "ch8/pareto_ps_class_a", 1.5)[1]
+    with h5py.File(front, "r+") as h5:
+        assert list(h5["pareto/X"].attrs["names"].astype(str)) == ["K_v", "C_v"]
+        assert list(h5["pareto/F"].attrs["names"].astype(str)) == ["RC_se", "X_ST"]
+        limit = float(f"{0.97 * h5['pareto/F'][:, 1].max():.6g}")
+        text = h5.attrs["config"]
+        old = "quantity: seat.static_deflection, max: 0.1}"
+        assert text.count(old) == 1
+        h5.attrs["config"] = text.replace(old, old.replace("0.1", repr(limit)))
+    return front, limit
+
+
+def test_every_build_moves_the_static_deflection_as_m_g_over_k_and_breaks_its_limit_so(
+    ps_front, tmp_path
+):
+    """Every build has each variable within ±t % of its design's value. The PS seat's static
+    deflection is m g / K_v (Eq 8.2), so each build's X_ST is the stored one times
+    K_v/K_v_built, whatever C_v is; a build is feasible exactly when that X_ST is within
+    the stored config's limit (the comfort constraint, 1 m/s^2, is far). The report's spread and
+    share are the file's, and the seed is the stored config's."""
+    ps_front, limit = ps_front
+    out = tmp_path / "builds.h5"
+    res = _invoke("analyse", "builds", ps_front, "-o", out, "--samples", 40, "--tolerance", 8)
+    assert res.exit_code == 0, res.output
+    with h5py.File(ps_front) as h5:
+        X0, F0 = h5["pareto/X"][()], h5["pareto/F"][()]
+        seed = yaml.safe_load(h5.attrs["config"])["optimiser"]["seed"]
+    with h5py.File(out) as h5:
+        assert h5.attrs["analysis"] == "builds" and h5.attrs["seed"] == seed
+        assert h5.attrs["samples"] == 40 and h5.attrs["tolerance"] == 8
+        X, F = h5["builds/X"][()], h5["builds/F"][()]
+        feasible, share = h5["builds/feasible"][()], h5["builds/feasible_share"][()]
+        p05, p95 = h5["builds/F_p05"][()], h5["builds/F_p95"][()]
+        assert h5["builds/X"].attrs["units"].astype(str).tolist() == ["N/m", "N s/m"]
+        assert h5["builds/change"].attrs["units"].astype(str).tolist() == ["%", "%"]
+        np.testing.assert_array_equal(h5["pareto/X"][()], X0)
+    assert X.shape == (40,) + X0.shape and F.shape == (40,) + F0.shape
+    off = X / X0 - 1
+    assert np.abs(off).max() <= 0.08 + 1e-12 and np.abs(off).max() > 0.07
+    assert off[..., 0].std() > 0.03 and off[..., 1].std() > 0.03  # (every variable drawn)
+    np.testing.assert_allclose(F[..., 1], F0[:, 1] * X0[:, 0] / X[..., 0], rtol=1e-9)
+    np.testing.assert_array_equal(feasible, F[..., 1] <= limit)
+    k = int(np.argmax(F0[:, 1]))
+    assert 0 < share[k] < 1 and share[k] == feasible[:, k].mean()
+    np.testing.assert_allclose(p05, np.percentile(F, 5, axis=0))
+    np.testing.assert_allclose(p95, np.percentile(F, 95, axis=0))
+    said = " ".join(res.output.split())
+    change = 100 * (F / F0 - 1)
+    low, high = np.percentile(change[:, 0], [5, 95], axis=0)
+    assert f"{low[1]:+.1f} to {high[1]:+.1f} %" in said
+    assert f"{100 * share[k]:.0f} %" in said and f"(seed {seed})" in said
+    assert f"feasible builds: {100 * share.min():.0f} % at the least (design " in said
+
+
+def test_the_same_seed_gives_the_same_builds_and_more_samples_extend_them(ps_front):
+    """The draws come in one call from ``default_rng(seed)``: the same seed gives the same
+    bits, and the first 6 of 12 builds are the 6 builds of a shorter run, evaluated in a
+    batch of another size; another seed gives other builds."""
+    pareto = read_pareto(ps_front[0])
+    six, twelve = builds(pareto, 6, 10, seed=3), builds(pareto, 12, 10, seed=3)
+    again = builds(pareto, 6, 10, seed=3)
+    for a, b in ((six, again), (six, twelve)):
+        assert a.X.tobytes() == b.X[:6].tobytes() and a.F.tobytes() == b.F[:6].tobytes()
+        assert (a.feasible == b.feasible[:6]).all()
+    assert not np.array_equal(builds(pareto, 6, 10, seed=4).X, six.X)
+
+
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        (["--samples", "0"], "--samples 0: give a whole number of builds from 1 on"),
+        (["--samples", "-3"], "--samples -3: give a whole number of builds from 1 on"),
+        (["--samples", "10000000"], "more than 1000000; give fewer samples"),
+        (["--seed", "-1"], "--seed -1: give a whole number from 0 to 2**63 - 1"),
+        (["--seed", str(2**64)], "--seed 18446744073709551616: give a whole number"),
+        (["--tolerance", "100"], "--tolerance 100: give a tolerance above 0 and below 100 %"),
+        (["--tolerance", "nan"], "--tolerance nan: give a tolerance above 0 and below 100 %"),
+    ],
+)
+def test_bad_samples_seeds_and_tolerances_are_one_line(ps_front, tmp_path, args, said):
+    out = tmp_path / "builds.h5"
+    res = _invoke("analyse", "builds", ps_front[0], "-o", out, *args)
+    assert res.exit_code == 2 and not out.exists()
+    assert res.output.strip().startswith("error: ") and said in res.output
+    assert len(res.output.strip().splitlines()) == 1
+
+
+def test_samples_and_seed_are_options_of_builds_alone(ps_front):
+    ps_front = ps_front[0]
+    res = _invoke("analyse", "tolerances", ps_front, "--samples", "5")
+    assert res.exit_code == 2 and "analyse tolerances does not take --samples" in res.output
+    res = _invoke("analyse", "roads", ps_front, "--road", "B", "--seed", "5")
+    assert res.exit_code == 2 and "analyse roads does not take --seed" in res.output
+
+
+def test_a_design_of_the_builds_file_is_taken_onward(ps_front, tmp_path):
+    """The file holds the stored front with its picks, as every analysis of a front does:
+    ``export --pick knee`` writes the knee's config."""
+    ps_front, out = ps_front[0], tmp_path / "builds.h5"
+    assert _invoke("analyse", "builds", ps_front, "-o", out, "--samples", 3).exit_code == 0
+    res = _invoke("export", out, "--pick", "knee", "-o", tmp_path / "knee.yaml")
+    assert res.exit_code == 0, res.output
+    with h5py.File(out) as h5:
+        knee = int(h5["pareto/picks/knee"][()])
+        K_v = h5["pareto/X"][knee, 0]
+    exported = yaml.safe_load((tmp_path / "knee.yaml").read_text())
+    assert exported["seat"]["stiffness"] == pytest.approx(K_v, rel=1e-12)
+
+
+def test_a_draw_off_its_fields_range_is_held_at_the_limit_and_counted(ps_front, monkeypatch):
+    """A drawn value beyond its config field's range is held at the limit, and counted."""
+    from suspopt.analyse import builds as module
+
+    pareto = read_pareto(ps_front[0])
+    top = float(pareto.X[:, 0].max())
+    monkeypatch.setattr(
+        module,
+        "variable_limits",
+        lambda p: [(0.0, True, top, True), (0.0, True, np.inf, True)],
+    )
+    X, held = module.draw_builds(pareto, 20, 10.0, 7)
+    assert X[..., 0].max() == top and held[0] == (X[..., 0] == top).sum() > 0
+    assert held[1] == 0
