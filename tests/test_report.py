@@ -481,3 +481,77 @@ def test_the_commands_shown_for_a_design_name_its_file_as_a_shell_reads_it(files
     source = _payload(page.read_text())["studies"][0]["data"]["source"]
     assert shlex.split(f"suspopt export {source} --pick 0") == [
         "suspopt", "export", str(odd), "--pick", "0"]  # fmt: skip
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+def test_a_design_of_an_analyse_builds_file_shows_the_spread_of_its_builds(
+    files, browser, tmp_path
+):
+    """Clicked on the page of an ``analyse builds`` file, a design's panel shows each
+    objective's 5th to 95th percentile over its builds and its share of feasible builds, as
+    the file holds them."""
+    builds, page = tmp_path / "builds.h5", tmp_path / "builds.html"
+    res = _invoke("analyse", "builds", files["front"], "--samples", 7, "-o", builds)
+    assert res.exit_code == 0, res.output
+    assert _invoke("report", builds, "-o", page).exit_code == 0
+    with h5py.File(builds) as h5:
+        low, high = h5["builds/F_p05"][()], h5["builds/F_p95"][()]
+        share = h5["builds/feasible_share"][()]
+        names = list(h5["builds/F"].attrs["names"].astype(str))
+    browser.get(page.resolve().as_uri())
+    _wait(browser, "return document.body.getAttribute('data-rendered')", "the plots rendered")
+    for row in (0, len(share) - 1):
+        browser.execute_script("window.suspoptReport.select(0, arguments[0])", row)
+        cells = dict(
+            browser.execute_script(
+                "return [...document.querySelectorAll('#design-0 tr')]"
+                ".map(tr => [tr.cells[0].textContent, tr.cells[1].textContent])"
+            )
+        )
+        for j, name in enumerate(names):
+            lo, hi = cells[f"{name}, built 5-95 %"].split(" to ")
+            assert [float(lo), float(hi)] == pytest.approx([low[row, j], high[row, j]], rel=1e-4)
+        assert float(cells["feasible builds"]) == pytest.approx(100 * share[row], rel=1e-4)
+        note = browser.execute_script(
+            "return document.querySelector('#design-0 > div.note').textContent"
+        )
+        assert note == "7 builds, every variable within ±10 % of its value"
+
+
+@pytest.fixture(scope="module")
+def builds_file(files, tmp_path_factory) -> Path:
+    """An ``analyse builds`` file of the seat front (5 builds of each design)."""
+    path = tmp_path_factory.mktemp("builds") / "builds.h5"
+    res = _invoke("analyse", "builds", files["front"], "--samples", 5, "-o", path)
+    assert res.exit_code == 0, res.output
+    return path
+
+
+def _set(group, key, value):
+    del group[key]
+    group[key] = value
+
+
+@pytest.mark.parametrize(
+    "damage, message",
+    [
+        (lambda g: g.attrs.__setitem__("tolerance", "ten"), "attribute 'tolerance': missing or"),
+        (lambda g: g.attrs.__setitem__("tolerance", np.nan), "attribute 'tolerance': missing or"),
+        (lambda g: g.attrs.__setitem__("tolerance", True), "attribute 'tolerance': missing or"),
+        (lambda g: g.attrs.__delitem__("samples"), "attribute 'samples': missing or not a whole"),
+        (lambda g: _set(g, "F_p05", np.zeros((3, 2))), "the percentiles do not have the front's"),
+        (lambda g: _set(g, "feasible_share", np.zeros((3, 2))), "expected 1 dimension"),
+        (lambda g: _set(g, "feasible_share", np.array([b"a"] * 3)), "not numbers"),
+        (lambda g: g.__delitem__("F_p95"), "/builds/F_p95: missing"),
+    ],
+)
+def test_a_damaged_builds_file_is_one_line_and_no_page(builds_file, tmp_path, damage, message):
+    broken, page = tmp_path / "broken.h5", tmp_path / "page.html"
+    shutil.copyfile(builds_file, broken)
+    with h5py.File(broken, "r+") as h5:
+        damage(h5["builds"])
+    res = _invoke("report", broken, "-o", page)
+    assert res.exit_code == 2 and not page.exists()
+    assert res.output.startswith(f"error: {broken}: /builds") and message in res.output
+    assert len(res.output.strip().splitlines()) == 1

@@ -22,10 +22,11 @@ split, since they are drawn in one call before any is evaluated. A failed simula
 build (NaN objectives) counts as not feasible and is left out of the percentiles.
 
 HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text;
-``analysis = "builds"``, ``source``, ``samples``, ``tolerance`` [%] and ``seed``):
+``analysis = "builds"``, ``source`` and ``seed``):
 
 - ``/pareto``: the stored front, as :mod:`.pseudo` writes it (X, F, feasible, picks, S);
-- ``/builds/X (sample, design, variable)`` the built designs (the variables' units),
+- ``/builds`` with attributes ``samples`` and ``tolerance`` [%];
+  ``/builds/X (sample, design, variable)`` the built designs (the variables' units),
   ``F (sample, design, objective)``, ``S (sample, design, supplementary)`` (if any),
   ``change (sample, design, objective)`` [%], ``feasible`` and ``failed (sample, design)``
   [1];
@@ -179,8 +180,9 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
     names, units = b.stored.names, b.stored.units
     with atomic_h5(path, p.config(), command, inputs=[("the input", p.path)]) as h5:
         write_stored_front(h5, "builds", p, b.stored)
-        h5.attrs["samples"], h5.attrs["tolerance"], h5.attrs["seed"] = len(b.X), b.tolerance, b.seed
+        h5.attrs["seed"] = b.seed
         g = h5.create_group("builds")
+        g.attrs["samples"], g.attrs["tolerance"] = len(b.X), b.tolerance
         three = ("sample", "design")
         write_dataset(g, "X", b.X, list(p.var_units), three + ("variable",), names=p.var_names)
         write_dataset(g, "F", b.F[..., :m], units[:m], three + ("objective",), names=names[:m])

@@ -181,6 +181,8 @@ def _extras(h5, table) -> dict[str, Any]:
             history["best"] = _list(best.T)
             history["best_names"] = h5.labels("history/best", "names", best.shape[1])
         out["history"] = history
+    if group == "pareto" and h5._node("builds/feasible_share") is not None:
+        out["builds"] = _builds(h5, N, table.F.shape[1])
     if h5._node("pseudo") is not None:
         fronts = []
         for label in h5.group("pseudo"):
@@ -189,6 +191,34 @@ def _extras(h5, table) -> dict[str, Any]:
                 fronts.append({"label": str(label), "F": _list(F)})
         out["pseudo"] = fronts
     return out
+
+
+def _builds(h5, N: int, m: int) -> dict[str, Any]:
+    """What an ``analyse builds`` file says of each design's builds
+    (:mod:`suspopt.analyse.builds`): the 5th and 95th percentiles of each objective, the share
+    of feasible builds, how many builds and within which tolerance [%]."""
+    from ..params import MAX_SWEEP_DESIGNS
+
+    low = h5.array("builds/F_p05", ndim=2, columns=m)
+    high = h5.array("builds/F_p95", ndim=2, columns=m)
+    share = h5.array("builds/feasible_share", ndim=1)
+    if not len(low) == len(high) == len(share) == N:
+        raise ConfigError(f"{h5.where}: /builds: the percentiles do not have the front's {N} rows")
+    tolerance = h5.attribute(h5.group("builds"), "tolerance", "/builds: attribute 'tolerance'")
+    if isinstance(tolerance, np.ndarray) and tolerance.ndim == 0:
+        tolerance = tolerance[()]
+    number = isinstance(tolerance, (float, int, np.number)) and not isinstance(tolerance, bool)
+    if not number or not 0 < tolerance < 100:
+        raise ConfigError(
+            f"{h5.where}: /builds: attribute 'tolerance': missing or not in (0, 100) %"
+        )
+    return {
+        "samples": h5.int_attr("builds", "samples", 1, MAX_SWEEP_DESIGNS),
+        "tolerance": float(tolerance),
+        "low": _list(low),
+        "high": _list(high),
+        "share": _list(share),
+    }
 
 
 def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, Any]:

@@ -79,6 +79,7 @@ SCRIPT = r"""
     }
     const side = { "-": "at lower bound", "+": "at upper bound" };
     d.objectives.forEach((n, j) => add(n, d.F[row][j], d.objective_units[j]));
+    if (d.builds) showBuilds(d, row, t, box);
     d.variables.forEach((n, j) => add(n, d.X[row][j], d.variable_units[j],
                                       d.at_bound && side[d.at_bound[j][row]]));
     if (d.G) d.constraints.forEach((n, j) => add("g: " + n, d.G[row][j], d.constraint_units[j]));
@@ -93,6 +94,16 @@ SCRIPT = r"""
     box.setAttribute("data-row", String(row));
   }
   api.select = showDesign;
+  function showBuilds(d, row, t, box) {  // an analyse builds file: the spread of its builds
+    const b = d.builds;
+    d.objectives.forEach((n, j) => {
+      const tr = el("tr", null, t); el("td", n + ", built 5-95 %", tr);
+      el("td", fmt(b.low[row][j]) + " to " + fmt(b.high[row][j]), tr); el("td", d.objective_units[j], tr);
+    });
+    const tr = el("tr", null, t); el("td", "feasible builds", tr);
+    el("td", fmt(100 * b.share[row]), tr); el("td", "%", tr);
+    el("div", b.samples + " builds, every variable within ±" + b.tolerance + " % of its value", box).className = "note";
+  }
   function showBaseline(i, d, box) {  // the config's own design (an optimise file's /baseline)
     box.textContent = "";
     el("h3", "the config's design", box);
