@@ -86,12 +86,12 @@ def test_the_same_seed_gives_the_same_builds_and_more_samples_extend_them(ps_fro
     bits, and the first 6 of 12 builds are the 6 builds of a shorter run, evaluated in a
     batch of another size; another seed gives other builds."""
     pareto = read_pareto(ps_front[0])
-    six, twelve = builds(pareto, 6, 10, seed=3), builds(pareto, 12, 10, seed=3)
-    again = builds(pareto, 6, 10, seed=3)
+    six, twelve = builds(pareto, 6, tolerance=10, seed=3), builds(pareto, 12, tolerance=10, seed=3)
+    again = builds(pareto, 6, tolerance=10, seed=3)
     for a, b in ((six, again), (six, twelve)):
         assert a.X.tobytes() == b.X[:6].tobytes() and a.F.tobytes() == b.F[:6].tobytes()
         assert (a.feasible == b.feasible[:6]).all()
-    assert not np.array_equal(builds(pareto, 6, 10, seed=4).X, six.X)
+    assert not np.array_equal(builds(pareto, 6, tolerance=10, seed=4).X, six.X)
 
 
 @pytest.mark.parametrize(

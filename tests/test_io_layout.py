@@ -50,7 +50,7 @@ def files(tmp_path_factory):
     roads = write_pseudo_fronts(
         d / "roads.h5", pseudo_fronts("roads", pareto, road_variants(pareto, ["B"]))
     )
-    builds = write_builds(d / "builds.h5", draw_and_evaluate(pareto, 4, 10.0, seed=1))
+    builds = write_builds(d / "builds.h5", draw_and_evaluate(pareto, 4, tolerance=10.0, seed=1))
     transmissibility.run(front, output=d / "stht.h5")
     models.run(
         [CONFIGS / "ch3/part1a_qc_bump.yaml", CONFIGS / "ch3/part1a_hc1_bump.yaml"],

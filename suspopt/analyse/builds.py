@@ -143,13 +143,10 @@ def draw_builds(
     return X, (X != wanted).sum(axis=(0, 1))
 
 
-def builds(
-    pareto: ParetoSet,
-    samples: int | None = SAMPLES,
-    tolerance: float | None = TOLERANCE,
-    seed: int | None = None,
-) -> Builds:
-    """Draw and evaluate the builds of every design of ``pareto`` (module docstring)."""
+def builds(pareto: ParetoSet, samples=SAMPLES, *, tolerance=TOLERANCE, seed=None) -> Builds:
+    """Draw and evaluate ``samples`` builds (int) of every design of ``pareto``, each design
+    variable within ``tolerance`` [%] (float), from ``default_rng(seed)`` (int; None: the
+    stored config's ``optimiser.seed``) (module docstring)."""
     t = checked_tolerance(tolerance)
     N = _checked_samples(samples, len(pareto.X))
     s = _checked_seed(seed, pareto)
@@ -280,7 +277,7 @@ def run_builds(
     if plot is not None:
         plots.check_path(plot)
     pareto = read_pareto(Path(source))
-    b = builds(pareto, samples, tolerance, seed)
+    b = builds(pareto, samples, tolerance=tolerance, seed=seed)
     title = f"builds: {pareto.path.name} as built to ±{b.tolerance:g} %"
     if output is not None:
         write_builds(output, b)

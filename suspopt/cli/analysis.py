@@ -21,6 +21,11 @@ _ANALYSE_OPTIONS = {
 }
 
 
+_TOLERANCE_HELP = (
+    "tolerances, builds: how far each design variable is off, in % of its value (default 10)"
+)
+
+
 def _analysis_help() -> str:
     from ..analyse import SUMMARIES
 
@@ -88,12 +93,7 @@ def analyse(
         "--mass-change",
         help="masses: change of the load on the seat, in kg; repeatable (default -20 and +20)",
     ),
-    tolerance: float | None = typer.Option(
-        None,
-        "--tolerance",
-        help="tolerances, builds: how far each design variable is off, in % of its value "
-        "(default 10)",
-    ),
+    tolerance: float | None = typer.Option(None, "--tolerance", help=_TOLERANCE_HELP),
     samples: int | None = typer.Option(
         None, "--samples", help="builds: how many builds of each design (default 100)"
     ),
