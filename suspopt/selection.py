@@ -98,7 +98,9 @@ class DesignSet:
     """The designs of one Pareto set with every objective evaluated under ``config``:
     ``F (N, m)`` main then supplementary objectives (``names``, ``units``); ``feasible (N,)``
     (every constraint ``g <= 0``); ``failed (N,)`` (the simulation diverged or gave NaN);
-    ``resimulated``: whether the designs were simulated again; ``notes`` for the report."""
+    ``resimulated``: whether the designs were simulated again; ``notes`` for the report;
+    ``G (N, k)`` the constraints (``g <= 0`` is met; ``constraint_names``,
+    ``constraint_units``)."""
 
     label: str
     source: Path
@@ -113,6 +115,9 @@ class DesignSet:
     failed: np.ndarray
     resimulated: bool
     notes: tuple[str, ...] = ()
+    G: np.ndarray | None = None
+    constraint_names: tuple[str, ...] = ()
+    constraint_units: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -255,9 +260,15 @@ def evaluate_pareto(
     else:
         F, G, constraint_names = pareto.F, pareto.G, pareto.constraint_names
     failed = ~np.isfinite(F).all(axis=1) | (F >= PENALTY).any(axis=1)
+    same = list(constraint_names) == problem.constraint_names
+    constraint_units = problem.constraint_units if same else [""] * len(constraint_names)
     if constraint_names and constraint_names[-1] == _FAILED:
         failed |= G[:, -1] > 0
-        G = G[:, :-1]
+        G, constraint_names, constraint_units = (
+            G[:, :-1],
+            constraint_names[:-1],
+            constraint_units[:-1],
+        )
     feasible = (G <= 0).all(axis=1) & ~failed
     default = cfg.source.stem if not own and cfg.source is not None else pareto.path.stem
     return DesignSet(
@@ -274,6 +285,9 @@ def evaluate_pareto(
         failed,
         resimulate,
         tuple(notes),
+        G,
+        tuple(constraint_names),
+        tuple(constraint_units),
     )
 
 

@@ -69,6 +69,14 @@ def test_every_build_moves_the_static_deflection_as_m_g_over_k_and_breaks_its_li
     assert off[..., 0].std() > 0.03 and off[..., 1].std() > 0.03  # (every variable drawn)
     np.testing.assert_allclose(F[..., 1], F0[:, 1] * X0[:, 0] / X[..., 0], rtol=1e-9)
     np.testing.assert_array_equal(feasible, F[..., 1] <= limit)
+    with h5py.File(out) as h5:
+        G, constraints = h5["builds/G"][()], list(h5["builds/G"].attrs["names"].astype(str))
+        units = h5["builds/G"].attrs["units"].astype(str).tolist()
+    j = constraints.index(f"X_ST <= {limit:g}")
+    assert units[j] == "m"
+    np.testing.assert_allclose(G[..., j], F[..., 1] - limit, rtol=0, atol=1e-15)
+    others = [c for c in range(len(constraints)) if c != j]
+    assert (G[..., others] <= 0).all()  # (the builds break the static deflection's alone)
     k = int(np.argmax(F0[:, 1]))
     assert 0 < share[k] < 1 and share[k] == feasible[:, k].mean()
     np.testing.assert_allclose(p05, np.percentile(F, 5, axis=0))
@@ -79,6 +87,11 @@ def test_every_build_moves_the_static_deflection_as_m_g_over_k_and_breaks_its_li
     assert f"{low[1]:+.1f} to {high[1]:+.1f} %" in said
     assert f"{100 * share[k]:.0f} %" in said and f"(seed {seed})" in said
     assert f"feasible builds: {100 * share.min():.0f} % at the least (design " in said
+    broken = F[..., 1] > limit
+    assert (
+        f"constraints the builds break: X_ST <= {limit:g} in {100 * broken.mean():.0f} % of all "
+        f"builds (design {k}: {100 * broken[:, k].mean():.0f} %)" in said
+    )
 
 
 def test_the_same_seed_gives_the_same_builds_and_more_samples_extend_them(ps_front):

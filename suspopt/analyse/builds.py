@@ -30,6 +30,8 @@ HDF5 layout (root attributes as every suspopt file, ``config`` = the stored conf
   ``F (sample, design, objective)``, ``S (sample, design, supplementary)`` (if any),
   ``change (sample, design, objective)`` [%], ``feasible`` and ``failed (sample, design)``
   [1];
+- ``/builds/G (sample, design, constraint)`` the builds' constraints (``g <= 0`` is met;
+  their units; the config's constraints, if it has any);
 - ``/builds/F_p05``, ``F_median``, ``F_p95 (design, objective)``: each objective's 5th
   percentile, median and 95th percentile over the builds; ``feasible_share (design,)`` [1].
 """
@@ -64,9 +66,10 @@ PERCENTILES = (5.0, 50.0, 95.0)
 class Builds:
     """The builds of a stored front: ``X (N, D, n)`` built designs, ``F (N, D, m + s)``
     their main then supplementary objectives (NaN where the simulation failed),
-    ``feasible`` and ``failed (N, D)``; ``stored`` the front's designs under the stored
-    config (``names``, ``units``), ``held (n,)`` how many values of each variable were held
-    at its field's limit; ``tolerance`` [%] and ``seed`` as drawn."""
+    ``feasible`` and ``failed (N, D)``, ``G (N, D, k)`` their constraints (``g <= 0`` is
+    met; ``constraint_names``, ``constraint_units``); ``stored`` the front's designs under
+    the stored config (``names``, ``units``), ``held (n,)`` how many values of each variable
+    were held at its field's limit; ``tolerance`` [%] and ``seed`` as drawn."""
 
     pareto: ParetoSet
     stored: DesignSet
@@ -77,6 +80,9 @@ class Builds:
     held: np.ndarray
     tolerance: float
     seed: int
+    G: np.ndarray
+    constraint_names: tuple[str, ...]
+    constraint_units: tuple[str, ...]
 
     @property
     def m(self) -> int:
@@ -168,6 +174,9 @@ def builds(pareto: ParetoSet, samples=SAMPLES, *, tolerance=TOLERANCE, seed=None
         held=held,
         tolerance=t,
         seed=s,
+        G=(np.zeros((len(F), 0)) if built.G is None else built.G).reshape(shape + (-1,)),
+        constraint_names=built.constraint_names,
+        constraint_units=built.constraint_units,
     )
 
 
@@ -188,6 +197,9 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
             write_dataset(g, "S", b.F[..., m:], units[m:], three + ("supplementary",), names=extra)
         change = b.change[..., :m]
         write_dataset(g, "change", change, ["%"] * m, three + ("objective",), names=names[:m])
+        if b.constraint_names:
+            k = list(b.constraint_names)
+            write_dataset(g, "G", b.G, list(b.constraint_units), three + ("constraint",), names=k)
         write_dataset(g, "feasible", b.feasible.astype(np.int8), "1", three)
         write_dataset(g, "failed", b.failed.astype(np.int8), "1", three)
         for key, values in zip(("F_p05", "F_median", "F_p95"), b.percentiles(b.F[..., :m])):
@@ -198,6 +210,22 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
 
 def _spread(low: float, high: float) -> str:
     return "failed" if math.isnan(low) else f"{low:+.1f} to {high:+.1f} %"
+
+
+def _broken(b: Builds) -> str:
+    """Which constraints the builds break, how often, and the design that breaks each most
+    often."""
+    broken = (b.G > 0) & ~b.failed[..., None]  # (N, D, k)
+    parts = []
+    for j, name in enumerate(b.constraint_names):
+        if broken[..., j].any():
+            share = broken[..., j].mean(axis=0)
+            k = int(np.argmax(share))
+            parts.append(
+                f"{name} in {100 * broken[..., j].mean():.0f} % of all builds "
+                f"(design {k}: {100 * share[k]:.0f} %)"
+            )
+    return "constraints the builds break: " + ("; ".join(parts) if parts else "none")
 
 
 def _report(b: Builds, title: str) -> Report:
@@ -235,6 +263,7 @@ def _report(b: Builds, title: str) -> Report:
         f"feasible builds: {100 * share[k]:.0f} % at the least (design {k}); "
         f"{int((share == 1).sum())} of {len(p.X)} designs have every build feasible"
     )
+    notes.append(_broken(b))
     if b.failed.any():
         notes.append(f"{int(b.failed.sum())} of {b.failed.size} builds failed to simulate")
     notes += [
