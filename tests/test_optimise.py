@@ -31,6 +31,7 @@ from suspopt.optimise import (
     optimise,
 )
 from suspopt.optimise.algorithms import pymoo_algorithm, termination
+from suspopt.params import numeric_paths
 
 # --- analytic problems: the algorithm layer needs no vehicle -----------------------------------
 
@@ -633,6 +634,17 @@ def test_optimise_and_kesort_name_the_variables_the_optimum_has_at_a_bound(tmp_p
     printed = " ".join(capsys.readouterr().out.split())
     assert f"note: the k-ε optimum is {note}" in printed
     assert f"the k-ε optimum against the config's own design (feasible): f1 {change} %" in printed
+    assert main(["kesort", str(out), "-o", str(tmp_path / "ke.h5")]) == 0
+    with h5py.File(tmp_path / "ke.h5") as h5:  # (the supplementary f2 too, not in the file)
+        assert list(h5["kesort/F"].attrs["names"].astype(str)) == ["f1", "f2"]
+        chosen_f2 = h5["kesort/F"][int(h5["kesort/chosen"][()]), 1]
+    values = numeric_paths(cfg)
+    problem = suspopt.Problem.from_config(cfg)
+    own_X = problem.to_search(np.array([[values[v.path] for v in problem.variables]]))
+    own_f2 = problem.evaluate(own_X, return_values_of=["S"])[0, 0]
+    f2 = f"{100 * (chosen_f2 - own_f2) / abs(own_f2):+.3g}"
+    printed = " ".join(capsys.readouterr().out.split())
+    assert f"own design (feasible): f1 {change} %, f2 {f2} %" in printed
     other = tmp_path / "other.yaml"  # (evaluated under another config: no baseline of its own)
     other.write_text(config.read_text().replace("speed: 11.111", "speed: 12.0"))
     assert main(["kesort", str(out), "--config", str(other), "--keep-infeasible"]) == 0

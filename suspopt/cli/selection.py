@@ -103,8 +103,12 @@ def _optimum_against_baseline(sel) -> str | None:
         F = h5.array("baseline/F", ndim=2)
         G = h5.array("baseline/G", ndim=2)
         names = h5.labels("baseline/F", "names", F.shape[1])
-    if len(F) != 1 or len(G) != 1:
+        X = h5.array("baseline/X", ndim=2)
+        variables = h5.labels("baseline/X", "names", X.shape[1])
+    if len(F) != 1 or len(G) != 1 or len(X) != 1:
         return None
+    if any(name not in names for name in sel.names):  # (supplementary: not in the file)
+        F, names = _with_supplementary(design_set.config, X, variables, F, names)
     mine = [j for j, name in enumerate(sel.names) if name in names]
     return base.against_baseline(
         [sel.names[j] for j in mine],
@@ -112,6 +116,21 @@ def _optimum_against_baseline(sel) -> str | None:
         [F[0, names.index(sel.names[j])] for j in mine],
         bool((G <= 0).all()),
     )
+
+
+def _with_supplementary(cfg, X, variables: list[str], F, names: list[str]):
+    """The config's design ``X (1, n)`` (columns ``variables``) with its supplementary
+    objectives evaluated under ``cfg`` beside its main ones ``F (1, m)``: (F, names)."""
+    import numpy as np
+
+    from ..optimise.problem import Problem
+
+    problem = Problem.from_config(cfg)
+    if sorted(variables) != sorted(problem.var_names):
+        return F, names
+    ordered = X[:, [variables.index(name) for name in problem.var_names]]
+    S = problem.evaluate(problem.to_search(ordered), return_values_of=["S"])
+    return np.hstack([F, S]), names + problem.supplementary_names
 
 
 def _threshold_line(sort, label: str) -> str:
