@@ -9,7 +9,7 @@ import yaml
 from conftest import optimised_front
 from typer.testing import CliRunner
 
-from suspopt.analyse.builds import builds
+from suspopt.analyse.builds import builds, draw_builds
 from suspopt.cli import app
 from suspopt.selection import read_pareto
 
@@ -163,3 +163,31 @@ def test_a_draw_off_its_fields_range_is_held_at_the_limit_and_counted(ps_front, 
     X, held = module.draw_builds(pareto, 20, 10.0, 7)
     assert X[..., 0].max() == top and held[0] == (X[..., 0] == top).sum() > 0
     assert held[1] == 0
+
+
+@pytest.mark.parametrize("distribution", ["uniform", "normal"])
+def test_the_draws_follow_their_distribution_within_the_band(ps_front, distribution):
+    """Each build's relative offset ``u = (x/x0 - 1)/(t/100)`` lies in [-1, 1] and follows
+    the distribution asked for, by a Kolmogorov-Smirnov test against scipy's own: uniform
+    on [-1, 1], or normal with standard deviation 1/3 truncated at ±1 (±3 σ)."""
+    from scipy import stats
+
+    pareto = read_pareto(ps_front[0])
+    X, held = draw_builds(pareto, 200, 8.0, 11, distribution)
+    assert held.sum() == 0
+    u = ((X / pareto.X - 1) / 0.08).ravel()
+    assert np.abs(u).max() <= 1 + 1e-12
+    expected = {
+        "uniform": stats.uniform(loc=-1, scale=2),
+        "normal": stats.truncnorm(-3, 3, scale=1 / 3),
+    }
+    for name, law in expected.items():
+        p = stats.kstest(u, law.cdf).pvalue
+        assert (p > 0.01) if name == distribution else (p < 1e-6), (name, p)
+
+
+def test_a_distribution_it_does_not_know_is_one_line(ps_front, tmp_path):
+    out = tmp_path / "builds.h5"
+    res = _invoke("analyse", "builds", ps_front[0], "-o", out, "--distribution", "triangle")
+    assert res.exit_code == 2 and not out.exists()
+    assert res.output.strip() == "error: --distribution 'triangle': give one of uniform, normal"

@@ -492,7 +492,17 @@ def test_a_design_of_an_analyse_builds_file_shows_the_spread_of_its_builds(
     objective's 5th to 95th percentile over its builds and its share of feasible builds, as
     the file holds them."""
     builds, page = tmp_path / "builds.h5", tmp_path / "builds.html"
-    res = _invoke("analyse", "builds", files["front"], "--samples", 7, "-o", builds)
+    res = _invoke(
+        "analyse",
+        "builds",
+        files["front"],
+        "--samples",
+        7,
+        "--distribution",
+        "normal",
+        "-o",
+        builds,
+    )
     assert res.exit_code == 0, res.output
     assert _invoke("report", builds, "-o", page).exit_code == 0
     with h5py.File(builds) as h5:
@@ -516,7 +526,7 @@ def test_a_design_of_an_analyse_builds_file_shows_the_spread_of_its_builds(
         note = browser.execute_script(
             "return document.querySelector('#design-0 > div.note').textContent"
         )
-        assert note == "7 builds, every variable within ±10 % of its value"
+        assert note == "7 builds, every variable within ±10 % of its value (normal)"
 
 
 @pytest.fixture(scope="module")
@@ -544,6 +554,14 @@ def _set(group, key, value):
         (lambda g: _set(g, "feasible_share", np.zeros((3, 2))), "expected 1 dimension"),
         (lambda g: _set(g, "feasible_share", np.array([b"a"] * 3)), "not numbers"),
         (lambda g: g.__delitem__("F_p95"), "/builds/F_p95: missing"),
+        (
+            lambda g: g.attrs.__setitem__("distribution", "<b>x</b>"),
+            "is not one of uniform, normal",
+        ),
+        (
+            lambda g: g.attrs.__delitem__("distribution"),
+            "attribute 'distribution' of /builds: missing",
+        ),
     ],
 )
 def test_a_damaged_builds_file_is_one_line_and_no_page(builds_file, tmp_path, damage, message):
@@ -553,5 +571,6 @@ def test_a_damaged_builds_file_is_one_line_and_no_page(builds_file, tmp_path, da
         damage(h5["builds"])
     res = _invoke("report", broken, "-o", page)
     assert res.exit_code == 2 and not page.exists()
-    assert res.output.startswith(f"error: {broken}: /builds") and message in res.output
+    assert res.output.startswith(f"error: {broken}: ") and message in res.output
+    assert "/builds" in res.output
     assert len(res.output.strip().splitlines()) == 1

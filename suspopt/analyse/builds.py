@@ -1,18 +1,23 @@
-"""``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]``: a
-front's designs as many parts built to their tolerances at once.
+"""``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]
+[--distribution uniform|normal]``: a front's designs as many parts built to their tolerances
+at once.
 
 ``analyse tolerances`` moves one design variable at a time to the edge of its band; a built
 suspension has every part off at once, by an amount nobody chose. This analysis builds each
 design of the front ``--samples`` times: every design variable of every build is its
-design's value times ``1 + u t/100``, ``u`` drawn uniformly from [-1, 1] independently for
-each variable, design and build (``t`` = ``--tolerance`` [%]). All builds of all designs are
+design's value times ``1 + u t/100``, ``u`` drawn from [-1, 1] independently for each
+variable, design and build (``t`` = ``--tolerance`` [%]): uniformly, or with
+``--distribution normal`` from a normal distribution of standard deviation 1/3 cut at ±1
+(the band is ±3 σ: a process of capability 1, its parts outside the band rejected), by
+the inverse of its distribution function. All builds of all designs are
 evaluated under the stored config in one batch (:func:`suspopt.selection.evaluate_pareto`).
 It reports, per design, the spread of each objective's change over its builds (5th to 95th
 percentile, ``100 (f_built - f_stored)/f_stored``) and the share of builds that meet every
 constraint. The thesis has no such analysis; it is ours.
 
-Choices: a uniform draw, since a tolerance band says where a part may lie and nothing of how
-often (a process's own distribution, where known, would narrow the spread); independent
+Choices: a uniform draw by default, since a tolerance band says where a part may lie and
+nothing of how often (the normal one narrows the spread, as a capable process does);
+independent
 variables (two springs of one batch may well be off alike, which this does not model). A
 value the draw would take outside what its config field accepts is held at the field's
 limit, and the report says how many (as ``analyse tolerances`` does). The draws come from
@@ -25,7 +30,7 @@ HDF5 layout (root attributes as every suspopt file, ``config`` = the stored conf
 ``analysis = "builds"``, ``source`` and ``seed``):
 
 - ``/pareto``: the stored front, as :mod:`.pseudo` writes it (X, F, feasible, picks, S);
-- ``/builds`` with attributes ``samples`` and ``tolerance`` [%];
+- ``/builds`` with attributes ``samples``, ``tolerance`` [%] and ``distribution``;
   ``/builds/X (sample, design, variable)`` the built designs (the variables' units),
   ``F (sample, design, objective)``, ``S (sample, design, supplementary)`` (if any),
   ``change (sample, design, objective)`` [%], ``feasible`` and ``failed (sample, design)``
@@ -60,6 +65,9 @@ __all__ = ["SAMPLES", "Builds", "draw_builds", "builds", "write_builds", "run_bu
 SAMPLES = 100
 #: The percentiles the report and the file give [%].
 PERCENTILES = (5.0, 50.0, 95.0)
+#: How a build's variable is drawn within its band (module docstring), as the report says it.
+DRAWS = {"uniform": "uniform draw", "normal": "normal draw (σ = t/3, cut at ±t)"}
+DISTRIBUTIONS = tuple(DRAWS)
 
 
 @dataclass(frozen=True)
@@ -69,7 +77,8 @@ class Builds:
     ``feasible`` and ``failed (N, D)``, ``G (N, D, k)`` their constraints (``g <= 0`` is
     met; ``constraint_names``, ``constraint_units``); ``stored`` the front's designs under
     the stored config (``names``, ``units``), ``held (n,)`` how many values of each variable
-    were held at its field's limit; ``tolerance`` [%] and ``seed`` as drawn."""
+    were held at its field's limit; ``tolerance`` [%], ``seed`` and ``distribution`` as
+    drawn."""
 
     pareto: ParetoSet
     stored: DesignSet
@@ -80,6 +89,7 @@ class Builds:
     held: np.ndarray
     tolerance: float
     seed: int
+    distribution: str
     G: np.ndarray
     constraint_names: tuple[str, ...]
     constraint_units: tuple[str, ...]
@@ -137,11 +147,18 @@ def _checked_seed(seed: int | None, pareto: ParetoSet) -> int:
 
 
 def draw_builds(
-    pareto: ParetoSet, samples: int, tolerance: float, seed: int
+    pareto: ParetoSet, samples: int, tolerance: float, seed: int, distribution: str = "uniform"
 ) -> tuple[np.ndarray, np.ndarray]:
     """``samples`` builds of every design of ``pareto`` (module docstring): ``X (N, D, n)``
     and how many values of each variable were held at its field's limit ``(n,)``."""
-    u = np.random.default_rng(seed).uniform(-1.0, 1.0, (samples,) + pareto.X.shape)
+    shape = (samples,) + pareto.X.shape
+    if distribution == "uniform":
+        u = np.random.default_rng(seed).uniform(-1.0, 1.0, shape)
+    else:  # normal, sigma 1/3, cut at ±1: the inverse of its distribution function
+        from scipy.special import ndtr, ndtri
+
+        low = ndtr(-3.0)
+        u = ndtri(low + np.random.default_rng(seed).random(shape) * (1.0 - 2.0 * low)) / 3.0
     wanted = pareto.X * (1.0 + u * tolerance / 100.0)
     X = np.empty_like(wanted)
     for j, limits in enumerate(variable_limits(pareto)):  # (per variable: its field's range)
@@ -149,14 +166,22 @@ def draw_builds(
     return X, (X != wanted).sum(axis=(0, 1))
 
 
-def builds(pareto: ParetoSet, samples=SAMPLES, *, tolerance=TOLERANCE, seed=None) -> Builds:
+def builds(
+    pareto: ParetoSet, samples=SAMPLES, *, tolerance=TOLERANCE, seed=None, distribution=None
+) -> Builds:
     """Draw and evaluate ``samples`` builds (int) of every design of ``pareto``, each design
     variable within ``tolerance`` [%] (float), from ``default_rng(seed)`` (int; None: the
-    stored config's ``optimiser.seed``) (module docstring)."""
+    stored config's ``optimiser.seed``), ``distribution`` ``"uniform"`` (None) or
+    ``"normal"`` (module docstring)."""
+    distribution = "uniform" if distribution is None else distribution
+    if distribution not in DISTRIBUTIONS:
+        raise ConfigError(
+            f"--distribution {distribution!r}: give one of {', '.join(DISTRIBUTIONS)}"
+        )
     t = checked_tolerance(tolerance)
     N = _checked_samples(samples, len(pareto.X))
     s = _checked_seed(seed, pareto)
-    X, held = draw_builds(pareto, N, t, s)
+    X, held = draw_builds(pareto, N, t, s, distribution)
     stored = evaluate_pareto(pareto)
     flat = replace(pareto, X=X.reshape(-1, X.shape[-1]))
     built = evaluate_pareto(flat, pareto.config(), "builds")  # (one batch of N D designs)
@@ -174,6 +199,7 @@ def builds(pareto: ParetoSet, samples=SAMPLES, *, tolerance=TOLERANCE, seed=None
         held=held,
         tolerance=t,
         seed=s,
+        distribution=distribution,
         G=(np.zeros((len(F), 0)) if built.G is None else built.G).reshape(shape + (-1,)),
         constraint_names=built.constraint_names,
         constraint_units=built.constraint_units,
@@ -189,6 +215,7 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
         h5.attrs["seed"] = b.seed
         g = h5.create_group("builds")
         g.attrs["samples"], g.attrs["tolerance"] = len(b.X), b.tolerance
+        g.attrs["distribution"] = b.distribution
         three = ("sample", "design")
         write_dataset(g, "X", b.X, list(p.var_units), three + ("variable",), names=p.var_names)
         write_dataset(g, "F", b.F[..., :m], units[:m], three + ("objective",), names=names[:m])
@@ -245,7 +272,8 @@ def _report(b: Builds, title: str) -> Report:
     ]
     notes = [
         f"{len(b.X)} builds of each of {len(p.X)} designs of {p.path.name}: every design "
-        f"variable off at once by a uniform draw within ±{b.tolerance:g} % of its value "
+        f"variable off at once by a {DRAWS[b.distribution]} within ±{b.tolerance:g} % of its "
+        f"value "
         f"(seed {b.seed}); change = (f_built - f_stored)/f_stored, its 5th to 95th "
         f"percentile over the builds",
         *b.stored.notes,
@@ -298,15 +326,16 @@ def run_builds(
     tolerance: float | None = TOLERANCE,
     samples: int | None = SAMPLES,
     seed: int | None = None,
+    distribution: str | None = None,
 ) -> Report:
-    """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]``
-    (module docstring)."""
+    """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]
+    [--distribution uniform|normal]`` (module docstring)."""
     from .. import plots
 
     if plot is not None:
         plots.check_path(plot)
     pareto = read_pareto(Path(source))
-    b = builds(pareto, samples, tolerance=tolerance, seed=seed)
+    b = builds(pareto, samples, tolerance=tolerance, seed=seed, distribution=distribution)
     title = f"builds: {pareto.path.name} as built to ±{b.tolerance:g} %"
     if output is not None:
         write_builds(output, b)
@@ -315,4 +344,4 @@ def run_builds(
     return _report(b, title)
 
 
-KINDS["builds"] = Kind(run_builds, options=("tolerance", "samples", "seed"))
+KINDS["builds"] = Kind(run_builds, options=("tolerance", "samples", "seed", "distribution"))

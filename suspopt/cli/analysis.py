@@ -18,6 +18,7 @@ _ANALYSE_OPTIONS = {
     "tolerance": "--tolerance",
     "samples": "--samples",
     "seed": "--seed",
+    "distribution": "--distribution",
 }
 
 
@@ -100,6 +101,9 @@ def analyse(
     seed: int | None = typer.Option(
         None, "--seed", help="builds: the seed of the draws (default the config's optimiser.seed)"
     ),
+    distribution: str | None = typer.Option(
+        None, "--distribution", help="builds: uniform (default) or normal (σ = t/3, cut at ±t)"
+    ),
     *,
     run: base.RunOptions,
 ) -> None:
@@ -117,6 +121,7 @@ def analyse(
         "tolerance": tolerance,
         "samples": samples,
         "seed": seed,
+        "distribution": distribution,
     }
     spec, options = _checked(kind, sources, given)
     try:

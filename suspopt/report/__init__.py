@@ -197,6 +197,7 @@ def _builds(h5, N: int, m: int) -> dict[str, Any]:
     """What an ``analyse builds`` file says of each design's builds
     (:mod:`suspopt.analyse.builds`): the 5th and 95th percentiles of each objective, the share
     of feasible builds, how many builds and within which tolerance [%]."""
+    from ..analyse.builds import DISTRIBUTIONS
     from ..params import MAX_SWEEP_DESIGNS
 
     low = h5.array("builds/F_p05", ndim=2, columns=m)
@@ -212,9 +213,16 @@ def _builds(h5, N: int, m: int) -> dict[str, Any]:
         raise ConfigError(
             f"{h5.where}: /builds: attribute 'tolerance': missing or not in (0, 100) %"
         )
+    distribution = h5.text_attr("distribution", "builds")
+    if distribution not in DISTRIBUTIONS:
+        raise ConfigError(
+            f"{h5.where}: /builds: attribute 'distribution': {distribution[:40]!r} is not one of "
+            f"{', '.join(DISTRIBUTIONS)}"
+        )
     return {
         "samples": h5.int_attr("builds", "samples", 1, MAX_SWEEP_DESIGNS),
         "tolerance": float(tolerance),
+        "distribution": distribution,
         "low": _list(low),
         "high": _list(high),
         "share": _list(share),

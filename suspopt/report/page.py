@@ -102,7 +102,7 @@ SCRIPT = r"""
     });
     const tr = el("tr", null, t); el("td", "feasible builds", tr);
     el("td", fmt(100 * b.share[row]), tr); el("td", "%", tr);
-    el("div", b.samples + " builds, every variable within ±" + b.tolerance + " % of its value", box).className = "note";
+    el("div", b.samples + " builds, every variable within ±" + b.tolerance + " % of its value (" + b.distribution + ")", box).className = "note";
   }
   function showBaseline(i, d, box) {  // the config's own design (an optimise file's /baseline)
     box.textContent = "";
