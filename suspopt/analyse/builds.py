@@ -9,16 +9,16 @@ design's value times ``1 + u t/100``, ``u`` drawn from [-1, 1] independently for
 variable, design and build (``t`` = ``--tolerance`` [%]): uniformly, or with
 ``--distribution normal`` from a normal distribution of standard deviation 1/3 cut at ±1
 (the band is ±3 σ: a process of capability 1, its parts outside the band rejected), by
-the inverse of its distribution function. All builds of all designs are
-evaluated under the stored config in one batch (:func:`suspopt.selection.evaluate_pareto`).
+the inverse of its distribution function. All builds of all designs are evaluated under
+the stored config in one call (:func:`suspopt.selection.evaluate_pareto`).
 It reports, per design, the spread of each objective's change over its builds (5th to 95th
 percentile, ``100 (f_built - f_stored)/f_stored``) and the share of builds that meet every
 constraint. The thesis has no such analysis; it is ours.
 
 Choices: a uniform draw by default, since a tolerance band says where a part may lie and
 nothing of how often (the normal one narrows the spread, as a capable process does);
-independent
-variables (two springs of one batch may well be off alike, which this does not model). A
+independent variables (two springs of one batch may well be off alike, which this does not
+model). A
 value the draw would take outside what its config field accepts is held at the field's
 limit, and the report says how many (as ``analyse tolerances`` does). The draws come from
 ``numpy.random.default_rng(seed)``, ``seed`` = ``--seed``, by default the stored config's
@@ -273,8 +273,7 @@ def _report(b: Builds, title: str) -> Report:
     notes = [
         f"{len(b.X)} builds of each of {len(p.X)} designs of {p.path.name}: every design "
         f"variable off at once by a {DRAWS[b.distribution]} within ±{b.tolerance:g} % of its "
-        f"value "
-        f"(seed {b.seed}); change = (f_built - f_stored)/f_stored, its 5th to 95th "
+        f"value (seed {b.seed}); change = (f_built - f_stored)/f_stored, its 5th to 95th "
         f"percentile over the builds",
         *b.stored.notes,
     ]
