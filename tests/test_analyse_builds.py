@@ -79,6 +79,16 @@ def test_every_build_moves_the_static_deflection_as_m_g_over_k_and_breaks_its_li
     assert (G[..., others] <= 0).all()  # (the builds break the static deflection's alone)
     k = int(np.argmax(F0[:, 1]))
     assert 0 < share[k] < 1 and share[k] == feasible[:, k].mean()
+    with h5py.File(out) as h5:  # what drives the spread: X_ST follows K_v alone
+        r2 = h5["builds/contribution"][()]  # (design, variable, objective)
+    for d in range(len(X0)):
+        for i in range(2):
+            for o in range(2):
+                own = np.corrcoef(X[:, d, i], F[:, d, o])[0, 1] ** 2
+                assert r2[d, i, o] == pytest.approx(own, rel=1e-9)
+    assert (r2[:, 0, 1] > 0.95).all() and (r2[:, 1, 1] < 0.2).all()
+    drivers = np.median(r2, axis=0)
+    assert f"X_ST: K_v {drivers[0, 1]:.2f}, C_v {drivers[1, 1]:.2f}" in " ".join(res.output.split())
     np.testing.assert_allclose(p05, np.percentile(F, 5, axis=0))
     np.testing.assert_allclose(p95, np.percentile(F, 95, axis=0))
     said = " ".join(res.output.split())

@@ -38,7 +38,10 @@ HDF5 layout (root attributes as every suspopt file, ``config`` = the stored conf
 - ``/builds/G (sample, design, constraint)`` the builds' constraints (``g <= 0`` is met;
   their units; the config's constraints, if it has any);
 - ``/builds/F_p05``, ``F_median``, ``F_p95 (design, objective)``: each objective's 5th
-  percentile, median and 95th percentile over the builds; ``feasible_share (design,)`` [1].
+  percentile, median and 95th percentile over the builds; ``feasible_share (design,)`` [1];
+  ``contribution (design, variable, objective)`` [1]: the share of the objective's variance
+  over the design's builds that goes with the variable (their squared correlation; the
+  variables are drawn independently, so it is the share a linear fit gives each).
 """
 
 from __future__ import annotations
@@ -107,6 +110,24 @@ class Builds:
     def change(self) -> np.ndarray:
         """(N, D, m + s) change of each objective of each build [%]."""
         return relative_change(self.F, self.reference)
+
+    def contributions(self) -> np.ndarray:
+        """(D, n, m + s): for each design, the share of each objective's variance over its
+        builds that goes with each design variable: their squared correlation over the
+        builds that did not fail (the variables are drawn independently, so this is the
+        share a linear fit gives each; what no variable explains alone, through a curved or
+        joint effect, is left over). NaN where a variable or an objective did not vary."""
+        ok = ~self.failed[..., None]  # (N, D, 1)
+        count = ok.sum(axis=0)  # (D, 1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = np.where(ok, self.X, 0.0)
+            y = np.where(ok, self.F, 0.0)
+            x = np.where(ok, x - x.sum(axis=0) / count, 0.0)  # (N, D, n), centred
+            y = np.where(ok, y - y.sum(axis=0) / count, 0.0)  # (N, D, M)
+            cov = np.einsum("kdi,kdj->dij", x, y)
+            var_x, var_y = (x * x).sum(axis=0), (y * y).sum(axis=0)
+            r2 = cov**2 / (var_x[:, :, None] * var_y[:, None, :])
+        return np.where(np.isfinite(r2), r2, np.nan)
 
     def percentiles(self, values: np.ndarray) -> np.ndarray:
         """(3, D, ...) the :data:`PERCENTILES` of ``values (N, D, ...)`` over the builds (NaN
@@ -232,6 +253,9 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
         for key, values in zip(("F_p05", "F_median", "F_p95"), b.percentiles(b.F[..., :m])):
             write_dataset(g, key, values, units[:m], ("design", "objective"), names=names[:m])
         write_dataset(g, "feasible_share", b.feasible.mean(axis=0), "1", ("design",))
+        r2 = b.contributions()[..., :m]
+        dims = ("design", "variable", "objective")
+        write_dataset(g, "contribution", r2, "1", dims, names=names[:m])
     return Path(path)
 
 
@@ -253,6 +277,24 @@ def _broken(b: Builds) -> str:
                 f"(design {k}: {100 * share[k]:.0f} %)"
             )
     return "constraints the builds break: " + ("; ".join(parts) if parts else "none")
+
+
+def _drivers(b: Builds) -> str:
+    """What drives each objective's spread: each variable's median share over the designs
+    (:meth:`Builds.contributions`), largest first."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # (nothing varied: NaN)
+        share = np.nanmedian(b.contributions(), axis=0)  # (n, M)
+    parts = []
+    for j, name in enumerate(b.stored.names):
+        order = [i for i in np.argsort(-np.nan_to_num(share[:, j], nan=-1.0)) if share[i, j] >= 0]
+        if order:
+            each = ", ".join(f"{b.pareto.var_names[i]} {share[i, j]:.2f}" for i in order)
+            parts.append(f"{name}: {each}")
+    return (
+        "what drives each objective's spread (squared correlation with each variable over "
+        "the builds, median over the designs): " + ("; ".join(parts) if parts else "nothing varied")
+    )
 
 
 def _report(b: Builds, title: str) -> Report:
@@ -291,6 +333,7 @@ def _report(b: Builds, title: str) -> Report:
         f"{int((share == 1).sum())} of {len(p.X)} designs have every build feasible"
     )
     notes.append(_broken(b))
+    notes.append(_drivers(b))
     if b.failed.any():
         notes.append(f"{int(b.failed.sum())} of {b.failed.size} builds failed to simulate")
     notes += [
