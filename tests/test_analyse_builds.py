@@ -201,3 +201,16 @@ def test_a_distribution_it_does_not_know_is_one_line(ps_front, tmp_path):
     res = _invoke("analyse", "builds", ps_front[0], "-o", out, "--distribution", "triangle")
     assert res.exit_code == 2 and not out.exists()
     assert res.output.strip() == "error: --distribution 'triangle': give one of uniform, normal"
+
+
+def test_what_drives_a_spread_is_said_from_ten_builds_on(ps_front):
+    """Over two builds any two quantities correlate perfectly: the report does not say what
+    drives a spread until there are ten."""
+    res = _invoke("analyse", "builds", ps_front[0], "--samples", 9)
+    assert res.exit_code == 0, res.output
+    said = " ".join(res.output.split())
+    assert "what drives each objective's spread: give 10 builds or more to see" in said
+    res = _invoke("analyse", "builds", ps_front[0], "--samples", 10)
+    assert "what drives each objective's spread (squared correlation" in " ".join(
+        res.output.split()
+    )

@@ -71,6 +71,8 @@ PERCENTILES = (5.0, 50.0, 95.0)
 #: How a build's variable is drawn within its band (module docstring), as the report says it.
 DRAWS = {"uniform": "uniform draw", "normal": "normal draw (σ = t/3, cut at ±t)"}
 DISTRIBUTIONS = tuple(DRAWS)
+#: The fewest builds the report says what drives a spread from.
+DRIVER_SAMPLES = 10
 
 
 @dataclass(frozen=True)
@@ -281,7 +283,11 @@ def _broken(b: Builds) -> str:
 
 def _drivers(b: Builds) -> str:
     """What drives each objective's spread: each variable's median share over the designs
-    (:meth:`Builds.contributions`), largest first."""
+    (:meth:`Builds.contributions`), largest first; from :data:`DRIVER_SAMPLES` builds on
+    (the squared correlation of two unrelated quantities over N builds is about 1/(N - 1):
+    1 over two builds)."""
+    if len(b.X) < DRIVER_SAMPLES:
+        return f"what drives each objective's spread: give {DRIVER_SAMPLES} builds or more to see"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # (nothing varied: NaN)
         share = np.nanmedian(b.contributions(), axis=0)  # (n, M)
