@@ -489,15 +489,16 @@ def test_a_design_of_an_analyse_builds_file_shows_the_spread_of_its_builds(
     files, browser, tmp_path
 ):
     """Clicked on the page of an ``analyse builds`` file, a design's panel shows each
-    objective's 5th to 95th percentile over its builds and its share of feasible builds, as
-    the file holds them."""
+    objective's 5th to 95th percentile over its builds, what its spread comes from (each
+    variable's squared correlation, largest first) and its share of feasible builds, as the
+    file holds them."""
     builds, page = tmp_path / "builds.h5", tmp_path / "builds.html"
     res = _invoke(
         "analyse",
         "builds",
         files["front"],
         "--samples",
-        7,
+        12,
         "--distribution",
         "normal",
         "-o",
@@ -509,24 +510,29 @@ def test_a_design_of_an_analyse_builds_file_shows_the_spread_of_its_builds(
         low, high = h5["builds/F_p05"][()], h5["builds/F_p95"][()]
         share = h5["builds/feasible_share"][()]
         names = list(h5["builds/F"].attrs["names"].astype(str))
+        variables = list(h5["builds/X"].attrs["names"].astype(str))
+        r2 = h5["builds/contribution"][()]
     browser.get(page.resolve().as_uri())
     _wait(browser, "return document.body.getAttribute('data-rendered')", "the plots rendered")
     for row in (0, len(share) - 1):
         browser.execute_script("window.suspoptReport.select(0, arguments[0])", row)
-        cells = dict(
-            browser.execute_script(
-                "return [...document.querySelectorAll('#design-0 tr')]"
-                ".map(tr => [tr.cells[0].textContent, tr.cells[1].textContent])"
-            )
+        rows = browser.execute_script(
+            "return [...document.querySelectorAll('#design-0 tr')]"
+            ".map(tr => [...tr.cells].map(c => c.textContent))"
         )
+        cells = {r[0]: r[1] for r in rows}
+        notes = {r[0]: r[3] if len(r) > 3 else "" for r in rows}
         for j, name in enumerate(names):
             lo, hi = cells[f"{name}, built 5-95 %"].split(" to ")
             assert [float(lo), float(hi)] == pytest.approx([low[row, j], high[row, j]], rel=1e-4)
+            order = sorted(range(len(variables)), key=lambda i: -r2[row, i, j])
+            drivers = ", ".join(f"{variables[i]} {r2[row, i, j]:.2f}" for i in order)
+            assert notes[f"{name}, built 5-95 %"] == f"spread from: {drivers}"
         assert float(cells["feasible builds"]) == pytest.approx(100 * share[row], rel=1e-4)
         note = browser.execute_script(
             "return document.querySelector('#design-0 > div.note').textContent"
         )
-        assert note == "7 builds, every variable within ±10 % of its value (normal)"
+        assert note == "12 builds, every variable within ±10 % of its value (normal)"
 
 
 @pytest.fixture(scope="module")
@@ -550,10 +556,13 @@ def _set(group, key, value):
         (lambda g: g.attrs.__setitem__("tolerance", np.nan), "attribute 'tolerance': missing or"),
         (lambda g: g.attrs.__setitem__("tolerance", True), "attribute 'tolerance': missing or"),
         (lambda g: g.attrs.__delitem__("samples"), "attribute 'samples': missing or not a whole"),
-        (lambda g: _set(g, "F_p05", np.zeros((3, 2))), "the percentiles do not have the front's"),
+        (lambda g: _set(g, "F_p05", np.zeros((3, 2))), "do not have the front's"),
         (lambda g: _set(g, "feasible_share", np.zeros((3, 2))), "expected 1 dimension"),
         (lambda g: _set(g, "feasible_share", np.array([b"a"] * 3)), "not numbers"),
         (lambda g: g.__delitem__("F_p95"), "/builds/F_p95: missing"),
+        (lambda g: _set(g, "contribution", np.zeros((3, 2, 2))), "do not have the front's"),
+        (lambda g: _set(g, "contribution", np.zeros((3, 2))), "expected 3 dimensions"),
+        (lambda g: _set(g, "contribution", g["contribution"][:, :1]), "2 variables and 2"),
         (
             lambda g: g.attrs.__setitem__("distribution", "<b>x</b>"),
             "is not one of uniform, normal",

@@ -182,7 +182,7 @@ def _extras(h5, table) -> dict[str, Any]:
             history["best_names"] = h5.labels("history/best", "names", best.shape[1])
         out["history"] = history
     if group == "pareto" and h5._node("builds/feasible_share") is not None:
-        out["builds"] = _builds(h5, N, table.F.shape[1])
+        out["builds"] = _builds(h5, N, table.X.shape[1], table.F.shape[1])
     if h5._node("pseudo") is not None:
         fronts = []
         for label in h5.group("pseudo"):
@@ -193,18 +193,23 @@ def _extras(h5, table) -> dict[str, Any]:
     return out
 
 
-def _builds(h5, N: int, m: int) -> dict[str, Any]:
+def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
     """What an ``analyse builds`` file says of each design's builds
     (:mod:`suspopt.analyse.builds`): the 5th and 95th percentiles of each objective, the share
-    of feasible builds, how many builds and within which tolerance [%]."""
-    from ..analyse.builds import DISTRIBUTIONS
+    of feasible builds, what drives each objective's spread, how many builds and within which
+    tolerance [%]."""
+    from ..analyse.builds import DISTRIBUTIONS, DRIVER_SAMPLES
     from ..params import MAX_SWEEP_DESIGNS
 
     low = h5.array("builds/F_p05", ndim=2, columns=m)
     high = h5.array("builds/F_p95", ndim=2, columns=m)
     share = h5.array("builds/feasible_share", ndim=1)
-    if not len(low) == len(high) == len(share) == N:
-        raise ConfigError(f"{h5.where}: /builds: the percentiles do not have the front's {N} rows")
+    r2 = h5.array("builds/contribution", ndim=3)
+    if not len(low) == len(high) == len(share) == N or r2.shape != (N, n, m):
+        raise ConfigError(
+            f"{h5.where}: /builds: the percentiles, shares and contributions do not have "
+            f"the front's {N} rows, {n} variables and {m} objectives"
+        )
     tolerance = h5.attribute(h5.group("builds"), "tolerance", "/builds: attribute 'tolerance'")
     if isinstance(tolerance, np.ndarray) and tolerance.ndim == 0:
         tolerance = tolerance[()]
@@ -226,6 +231,8 @@ def _builds(h5, N: int, m: int) -> dict[str, Any]:
         "low": _list(low),
         "high": _list(high),
         "share": _list(share),
+        "contribution": _list(r2),
+        "driver_samples": DRIVER_SAMPLES,
     }
 
 

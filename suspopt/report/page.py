@@ -99,6 +99,9 @@ SCRIPT = r"""
     d.objectives.forEach((n, j) => {
       const tr = el("tr", null, t); el("td", n + ", built 5-95 %", tr);
       el("td", fmt(b.low[row][j]) + " to " + fmt(b.high[row][j]), tr); el("td", d.objective_units[j], tr);
+      const r2 = d.variables.map((v, i) => [v, b.contribution[row][i][j]]).filter(([, c]) => c !== null)
+        .sort((a, c) => c[1] - a[1]).map(([v, c]) => v + " " + c.toFixed(2)).join(", ");
+      if (b.samples >= b.driver_samples && r2) el("td", "spread from: " + r2, tr).className = "note";
     });
     const tr = el("tr", null, t); el("td", "feasible builds", tr);
     el("td", fmt(100 * b.share[row]), tr); el("td", "%", tr);
