@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import shutil
+
 import h5py
 import numpy as np
 import pytest
@@ -214,3 +216,58 @@ def test_what_drives_a_spread_is_said_from_ten_builds_on(ps_front):
     assert "what drives each objective's spread (squared correlation" in " ".join(
         res.output.split()
     )
+
+
+def test_kesort_counts_a_design_with_too_few_feasible_builds_infeasible(ps_front, tmp_path):
+    """``kesort FRONT --builds BUILDS``: a design fewer of whose builds than
+    ``--min-feasible-builds`` % meet the constraints counts as infeasible, so the k-ε
+    optimum is chosen among the designs that survive their tolerances."""
+    front, _ = ps_front
+    builds_file, out = tmp_path / "builds.h5", tmp_path / "ke.h5"
+    res = _invoke("analyse", "builds", front, "-o", builds_file, "--samples", 40, "--tolerance", 8)
+    assert res.exit_code == 0, res.output
+    with h5py.File(builds_file) as h5:
+        share = h5["builds/feasible_share"][()]
+    assert 0 < (share < 0.95).sum() < len(share)
+    res = _invoke("kesort", front, "--builds", builds_file, "-o", out)
+    assert res.exit_code == 0, res.output
+    with h5py.File(out) as h5:
+        feasible = h5["kesort/feasible"][()].astype(bool)
+        rows, chosen = h5["kesort/row"][()], int(h5["kesort/chosen"][()])
+    with h5py.File(front) as h5:
+        stored = (h5["pareto/G"][()] <= 0).all(axis=1)
+    np.testing.assert_array_equal(feasible, stored[rows] & (share[rows] >= 0.95))
+    assert share[rows[chosen]] >= 0.95
+    short = int((share < 0.95).sum())
+    said = " ".join(res.output.split())
+    assert f"note: {short} of {len(share)} designs have fewer than 95 % of their builds" in said
+    res = _invoke("kesort", front, "--builds", builds_file, "--min-feasible-builds", 0)
+    assert res.exit_code == 0 and f"note: 0 of {len(share)} designs" in " ".join(res.output.split())
+
+
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        (["--builds", "{front}"], "not a file of suspopt analyse builds"),
+        (["--builds", "{other}"], "its designs (/pareto/X) are not those of"),
+        (["--builds", "{builds}", "--min-feasible-builds", "101"], "give a share from 0 to 100"),
+        (["--builds", "{builds}", "--min-feasible-builds", "nan"], "give a share from 0 to 100"),
+        (["--min-feasible-builds", "90"], "--min-feasible-builds: give --builds too"),
+        (["{front}", "--builds", "{builds}"], "--builds: give one Pareto file, not 2"),
+    ],
+)
+def test_kesort_builds_of_the_wrong_file_are_one_line(ps_front, tmp_path, args, said):
+    front, _ = ps_front
+    builds_file, other = tmp_path / "builds.h5", tmp_path / "other.h5"
+    assert _invoke("analyse", "builds", front, "-o", builds_file, "--samples", 3).exit_code == 0
+    with h5py.File(builds_file) as h5:
+        X = h5["pareto/X"][()]
+    shutil.copyfile(builds_file, other)
+    with h5py.File(other, "r+") as h5:
+        h5["pareto/X"][0, 0] = X[0, 0] * 1.01
+    paths = {"front": front, "builds": builds_file, "other": other}
+    out = tmp_path / "ke.h5"
+    res = _invoke("kesort", front, *[a.format(**paths) for a in args], "-o", out)
+    assert res.exit_code == 2 and not out.exists(), res.output
+    assert res.output.startswith("error: ") and said in res.output
+    assert len(res.output.strip().splitlines()) == 1

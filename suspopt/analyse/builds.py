@@ -62,7 +62,15 @@ from . import KINDS, Kind, Report, relative_change
 from .pseudo import is_comfort, table_designs, write_stored_front
 from .tolerances import TOLERANCE, checked_tolerance, inside, variable_limits
 
-__all__ = ["SAMPLES", "Builds", "draw_builds", "builds", "write_builds", "run_builds"]
+__all__ = [
+    "SAMPLES",
+    "Builds",
+    "draw_builds",
+    "builds",
+    "write_builds",
+    "run_builds",
+    "feasible_builds",
+]
 
 #: The default number of builds of each design.
 SAMPLES = 100
@@ -390,6 +398,31 @@ def run_builds(
     if plot is not None:
         plot_builds(b, plot, title)
     return _report(b, title)
+
+
+def feasible_builds(path: str | Path, front: str | Path) -> np.ndarray:
+    """``(D,)`` the share of feasible builds of each design of the Pareto file ``front``, from
+    the ``analyse builds`` file ``path`` of that front (``suspopt kesort --builds``);
+    ConfigError naming the file when it is no builds file, or one of another front (its
+    ``/pareto/X`` differs from the front's)."""
+    from ..h5read import H5Reader
+
+    with H5Reader(path, where=f"--builds {path}") as h5:
+        if not h5.has_attr("analysis") or h5.text_attr("analysis") != "builds":
+            raise ConfigError(f"--builds {path}: not a file of suspopt analyse builds")
+        X = h5.array("pareto/X", ndim=2)
+        share = h5.array("builds/feasible_share", ndim=1)
+    own = read_pareto(front).X
+    if X.shape != own.shape or not np.array_equal(X, own):
+        raise ConfigError(
+            f"--builds {path}: its designs (/pareto/X) are not those of {front}: give the "
+            f"builds of that front"
+        )
+    if len(share) != len(own) or not ((share >= 0) & (share <= 1)).all():
+        raise ConfigError(
+            f"--builds {path}: /builds/feasible_share: not one share in [0, 1] per design"
+        )
+    return share
 
 
 KINDS["builds"] = Kind(run_builds, options=("tolerance", "samples", "seed", "distribution"))

@@ -133,6 +133,34 @@ def _with_supplementary(cfg, X, variables: list[str], F, names: list[str]):
     return np.hstack([F, S]), names + problem.supplementary_names
 
 
+def _as_built(sets, pareto: list[Path], builds: Path | None, least: float | None):
+    """``sets`` with a design counted infeasible where fewer than ``least`` % (None:
+    :data:`MIN_FEASIBLE_BUILDS`) of its builds (the ``analyse builds`` file ``builds`` of the
+    one Pareto file) are feasible, and the note that says how many; ``sets`` and no note
+    without ``builds``."""
+    import math
+    from dataclasses import replace
+
+    from ..analyse.builds import feasible_builds
+
+    if builds is None:
+        if least is not None:
+            raise ConfigError("--min-feasible-builds: give --builds too (the builds it counts)")
+        return sets, []
+    least = MIN_FEASIBLE_BUILDS if least is None else least
+    if not (math.isfinite(least) and 0 <= least <= 100):
+        raise ConfigError(f"--min-feasible-builds {least:g}: give a share from 0 to 100 %")
+    if len(pareto) != 1:
+        raise ConfigError(f"--builds: give one Pareto file, not {len(pareto)}")
+    short = feasible_builds(builds, pareto[0]) < least / 100
+    (design_set,) = sets
+    note = (
+        f"{int(short.sum())} of {len(short)} designs have fewer than {least:g} % of their "
+        f"builds feasible ({builds}): counted infeasible"
+    )
+    return [replace(design_set, feasible=design_set.feasible & ~short)], [note]
+
+
 def _threshold_line(sort, label: str) -> str:
     if sort.P is None:
         how = "absolute ε"
@@ -142,6 +170,17 @@ def _threshold_line(sort, label: str) -> str:
     return f"{label}: {how}, normalised by {sort.normalisation}{tied}"
 
 
+#: The share of a design's builds that must be feasible [%] (``kesort --builds``): a design
+#: that meets its constraints in 19 builds of 20.
+MIN_FEASIBLE_BUILDS = 95.0
+
+_BUILDS_HELP = (
+    "the analyse builds file of the (one) Pareto file: a design with fewer feasible builds "
+    "than --min-feasible-builds counts as infeasible"
+)
+_MIN_FEASIBLE_BUILDS_HELP = (
+    "with --builds: the share of a design's builds that must be feasible, in % (default 95)"
+)
 _EPS_HELP = (
     "absolute thresholds in the objectives' SI units: one value, or one per objective "
     "separated by commas"
@@ -182,6 +221,10 @@ def kesort(
     keep_infeasible: bool = typer.Option(
         False, "--keep-infeasible", help="sort infeasible designs too"
     ),
+    builds: Path | None = typer.Option(None, "--builds", help=_BUILDS_HELP),
+    min_feasible_builds: float | None = typer.Option(
+        None, "--min-feasible-builds", help=_MIN_FEASIBLE_BUILDS_HELP
+    ),
     output: Path | None = typer.Option(None, "-o", "--output", help="HDF5 file for /kesort"),
     plot: Path | None = typer.Option(
         None, "--plot", help="figure of the k-ε levels over the front (.png or .svg)"
@@ -193,15 +236,18 @@ def kesort(
 
     Supplementary objectives are re-simulated in one batch."""
     inputs = [("the input", p) for p in pareto] + [("--config", c) for c in config]
+    inputs += [("--builds", builds)] if builds is not None else []
     with run.outputs(output, plot, inputs=inputs):
         _kesort(
-            pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot
-        )
+            pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output,
+            plot, (builds, min_feasible_builds),
+        )  # fmt: skip
 
 
 def _kesort(
-    pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot
-) -> None:
+    pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot,
+    by_builds,
+) -> None:  # fmt: skip
     import importlib.util
 
     from ..kesort import check_options
@@ -226,6 +272,7 @@ def _kesort(
         base.fail(f"kesort options: {message}")
     try:
         sets = load_design_sets(pareto, config, label)
+        sets, built = _as_built(sets, pareto, *by_builds)
         selection = select(sets, eps_values, feasible_only=not keep_infeasible, **options)
     except ConfigError as exc:
         base.fail(str(exc))
@@ -242,7 +289,7 @@ def _kesort(
     out.print(
         _threshold_line(selection.sort, "all" if selection.case_sorts else selection.cases[0])
     )
-    for note in selection.notes:
+    for note in [*built, *selection.notes]:
         out.print(f"note: {note}")
     against = _optimum_against_baseline(selection)
     if against is not None:
