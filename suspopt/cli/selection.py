@@ -133,25 +133,31 @@ def _with_supplementary(cfg, X, variables: list[str], F, names: list[str]):
     return np.hstack([F, S]), names + problem.supplementary_names
 
 
-def _as_built(sets, pareto: list[Path], builds: Path | None, least: float | None):
-    """``sets`` with a design counted infeasible where fewer than ``least`` % (None:
-    :data:`MIN_FEASIBLE_BUILDS`) of its builds (the ``analyse builds`` file ``builds`` of the
-    one Pareto file) are feasible, and the note that says how many; ``sets`` and no note
-    without ``builds``."""
+def _builds_options(pareto: list[Path], builds: Path | None, least: float | None) -> float:
+    """``--min-feasible-builds`` [%] (None: :data:`MIN_FEASIBLE_BUILDS`), checked with
+    ``--builds`` before any design is evaluated."""
     import math
+
+    if builds is None and least is not None:
+        raise ConfigError("--min-feasible-builds: give --builds too (the builds it counts)")
+    least = MIN_FEASIBLE_BUILDS if least is None else least
+    if not (math.isfinite(least) and 0 <= least <= 100):
+        raise ConfigError(f"--min-feasible-builds {least:g}: give a share from 0 to 100 %")
+    if builds is not None and len(pareto) != 1:
+        raise ConfigError(f"--builds: give one Pareto file, not {len(pareto)}")
+    return least
+
+
+def _as_built(sets, pareto: list[Path], builds: Path | None, least: float):
+    """``sets`` with a design counted infeasible where fewer than ``least`` % of its builds
+    (the ``analyse builds`` file ``builds`` of the one Pareto file) are feasible, and the
+    note that says how many; ``sets`` and no note without ``builds``."""
     from dataclasses import replace
 
     from ..analyse.builds import feasible_builds
 
     if builds is None:
-        if least is not None:
-            raise ConfigError("--min-feasible-builds: give --builds too (the builds it counts)")
         return sets, []
-    least = MIN_FEASIBLE_BUILDS if least is None else least
-    if not (math.isfinite(least) and 0 <= least <= 100):
-        raise ConfigError(f"--min-feasible-builds {least:g}: give a share from 0 to 100 %")
-    if len(pareto) != 1:
-        raise ConfigError(f"--builds: give one Pareto file, not {len(pareto)}")
     short = feasible_builds(builds, pareto[0]) < least / 100
     (design_set,) = sets
     note = (
@@ -271,8 +277,9 @@ def _kesort(
         message = str(exc).replace("P_range", "--P-range").replace("P_step", "--P-step")
         base.fail(f"kesort options: {message}")
     try:
+        least = _builds_options(pareto, *by_builds)
         sets = load_design_sets(pareto, config, label)
-        sets, built = _as_built(sets, pareto, *by_builds)
+        sets, built = _as_built(sets, pareto, by_builds[0], least)
         selection = select(sets, eps_values, feasible_only=not keep_infeasible, **options)
     except ConfigError as exc:
         base.fail(str(exc))
