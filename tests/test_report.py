@@ -583,3 +583,42 @@ def test_a_damaged_builds_file_is_one_line_and_no_page(builds_file, tmp_path, da
     assert res.output.startswith(f"error: {broken}: ") and message in res.output
     assert "/builds" in res.output
     assert len(res.output.strip().splitlines()) == 1
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+def test_the_brushed_designs_command_lists_at_most_its_cap_of_rows(
+    files, browser, tmp_path, monkeypatch
+):
+    """The command that simulates the brushed designs lists at most
+    ``page.BRUSH_COMMAND_ROWS`` rows (100); above, the page asks for narrower ranges.
+    Here the cap is 3: three brushed designs give the command, four the request."""
+    from suspopt.report import page as page_module
+
+    monkeypatch.setattr(page_module, "BRUSH_COMMAND_ROWS", 3)
+    page = tmp_path / "front.html"
+    assert _invoke("report", files["front"], "-o", page).exit_code == 0
+    with h5py.File(files["front"]) as h5:
+        f1 = np.sort(h5["pareto/F"][:, 0])
+    assert len(f1) >= 4 and len(set(f1[:5])) == min(5, len(f1))
+    browser.get(page.resolve().as_uri())
+    _wait(browser, "return document.body.getAttribute('data-rendered')", "the plots rendered")
+    div = "document.getElementById('parallel-0')"
+    browser.execute_script(f"{div}.scrollIntoView({{block: 'center'}})")
+    _wait(browser, f"return {div}.getAttribute('data-drawn')", "parallel-0 drew")
+    for count in (3, 4):
+        top = (f1[count - 1] + f1[count]) / 2 if count < len(f1) else f1[-1]
+        browser.execute_script(
+            f"Plotly.restyle({div}, {{'dimensions[0].constraintrange': [arguments[0]]}})",
+            [float(f1[0]) - 1e-12, float(top)],
+        )
+        note, codes, box = browser.execute_script(
+            "return [document.getElementById('brush-0').textContent,"
+            " [...document.querySelectorAll('#brush-command-0 code')].map(c => c.textContent),"
+            " document.getElementById('brush-command-0').textContent]"
+        )
+        assert note == f"{count} of {len(f1)} designs in the brushed ranges"
+        if count == 3:
+            assert len(codes) == 1 and len(shlex.split(codes[0])[4].split(",")) == 3
+        else:
+            assert codes == [] and "more than 3 designs: narrow the ranges" in box

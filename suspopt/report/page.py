@@ -161,7 +161,7 @@ SCRIPT = r"""
     const values = active.map(([k, r]) => [column(study, k), r]);
     return study.data.F.map((_, row) => row).filter(row => values.every(([v, r]) => inside(v[row], r)));
   }
-  const BRUSH_COMMAND_ROWS = 100;  // (the most rows the command of the brushed designs lists)
+  const BRUSH_COMMAND_ROWS = data.brush_command_rows;  // (suspopt.report.page.BRUSH_COMMAND_ROWS)
   function showBrush(i) {
     const rows = brushed(i), note = document.getElementById("brush-" + i);
     const box = document.getElementById("brush-command-" + i);
@@ -456,11 +456,19 @@ def _section(i: int, study) -> str:
     return "\n".join(parts)
 
 
+#: The most designs the page's command for the brushed designs lists (``simulate --pick``):
+#: more make a command line too long to read, and a batch better chosen by narrower ranges.
+BRUSH_COMMAND_ROWS = 100
+
+
 def render(studies, title: str) -> str:
     """The whole page of ``studies`` (:class:`suspopt.report.Study`)."""
     from .. import __version__
 
-    payload = {"studies": [{"label": s.label, "kind": s.kind, "data": s.data} for s in studies]}
+    payload = {
+        "studies": [{"label": s.label, "kind": s.kind, "data": s.data} for s in studies],
+        "brush_command_rows": BRUSH_COMMAND_ROWS,
+    }
     e = html.escape
     return "\n".join(
         [
