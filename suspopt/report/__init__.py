@@ -210,14 +210,6 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
             f"{h5.where}: /builds: the percentiles, shares and contributions do not have "
             f"the front's {N} rows, {n} variables and {m} objectives"
         )
-    tolerance = h5.attribute(h5.group("builds"), "tolerance", "/builds: attribute 'tolerance'")
-    if isinstance(tolerance, np.ndarray) and tolerance.ndim == 0:
-        tolerance = tolerance[()]
-    number = isinstance(tolerance, (float, int, np.number)) and not isinstance(tolerance, bool)
-    if not number or not 0 < tolerance < 100:
-        raise ConfigError(
-            f"{h5.where}: /builds: attribute 'tolerance': missing or not in (0, 100) %"
-        )
     distribution = h5.text_attr("distribution", "builds")
     if distribution not in DISTRIBUTIONS:
         raise ConfigError(
@@ -226,7 +218,7 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
         )
     return {
         "samples": h5.int_attr("builds", "samples", 1, MAX_SWEEP_DESIGNS),
-        "tolerance": float(tolerance),
+        "tolerance": h5.float_attr("builds", "tolerance", 0.0, 100.0),
         "distribution": distribution,
         "low": _list(low),
         "high": _list(high),
