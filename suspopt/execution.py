@@ -8,8 +8,8 @@ object (the problem or config, sent once per worker) and its chunk of rows, and 
 come back in the chunks' order. A design's arithmetic never involves another design (both
 integrator engines compute each design on its own), so a design gives the same bits in any
 chunk, on any executor. Users of the seam: ``Problem.evaluate`` (every optimiser, ``kesort``'s
-re-simulation, the pseudo-fronts of ``analyse roads|masses|controllers|tolerances``) and ``simulate`` of
-a batch or sweep.
+re-simulation, the pseudo-fronts of ``analyse roads|masses|controllers|tolerances``, the
+builds of ``analyse builds``) and ``simulate`` of a batch or sweep.
 
 Executors (``execution.executor``, or ``--executor`` on the command line, which wins):
 

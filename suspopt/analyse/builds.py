@@ -49,6 +49,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -116,11 +117,12 @@ class Builds:
         """(D, m + s): the file's main objectives, then the re-simulated supplementary ones."""
         return np.hstack([self.pareto.F, self.stored.F[:, self.m :]])
 
-    @property
+    @cached_property
     def change(self) -> np.ndarray:
         """(N, D, m + s) change of each objective of each build [%]."""
         return relative_change(self.F, self.reference)
 
+    @cached_property
     def contributions(self) -> np.ndarray:
         """(D, n, m + s): for each design, the share of each objective's variance over its
         builds that goes with each design variable: their squared correlation over the
@@ -263,7 +265,7 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
         for key, values in zip(("F_p05", "F_median", "F_p95"), b.percentiles(b.F[..., :m])):
             write_dataset(g, key, values, units[:m], ("design", "objective"), names=names[:m])
         write_dataset(g, "feasible_share", b.feasible.mean(axis=0), "1", ("design",))
-        r2 = b.contributions()[..., :m]
+        r2 = b.contributions[..., :m]
         dims = ("design", "variable", "objective")
         write_dataset(g, "contribution", r2, "1", dims, names=names[:m])
     return Path(path)
@@ -291,14 +293,14 @@ def _broken(b: Builds) -> str:
 
 def _drivers(b: Builds) -> str:
     """What drives each objective's spread: each variable's median share over the designs
-    (:meth:`Builds.contributions`), largest first; from :data:`DRIVER_SAMPLES` builds on
+    (:attr:`Builds.contributions`), largest first; from :data:`DRIVER_SAMPLES` builds on
     (the squared correlation of two unrelated quantities over N builds is about 1/(N - 1):
     1 over two builds)."""
     if len(b.X) < DRIVER_SAMPLES:
         return f"what drives each objective's spread: give {DRIVER_SAMPLES} builds or more to see"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # (nothing varied: NaN)
-        share = np.nanmedian(b.contributions(), axis=0)  # (n, M)
+        share = np.nanmedian(b.contributions, axis=0)  # (n, M)
     parts = []
     for j, name in enumerate(b.stored.names):
         order = [i for i in np.argsort(-np.nan_to_num(share[:, j], nan=-1.0)) if share[i, j] >= 0]
