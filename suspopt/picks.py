@@ -6,8 +6,8 @@ A *design table* is the table of designs a result file holds, with their variabl
 - ``suspopt optimise`` output: ``/pareto`` (the optimum or the Pareto set);
 - ``suspopt kesort`` output: ``/kesort`` (the pooled sets; each design keeps the config of
   its set, ``/kesort/sets/config``);
-- ``suspopt analyse roads|masses|controllers|tolerances`` output: ``/pareto`` (the stored
-  front);
+- ``suspopt analyse roads|masses|controllers|tolerances|builds`` output: ``/pareto`` (the
+  stored front, or the designs it was given with ``--pick``: :func:`read_front`);
 - ``suspopt analyse transmissibility`` of a front: ``/designs`` (its edges and knee).
 
 A *pick* names one row of it: ``knee``, ``best_<objective>`` (the edges of the front,
@@ -22,6 +22,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,7 +33,18 @@ from .errors import require, type_name
 from .files import listed
 from .params import ParamView
 
-__all__ = ["Picked", "DesignTable", "read_table", "read_picks", "design_config", "split_picks"]
+if TYPE_CHECKING:
+    from .selection import ParetoSet
+
+__all__ = [
+    "Picked",
+    "DesignTable",
+    "read_table",
+    "read_picks",
+    "read_front",
+    "design_config",
+    "split_picks",
+]
 
 
 @dataclass
@@ -125,7 +137,7 @@ def read_table(path: str | Path) -> DesignTable:
             raise ConfigError(
                 f"{path}: holds no designs to pick (/pareto, /kesort or /designs){h5._holds()}:"
                 f" give a file of suspopt optimise, kesort or analyse roads, masses,"
-                f" controllers, tolerances or transmissibility (of a Pareto file)"
+                f" controllers, tolerances, builds or transmissibility (of a Pareto file)"
             )
         X = h5.array(f"{table}/X", ndim=2)
         F = h5.array(f"{table}/F", ndim=2)
@@ -279,3 +291,75 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
     )
     text = header + "\n" + edited.text
     return load_config_text(text, cfg.source), text
+
+
+def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSet:
+    """The front a front analysis takes: with no ``picks``, the Pareto set of a ``suspopt
+    optimise`` file (:func:`suspopt.selection.read_pareto`); with ``picks`` (``--pick`` as
+    ``simulate`` takes them: ``knee``, ``best_<objective>``, ``chosen``, row numbers;
+    comma-separated or repeated), those designs alone, from any file whose designs can be
+    picked (:func:`read_picks`: optimise, kesort or analyse), each once, in the order first
+    named. They keep their stored main objectives and, from an optimise file, their
+    constraints; from any other file ``G`` is None and they are evaluated again."""
+    from .optimise.problem import Problem
+    from .selection import ParetoSet, read_pareto
+
+    if not picks:
+        try:
+            return read_pareto(path)
+        except ConfigError as exc:
+            try:
+                stores = _stores_constraints(Path(path))
+            except ConfigError:
+                stores = True  # (unreadable: the first error says it)
+            if stores:
+                raise
+            raise ConfigError(
+                f"{exc}; to analyse designs of it, give --pick (knee, best_<objective>, "
+                f"chosen or row numbers)"
+            ) from None
+    picked = read_picks(path, split_picks(list(picks)))
+    first: dict[int, int] = {}  # source row -> row here
+    keep: list[int] = []  # each row here: its first pick
+    marks: dict[str, int] = {}
+    for i, (name, row) in enumerate(zip(picked.names, picked.rows.tolist())):
+        if row not in first:
+            first[row] = len(keep)
+            keep.append(i)
+        if not name.isdigit():  # (a row number names no design)
+            marks.setdefault(name, first[row])
+    cfg = picked.config
+    main = Problem.from_config(cfg).obj_names
+    missing = [n for n in main if n not in picked.obj_names]
+    if not main or missing:
+        raise ConfigError(
+            f"{picked.source}: /{picked.table}/F holds {', '.join(picked.obj_names)}; its "
+            f"config's main objectives are {', '.join(main) or 'none'}"
+        )
+    columns = [picked.obj_names.index(n) for n in main]
+    G, constraint_names = None, []
+    if picked.table == "pareto" and _stores_constraints(picked.source):
+        whole = read_pareto(picked.source)
+        G = None if whole.G is None else whole.G[list(first)]
+        constraint_names = whole.constraint_names
+    return ParetoSet(
+        picked.source,
+        picked.X[keep],
+        picked.var_names,
+        picked.var_units,
+        picked.F[keep][:, columns],
+        main,
+        G,
+        constraint_names,
+        cfg.text,
+        picked=marks,
+        source_rows=np.array(list(first), dtype=np.int64),
+    )
+
+
+def _stores_constraints(path: Path) -> bool:
+    """Whether the file ``path`` has ``/pareto/G`` (a ``suspopt optimise`` output)."""
+    from .h5read import H5Reader
+
+    with H5Reader(path) as h5:
+        return "pareto/G" in h5.file

@@ -75,7 +75,12 @@ _AGREE = 1e-6  # relative: re-simulated main objectives against the file's
 @dataclass(frozen=True)
 class ParetoSet:
     """A Pareto set as ``suspopt optimise`` wrote it: ``X (N, n)`` physical values,
-    ``F (N, m)``, ``G (N, k)``, their names and units, and the config's YAML text."""
+    ``F (N, m)``, ``G (N, k)``, their names and units, and the config's YAML text.
+
+    Designs picked from a file (:func:`suspopt.picks.read_front`) have ``picked``, each
+    pick's name -> its row here, and ``source_rows (N,)``, their rows in the file's table;
+    ``G`` is None where the file does not store their constraints (they are evaluated
+    again)."""
 
     path: Path
     X: np.ndarray
@@ -83,14 +88,36 @@ class ParetoSet:
     var_units: list[str]
     F: np.ndarray
     obj_names: list[str]
-    G: np.ndarray
+    G: np.ndarray | None
     constraint_names: list[str]
     config_text: str
+    picked: dict[str, int] | None = None
+    source_rows: np.ndarray | None = None
 
     def config(self) -> Config:
         """The config the set was optimised with; errors point into the file
         (``PARETO.h5:config:LINE``), and relative paths resolve from the file's folder."""
         return load_config_text(self.config_text, self.path.with_name(self.path.name + ":config"))
+
+    def marks(self) -> dict[str, int]:
+        """The designs a report names: the picks given (``--pick``; a row number names
+        none), or the edges and knee of the front (:func:`suspopt.kesort.pareto_picks`)."""
+        if self.picked is not None:
+            return dict(self.picked)
+        return pareto_picks(self.F, self.obj_names)
+
+    def picked_note(self) -> list[str]:
+        """The report's note of the designs picked from the file (none for a whole front)."""
+        if self.source_rows is None:
+            return []
+        named: dict[int, list[str]] = {}
+        for name, row in (self.picked or {}).items():
+            named.setdefault(row, []).append(name)
+        each = [
+            f"{k}: " + (f"{', '.join(named[k])} (row {int(r)})" if k in named else f"row {int(r)}")
+            for k, r in enumerate(self.source_rows)
+        ]
+        return [f"{len(self.X)} design(s) of {self.path.name} (--pick): " + "; ".join(each)]
 
 
 @dataclass(frozen=True)
@@ -241,7 +268,7 @@ def evaluate_pareto(
             f"{pareto.path}: /pareto/F holds {', '.join(pareto.obj_names)} but "
             f"its config's main objectives are {', '.join(problem.obj_names)}"
         )
-    resimulate = not own or bool(problem.supplementary_names)
+    resimulate = not own or bool(problem.supplementary_names) or pareto.G is None
     if resimulate:
         try:
             F, G, S = problem.evaluate(problem.to_search(X), return_values_of=["F", "G", "S"])
@@ -258,6 +285,7 @@ def evaluate_pareto(
         F = np.hstack([F, S])
         constraint_names = problem.constraint_names
     else:
+        assert pareto.G is not None  # (a set without stored constraints is evaluated again)
         F, G, constraint_names = pareto.F, pareto.G, pareto.constraint_names
     failed = ~np.isfinite(F).all(axis=1) | (F >= PENALTY).any(axis=1)
     same = list(constraint_names) == problem.constraint_names

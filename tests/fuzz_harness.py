@@ -1549,6 +1549,7 @@ OPTION_BASES = [
     ["analyse", "roads", "{path}/front.h5", "--road", "{path}/road.yaml", "-o", "{out}"],
     ["analyse", "masses", "{path}/front.h5", "-o", "{out}"],
     ["analyse", "builds", "{path}/front.h5", "--samples", "3", "-o", "{out}"],
+    ["analyse", "builds", "{path}/choice.h5", "--pick", "chosen", "--samples", "3", "-o", "{out}"],
     ["analyse", "models", "{path}/study.yaml", "{path}/study2.yaml"],
     ["analyse", "transmissibility", "{path}/front.h5"],
     ["analyse", "scenarios", "{path}/robust.h5"],

@@ -271,3 +271,59 @@ def test_kesort_builds_of_the_wrong_file_are_one_line(ps_front, tmp_path, args, 
     assert res.exit_code == 2 and not out.exists(), res.output
     assert res.output.startswith("error: ") and said in res.output
     assert len(res.output.strip().splitlines()) == 1
+
+
+def test_a_picked_design_is_built_as_it_is_in_its_whole_front(ps_front, tmp_path):
+    """Each design's draws come from a stream of its own, keyed by the seed and its values:
+    built alone (``--pick``) and in another order, a design has the builds it has when the
+    whole front is built, bit for bit. The file holds the picked designs once each, in the
+    order first named, their rows in the source and the named picks."""
+    front, _ = ps_front
+    whole_file, picked_file = tmp_path / "whole.h5", tmp_path / "picked.h5"
+    res = _invoke("analyse", "builds", front, "-o", whole_file, "--samples", 12)
+    assert res.exit_code == 0, res.output
+    with h5py.File(whole_file) as h5:
+        knee, N = int(h5["pareto/picks/knee"][()]), len(h5["pareto/X"])
+        whole = {k: h5[f"builds/{k}"][()] for k in ("X", "F", "G", "change", "feasible")}
+    other = N - 1 if knee != N - 1 else 0
+    picks = ["--pick", f"{other},knee", "--pick", str(other)]
+    res = _invoke("analyse", "builds", front, "-o", picked_file, "--samples", 12, *picks)
+    assert res.exit_code == 0, res.output
+    with h5py.File(picked_file) as h5:
+        assert list(h5["pareto/source_row"][()]) == [other, knee]
+        assert list(h5["pareto/picks"]) == ["knee"] and int(h5["pareto/picks/knee"][()]) == 1
+        for key, values in whole.items():
+            assert h5[f"builds/{key}"][()].tobytes() == values[:, [other, knee]].tobytes(), key
+    said = " ".join(res.output.split())
+    assert f"2 design(s) of {front.name} (--pick): 0: row {other}; 1: knee (row {knee})" in said
+
+
+def test_the_chosen_design_of_a_kesort_file_is_built_as_in_its_front(ps_front, tmp_path):
+    """``analyse builds CHOICE.h5 --pick chosen`` builds the k-ε optimum under its set's
+    config: its builds are those of its row of the front. The builds of picked designs are
+    not the builds of a front: ``kesort --builds`` refuses them, and a kesort file without
+    ``--pick`` is one line that says to give it."""
+    front, _ = ps_front
+    choice, whole_file, picked_file = (tmp_path / f"{n}.h5" for n in ("choice", "whole", "one"))
+    assert _invoke("kesort", front, "-o", choice).exit_code == 0
+    assert _invoke("analyse", "builds", front, "-o", whole_file, "--samples", 5).exit_code == 0
+    res = _invoke(
+        "analyse", "builds", choice, "-o", picked_file, "--samples", 5, "--pick", "chosen"
+    )
+    assert res.exit_code == 0, res.output
+    with h5py.File(choice) as h5:
+        row = int(h5["kesort/row"][int(h5["kesort/chosen"][()])])
+    with h5py.File(whole_file) as whole, h5py.File(picked_file) as one:
+        np.testing.assert_array_equal(one["pareto/F"][()], whole["pareto/F"][[row]])
+        for key in ("X", "F", "change", "feasible"):
+            assert one[f"builds/{key}"][()].tobytes() == whole[f"builds/{key}"][:, [row]].tobytes()
+    res = _invoke("kesort", front, "--builds", picked_file, "-o", tmp_path / "ke.h5")
+    assert res.exit_code == 2 and len(res.output.strip().splitlines()) == 1
+    assert "holds the builds of 1 picked design(s) (--pick); kesort needs" in res.output
+    res = _invoke("analyse", "builds", choice, "-o", tmp_path / "no.h5")
+    assert res.exit_code == 2 and not (tmp_path / "no.h5").exists()
+    assert "the file holds a k-ε selection (suspopt kesort); to analyse designs of it, give " in (
+        " ".join(res.output.split())
+    )
+    res = _invoke("export", picked_file, "--pick", "chosen", "-o", tmp_path / "chosen.yaml")
+    assert res.exit_code == 0, res.output

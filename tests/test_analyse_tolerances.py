@@ -90,3 +90,28 @@ def test_a_value_off_its_fields_range_is_held_at_the_limit_and_said():
         Variant("a -10 %", None, attrs={"held_at_limit": 0}),  # type: ignore[arg-type]
     ]
     assert _held_notes(held) == ["a +10 %: 3 design(s) held at the field's limit"]
+
+
+def test_picked_designs_are_analysed_as_in_their_whole_front(ps_front, tmp_path):
+    """``--pick`` analyses those designs alone (here of a pseudo-front analysis: each
+    variable off in turn): each has the values it has in the whole front's analysis, and
+    the file's ``/pareto`` holds them, so a pick is taken onward from it."""
+    whole_file, picked_file = tmp_path / "whole.h5", tmp_path / "picked.h5"
+    assert _invoke("analyse", "tolerances", ps_front, "-o", whole_file).exit_code == 0
+    res = _invoke("analyse", "tolerances", ps_front, "-o", picked_file, "--pick", "best_X_ST,knee")
+    assert res.exit_code == 0, res.output
+    with h5py.File(whole_file) as whole, h5py.File(picked_file) as picked:
+        rows = [int(whole["pareto/picks"][k][()]) for k in ("best_X_ST", "knee")]
+        assert list(picked["pareto/source_row"][()]) == rows
+        np.testing.assert_array_equal(picked["pareto/X"][()], whole["pareto/X"][()][rows])
+        for label in whole["pseudo"].attrs["labels"].astype(str):
+            for key in ("F", "change", "feasible"):
+                got, want = picked["pseudo"][label][key][()], whole["pseudo"][label][key][()][rows]
+                assert got.tobytes() == want.tobytes(), (label, key)
+    res = _invoke("export", picked_file, "--pick", "knee", "-o", tmp_path / "knee.yaml")
+    assert res.exit_code == 0, res.output
+
+
+def test_pick_is_an_option_of_the_front_analyses_alone(ps_front):
+    res = _invoke("analyse", "transmissibility", ps_front, "--pick", "knee")
+    assert res.exit_code == 2 and "analyse transmissibility does not take --pick" in res.output

@@ -1,6 +1,6 @@
 """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]
-[--distribution uniform|normal]``: a front's designs as many parts built to their tolerances
-at once.
+[--distribution uniform|normal] [--pick NAMES]``: a front's designs as many parts built to
+their tolerances at once.
 
 ``analyse tolerances`` moves one design variable at a time to the edge of its band; a built
 suspension has every part off at once, by an amount nobody chose. This analysis builds each
@@ -20,11 +20,18 @@ nothing of how often (the normal one narrows the spread, as a capable process do
 independent variables (two springs of one batch may well be off alike, which this does not
 model). A
 value the draw would take outside what its config field accepts is held at the field's
-limit, and the report says how many (as ``analyse tolerances`` does). The draws come from
-``numpy.random.default_rng(seed)``, ``seed`` = ``--seed``, by default the stored config's
-``optimiser.seed``: the same seed gives the same builds bit for bit, however the batch is
-split, since they are drawn in one call before any is evaluated. A failed simulation of a
+limit, and the report says how many (as ``analyse tolerances`` does). Each design's draws
+come from a stream of its own, ``numpy.random.default_rng([seed, the 64 bits of each of its
+values])`` (:func:`design_key`), ``seed`` = ``--seed``, by default the stored config's
+``optimiser.seed``: the same seed gives a design the same builds bit for bit, whether the
+whole front is built or only that design is (``--pick``), in any order and however the
+batch is split, since they are drawn before any is evaluated. A failed simulation of a
 build (NaN objectives) counts as not feasible and is left out of the percentiles.
+
+``--pick knee,best_f1,...`` builds only those designs (names or row numbers, as ``simulate
+--pick`` takes them, from an optimise, kesort or analyse file:
+:func:`suspopt.picks.read_front`): the file's ``/pareto`` then holds the picked designs,
+their picks by name and ``source_row``.
 
 HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text;
 ``analysis = "builds"``, ``source`` and ``seed``):
@@ -48,6 +55,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
@@ -56,8 +64,8 @@ import numpy as np
 
 from ..config import ConfigError
 from ..io import atomic_h5, write_dataset
-from ..kesort import pareto_picks
 from ..params import MAX_SWEEP_DESIGNS
+from ..picks import read_front
 from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
 from . import KINDS, Kind, Report, relative_change
 from .pseudo import is_comfort, table_designs, write_stored_front
@@ -179,19 +187,31 @@ def _checked_seed(seed: int | None, pareto: ParetoSet) -> int:
     return int(seed)
 
 
+def design_key(seed: int, x: np.ndarray) -> list[int]:
+    """The entropy of the stream a design's builds are drawn from: ``seed`` and the 64 bits
+    of each of its variables' values ``x (n,)`` (physical, as the file stores them)."""
+    return [int(seed), *np.ascontiguousarray(x, dtype=np.float64).view(np.uint64).tolist()]
+
+
 def draw_builds(
     pareto: ParetoSet, samples: int, tolerance: float, seed: int, distribution: str = "uniform"
 ) -> tuple[np.ndarray, np.ndarray]:
     """``samples`` builds of every design of ``pareto`` (module docstring): ``X (N, D, n)``
-    and how many values of each variable were held at its field's limit ``(n,)``."""
-    shape = (samples,) + pareto.X.shape
+    and how many values of each variable were held at its field's limit ``(n,)``. Each
+    design's offsets come from ``default_rng(design_key(seed, x))``, ``(N, n)`` in one call:
+    the first N of a longer run are those of a run of N."""
+    shape = (samples, pareto.X.shape[1])
+    # one stream per design, keyed by its values: its builds are the same whichever front,
+    # pick or order it is built in (a loop over random streams, not over simulations)
+    streams = [np.random.default_rng(design_key(seed, x)) for x in pareto.X]
     if distribution == "uniform":
-        u = np.random.default_rng(seed).uniform(-1.0, 1.0, shape)
+        u = np.stack([rng.uniform(-1.0, 1.0, shape) for rng in streams], axis=1)
     else:  # normal, sigma 1/3, cut at ±1: the inverse of its distribution function
         from scipy.special import ndtr, ndtri
 
         low = ndtr(-3.0)
-        u = ndtri(low + np.random.default_rng(seed).random(shape) * (1.0 - 2.0 * low)) / 3.0
+        drawn = np.stack([rng.random(shape) for rng in streams], axis=1)
+        u = ndtri(low + drawn * (1.0 - 2.0 * low)) / 3.0
     wanted = pareto.X * (1.0 + u * tolerance / 100.0)
     X = np.empty_like(wanted)
     for j, limits in enumerate(variable_limits(pareto)):  # (per variable: its field's range)
@@ -271,6 +291,10 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
     return Path(path)
 
 
+def _designs(n: int) -> str:
+    return f"{n} design" + ("" if n == 1 else "s")
+
+
 def _spread(low: float, high: float) -> str:
     return "failed" if math.isnan(low) else f"{low:+.1f} to {high:+.1f} %"
 
@@ -320,7 +344,7 @@ def _report(b: Builds, title: str) -> Report:
     share = b.feasible.mean(axis=0)
     columns = ["#", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
     columns += [f"{n}: 5-95 % (change)" for n in names] + ["feasible builds"]
-    picks = table_designs(len(p.X), pareto_picks(p.F, p.obj_names))
+    picks = table_designs(len(p.X), p.marks())
     rows = [
         [str(k), picked]
         + [f"{f:.4g}" for f in p.F[k]]
@@ -329,10 +353,11 @@ def _report(b: Builds, title: str) -> Report:
         for k, picked in picks
     ]
     notes = [
-        f"{len(b.X)} builds of each of {len(p.X)} designs of {p.path.name}: every design "
+        f"{len(b.X)} builds of each of {_designs(len(p.X))} of {p.path.name}: every design "
         f"variable off at once by a {DRAWS[b.distribution]} within ±{b.tolerance:g} % of its "
         f"value (seed {b.seed}); change = (f_built - f_stored)/f_stored, its 5th to 95th "
         f"percentile over the builds",
+        *p.picked_note(),
         *b.stored.notes,
     ]
     worst = [
@@ -371,7 +396,7 @@ def plot_builds(b: Builds, path: str | Path, title: str) -> Path:
     curves.append(("builds: 95th percentile", high))
     variables = [(n, u, p.X[:, j]) for j, (n, u) in enumerate(zip(p.var_names, p.var_units))]
     objectives = list(zip(b.stored.names[:m], b.stored.units[:m]))
-    marks, comfort = pareto_picks(p.F, p.obj_names), is_comfort(p.config())
+    marks, comfort = p.marks(), is_comfort(p.config())
     return plots.pareto_fronts(
         path, title, objectives, curves, variables, marks=marks, comfort=comfort
     )
@@ -385,14 +410,15 @@ def run_builds(
     samples: int | None = SAMPLES,
     seed: int | None = None,
     distribution: str | None = None,
+    pick: Sequence[str] | None = None,
 ) -> Report:
     """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]
-    [--distribution uniform|normal]`` (module docstring)."""
+    [--distribution uniform|normal] [--pick NAMES]`` (module docstring)."""
     from .. import plots
 
     if plot is not None:
         plots.check_path(plot)
-    pareto = read_pareto(Path(source))
+    pareto = read_front(Path(source), pick)
     b = builds(pareto, samples, tolerance=tolerance, seed=seed, distribution=distribution)
     title = f"builds: {pareto.path.name} as built to ±{b.tolerance:g} %"
     if output is not None:
@@ -414,6 +440,11 @@ def feasible_builds(path: str | Path, front: str | Path) -> np.ndarray:
             raise ConfigError(f"--builds {path}: not a file of suspopt analyse builds")
         X = h5.array("pareto/X", ndim=2)
         share = h5.array("builds/feasible_share", ndim=1)
+        if "pareto/source_row" in h5.file:
+            raise ConfigError(
+                f"--builds {path}: holds the builds of {len(X)} picked design(s) (--pick); "
+                f"kesort needs the builds of every design of {front}: build them all"
+            )
     own = read_pareto(front).X
     if X.shape != own.shape or not np.array_equal(X, own):
         raise ConfigError(
@@ -427,4 +458,4 @@ def feasible_builds(path: str | Path, front: str | Path) -> np.ndarray:
     return share
 
 
-KINDS["builds"] = Kind(run_builds, options=("tolerance", "samples", "seed", "distribution"))
+KINDS["builds"] = Kind(run_builds, options=("tolerance", "samples", "seed", "distribution", "pick"))

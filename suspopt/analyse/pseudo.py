@@ -54,6 +54,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import partial
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -62,10 +63,10 @@ from ..config import Config, ConfigError
 from ..config.loader import edit_config, line_of, set_path
 from ..files import Unreadable, listed, status
 from ..io import atomic_h5, write_attrs, write_dataset
-from ..kesort import pareto_picks
+from ..picks import read_front
 from ..plots.runs import evenly_spaced
 from ..seat import build_seat, passenger_mass_change
-from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
+from ..selection import DesignSet, ParetoSet, evaluate_pareto
 from . import KINDS, Kind, Report, relative_change
 
 __all__ = [
@@ -123,8 +124,8 @@ class PseudoFronts:
     @property
     def picks(self) -> dict[str, int]:
         """The edges and knee of the stored front (:func:`suspopt.kesort.pareto_picks`,
-        Fig. 8.21; Tables 8.12-8.13 report the edges)."""
-        return pareto_picks(self.pareto.F, self.pareto.obj_names)
+        Fig. 8.21; Tables 8.12-8.13 report the edges), or the picks given (``--pick``)."""
+        return self.pareto.marks()
 
     @property
     def reference(self) -> np.ndarray:
@@ -189,7 +190,7 @@ def config_with(pareto: ParetoSet, edit: Callable[[dict], None], what: str) -> C
     )
 
 
-def road_variants(pareto: ParetoSet, roads: Sequence[str]) -> list[Variant]:
+def road_variants(pareto: ParetoSet, roads: Sequence[str] = ()) -> list[Variant]:
     """One variant per road: an ISO 8608 class letter (A-E: the stored road with that class)
     or a config file whose ``road`` and ``simulation`` sections replace the stored ones."""
     roads = [str(road) for road in listed(roads)]
@@ -299,7 +300,7 @@ def mass_variants(pareto: ParetoSet, changes: Sequence[float] = MASS_CHANGES) ->
     return variants
 
 
-def controller_variants(pareto: ParetoSet, sources: Sequence[Path]) -> list[Variant]:
+def controller_variants(pareto: ParetoSet, sources: Sequence[Path] = ()) -> list[Variant]:
     """One variant per file whose ``control:`` section and dampers replace the stored ones
     (a damper in ``vehicle.corner_defaults`` replaces every corner's, one under
     ``vehicle.corners.<c>`` that corner's)."""
@@ -402,8 +403,10 @@ def write_stored_front(h5, kind: str, pareto: ParetoSet, stored: DesignSet) -> N
     _columns(grp, "F", pareto.F, "objective", names[:m], units[:m])
     write_dataset(grp, "feasible", stored.feasible.astype(np.int8), "1", dims=("design",))
     picks = grp.create_group("picks")
-    for key, row in pareto_picks(pareto.F, pareto.obj_names).items():
+    for key, row in pareto.marks().items():
         write_dataset(picks, key, row, "1")
+    if pareto.source_rows is not None:  # (designs picked from the file)
+        write_dataset(grp, "source_row", pareto.source_rows, "1", dims=("design",))
     if len(names) > m:
         _columns(grp, "S", stored.F[:, m:], "supplementary", names[m:], units[m:])
 
@@ -496,10 +499,12 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
                 for f, c in zip(value[k, :m], change[k, :m])
             ]
         rows.append(row)
-    notes = [
+    shown = p.picked_note() or [
         f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}, with "
-        f"the edges and knee of the front (suspopt.kesort.pareto_picks, Fig. 8.21); "
-        f"change = (f - f_stored)/f_stored (Tables 8.12-8.13)",
+        f"the edges and knee of the front (suspopt.kesort.pareto_picks, Fig. 8.21)"
+    ]
+    notes = [
+        f"{shown[0]}; change = (f - f_stored)/f_stored (Tables 8.12-8.13)",
         *fronts.stored.notes,
     ]
     for v, s, change in zip(fronts.variants, fronts.sets, changes):
@@ -523,12 +528,14 @@ def run_variants(
     plot: Path | None,
     variants: Callable[[ParetoSet], list[Variant]],
     what: str,
+    pick: Sequence[str] | None = None,
 ) -> tuple[Report, PseudoFronts]:
-    """The analysis ``kind`` of the Pareto file ``source`` under the ``variants`` made of
-    it: written, drawn, and its report (and the fronts, for more notes)."""
+    """The analysis ``kind`` of the Pareto file ``source`` (or of its designs ``pick``:
+    :func:`suspopt.picks.read_front`) under the ``variants`` made of it: written, drawn,
+    and its report (and the fronts, for more notes)."""
     if plot is not None:
         plots.check_path(plot)
-    pareto = read_pareto(source)
+    pareto = read_front(source, pick)
     fronts = pseudo_fronts(kind, pareto, variants(pareto))
     title = f"{kind}: {pareto.path.name} {what}"
     if output is not None:
@@ -538,36 +545,37 @@ def run_variants(
     return _report(fronts, title), fronts
 
 
-def run_roads(
-    source: Path, output: Path | None = None, plot: Path | None = None, road: Sequence[str] = ()
-) -> Report:
-    """``suspopt analyse roads PARETO.h5 --road B --road C`` (Sec 8.4.2, Table 8.12)."""
-    variants = partial(road_variants, roads=road)
-    return run_variants("roads", source, output, plot, variants, "on other roads (Sec 8.4.2)")[0]
+def _pseudo_kind(
+    kind: str, make: Callable[..., list[Variant]], option: str, keyword: str, what: str
+) -> Kind:
+    """The analysis ``kind``: the front (or its designs ``--pick`` names) under the variants
+    ``make`` gives, the command-line option ``option`` passed to it as ``keyword``
+    (:func:`run_variants`)."""
+
+    def run(
+        source: Path,
+        output: Path | None = None,
+        plot: Path | None = None,
+        pick: Sequence[str] | None = None,
+        **given: Any,
+    ) -> Report:
+        chosen = {keyword: given[option]} if option in given else {}
+        return run_variants(kind, source, output, plot, partial(make, **chosen), what, pick)[0]
+
+    run.__name__ = run.__qualname__ = f"run_{kind}"
+    run.__doc__ = (
+        f"``suspopt analyse {kind} PARETO.h5 [--{option.strip('_').replace('_', '-')} ...] "
+        f"[--pick NAMES]``: the front {what} (:func:`{make.__name__}`)."
+    )
+    return Kind(run, options=(option, "pick"))
 
 
-def run_masses(
-    source: Path,
-    output: Path | None = None,
-    plot: Path | None = None,
-    mass_change: Sequence[float] = MASS_CHANGES,
-) -> Report:
-    """``suspopt analyse masses PARETO.h5 [--mass-change -20 --mass-change 20]`` (Sec 8.4.3,
-    Table 8.13)."""
-    variants = partial(mass_variants, changes=mass_change)
-    what = "with other passengers (Sec 8.4.3)"
-    return run_variants("masses", source, output, plot, variants, what)[0]
-
-
-def run_controllers(
-    source: Path, output: Path | None = None, plot: Path | None = None, with_: Sequence[Path] = ()
-) -> Report:
-    """``suspopt analyse controllers PARETO.h5 --with OTHER.yaml`` (Sec 7.3, Fig. 7.4b)."""
-    variants = partial(controller_variants, sources=with_)
-    what = "with other controllers (Fig. 7.4b)"
-    return run_variants("controllers", source, output, plot, variants, what)[0]
-
-
-KINDS["roads"] = Kind(run_roads, options=("road",))
-KINDS["masses"] = Kind(run_masses, options=("mass_change",))
-KINDS["controllers"] = Kind(run_controllers, options=("with_",))
+# Sec 8.4.2 and Table 8.12; Sec 8.4.3 and Table 8.13; Sec 7.3 and Fig. 7.4b
+KINDS["roads"] = _pseudo_kind("roads", road_variants, "road", "roads", "on other roads (Sec 8.4.2)")
+KINDS["masses"] = _pseudo_kind(
+    "masses", mass_variants, "mass_change", "changes", "with other passengers (Sec 8.4.3)"
+)
+KINDS["controllers"] = _pseudo_kind(
+    "controllers", controller_variants, "with_", "sources", "with other controllers (Fig. 7.4b)"
+)
+run_roads, run_masses, run_controllers = (KINDS[k].run for k in ("roads", "masses", "controllers"))

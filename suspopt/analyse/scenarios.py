@@ -38,7 +38,7 @@ def read_scenarios(path: Path):
     ConfigError naming the file and the dataset when it has no scenarios or they do not fit
     its ``/pareto`` tables."""
     pareto = read_pareto(path)
-    N, m, k = len(pareto.X), pareto.F.shape[1], pareto.G.shape[1]
+    N, m, k = len(pareto.X), pareto.F.shape[1], len(pareto.constraint_names)
     with H5Reader(path) as h5:
         if h5._node("pareto/scenarios") is None:
             raise ConfigError(

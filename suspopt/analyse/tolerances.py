@@ -137,8 +137,10 @@ def run_tolerances(
     output: Path | None = None,
     plot: Path | None = None,
     tolerance: float | None = TOLERANCE,
+    pick: Sequence[str] | None = None,
 ) -> Report:
-    """``suspopt analyse tolerances PARETO.h5 [--tolerance 10]`` (module docstring)."""
+    """``suspopt analyse tolerances PARETO.h5 [--tolerance 10] [--pick NAMES]`` (module
+    docstring)."""
     variants = partial(tolerance_variants, tolerance=tolerance)
     report, fronts = run_variants(
         "tolerances",
@@ -147,9 +149,10 @@ def run_tolerances(
         plot,
         variants,
         "with each design variable off by its tolerance in turn",
+        pick,
     )
     report.notes += [_largest_changes(fronts), *_held_notes(fronts.variants)]
     return report
 
 
-KINDS["tolerances"] = Kind(run_tolerances, options=("tolerance",))
+KINDS["tolerances"] = Kind(run_tolerances, options=("tolerance", "pick"))

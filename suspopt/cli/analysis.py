@@ -19,11 +19,19 @@ _ANALYSE_OPTIONS = {
     "samples": "--samples",
     "seed": "--seed",
     "distribution": "--distribution",
+    "pick": "--pick",
 }
 
 
 _TOLERANCE_HELP = (
     "tolerances, builds: how far each design variable is off, in % of its value (default 10)"
+)
+
+
+_PICK_HELP = (
+    "roads, masses, controllers, tolerances, builds: analyse only these designs of the file "
+    "(knee, best_<objective>, chosen of a kesort file, or row numbers; comma-separated or "
+    "repeated), from any file simulate --pick reads"
 )
 
 
@@ -104,6 +112,7 @@ def analyse(
     distribution: str | None = typer.Option(
         None, "--distribution", help="builds: uniform (default) or normal (σ = t/3, cut at ±t)"
     ),
+    pick: list[str] | None = typer.Option(None, "--pick", help=_PICK_HELP),
     *,
     run: base.RunOptions,
 ) -> None:
@@ -122,6 +131,7 @@ def analyse(
         "samples": samples,
         "seed": seed,
         "distribution": distribution,
+        "pick": pick or None,
     }
     spec, options = _checked(kind, sources, given)
     try:

@@ -117,7 +117,7 @@ def export(
     source: Path = typer.Argument(
         ...,
         help="result file of optimise, kesort or analyse"
-        " roads|masses|controllers|tolerances|transmissibility",
+        " roads|masses|controllers|tolerances|builds|transmissibility",
     ),
     pick: list[str] = typer.Option(
         [],

@@ -18,7 +18,7 @@ def report(
     sources: list[Path] = typer.Argument(
         ...,
         help="result files of optimise, kesort or analyse"
-        " roads|masses|controllers|tolerances|transmissibility",
+        " roads|masses|controllers|tolerances|builds|transmissibility",
     ),
     output: Path = typer.Option(..., "-o", "--output", help="the HTML file to write"),
     with_signals: list[str] = typer.Option(

@@ -107,7 +107,7 @@ def simulate(
     source: Path = typer.Argument(
         ...,
         help="YAML config, or with --pick a result file of optimise, kesort or analyse"
-        " roads|masses|controllers|tolerances|transmissibility",
+        " roads|masses|controllers|tolerances|builds|transmissibility",
     ),
     output: Path | None = typer.Option(None, "-o", "--output", help="HDF5 file to write"),
     pick: list[str] = typer.Option([], "--pick", help=_PICK_HELP),
