@@ -416,20 +416,6 @@ class H5Reader:
             )
         return int(value)
 
-    def float_attr(self, node: str, key: str, low: float, high: float) -> float:
-        """The number attribute ``key`` of ``/node``, finite and strictly between ``low`` and
-        ``high``."""
-        label = f"/{node}: attribute {key!r}"
-        value = self.attribute(self._node(node), key, label)
-        if isinstance(value, np.ndarray) and value.ndim == 0:
-            value = value[()]
-        number = isinstance(value, (int, float, np.integer, np.floating))
-        if not number or isinstance(value, bool) or not low < value < high:
-            raise ConfigError(
-                f"{self.where}: {label}: missing or not a number in ({low:g}, {high:g})"
-            )
-        return float(value)
-
     def labels(self, name: str, key: str, columns: int) -> list[str]:
         """The per-column text attribute ``key`` (``names``, ``units``) of dataset ``/name``,
         one entry per column."""

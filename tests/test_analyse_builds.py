@@ -58,7 +58,9 @@ def test_every_build_moves_the_static_deflection_as_m_g_over_k_and_breaks_its_li
         seed = yaml.safe_load(h5.attrs["config"])["optimiser"]["seed"]
     with h5py.File(out) as h5:
         assert h5.attrs["analysis"] == "builds" and h5.attrs["seed"] == seed
-        assert h5["builds"].attrs["samples"] == 40 and h5["builds"].attrs["tolerance"] == 8
+        assert h5["builds"].attrs["samples"] == 40
+        assert h5["builds/tolerance"][()].tolist() == [8, 8]
+        assert h5["builds/tolerance"].attrs["units"] == "%"
         X, F = h5["builds/X"][()], h5["builds/F"][()]
         feasible, share = h5["builds/feasible"][()], h5["builds/feasible_share"][()]
         p05, p95 = h5["builds/F_p05"][()], h5["builds/F_p95"][()]
@@ -129,6 +131,11 @@ def test_the_same_seed_gives_the_same_builds_and_more_samples_extend_them(ps_fro
         (["--seed", str(2**64)], "--seed 18446744073709551616: give a whole number"),
         (["--tolerance", "100"], "--tolerance 100: give a tolerance above 0 and below 100 %"),
         (["--tolerance", "nan"], "--tolerance nan: give a tolerance above 0 and below 100 %"),
+        (["--tolerance", "K_v=0"], "--tolerance K_v=0: give a tolerance above 0 and below 100"),
+        (["--tolerance", "K_v=x"], "--tolerance K_v='x': give a number of %"),
+        (["--tolerance", "k_v=5"], "has no design variable 'k_v'; it has K_v, C_v"),
+        (["--tolerance", "5", "--tolerance", "6"], "give one tolerance T for every variable"),
+        (["--tolerance", "C_v=5", "--tolerance", "C_v=6"], "--tolerance C_v=: give each"),
     ],
 )
 def test_bad_samples_seeds_and_tolerances_are_one_line(ps_front, tmp_path, args, said):
@@ -327,3 +334,38 @@ def test_the_chosen_design_of_a_kesort_file_is_built_as_in_its_front(ps_front, t
     )
     res = _invoke("export", picked_file, "--pick", "chosen", "-o", tmp_path / "chosen.yaml")
     assert res.exit_code == 0, res.output
+
+
+def test_each_variable_is_built_to_its_own_tolerance(ps_front, tmp_path):
+    """A design variable's ``tolerance`` in the stored config is its band; ``--tolerance T``
+    is the band of the variables without one, and ``--tolerance NAME=T`` the band of NAME
+    whatever the config says. Each variable's offsets fill its own band, and ``analyse
+    tolerances`` moves each by its own."""
+    front, _ = ps_front
+    own = tmp_path / "own.h5"
+    shutil.copyfile(front, own)
+    with h5py.File(own, "r+") as h5:
+        text = h5.attrs["config"]
+        old = "{name: K_v, path: seat.stiffness,"
+        assert text.count(old) == 1
+        h5.attrs["config"] = text.replace(old, "{name: K_v, tolerance: 3, path: seat.stiffness,")
+        X0 = h5["pareto/X"][()]
+    for given, bands in (([], [3, 12]), (["--tolerance", "K_v=6"], [6, 12])):
+        out = tmp_path / "builds.h5"
+        res = _invoke(
+            "analyse", "builds", own, "-o", out, "--samples", 40, "--tolerance", 12, *given
+        )
+        assert res.exit_code == 0, res.output
+        with h5py.File(out) as h5:
+            assert h5["builds/tolerance"][()].tolist() == bands
+            off = np.abs(h5["builds/X"][()] / X0 - 1).max(axis=(0, 1))
+        assert (off <= np.array(bands) / 100 + 1e-12).all() and (
+            off > 0.85 * np.array(bands) / 100
+        ).all()
+        said = " ".join(res.output.split())
+        assert f"within its tolerance (K_v ±{bands[0]} %, C_v ±{bands[1]} %) (seed" in said
+    res = _invoke("analyse", "tolerances", own, "-o", tmp_path / "tol.h5")
+    assert res.exit_code == 0, res.output
+    with h5py.File(tmp_path / "tol.h5") as h5:
+        labels = list(h5["pseudo"].attrs["labels"].astype(str))
+    assert labels == ["K_v -3 %", "K_v +3 %", "C_v -10 %", "C_v +10 %"]

@@ -493,6 +493,8 @@ def test_a_design_of_an_analyse_builds_file_shows_the_spread_of_its_builds(
     variable's squared correlation, largest first) and its share of feasible builds, as the
     file holds them."""
     builds, page = tmp_path / "builds.h5", tmp_path / "builds.html"
+    with h5py.File(files["front"]) as h5:
+        first, second = h5["pareto/X"].attrs["names"].astype(str)[:2]
     res = _invoke(
         "analyse",
         "builds",
@@ -501,6 +503,8 @@ def test_a_design_of_an_analyse_builds_file_shows_the_spread_of_its_builds(
         12,
         "--distribution",
         "normal",
+        "--tolerance",
+        f"{first}=7.5",
         "-o",
         builds,
     )
@@ -532,7 +536,8 @@ def test_a_design_of_an_analyse_builds_file_shows_the_spread_of_its_builds(
         note = browser.execute_script(
             "return document.querySelector('#design-0 > div.note').textContent"
         )
-        assert note == "12 builds, every variable within ±10 % of its value (normal)"
+        within = f"each variable within its tolerance ({first} ±7.5 %, {second} ±10 %)"
+        assert note == f"12 builds, {within} (normal)"
 
 
 @pytest.fixture(scope="module")
@@ -552,9 +557,11 @@ def _set(group, key, value):
 @pytest.mark.parametrize(
     "damage, message",
     [
-        (lambda g: g.attrs.__setitem__("tolerance", "ten"), "attribute 'tolerance': missing or"),
-        (lambda g: g.attrs.__setitem__("tolerance", np.nan), "attribute 'tolerance': missing or"),
-        (lambda g: g.attrs.__setitem__("tolerance", True), "attribute 'tolerance': missing or"),
+        (lambda g: _set(g, "tolerance", np.array([b"ten", b"ten"])), "not numbers"),
+        (lambda g: _set(g, "tolerance", np.array([np.nan, 10.0])), "not one tolerance in (0,"),
+        (lambda g: _set(g, "tolerance", np.array([100.0, 10.0])), "not one tolerance in (0,"),
+        (lambda g: _set(g, "tolerance", np.array([10.0])), "for each of the front's 2 variables"),
+        (lambda g: g.__delitem__("tolerance"), "/builds/tolerance: missing"),
         (lambda g: g.attrs.__delitem__("samples"), "attribute 'samples': missing or not a whole"),
         (lambda g: _set(g, "F_p05", np.zeros((3, 2))), "do not have the front's"),
         (lambda g: _set(g, "feasible_share", np.zeros((3, 2))), "expected 1 dimension"),

@@ -1,12 +1,13 @@
-"""``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]
-[--distribution uniform|normal] [--pick NAMES]``: a front's designs as many parts built to
-their tolerances at once.
+"""``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--tolerance NAME=T]
+[--seed S] [--distribution uniform|normal] [--pick NAMES]``: a front's designs as many parts
+built to their tolerances at once.
 
 ``analyse tolerances`` moves one design variable at a time to the edge of its band; a built
 suspension has every part off at once, by an amount nobody chose. This analysis builds each
 design of the front ``--samples`` times: every design variable of every build is its
 design's value times ``1 + u t/100``, ``u`` drawn from [-1, 1] independently for each
-variable, design and build (``t`` = ``--tolerance`` [%]): uniformly, or with
+variable, design and build (``t`` the variable's tolerance [%], as ``analyse
+tolerances`` takes it: :func:`.tolerances.variable_tolerances`): uniformly, or with
 ``--distribution normal`` from a normal distribution of standard deviation 1/3 cut at ±1
 (the band is ±3 σ: a process of capability 1, its parts outside the band rejected), by
 the inverse of its distribution function. All builds of all designs are evaluated under
@@ -37,7 +38,8 @@ HDF5 layout (root attributes as every suspopt file, ``config`` = the stored conf
 ``analysis = "builds"``, ``source`` and ``seed``):
 
 - ``/pareto``: the stored front, as :mod:`.pseudo` writes it (X, F, feasible, picks, S);
-- ``/builds`` with attributes ``samples``, ``tolerance`` [%] and ``distribution``;
+- ``/builds`` with attributes ``samples`` and ``distribution``; ``/builds/tolerance
+  (variable,)`` [%] each variable's tolerance;
   ``/builds/X (sample, design, variable)`` the built designs (the variables' units),
   ``F (sample, design, objective)``, ``S (sample, design, supplementary)`` (if any),
   ``change (sample, design, objective)`` [%], ``feasible`` and ``failed (sample, design)``
@@ -69,7 +71,7 @@ from ..picks import read_front
 from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
 from . import KINDS, Kind, Report, relative_change
 from .pseudo import is_comfort, table_designs, write_stored_front
-from .tolerances import TOLERANCE, checked_tolerance, inside, variable_limits
+from .tolerances import Tolerances, bands, inside, variable_limits, variable_tolerances
 
 __all__ = [
     "SAMPLES",
@@ -99,7 +101,7 @@ class Builds:
     ``feasible`` and ``failed (N, D)``, ``G (N, D, k)`` their constraints (``g <= 0`` is
     met; ``constraint_names``, ``constraint_units``); ``stored`` the front's designs under
     the stored config (``names``, ``units``), ``held (n,)`` how many values of each variable
-    were held at its field's limit; ``tolerance`` [%], ``seed`` and ``distribution`` as
+    were held at its field's limit; ``tolerance (n,)`` [%], ``seed`` and ``distribution`` as
     drawn."""
 
     pareto: ParetoSet
@@ -109,7 +111,7 @@ class Builds:
     feasible: np.ndarray
     failed: np.ndarray
     held: np.ndarray
-    tolerance: float
+    tolerance: np.ndarray
     seed: int
     distribution: str
     G: np.ndarray
@@ -194,10 +196,15 @@ def design_key(seed: int, x: np.ndarray) -> list[int]:
 
 
 def draw_builds(
-    pareto: ParetoSet, samples: int, tolerance: float, seed: int, distribution: str = "uniform"
+    pareto: ParetoSet,
+    samples: int,
+    tolerance: float | np.ndarray,
+    seed: int,
+    distribution: str = "uniform",
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``samples`` builds of every design of ``pareto`` (module docstring): ``X (N, D, n)``
-    and how many values of each variable were held at its field's limit ``(n,)``. Each
+    """``samples`` builds of every design of ``pareto`` (module docstring), each variable
+    within ``tolerance`` [%] (one for all, or ``(n,)`` one each): ``X (N, D, n)`` and how
+    many values of each variable were held at its field's limit ``(n,)``. Each
     design's offsets come from ``default_rng(design_key(seed, x))``, ``(N, n)`` in one call:
     the first N of a longer run are those of a run of N."""
     shape = (samples, pareto.X.shape[1])
@@ -220,18 +227,24 @@ def draw_builds(
 
 
 def builds(
-    pareto: ParetoSet, samples=SAMPLES, *, tolerance=TOLERANCE, seed=None, distribution=None
+    pareto: ParetoSet,
+    samples=SAMPLES,
+    *,
+    tolerance: Tolerances = None,
+    seed=None,
+    distribution=None,
 ) -> Builds:
     """Draw and evaluate ``samples`` builds (int) of every design of ``pareto``, each design
-    variable within ``tolerance`` [%] (float), from ``default_rng(seed)`` (int; None: the
-    stored config's ``optimiser.seed``), ``distribution`` ``"uniform"`` (None) or
+    variable within its tolerance [%] (``tolerance`` as
+    :func:`.tolerances.variable_tolerances` takes it), from the streams of ``seed`` (int;
+    None: the stored config's ``optimiser.seed``), ``distribution`` ``"uniform"`` (None) or
     ``"normal"`` (module docstring)."""
     distribution = "uniform" if distribution is None else distribution
     if distribution not in DISTRIBUTIONS:
         raise ConfigError(
             f"--distribution {distribution!r}: give one of {', '.join(DISTRIBUTIONS)}"
         )
-    t = checked_tolerance(tolerance)
+    t = variable_tolerances(pareto, tolerance)
     N = _checked_samples(samples, len(pareto.X))
     s = _checked_seed(seed, pareto)
     X, held = draw_builds(pareto, N, t, s, distribution)
@@ -267,10 +280,11 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
         write_stored_front(h5, "builds", p, b.stored)
         h5.attrs["seed"] = b.seed
         g = h5.create_group("builds")
-        g.attrs["samples"], g.attrs["tolerance"] = len(b.X), b.tolerance
+        g.attrs["samples"] = len(b.X)
         g.attrs["distribution"] = b.distribution
         three = ("sample", "design")
         write_dataset(g, "X", b.X, list(p.var_units), three + ("variable",), names=p.var_names)
+        write_dataset(g, "tolerance", b.tolerance, "%", ("variable",))
         write_dataset(g, "F", b.F[..., :m], units[:m], three + ("objective",), names=names[:m])
         if len(names) > m:
             extra = names[m:]
@@ -289,6 +303,11 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
         dims = ("design", "variable", "objective")
         write_dataset(g, "contribution", r2, "1", dims, names=names[:m])
     return Path(path)
+
+
+def _within(b: Builds) -> str:
+    band = bands(b.pareto.var_names, b.tolerance)
+    return f"{band} of its value" if band.startswith("±") else f"its tolerance ({band})"
 
 
 def _designs(n: int) -> str:
@@ -354,8 +373,8 @@ def _report(b: Builds, title: str) -> Report:
     ]
     notes = [
         f"{len(b.X)} builds of each of {_designs(len(p.X))} of {p.path.name}: every design "
-        f"variable off at once by a {DRAWS[b.distribution]} within ±{b.tolerance:g} % of its "
-        f"value (seed {b.seed}); change = (f_built - f_stored)/f_stored, its 5th to 95th "
+        f"variable off at once by a {DRAWS[b.distribution]} within {_within(b)} "
+        f"(seed {b.seed}); change = (f_built - f_stored)/f_stored, its 5th to 95th "
         f"percentile over the builds",
         *p.picked_note(),
         *b.stored.notes,
@@ -406,21 +425,22 @@ def run_builds(
     source: Path,
     output: Path | None = None,
     plot: Path | None = None,
-    tolerance: float | None = TOLERANCE,
+    tolerance: Tolerances = None,
     samples: int | None = SAMPLES,
     seed: int | None = None,
     distribution: str | None = None,
     pick: Sequence[str] | None = None,
 ) -> Report:
-    """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--seed S]
-    [--distribution uniform|normal] [--pick NAMES]`` (module docstring)."""
+    """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--tolerance
+    NAME=T] [--seed S] [--distribution uniform|normal] [--pick NAMES]`` (module
+    docstring)."""
     from .. import plots
 
     if plot is not None:
         plots.check_path(plot)
     pareto = read_front(Path(source), pick)
     b = builds(pareto, samples, tolerance=tolerance, seed=seed, distribution=distribution)
-    title = f"builds: {pareto.path.name} as built to ±{b.tolerance:g} %"
+    title = f"builds: {pareto.path.name} as built to {bands(pareto.var_names, b.tolerance)}"
     if output is not None:
         write_builds(output, b)
     if plot is not None:

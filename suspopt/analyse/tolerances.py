@@ -1,4 +1,5 @@
-"""``suspopt analyse tolerances PARETO.h5 [--tolerance 10]``: a front's designs as built.
+"""``suspopt analyse tolerances PARETO.h5 [--tolerance 10] [--tolerance NAME=T]``: a front's
+designs as built.
 
 A design leaves the drawing office as numbers and the factory as parts: a spring within its
 rate tolerance, a damper within its force band. This analysis shows what that does to the
@@ -10,9 +11,12 @@ of each objective and where it came from. The thesis has no such analysis; it is
 ours, in the form of its pseudo-fronts (Sec 8.4).
 
 A value the change would take outside what its config field accepts (a ratio above 1) is
-held at the field's limit, and the report says for how many designs. ``--tolerance`` is in %
-of the value, for a variable on a log scale too; an integer variable is rounded as the
-optimiser rounds it. Each variant's ``/pseudo/<label>`` has the attributes ``variable``,
+held at the field's limit, and the report says for how many designs. A tolerance is in % of
+the value, for a variable on a log scale too; an integer variable is rounded as the
+optimiser rounds it. Each variable has its own (:func:`variable_tolerances`): the
+``--tolerance NAME=T`` given for it, else its config's ``design_variables[i].tolerance``
+(springs and dampers are made to different bands), else the bare ``--tolerance T``, else
+10 %. Each variant's ``/pseudo/<label>`` has the attributes ``variable``,
 ``tolerance`` [%] (signed) and ``held_at_limit`` (how many designs), and the dataset ``X``
 (the changed designs).
 """
@@ -20,9 +24,10 @@ optimiser rounds it. Each variant's ``/pseudo/<label>`` has the attributes ``var
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from functools import partial
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -36,6 +41,8 @@ from .pseudo import PseudoFronts, Variant, run_variants
 __all__ = [
     "TOLERANCE",
     "checked_tolerance",
+    "variable_tolerances",
+    "bands",
     "inside",
     "variable_limits",
     "tolerance_variants",
@@ -44,6 +51,8 @@ __all__ = [
 
 #: The default tolerance [%]: a spring's or a damper's usual rate band.
 TOLERANCE = 10.0
+#: What ``--tolerance`` takes (:func:`variable_tolerances`).
+Tolerances = float | str | Sequence[float | str] | Mapping[str, float] | None
 
 
 def inside(values: np.ndarray, limits: tuple[float, bool, float, bool]) -> np.ndarray:
@@ -55,21 +64,68 @@ def inside(values: np.ndarray, limits: tuple[float, bool, float, bool]) -> np.nd
     return np.clip(values, low, high)
 
 
-def checked_tolerance(tolerance: float | None) -> float:
-    """``--tolerance`` [%] as a number above 0 and below 100 (None: :data:`TOLERANCE`);
-    ConfigError naming the option for anything else."""
-    values = listed(TOLERANCE if tolerance is None else tolerance)
-    if len(values) != 1:
-        raise ConfigError(f"--tolerance: give one tolerance in %, got {len(values)}")
+def checked_tolerance(tolerance: float | str | None, label: str = "--tolerance ") -> float:
+    """One tolerance [%] as a number above 0 and below 100 (None: :data:`TOLERANCE`);
+    ConfigError naming the option (``label``, followed by the value) for anything else."""
+    value = TOLERANCE if tolerance is None else tolerance
     try:
-        if isinstance(values[0], bool):
+        if isinstance(value, bool):
             raise TypeError
-        t = float(values[0])
+        t = float(value)
     except (TypeError, ValueError):
-        raise ConfigError(f"--tolerance {values[0]!r}: give a number of %") from None
+        raise ConfigError(f"{label}{value!r}: give a number of %") from None
     if not (0.0 < t < 100.0 and math.isfinite(t)):
-        raise ConfigError(f"--tolerance {t:g}: give a tolerance above 0 and below 100 %")
+        raise ConfigError(f"{label}{t:g}: give a tolerance above 0 and below 100 %")
     return t
+
+
+def variable_tolerances(pareto: ParetoSet, tolerance: Tolerances = None) -> np.ndarray:
+    """``(n,)`` the tolerance [%] of each design variable of ``pareto``: the ``NAME=T`` given
+    for it (``--tolerance``, repeatable), else its stored config's
+    ``design_variables[i].tolerance``, else the one bare ``T`` given, else
+    :data:`TOLERANCE`. ``tolerance``: None, a number, ``"T"``, ``"NAME=T"``, a sequence of
+    those, or a mapping name -> T; ConfigError naming the option for a wrong one."""
+    if isinstance(tolerance, Mapping):
+        items: list[tuple[str | None, Any]] = list(tolerance.items())
+    else:
+        items = [(None, v) for v in listed(tolerance)] if tolerance is not None else []
+    default, each = None, {}
+    for name, value in items:
+        if name is None and isinstance(value, str) and "=" in value:
+            name, _, value = (part.strip() for part in value.partition("="))
+        if name is None:
+            if default is not None:
+                raise ConfigError(
+                    "--tolerance: give one tolerance T for every variable, and NAME=T for "
+                    "those with another; not two of T"
+                )
+            default = checked_tolerance(value)
+            continue
+        if name not in pareto.var_names:
+            raise ConfigError(
+                f"--tolerance {name}={value}: {pareto.path.name} has no design variable "
+                f"{name!r}; it has {', '.join(pareto.var_names)}"
+            )
+        if name in each:
+            raise ConfigError(f"--tolerance {name}=: give each variable's tolerance once")
+        each[name] = checked_tolerance(value, f"--tolerance {name}=")
+    stored = {v.label: v.tolerance for v in pareto.config().design_variables}
+    fallback = TOLERANCE if default is None else default
+    return np.array(
+        [
+            each.get(name, stored.get(name) or fallback)  # (a stored one is above 0)
+            for name in pareto.var_names
+        ],
+        dtype=float,
+    )
+
+
+def bands(names: Sequence[str], tolerance: np.ndarray) -> str:
+    """The tolerances [%] of the variables ``names`` as a report says them: ``±10 %`` when
+    they are one, else each (``K_v ±5 %, C_v ±15 %``)."""
+    if len(set(tolerance.tolist())) == 1:
+        return f"±{tolerance[0]:g} %"
+    return ", ".join(f"{name} ±{t:g} %" for name, t in zip(names, tolerance))
 
 
 def variable_limits(pareto: ParetoSet) -> list[tuple[float, bool, float, bool]]:
@@ -87,14 +143,15 @@ def variable_limits(pareto: ParetoSet) -> list[tuple[float, bool, float, bool]]:
     return [field_range(cfg, path_of[name]) for name in pareto.var_names]
 
 
-def tolerance_variants(pareto: ParetoSet, tolerance: float | None = TOLERANCE) -> list[Variant]:
+def tolerance_variants(pareto: ParetoSet, tolerance: Tolerances = None) -> list[Variant]:
     """Two variants per design variable: its value in every design times ``1 - t/100`` and
-    ``1 + t/100`` (``t`` = ``tolerance`` [%], above 0 and below 100; None: :data:`TOLERANCE`),
-    the stored config."""
-    t = checked_tolerance(tolerance)
+    ``1 + t/100`` (``t`` its tolerance [%]: :func:`variable_tolerances`), the stored
+    config."""
     cfg = pareto.config()
     variants = []
+    tolerances = variable_tolerances(pareto, tolerance)
     for j, (name, limits) in enumerate(zip(pareto.var_names, variable_limits(pareto))):
+        t = float(tolerances[j])
         for sign in (-1.0, 1.0):
             X = pareto.X.copy()
             X[:, j] = inside(X[:, j] * (1.0 + sign * t / 100.0), limits)
@@ -136,11 +193,11 @@ def run_tolerances(
     source: Path,
     output: Path | None = None,
     plot: Path | None = None,
-    tolerance: float | None = TOLERANCE,
+    tolerance: Tolerances = None,
     pick: Sequence[str] | None = None,
 ) -> Report:
-    """``suspopt analyse tolerances PARETO.h5 [--tolerance 10] [--pick NAMES]`` (module
-    docstring)."""
+    """``suspopt analyse tolerances PARETO.h5 [--tolerance 10] [--tolerance NAME=T] [--pick
+    NAMES]`` (module docstring)."""
     variants = partial(tolerance_variants, tolerance=tolerance)
     report, fronts = run_variants(
         "tolerances",

@@ -24,7 +24,9 @@ _ANALYSE_OPTIONS = {
 
 
 _TOLERANCE_HELP = (
-    "tolerances, builds: how far each design variable is off, in % of its value (default 10)"
+    "tolerances, builds: how far a design variable may be off, in % of its value: T for "
+    "every variable, NAME=T for one (repeatable); default each variable's tolerance in the "
+    "config, else 10"
 )
 
 
@@ -102,7 +104,7 @@ def analyse(
         "--mass-change",
         help="masses: change of the load on the seat, in kg; repeatable (default -20 and +20)",
     ),
-    tolerance: float | None = typer.Option(None, "--tolerance", help=_TOLERANCE_HELP),
+    tolerance: list[str] | None = typer.Option(None, "--tolerance", help=_TOLERANCE_HELP),
     samples: int | None = typer.Option(
         None, "--samples", help="builds: how many builds of each design (default 100)"
     ),
@@ -127,7 +129,7 @@ def analyse(
         "road": road or None,
         "with_": with_ or None,
         "mass_change": mass_change or None,
-        "tolerance": tolerance,
+        "tolerance": tolerance or None,
         "samples": samples,
         "seed": seed,
         "distribution": distribution,

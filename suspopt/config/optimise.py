@@ -45,6 +45,12 @@ __all__ = [
 
 #: a bound or limit in a field's or a metric's SI unit
 _Finite = Annotated[float, bounds(-1e15, 1e15)]
+#: [%] of a value, above 0 and below 100: a part's tolerance
+Tolerance = Annotated[float, Field(gt=0.0, lt=100.0, allow_inf_nan=False)]
+_TOLERANCE = (
+    "how far a built part may be off its value [%] (analyse tolerances and builds; default: "
+    "their --tolerance, else 10)"
+)
 
 
 def _count(high: int) -> Any:
@@ -103,6 +109,7 @@ class DesignVariable(Section):
     name: str | None = Field(
         None, description="short label for tables and HDF5 (default: the path)"
     )
+    tolerance: Tolerance | None = Field(None, description=_TOLERANCE)
 
     @model_validator(mode="after")
     def _check_bounds(self) -> DesignVariable:

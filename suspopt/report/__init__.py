@@ -197,7 +197,7 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
     """What an ``analyse builds`` file says of each design's builds
     (:mod:`suspopt.analyse.builds`): the 5th and 95th percentiles of each objective, the share
     of feasible builds, what drives each objective's spread, how many builds and within which
-    tolerance [%]."""
+    tolerance [%] (one per variable)."""
     from ..analyse.builds import DISTRIBUTIONS, DRIVER_SAMPLES
     from ..params import MAX_SWEEP_DESIGNS
 
@@ -205,6 +205,12 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
     high = h5.array("builds/F_p95", ndim=2, columns=m)
     share = h5.array("builds/feasible_share", ndim=1)
     r2 = h5.array("builds/contribution", ndim=3)
+    tolerance = h5.array("builds/tolerance", ndim=1)
+    if not (len(tolerance) == n and ((tolerance > 0) & (tolerance < 100)).all()):
+        raise ConfigError(
+            f"{h5.where}: /builds/tolerance: not one tolerance in (0, 100) % for each of the "
+            f"front's {n} variables"
+        )
     if not len(low) == len(high) == len(share) == N or r2.shape != (N, n, m):
         raise ConfigError(
             f"{h5.where}: /builds: the percentiles, shares and contributions do not have "
@@ -218,7 +224,7 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
         )
     return {
         "samples": h5.int_attr("builds", "samples", 1, MAX_SWEEP_DESIGNS),
-        "tolerance": h5.float_attr("builds", "tolerance", 0.0, 100.0),
+        "tolerance": _list(tolerance),
         "distribution": distribution,
         "low": _list(low),
         "high": _list(high),

@@ -105,7 +105,10 @@ SCRIPT = r"""
     });
     const tr = el("tr", null, t); el("td", "feasible builds", tr);
     el("td", fmt(100 * b.share[row]), tr); el("td", "%", tr);
-    el("div", b.samples + " builds, every variable within ±" + b.tolerance + " % of its value (" + b.distribution + ")", box).className = "note";
+    const one = b.tolerance.every(t => t === b.tolerance[0]);
+    const within = one ? "every variable within ±" + b.tolerance[0] + " % of its value"
+      : "each variable within its tolerance (" + d.variables.map((v, i) => v + " ±" + b.tolerance[i] + " %").join(", ") + ")";
+    el("div", b.samples + " builds, " + within + " (" + b.distribution + ")", box).className = "note";
   }
   function showBaseline(i, d, box) {  // the config's own design (an optimise file's /baseline)
     box.textContent = "";
