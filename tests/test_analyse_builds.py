@@ -337,9 +337,9 @@ def test_the_chosen_design_of_a_kesort_file_is_built_as_in_its_front(ps_front, t
 
 
 def test_each_variable_is_built_to_its_own_tolerance(ps_front, tmp_path):
-    """A design variable's ``tolerance`` in the stored config is its band; ``--tolerance T``
-    is the band of the variables without one, and ``--tolerance NAME=T`` the band of NAME
-    whatever the config says. Each variable's offsets fill its own band, and ``analyse
+    """A design variable's ``tolerance`` in the stored config is its band (10 % where it has
+    none); ``--tolerance T`` sets every variable's over the config, and ``--tolerance
+    NAME=T`` NAME's over both. Each variable's offsets fill its own band, and ``analyse
     tolerances`` moves each by its own."""
     front, _ = ps_front
     own = tmp_path / "own.h5"
@@ -350,11 +350,11 @@ def test_each_variable_is_built_to_its_own_tolerance(ps_front, tmp_path):
         assert text.count(old) == 1
         h5.attrs["config"] = text.replace(old, "{name: K_v, tolerance: 3, path: seat.stiffness,")
         X0 = h5["pareto/X"][()]
-    for given, bands in (([], [3, 12]), (["--tolerance", "K_v=6"], [6, 12])):
+    cases = (([], [3, 10]), (["--tolerance", "K_v=6"], [6, 10]), (["--tolerance", "4"], [4, 4]))
+    cases += ((["--tolerance", "12", "--tolerance", "K_v=6"], [6, 12]),)
+    for given, bands in cases:
         out = tmp_path / "builds.h5"
-        res = _invoke(
-            "analyse", "builds", own, "-o", out, "--samples", 40, "--tolerance", 12, *given
-        )
+        res = _invoke("analyse", "builds", own, "-o", out, "--samples", 40, *given)
         assert res.exit_code == 0, res.output
         with h5py.File(out) as h5:
             assert h5["builds/tolerance"][()].tolist() == bands
@@ -363,7 +363,9 @@ def test_each_variable_is_built_to_its_own_tolerance(ps_front, tmp_path):
             off > 0.85 * np.array(bands) / 100
         ).all()
         said = " ".join(res.output.split())
-        assert f"within its tolerance (K_v ±{bands[0]} %, C_v ±{bands[1]} %) (seed" in said
+        one = f"±{bands[0]} % of its value" if bands[0] == bands[1] else ""
+        each = f"its tolerance (K_v ±{bands[0]} %, C_v ±{bands[1]} %)"
+        assert f"within {one or each} (seed" in said
     res = _invoke("analyse", "tolerances", own, "-o", tmp_path / "tol.h5")
     assert res.exit_code == 0, res.output
     with h5py.File(tmp_path / "tol.h5") as h5:

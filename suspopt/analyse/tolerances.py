@@ -14,8 +14,8 @@ A value the change would take outside what its config field accepts (a ratio abo
 held at the field's limit, and the report says for how many designs. A tolerance is in % of
 the value, for a variable on a log scale too; an integer variable is rounded as the
 optimiser rounds it. Each variable has its own (:func:`variable_tolerances`): the
-``--tolerance NAME=T`` given for it, else its config's ``design_variables[i].tolerance``
-(springs and dampers are made to different bands), else the bare ``--tolerance T``, else
+``--tolerance NAME=T`` given for it, else the bare ``--tolerance T``, else its config's
+``design_variables[i].tolerance`` (springs and dampers are made to different bands), else
 10 %. Each variant's ``/pseudo/<label>`` has the attributes ``variable``,
 ``tolerance`` [%] (signed) and ``held_at_limit`` (how many designs), and the dataset ``X``
 (the changed designs).
@@ -81,8 +81,8 @@ def checked_tolerance(tolerance: float | str | None, label: str = "--tolerance "
 
 def variable_tolerances(pareto: ParetoSet, tolerance: Tolerances = None) -> np.ndarray:
     """``(n,)`` the tolerance [%] of each design variable of ``pareto``: the ``NAME=T`` given
-    for it (``--tolerance``, repeatable), else its stored config's
-    ``design_variables[i].tolerance``, else the one bare ``T`` given, else
+    for it (``--tolerance``, repeatable), else the one bare ``T`` given (the command line
+    over the config), else its stored config's ``design_variables[i].tolerance``, else
     :data:`TOLERANCE`. ``tolerance``: None, a number, ``"T"``, ``"NAME=T"``, a sequence of
     those, or a mapping name -> T; ConfigError naming the option for a wrong one."""
     if isinstance(tolerance, Mapping):
@@ -110,10 +110,9 @@ def variable_tolerances(pareto: ParetoSet, tolerance: Tolerances = None) -> np.n
             raise ConfigError(f"--tolerance {name}=: give each variable's tolerance once")
         each[name] = checked_tolerance(value, f"--tolerance {name}=")
     stored = {v.label: v.tolerance for v in pareto.config().design_variables}
-    fallback = TOLERANCE if default is None else default
     return np.array(
         [
-            each.get(name, stored.get(name) or fallback)  # (a stored one is above 0)
+            each.get(name, default or stored.get(name) or TOLERANCE)  # (each one is above 0)
             for name in pareto.var_names
         ],
         dtype=float,

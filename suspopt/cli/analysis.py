@@ -25,8 +25,8 @@ _ANALYSE_OPTIONS = {
 
 _TOLERANCE_HELP = (
     "tolerances, builds: how far a design variable may be off, in % of its value: T for "
-    "every variable, NAME=T for one (repeatable); default each variable's tolerance in the "
-    "config, else 10"
+    "every variable, NAME=T for one (repeatable); without them each variable's tolerance "
+    "in the config, else 10"
 )
 
 

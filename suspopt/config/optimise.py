@@ -48,8 +48,8 @@ _Finite = Annotated[float, bounds(-1e15, 1e15)]
 #: [%] of a value, above 0 and below 100: a part's tolerance
 Tolerance = Annotated[float, Field(gt=0.0, lt=100.0, allow_inf_nan=False)]
 _TOLERANCE = (
-    "how far a built part may be off its value [%] (analyse tolerances and builds; default: "
-    "their --tolerance, else 10)"
+    "how far a built part may be off its value [%] (analyse tolerances and builds, unless "
+    "their --tolerance says otherwise; default 10)"
 )
 
 
