@@ -390,7 +390,7 @@ def _report(b: Builds, title: str) -> Report:
     k = int(np.argmin(share))
     notes.append(
         f"feasible builds: {100 * share[k]:.0f} % at the least (design {k}); "
-        f"{int((share == 1).sum())} of {len(p.X)} designs have every build feasible"
+        f"every build feasible in {int((share == 1).sum())} of {_designs(len(p.X))}"
     )
     notes.append(_broken(b))
     notes.append(_drivers(b))
