@@ -161,15 +161,8 @@ def read_table(path: str | Path) -> DesignTable:
         else:
             configs = [h5.text_attr("config")]
             config_of = np.zeros(len(X), dtype=np.int64)
-            if table == "designs":
-                entries = (
-                    h5.labels("designs/F", "picks", len(X))
-                    if "picks" in h5.dataset("designs/F").attrs
-                    else []
-                )
-                if not entries and "picks" in h5.dataset("designs/X").attrs:
-                    entries = h5.labels("designs/X", "picks", len(X))
-                for row, entry in enumerate(entries):
+            if table == "designs":  # (analyse transmissibility: the picks of each row)
+                for row, entry in enumerate(_row_picks(h5, len(X))):
                     for name in entry.split(","):
                         picks.setdefault(name.strip(), row)
             elif "pareto/picks" in h5.file:
@@ -181,6 +174,19 @@ def read_table(path: str | Path) -> DesignTable:
     return DesignTable(
         path, table, X, var_names, var_units, F, obj_names, obj_units, picks, configs, config_of
     )
+
+
+def _row_picks(h5, rows: int) -> list[str]:
+    """The attribute ``picks`` of ``/designs``: the picks of each of its ``rows`` rows,
+    comma-separated (none where it is missing)."""
+    label = "/designs: attribute 'picks'"
+    raw = h5.attribute(h5.group("designs"), "picks", label)
+    if raw is None:
+        return []
+    entries = [h5.text(v, label) for v in np.atleast_1d(raw)]
+    if len(entries) != rows:
+        raise ConfigError(f"{h5.where}: {label}: {len(entries)} entries for {rows} designs")
+    return entries
 
 
 def _index(h5, name: str, rows: int) -> int:

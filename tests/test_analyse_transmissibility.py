@@ -104,7 +104,7 @@ def test_front_picks_with_the_passenger_give_stht(tmp_path, ps_front):
 @pytest.mark.parametrize(
     "case, needle",
     [
-        ("config_with", "--with is for a Pareto file"),
+        ("config_with", "--with is for a result file"),
         ("no_passenger", "has no seat.passenger"),
         ("two", "takes one --with"),
     ],
@@ -122,3 +122,31 @@ def test_front_bad_input_exits_2_with_one_line(tmp_path, ps_front, case, needle)
     message = proc.stderr.strip()
     assert len(message.splitlines()) == 1 and needle in message, message
     assert not out.exists()
+
+
+def test_the_designs_picked_are_analysed_and_keep_their_picks(tmp_path, ps_front):
+    """``--pick`` analyses the designs it names (a row number too), each once, and the file
+    keeps each design's picks (``/designs`` attribute ``picks``), which ``export`` and
+    ``simulate --pick`` read back: a pick the file does not hold is bad input there, not
+    one computed anew over the few designs it has."""
+    edge = next(iter(ps_front.picks))  # best_<first objective>
+    row = next(r for r in range(len(ps_front.X)) if r not in ps_front.picks.values())
+    out = tmp_path / "tr.h5"
+    proc = run(
+        "analyse", "transmissibility", ps_front.path, "-o", out, "--pick", f"{edge},{row},{edge}"
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert f"2 design(s) of {ps_front.path.name} (--pick): 0: {edge} (row " in " ".join(
+        proc.stdout.split()
+    )
+    with h5py.File(out) as h5:
+        assert list(h5["designs"].attrs["picks"].astype(str)) == [edge, f"row {row}"]
+        np.testing.assert_array_equal(h5["designs/X"][()], ps_front.X[[ps_front.picks[edge], row]])
+    res = run("export", out, "--pick", edge, "-o", tmp_path / "edge.yaml")
+    assert res.returncode == 0, res.stdout + res.stderr
+    picked = suspopt.load_config(tmp_path / "edge.yaml")
+    assert picked.seat.stiffness == pytest.approx(ps_front.X[ps_front.picks[edge], 0], rel=1e-12)
+    res = run("export", out, "--pick", "knee", "-o", tmp_path / "knee.yaml")
+    assert res.returncode == 2 and "has no such pick; it has " in res.stderr
+    res = run("analyse", "transmissibility", PASSENGER, "--pick", "knee")
+    assert res.returncode == 2 and "--pick is for a result file" in res.stderr

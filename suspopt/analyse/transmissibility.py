@@ -18,7 +18,9 @@ transmissibility of Fig. 2.18b is the ``seat`` entry.
 For a Pareto file (``suspopt optimise`` output, Sec 8.4.4, Fig. 8.26), the same for the
 Pareto-theory picks of its front (:func:`suspopt.kesort.pareto_picks`, Fig. 8.21): the edges
 ``best_<objective>`` (the thesis's Edge 1 and Edge 2: in Ch. 8 ``best_X_ST`` and
-``best_RC_se``) and the ``knee`` (its Mid), simulated in one batch. The thesis adds the
+``best_RC_se``) and the ``knee`` (its Mid), simulated in one batch; with ``pick``
+(``--pick``), the designs it names, of any result file (:func:`suspopt.picks.read_front`:
+``analyse transmissibility choice.h5 --pick chosen``). The thesis adds the
 passenger and keeps only the seat's 13.6 kg as the seat mass; ``with_`` (``--with FILE.yaml``)
 does that: the ``seat.mass`` and ``seat.passenger`` of that file (e.g.
 ``configs/ch8/<seat>_class_a_passenger.yaml``) replace the stored ones. NSS1-NSS3 keep the
@@ -56,10 +58,10 @@ from ..config import Config, ConfigError, load_config
 from ..config.loader import require_config
 from ..files import is_hdf5
 from ..io import atomic_h5, write_attrs, write_dataset
-from ..kesort import pareto_picks
 from ..metrics import coherence, transmissibility, weighted_rms
 from ..optimise import Problem
 from ..params import ParamView
+from ..picks import read_front
 from ..seat import (
     CONSTRAINT_UNITS,
     base_transmissibility,
@@ -68,7 +70,7 @@ from ..seat import (
     natural_frequencies,
     seat_constraints,
 )
-from ..selection import ParetoSet, read_pareto
+from ..selection import ParetoSet
 from ..simulate import simulate
 from . import KINDS, Kind, Report
 from .pseudo import config_with, read_sections
@@ -188,12 +190,16 @@ def seat_transmissibility(
 
 def front_designs(pareto: ParetoSet) -> FrontDesigns:
     """The edges and the knee of ``pareto``'s front (:func:`suspopt.kesort.pareto_picks`),
-    each design once, in the order of the picks."""
+    each design once, in the order of the picks; of designs picked from a file
+    (:func:`suspopt.picks.read_front`), every one, by the names it was picked by (``row
+    R`` for a row number)."""
     cfg = pareto.config()
     problem = Problem.from_config(cfg)
     picks: dict[int, list[str]] = {}
-    for name, row in pareto_picks(pareto.F, pareto.obj_names).items():
+    for name, row in pareto.marks().items():
         picks.setdefault(row, []).append(name)
+    if pareto.source_rows is not None:
+        picks = {k: picks.get(k, [f"row {int(r)}"]) for k, r in enumerate(pareto.source_rows)}
     rows = np.array(list(picks))
     path_of = {v.label: v.path for v in cfg.design_variables}
     if sorted(path_of) != sorted(pareto.var_names):
@@ -373,12 +379,16 @@ def _peak(f: np.ndarray, values: np.ndarray, valid: np.ndarray | None = None):
 
 
 def _run_front(
-    source: Path, output: Path | None, plot: Path | None, with_: Sequence[Path]
+    source: Path,
+    output: Path | None,
+    plot: Path | None,
+    with_: Sequence[Path],
+    pick: Sequence[str] | None,
 ) -> Report:
-    """The picks of a Pareto file (module docstring)."""
+    """The picks of a Pareto file, or the designs ``pick`` names (module docstring)."""
     if len(with_) > 1:
         raise ConfigError("analyse transmissibility takes one --with FILE.yaml")
-    pareto = read_pareto(source)
+    pareto = read_front(source, pick)
     cfg = with_passenger(pareto, with_[0]) if with_ else pareto.config()
     designs = front_designs(pareto)
     try:
@@ -424,9 +434,12 @@ def _run_front(
         f"{label} peak, simulated [- @ Hz]",
         f"Wk r.m.s. {name}.acc [m/s^2]",
     ]
+    shown = pareto.picked_note() or [
+        "picks of the front (suspopt.kesort.pareto_picks, Fig. 8.21): the edges "
+        "best_<objective> and the knee"
+    ]
     notes = [
-        f"picks of the front (suspopt.kesort.pareto_picks, Fig. 8.21): the edges "
-        f"best_<objective> and the knee; objectives as stored; X_ST, peaks and r.m.s. "
+        f"{shown[0]}; objectives as stored; X_ST, peaks and r.m.s. "
         f"{'with the passenger of ' + str(with_[0]) if with_ else 'as stored'}",
         "TR = |z̈_i / z̈_s| from the floor z_s (Eq 2.86); peaks in 0.5-20 Hz, simulated "
         f"where the coherence is >= {_MIN_COHERENCE}",
@@ -440,16 +453,22 @@ def _run_front(
 
 
 def run(
-    source: Path, output: Path | None = None, plot: Path | None = None, with_: Sequence[Path] = ()
+    source: Path,
+    output: Path | None = None,
+    plot: Path | None = None,
+    with_: Sequence[Path] = (),
+    pick: Sequence[str] | None = None,
 ) -> Report:
     """The ``transmissibility`` analysis of ``source``: a YAML config with a seat, or a Pareto
-    file (then ``with_`` may give the passenger, module docstring)."""
+    file (then ``with_`` may give the passenger, module docstring), or with ``pick`` those
+    designs of a result file (:func:`suspopt.picks.read_front`)."""
     if plot is not None:
         plots.check_path(plot)
     if is_hdf5(source):
-        return _run_front(Path(source), output, plot, with_)
-    if with_:
-        raise ConfigError(f"analyse transmissibility {source}: --with is for a Pareto file")
+        return _run_front(Path(source), output, plot, with_, pick)
+    for given, option in ((with_, "--with"), (pick, "--pick")):
+        if given:
+            raise ConfigError(f"analyse transmissibility {source}: {option} is for a result file")
     cfg = load_config(source)
     data = seat_transmissibility(cfg)
     if output is not None:
@@ -490,4 +509,4 @@ def run(
     )
 
 
-KINDS["transmissibility"] = Kind(run, options=("with_",))
+KINDS["transmissibility"] = Kind(run, options=("with_", "pick"))
