@@ -260,7 +260,8 @@ def test_kesort_counts_a_design_with_too_few_feasible_builds_infeasible(ps_front
         (["--builds", "{builds}", "--min-feasible-builds", "101"], "give a share from 0 to 100"),
         (["--builds", "{builds}", "--min-feasible-builds", "nan"], "give a share from 0 to 100"),
         (["--min-feasible-builds", "90"], "--min-feasible-builds: give --builds too"),
-        (["{front}", "--builds", "{builds}"], "--builds: give one Pareto file, not 2"),
+        (["{front}", "--builds", "{builds}"], "--builds: give one per Pareto file, in their"),
+        (["--builds", "{builds}", "--builds", "{builds}"], "Pareto file, in their order (1), not 2"),
     ],
 )
 def test_kesort_builds_of_the_wrong_file_are_one_line(ps_front, tmp_path, args, said):
@@ -371,3 +372,28 @@ def test_each_variable_is_built_to_its_own_tolerance(ps_front, tmp_path):
     with h5py.File(tmp_path / "tol.h5") as h5:
         labels = list(h5["pseudo"].attrs["labels"].astype(str))
     assert labels == ["K_v -3 %", "K_v +3 %", "C_v -10 %", "C_v +10 %"]
+
+
+def test_kesort_of_pooled_fronts_takes_the_builds_of_each(ps_front, tmp_path):
+    """Pooled Pareto files take one ``--builds`` each, in their order: each set's designs
+    with too few feasible builds count as infeasible, and a note says how many, per file."""
+    front, _ = ps_front
+    twin, builds_file, out = tmp_path / "twin.h5", tmp_path / "builds.h5", tmp_path / "ke.h5"
+    shutil.copyfile(front, twin)
+    res = _invoke("analyse", "builds", front, "-o", builds_file, "--samples", 40, "--tolerance", 8)
+    assert res.exit_code == 0, res.output
+    with h5py.File(builds_file) as h5:
+        share = h5["builds/feasible_share"][()]
+    assert 0 < (share < 0.95).sum() < len(share)
+    pool = [front, twin, "--label", "a", "--label", "b"]
+    res = _invoke("kesort", *pool, "--builds", builds_file, "--builds", builds_file, "-o", out)
+    assert res.exit_code == 0, res.output
+    with h5py.File(out) as h5:
+        feasible = h5["kesort/feasible"][()].astype(bool)
+        rows, source = h5["kesort/row"][()], h5["kesort/source"][()]
+    with h5py.File(front) as h5:
+        stored = (h5["pareto/G"][()] <= 0).all(axis=1)
+    assert sorted(set(source.tolist())) == [0, 1]
+    np.testing.assert_array_equal(feasible, stored[rows] & (share[rows] >= 0.95))
+    said = " ".join(res.output.split())
+    assert said.count(f"{int((share < 0.95).sum())} of {len(share)} designs have fewer") == 2

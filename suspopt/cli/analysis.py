@@ -98,7 +98,8 @@ def analyse(
         None,
         "--with",
         help="controllers: YAML whose control: section and dampers "
-        "replace the stored ones; repeatable",
+        "replace the stored ones, repeatable; transmissibility of a front: YAML whose "
+        "seat.mass and seat.passenger replace the stored ones",
     ),
     mass_change: list[float] | None = typer.Option(
         None,

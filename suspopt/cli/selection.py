@@ -133,38 +133,40 @@ def _with_supplementary(cfg, X, variables: list[str], F, names: list[str]):
     return np.hstack([F, S]), names + problem.supplementary_names
 
 
-def _builds_options(pareto: list[Path], builds: Path | None, least: float | None) -> float:
+def _builds_options(pareto: list[Path], builds: list[Path], least: float | None) -> float:
     """``--min-feasible-builds`` [%] (None: :data:`MIN_FEASIBLE_BUILDS`), checked with
-    ``--builds`` before any design is evaluated."""
+    ``--builds`` (one per Pareto file) before any design is evaluated."""
     import math
 
-    if builds is None and least is not None:
+    if not builds and least is not None:
         raise ConfigError("--min-feasible-builds: give --builds too (the builds it counts)")
     least = MIN_FEASIBLE_BUILDS if least is None else least
     if not (math.isfinite(least) and 0 <= least <= 100):
         raise ConfigError(f"--min-feasible-builds {least:g}: give a share from 0 to 100 %")
-    if builds is not None and len(pareto) != 1:
-        raise ConfigError(f"--builds: give one Pareto file, not {len(pareto)}")
+    if builds and len(builds) != len(pareto):
+        raise ConfigError(
+            f"--builds: give one per Pareto file, in their order ({len(pareto)}), "
+            f"not {len(builds)}"
+        )
     return least
 
 
-def _as_built(sets, pareto: list[Path], builds: Path | None, least: float):
+def _as_built(sets, pareto: list[Path], builds: list[Path], least: float):
     """``sets`` with a design counted infeasible where fewer than ``least`` % of its builds
-    (the ``analyse builds`` file ``builds`` of the one Pareto file) are feasible, and the
-    note that says how many; ``sets`` and no note without ``builds``."""
+    (the ``analyse builds`` file of its Pareto file, ``builds[i]`` of ``pareto[i]``) are
+    feasible, and the notes that say how many; ``sets`` and no note without ``builds``."""
     from dataclasses import replace
 
     from ..analyse.builds import feasible_builds
 
-    if builds is None:
-        return sets, []
-    short = feasible_builds(builds, pareto[0]) < least / 100
-    (design_set,) = sets
-    note = (
+    shorts = [feasible_builds(b, p) < least / 100 for b, p in zip(builds, pareto)]
+    notes = [
         f"{int(short.sum())} of {len(short)} designs have fewer than {least:g} % of their "
-        f"builds feasible ({builds}): counted infeasible"
-    )
-    return [replace(design_set, feasible=design_set.feasible & ~short)], [note]
+        f"builds feasible ({b}): counted infeasible"
+        for short, b in zip(shorts, builds)
+    ]
+    built = [replace(s, feasible=s.feasible & ~short) for s, short in zip(sets, shorts)]
+    return (built, notes) if builds else (sets, [])
 
 
 def _threshold_line(sort, label: str) -> str:
@@ -181,8 +183,8 @@ def _threshold_line(sort, label: str) -> str:
 MIN_FEASIBLE_BUILDS = 95.0
 
 _BUILDS_HELP = (
-    "the analyse builds file of the (one) Pareto file: a design with fewer feasible builds "
-    "than --min-feasible-builds counts as infeasible"
+    "the analyse builds file of each Pareto file, in their order (repeatable): a design with "
+    "fewer feasible builds than --min-feasible-builds counts as infeasible"
 )
 _MIN_FEASIBLE_BUILDS_HELP = (
     "with --builds: the share of a design's builds that must be feasible, in % (default 95)"
@@ -227,7 +229,7 @@ def kesort(
     keep_infeasible: bool = typer.Option(
         False, "--keep-infeasible", help="sort infeasible designs too"
     ),
-    builds: Path | None = typer.Option(None, "--builds", help=_BUILDS_HELP),
+    builds: list[Path] = typer.Option([], "--builds", help=_BUILDS_HELP),
     min_feasible_builds: float | None = typer.Option(
         None, "--min-feasible-builds", help=_MIN_FEASIBLE_BUILDS_HELP
     ),
@@ -242,7 +244,7 @@ def kesort(
 
     Supplementary objectives are re-simulated in one batch."""
     inputs = [("the input", p) for p in pareto] + [("--config", c) for c in config]
-    inputs += [("--builds", builds)] if builds is not None else []
+    inputs += [("--builds", b) for b in builds]
     with run.outputs(output, plot, inputs=inputs):
         _kesort(
             pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output,
