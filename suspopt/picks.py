@@ -148,6 +148,7 @@ def read_table(path: str | Path) -> DesignTable:
         obj_names = h5.labels(f"{table}/F", "names", F.shape[1])
         obj_units = h5.labels(f"{table}/F", "units", F.shape[1])
         picks: dict[str, int] = {}
+        stored = True  # (the file says which design each pick is; else they are computed)
         if table == "kesort":
             sets = h5.group("kesort/sets")
             configs = [
@@ -162,27 +163,31 @@ def read_table(path: str | Path) -> DesignTable:
             configs = [h5.text_attr("config")]
             config_of = np.zeros(len(X), dtype=np.int64)
             if table == "designs":  # (analyse transmissibility: the picks of each row)
-                for row, entry in enumerate(_row_picks(h5, len(X))):
+                entries = _row_picks(h5, len(X))
+                stored = entries is not None
+                for row, entry in enumerate(entries or []):
                     for name in entry.split(","):
                         picks.setdefault(name.strip(), row)
-            elif "pareto/picks" in h5.file:
+            elif "pareto/picks" in h5.file:  # (an analysis: of the front, or --pick)
                 picks.update(_stored_picks(h5, "pareto/picks", len(X)))
+            else:  # (an optimise file)
+                stored = False
         if ((config_of < 0) | (config_of >= len(configs))).any():
             raise ConfigError(f"{path}: /kesort/source: indices beyond /kesort/sets")
-    if not picks and np.isfinite(F).all():
+    if not stored and np.isfinite(F).all():
         picks = pareto_picks(F, obj_names)
     return DesignTable(
         path, table, X, var_names, var_units, F, obj_names, obj_units, picks, configs, config_of
     )
 
 
-def _row_picks(h5, rows: int) -> list[str]:
+def _row_picks(h5, rows: int) -> list[str] | None:
     """The attribute ``picks`` of ``/designs``: the picks of each of its ``rows`` rows,
-    comma-separated (none where it is missing)."""
+    comma-separated (None where it is missing)."""
     label = "/designs: attribute 'picks'"
     raw = h5.attribute(h5.group("designs"), "picks", label)
     if raw is None:
-        return []
+        return None
     entries = [h5.text(v, label) for v in np.atleast_1d(raw)]
     if len(entries) != rows:
         raise ConfigError(f"{h5.where}: {label}: {len(entries)} entries for {rows} designs")

@@ -261,7 +261,10 @@ def test_kesort_counts_a_design_with_too_few_feasible_builds_infeasible(ps_front
         (["--builds", "{builds}", "--min-feasible-builds", "nan"], "give a share from 0 to 100"),
         (["--min-feasible-builds", "90"], "--min-feasible-builds: give --builds too"),
         (["{front}", "--builds", "{builds}"], "--builds: give one per Pareto file, in their"),
-        (["--builds", "{builds}", "--builds", "{builds}"], "Pareto file, in their order (1), not 2"),
+        (
+            ["--builds", "{builds}", "--builds", "{builds}"],
+            "Pareto file, in their order (1), not 2",
+        ),
     ],
 )
 def test_kesort_builds_of_the_wrong_file_are_one_line(ps_front, tmp_path, args, said):

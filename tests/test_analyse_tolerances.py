@@ -110,8 +110,15 @@ def test_picked_designs_are_analysed_as_in_their_whole_front(ps_front, tmp_path)
                 assert got.tobytes() == want.tobytes(), (label, key)
     res = _invoke("export", picked_file, "--pick", "knee", "-o", tmp_path / "knee.yaml")
     assert res.exit_code == 0, res.output
+    # designs picked by row number have no names: none is computed over the few picked
+    rows_file = tmp_path / "rows.h5"
+    assert (
+        _invoke("analyse", "tolerances", ps_front, "-o", rows_file, "--pick", "0,1").exit_code == 0
+    )
+    res = _invoke("export", rows_file, "--pick", "knee", "-o", tmp_path / "no.yaml")
+    assert res.exit_code == 2 and "has no such pick; it has a row number" in res.output
 
 
 def test_pick_is_an_option_of_the_front_analyses_alone(ps_front):
-    res = _invoke("analyse", "transmissibility", ps_front, "--pick", "knee")
-    assert res.exit_code == 2 and "analyse transmissibility does not take --pick" in res.output
+    res = _invoke("analyse", "scenarios", ps_front, "--pick", "knee")
+    assert res.exit_code == 2 and "analyse scenarios does not take --pick" in res.output

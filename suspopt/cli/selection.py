@@ -145,8 +145,7 @@ def _builds_options(pareto: list[Path], builds: list[Path], least: float | None)
         raise ConfigError(f"--min-feasible-builds {least:g}: give a share from 0 to 100 %")
     if builds and len(builds) != len(pareto):
         raise ConfigError(
-            f"--builds: give one per Pareto file, in their order ({len(pareto)}), "
-            f"not {len(builds)}"
+            f"--builds: give one per Pareto file, in their order ({len(pareto)}), not {len(builds)}"
         )
     return least
 
