@@ -361,15 +361,23 @@ def test_the_report_in_a_real_browser(files, chapters, browser, tmp_path, monkey
     onward = browser.execute_script(  # the commands that take the design on, run as shown
         "return [...document.querySelectorAll('#design-0 .onward code')].map(c => c.textContent)"
     )
-    assert [shlex.split(c)[:2] for c in onward] == [["suspopt", "export"], ["suspopt", "simulate"]]
+    source = shlex.split(study["source"])[0]
+    assert [shlex.split(c)[:3] for c in onward] == [
+        ["suspopt", "export", source],
+        ["suspopt", "simulate", source],
+        ["suspopt", "analyse", "builds"],
+    ]
     monkeypatch.chdir(tmp_path)
-    for command in onward if which == "ch5" else onward[:1]:  # (one simulation is enough)
+    for command in onward if which == "ch5" else onward[:1]:  # (one run of each is enough)
         res = _invoke(*shlex.split(command)[1:])
         assert res.exit_code == 0, (command, res.output)
     exported = (tmp_path / f"design_{row}.yaml").read_text().splitlines()[0]
     assert exported.startswith(f"# Design '{row}' (row {row} of /")
     assert exported.endswith(f" of {shlex.split(onward[0])[2]}")
     assert which != "ch5" or (tmp_path / f"design_{row}.h5").exists()
+    if which == "ch5":  # the design's builds, as the file's own row
+        with h5py.File(tmp_path / f"design_{row}_builds.h5") as h5:
+            assert h5["pareto/source_row"][()].tolist() == [row]
     requests = [
         json.loads(entry["message"])["message"]["params"]["request"]["url"]
         for entry in browser.get_log("performance")

@@ -90,6 +90,7 @@ SCRIPT = r"""
     el("div", "take it on (from where the report was made):", onward);
     el("code", "suspopt export " + d.source + " --pick " + row + " -o design_" + row + ".yaml", onward);
     el("code", "suspopt simulate " + d.source + " --pick " + row + " -o design_" + row + ".h5 --plot design_" + row + ".png", onward);
+    el("code", "suspopt analyse builds " + d.source + " --pick " + row + " -o design_" + row + "_builds.h5", onward);
     api.selected = { study: i, row: row };
     box.setAttribute("data-row", String(row));
   }
