@@ -22,6 +22,7 @@ from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
 from suspopt.export import write_csv
 from suspopt.io import is_suspopt_output, open_dataset, write_dataset, write_simulation
+from suspopt.picks import read_front
 from suspopt.selection import load_design_sets, read_pareto, select, write_selection
 
 K = [4.0e4, 6.0e4]  # two designs: the design axis is not a single row
@@ -51,6 +52,8 @@ def files(tmp_path_factory):
         d / "roads.h5", pseudo_fronts("roads", pareto, road_variants(pareto, ["B"]))
     )
     builds = write_builds(d / "builds.h5", draw_and_evaluate(pareto, 4, tolerance=10.0, seed=1))
+    knee = read_front(ke, ["chosen", "knee"])  # (designs picked from a kesort file)
+    picked = write_builds(d / "picked.h5", draw_and_evaluate(knee, 3, tolerance="C_v=5", seed=1))
     transmissibility.run(front, output=d / "stht.h5")
     models.run(
         [CONFIGS / "ch3/part1a_qc_bump.yaml", CONFIGS / "ch3/part1a_hc1_bump.yaml"],
@@ -64,6 +67,7 @@ def files(tmp_path_factory):
         "stht": d / "stht.h5",
         "models": d / "models.h5",
         "builds": builds,
+        "picked": picked,
     }
 
 
@@ -103,7 +107,9 @@ def datasets(path) -> list[tuple[str, tuple, dict]]:
     return out
 
 
-@pytest.mark.parametrize("kind", ["sim", "front", "ke", "roads", "stht", "models", "builds"])
+@pytest.mark.parametrize(
+    "kind", ["sim", "front", "ke", "roads", "stht", "models", "builds", "picked"]
+)
 @pytest.mark.slow
 def test_every_group_opens_in_xarray_with_named_dimensions(files, kind):
     """No phony_dim anywhere; the whole file is one DataTree (one length per name)."""
