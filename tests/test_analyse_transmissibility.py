@@ -148,5 +148,10 @@ def test_the_designs_picked_are_analysed_and_keep_their_picks(tmp_path, ps_front
     assert picked.seat.stiffness == pytest.approx(ps_front.X[ps_front.picks[edge], 0], rel=1e-12)
     res = run("export", out, "--pick", "knee", "-o", tmp_path / "knee.yaml")
     assert res.returncode == 2 and "has no such pick; it has " in res.stderr
+    for damaged, said in (([edge], "1 entries for 2 designs"), (np.arange(2), "not text")):
+        with h5py.File(out, "r+") as h5:
+            h5["designs"].attrs["picks"] = damaged
+        res = run("export", out, "--pick", edge, "-o", tmp_path / "no.yaml")
+        assert res.returncode == 2 and f"/designs: attribute 'picks': {said}" in res.stderr
     res = run("analyse", "transmissibility", PASSENGER, "--pick", "knee")
     assert res.returncode == 2 and "--pick is for a result file" in res.stderr
