@@ -120,5 +120,5 @@ def test_picked_designs_are_analysed_as_in_their_whole_front(ps_front, tmp_path)
 
 
 def test_pick_is_an_option_of_the_front_analyses_alone(ps_front):
-    res = _invoke("analyse", "scenarios", ps_front, "--pick", "knee")
-    assert res.exit_code == 2 and "analyse scenarios does not take --pick" in res.output
+    res = _invoke("analyse", "cdf-sensitivity", ps_front, "--pick", "knee")
+    assert res.exit_code == 2 and "analyse cdf-sensitivity does not take --pick" in res.output

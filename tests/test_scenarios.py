@@ -330,6 +330,17 @@ def test_simulate_a_pick_under_one_scenario(tmp_path):
         rows = h5["scenarios/row"][...]
         assert np.array_equal(h5["scenarios/F"][...], src["pareto/scenarios/F"][...][rows])
         assert list(h5["scenarios/F"].attrs["over_scenarios"]) == ["max", "max"]
+        knee = int(rows[picks.index("knee")])
+    # --pick: the designs named, a row number as "row R", each name once
+    res = runner.invoke(
+        app, ["analyse", "scenarios", str(front), "--pick", "0,knee,0", "-o", str(report),
+              "--force"],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    with h5py.File(report) as h5, h5py.File(front) as src:
+        assert [p.decode() for p in h5["scenarios/pick"][...]] == ["row 0", "knee"]
+        assert list(h5["scenarios/row"][...]) == [0, knee]
+        assert np.array_equal(h5["scenarios/F"][...], src["pareto/scenarios/F"][...][[0, knee]])
     for command in (  # it holds no design set: each command says what it is and made from
         ["report", str(report), "-o", str(tmp_path / "spread.html")],
         ["export", str(report), "--pick", "knee", "-o", str(tmp_path / "knee.yaml")],

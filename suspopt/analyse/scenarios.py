@@ -5,7 +5,7 @@ objectives and constraint margins under every scenario (``/pareto/scenarios/F (N
 ``G (N, S, k)``, the combined values in ``/pareto/F`` and ``G``;
 :mod:`suspopt.optimise.scenarios`). This analysis reads them, simulates nothing, and reports
 for the front's picks (:func:`suspopt.kesort.pareto_picks`: each objective's edge and the
-knee, taken on the combined objectives) each objective's combined value, its smallest, mean
+knee, taken on the combined objectives; or the designs ``--pick`` names) each objective's combined value, its smallest, mean
 and largest value over the scenarios, the scenario where it is largest, and in how many
 scenarios the design holds every constraint; and for the whole front, how many designs hold
 every constraint in every scenario.
@@ -18,6 +18,7 @@ HDF5 layout (root attributes as every suspopt file, ``config`` the stored config
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -61,15 +62,21 @@ def read_scenarios(path: Path):
     return pareto, names, FS, GS
 
 
-def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
-    """The picks of a robust front under every scenario (module docstring)."""
+def run(
+    source: Path,
+    output: Path | None = None,
+    plot: Path | None = None,
+    pick: Sequence[str] | None = None,
+) -> Report:
+    """The picks of a robust front under every scenario, or the designs ``pick`` names
+    (:func:`_picks`; module docstring)."""
     if plot is not None:
         plots.check_path(plot)
     pareto, names, FS, GS = read_scenarios(source)
     cfg = pareto.config()
     with H5Reader(source) as h5:
         units = h5.labels("pareto/F", "units", pareto.F.shape[1])
-    picks = pareto_picks(pareto.F, pareto.obj_names)
+    picks = _picks(source, pareto.F, pareto.obj_names, pick)
     rows_of = list(picks.values())
     holds = (GS <= 0).all(axis=2)  # (N, S)
     rules = _rules(source, len(pareto.obj_names))
@@ -130,6 +137,25 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
     )  # fmt: skip
 
 
+def _picks(
+    source: Path, F: np.ndarray, names: list[str], pick: Sequence[str] | None
+) -> dict[str, int]:
+    """The designs reported, name -> row: the front's edges and knee
+    (:func:`suspopt.kesort.pareto_picks`), or those ``pick`` names (``--pick``: names of the
+    file's table or row numbers, comma-separated or repeated; a row number is named ``row
+    R``), each name once."""
+    if not pick:
+        return pareto_picks(F, names)
+    from ..picks import read_table, split_picks
+
+    table = read_table(source)
+    chosen: dict[str, int] = {}
+    for name in split_picks(list(pick)):
+        row = table.resolve(name)
+        chosen.setdefault(f"row {row}" if name.isdigit() else name, row)
+    return chosen
+
+
 def _rules(source: Path, m: int) -> list[str]:
     """Each objective's ``over_scenarios`` rule as the file states it ("" if it does not)."""
     with H5Reader(source) as h5:
@@ -138,4 +164,4 @@ def _rules(source: Path, m: int) -> list[str]:
         return h5.labels("pareto/F", "over_scenarios", m)
 
 
-KINDS["scenarios"] = Kind(run)
+KINDS["scenarios"] = Kind(run, options=("pick",))
