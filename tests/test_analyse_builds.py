@@ -318,10 +318,13 @@ def test_the_chosen_design_of_a_kesort_file_is_built_as_in_its_front(ps_front, t
     choice, whole_file, picked_file = (tmp_path / f"{n}.h5" for n in ("choice", "whole", "one"))
     assert _invoke("kesort", front, "-o", choice).exit_code == 0
     assert _invoke("analyse", "builds", front, "-o", whole_file, "--samples", 5).exit_code == 0
+    figure = tmp_path / "one.png"
     res = _invoke(
-        "analyse", "builds", choice, "-o", picked_file, "--samples", 5, "--pick", "chosen"
-    )
+        "analyse", "builds", choice, "-o", picked_file, "--samples", 5, "--pick", "chosen",
+        "--plot", figure,
+    )  # fmt: skip
     assert res.exit_code == 0, res.output
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     with h5py.File(choice) as h5:
         row = int(h5["kesort/row"][int(h5["kesort/chosen"][()])])
     with h5py.File(whole_file) as whole, h5py.File(picked_file) as one:

@@ -50,3 +50,20 @@ def test_pareto_fronts_draw_one_panel_per_objective_pair_and_variable(tmp_path):
     text = path.read_text()
     # three panels (front, K_v, C_v) and the mark's label
     assert text.count('id="axes_') == 3 and "knee" in text
+
+
+def test_a_cloud_of_builds_is_drawn_beneath_the_fronts(tmp_path, monkeypatch):
+    """``cloud`` draws every point it is given (the builds of ``analyse builds``), on the
+    panel's pair of objectives, beneath the fronts, under its label."""
+    F = np.column_stack([np.linspace(0.1, 0.3, 8), np.linspace(0.09, 0.01, 8)])
+    builds = np.repeat(F, 5, axis=0) * np.linspace(0.95, 1.05, 40)[:, None]
+    drawn = []
+    monkeypatch.setattr(plots.figures, "save", lambda fig, path: drawn.append(fig) or path)
+    plots.pareto_fronts(
+        tmp_path / "f.png", "f", [("RC_se", "m/s^2"), ("X_ST", "m")], [("optimised", F)],
+        cloud=("builds (40)", builds),
+    )  # fmt: skip
+    ax = drawn[0].axes[0]
+    cloud = next(c for c in ax.collections if c.get_label() == "builds (40)")
+    np.testing.assert_array_equal(cloud.get_offsets(), builds)
+    assert cloud.get_zorder() < min(c.get_zorder() for c in ax.collections if c is not cloud)

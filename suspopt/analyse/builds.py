@@ -405,8 +405,9 @@ def _report(b: Builds, title: str) -> Report:
 
 
 def plot_builds(b: Builds, path: str | Path, title: str) -> Path:
-    """The stored front with each objective's 5th and 95th percentile over the builds, and
-    the design variables along it (:func:`suspopt.plots.pareto_fronts`)."""
+    """The stored front with each objective's 5th and 95th percentile over the builds, every
+    build that did not fail as a faint dot beneath, and the design variables along it
+    (:func:`suspopt.plots.pareto_fronts`)."""
     from .. import plots
 
     p, m = b.pareto, b.m
@@ -416,9 +417,11 @@ def plot_builds(b: Builds, path: str | Path, title: str) -> Path:
     variables = [(n, u, p.X[:, j]) for j, (n, u) in enumerate(zip(p.var_names, p.var_units))]
     objectives = list(zip(b.stored.names[:m], b.stored.units[:m]))
     marks, comfort = p.marks(), is_comfort(p.config())
+    built = b.F[..., :m][~b.failed]  # (builds that did not fail, m)
     return plots.pareto_fronts(
-        path, title, objectives, curves, variables, marks=marks, comfort=comfort
-    )
+        path, title, objectives, curves, variables, marks=marks, comfort=comfort,
+        cloud=(f"builds ({len(built)})", built),
+    )  # fmt: skip
 
 
 def run_builds(

@@ -57,6 +57,7 @@ def pareto_fronts(
     variables: Sequence[tuple[str, str, np.ndarray]] = (),
     marks: Mapping[str, int] | None = None,
     comfort: Sequence[bool] | None = None,
+    cloud: tuple[str, np.ndarray] | None = None,
 ) -> Path:
     """Fronts ``(label, F (N, m))`` over ``objectives`` ``(name, unit)`` - the first the
     optimised front, the rest pseudo-fronts of the same designs - as the first objective
@@ -64,7 +65,8 @@ def pareto_fronts(
     ``(name, unit, values (N,))`` of the optimised front against the first objective
     (Figs. 8.11-8.20). ``marks`` (name -> design index) are starred on the optimised front;
     ``comfort[j]`` tells that objective ``j`` is an ISO 2631-1 weighted r.m.s. (its levels
-    are drawn when it is the x axis)."""
+    are drawn when it is the x axis); ``cloud`` ``(label, F (K, m))``: many points drawn
+    faint beneath the fronts (the builds of ``analyse builds``)."""
     m = len(objectives)
     pairs = [(0, j) for j in range(1, m)] or [(0, 0)]
     fig, axes = new_figure(len(pairs) + len(variables), columns=3)
@@ -80,6 +82,7 @@ def pareto_fronts(
             axis_label(*objectives[j]),
             points,
             bool(comfort and comfort[0]),
+            cloud=None if cloud is None else (cloud[0], cloud[1][:, i], cloud[1][:, j]),
         )
     F0 = fronts[0][1]
     for ax, (name, unit, values) in zip(axes[len(pairs) :], variables):

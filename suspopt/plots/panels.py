@@ -134,11 +134,16 @@ def draw_front(
     marks: Mapping[str, tuple[float, float]] | None = None,
     comfort: bool = False,
     legend: bool = True,
+    cloud: tuple[str, np.ndarray, np.ndarray] | None = None,
 ) -> None:
     """Fronts ``(label, x (N,), y (N,))`` as points, the first one (the optimised front)
     filled, the others (pseudo-fronts) hollow; ``marks`` (name -> (x, y)) as labelled stars;
     ``comfort`` draws the ISO 2631-1 levels on the x axis; ``legend`` False leaves the
-    legend to the figure."""
+    legend to the figure; ``cloud`` ``(label, x, y)``: many points (a front's builds) as
+    faint dots beneath the rest."""
+    if cloud is not None:
+        label, x, y = cloud
+        ax.scatter(x, y, s=2, color="0.6", alpha=0.4, linewidths=0, label=label, zorder=0)
     for i, (label, x, y) in enumerate(fronts):
         style = dict(s=18, label=label)
         if i:
