@@ -33,6 +33,9 @@ from . import KINDS, Kind, Report
 
 __all__ = ["run", "read_scenarios"]
 
+#: ``--pick`` as the analyses take it: names or row numbers, or None for the front's picks
+Picks = Sequence[str] | None
+
 
 def read_scenarios(path: Path):
     """``(pareto, names (S,), FS (N, S, m), GS (N, S, k))`` of a robust optimisation's file;
@@ -63,10 +66,7 @@ def read_scenarios(path: Path):
 
 
 def run(
-    source: Path,
-    output: Path | None = None,
-    plot: Path | None = None,
-    pick: Sequence[str] | None = None,
+    source: Path, output: Path | None = None, plot: Path | None = None, *, pick: Picks = None
 ) -> Report:
     """The picks of a robust front under every scenario, or the designs ``pick`` names
     (:func:`_picks`; module docstring)."""
@@ -137,9 +137,7 @@ def run(
     )  # fmt: skip
 
 
-def _picks(
-    source: Path, F: np.ndarray, names: list[str], pick: Sequence[str] | None
-) -> dict[str, int]:
+def _picks(source: Path, F: np.ndarray, names: list[str], pick: Picks) -> dict[str, int]:
     """The designs reported, name -> row: the front's edges and knee
     (:func:`suspopt.kesort.pareto_picks`), or those ``pick`` names (``--pick``: names of the
     file's table or row numbers, comma-separated or repeated; a row number is named ``row
