@@ -5,10 +5,10 @@ objectives and constraint margins under every scenario (``/pareto/scenarios/F (N
 ``G (N, S, k)``, the combined values in ``/pareto/F`` and ``G``;
 :mod:`suspopt.optimise.scenarios`). This analysis reads them, simulates nothing, and reports
 for the front's picks (:func:`suspopt.kesort.pareto_picks`: each objective's edge and the
-knee, taken on the combined objectives; or the designs ``--pick`` names) each objective's combined value, its smallest, mean
-and largest value over the scenarios, the scenario where it is largest, and in how many
-scenarios the design holds every constraint; and for the whole front, how many designs hold
-every constraint in every scenario.
+knee, taken on the combined objectives; or the designs ``--pick`` names) each objective's
+combined value, its smallest, mean and largest value over the scenarios, the scenario where
+it is largest, and in how many scenarios the design holds every constraint; and for the
+whole front, how many designs hold every constraint in every scenario.
 
 HDF5 layout (root attributes as every suspopt file, ``config`` the stored config's text,
 ``analysis = "scenarios"``, ``source`` the Pareto file): ``/scenarios/pick`` (names),
