@@ -416,19 +416,20 @@ class H5Reader:
             )
         return int(value)
 
-    def labels(self, name: str, key: str, columns: int) -> list[str]:
+    def labels(
+        self, name: str, key: str, columns: int, *, kind: str = "Dataset", of: str = "columns"
+    ) -> list[str]:
         """The per-column text attribute ``key`` (``names``, ``units``) of dataset ``/name``,
-        one entry per column."""
-        ds = self.dataset(name)
+        one entry per column; of a group with ``kind="Group"``, one per item ``of`` it
+        (``picks`` of ``/designs``: one per design)."""
+        obj = self._kind(name, kind)
         label = f"/{name}: attribute {key!r}"
-        raw = self.attribute(ds, key, label)
+        raw = self.attribute(obj, key, label)
         if raw is None:
             raise ConfigError(f"{self.where}: {label}: missing")
         entries = [self.text(v, label) for v in np.atleast_1d(raw)]
         if len(entries) != columns:
-            raise ConfigError(
-                f"{self.where}: {label}: {len(entries)} entries for {columns} columns"
-            )
+            raise ConfigError(f"{self.where}: {label}: {len(entries)} entries for {columns} {of}")
         return entries
 
 

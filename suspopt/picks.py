@@ -184,14 +184,9 @@ def read_table(path: str | Path) -> DesignTable:
 def _row_picks(h5, rows: int) -> list[str] | None:
     """The attribute ``picks`` of ``/designs``: the picks of each of its ``rows`` rows,
     comma-separated (None where it is missing)."""
-    label = "/designs: attribute 'picks'"
-    raw = h5.attribute(h5.group("designs"), "picks", label)
-    if raw is None:
+    if not h5.has_attr("picks", "designs"):
         return None
-    entries = [h5.text(v, label) for v in np.atleast_1d(raw)]
-    if len(entries) != rows:
-        raise ConfigError(f"{h5.where}: {label}: {len(entries)} entries for {rows} designs")
-    return entries
+    return h5.labels("designs", "picks", rows, kind="Group", of="designs")
 
 
 def _index(h5, name: str, rows: int) -> int:

@@ -106,13 +106,18 @@ class ParetoSet:
             return dict(self.picked)
         return pareto_picks(self.F, self.obj_names)
 
+    def marks_by_row(self) -> dict[int, list[str]]:
+        """:meth:`marks` by design: row -> the names it is marked by, in their order."""
+        named: dict[int, list[str]] = {}
+        for name, row in self.marks().items():
+            named.setdefault(row, []).append(name)
+        return named
+
     def picked_note(self) -> list[str]:
         """The report's note of the designs picked from the file (none for a whole front)."""
         if self.source_rows is None:
             return []
-        named: dict[int, list[str]] = {}
-        for name, row in (self.picked or {}).items():
-            named.setdefault(row, []).append(name)
+        named = self.marks_by_row()
         each = [
             f"{k}: " + (f"{', '.join(named[k])} (row {int(r)})" if k in named else f"row {int(r)}")
             for k, r in enumerate(self.source_rows)

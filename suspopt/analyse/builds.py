@@ -363,7 +363,7 @@ def _report(b: Builds, title: str) -> Report:
     share = b.feasible.mean(axis=0)
     columns = ["#", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
     columns += [f"{n}: 5-95 % (change)" for n in names] + ["feasible builds"]
-    picks = table_designs(len(p.X), p.marks())
+    picks = table_designs(len(p.X), p.marks_by_row())
     rows = [
         [str(k), picked]
         + [f"{f:.4g}" for f in p.F[k]]

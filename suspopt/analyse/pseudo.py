@@ -472,12 +472,11 @@ def plot_pseudo_fronts(
     )
 
 
-def table_designs(N: int, picks: Mapping[str, int]) -> list[tuple[int, str]]:
+def table_designs(N: int, picked: Mapping[int, list[str]]) -> list[tuple[int, str]]:
     """The rows of a table of a front of ``N`` designs: at most :data:`_TABLE_ROWS` evenly
-    spaced, and every pick; (row, the names of its picks), in order."""
-    picked: dict[int, list[str]] = {}
-    for key, row in picks.items():
-        picked.setdefault(row, []).append(key)
+    spaced, and every design ``picked`` names (row -> its picks:
+    :meth:`~suspopt.selection.ParetoSet.marks_by_row`); (row, the names of its picks), in
+    order."""
     rows = sorted(set(evenly_spaced(N, _TABLE_ROWS)) | set(picked))
     return [(k, ", ".join(picked.get(k, []))) for k in rows]
 
@@ -491,7 +490,7 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
     values = [fronts.values(i) for i in range(len(fronts.sets))]
     changes = [fronts.change(i) for i in range(len(fronts.sets))]
     rows = []
-    for k, picks in table_designs(len(p.X), fronts.picks):
+    for k, picks in table_designs(len(p.X), p.marks_by_row()):
         row = [str(k), picks] + [f"{f:.4g}" for f in p.F[k]]
         for s, value, change in zip(fronts.sets, values, changes):
             row += [

@@ -195,9 +195,7 @@ def front_designs(pareto: ParetoSet) -> FrontDesigns:
     R`` for a row number)."""
     cfg = pareto.config()
     problem = Problem.from_config(cfg)
-    picks: dict[int, list[str]] = {}
-    for name, row in pareto.marks().items():
-        picks.setdefault(row, []).append(name)
+    picks = pareto.marks_by_row()
     if pareto.source_rows is not None:
         picks = {k: picks.get(k, [f"row {int(r)}"]) for k, r in enumerate(pareto.source_rows)}
     rows = np.array(list(picks))

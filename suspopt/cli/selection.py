@@ -158,14 +158,15 @@ def _as_built(sets, pareto: list[Path], builds: list[Path], least: float):
 
     from ..analyse.builds import feasible_builds
 
+    if not builds:
+        return sets, []
     shorts = [feasible_builds(b, p) < least / 100 for b, p in zip(builds, pareto)]
     notes = [
         f"{int(short.sum())} of {len(short)} designs have fewer than {least:g} % of their "
         f"builds feasible ({b}): counted infeasible"
         for short, b in zip(shorts, builds)
     ]
-    built = [replace(s, feasible=s.feasible & ~short) for s, short in zip(sets, shorts)]
-    return (built, notes) if builds else (sets, [])
+    return [replace(s, feasible=s.feasible & ~short) for s, short in zip(sets, shorts)], notes
 
 
 def _threshold_line(sort, label: str) -> str:
