@@ -341,6 +341,21 @@ class H5Reader:
             raise ConfigError(f"{self.where}: /{name}: damaged, cannot be read") from None
         return np.asarray(values, dtype=np.int64 if integer else np.float64)
 
+    def texts(self, name: str, count: int) -> list[str]:
+        """The 1-D text dataset ``/name``, checked to hold ``count`` entries of
+        UTF-8 text (each as :meth:`text` reads it)."""
+        ds = self.dataset(name)
+        if ds.dtype.kind not in ("O", "S") or ds.ndim != 1 or len(ds) != count:
+            raise ConfigError(
+                f"{self.where}: /{name}: expected {count} entries of text, got {ds.dtype} "
+                f"values of shape {ds.shape}"
+            )
+        try:
+            values = ds[()]
+        except (OSError, ValueError, RuntimeError):
+            raise ConfigError(f"{self.where}: /{name}: damaged, cannot be read") from None
+        return [self.text(v, f"/{name}") for v in values]
+
     def text(self, value, name: str) -> str:
         """``value`` (an attribute or dataset element) as text."""
         if isinstance(value, np.ndarray) and value.ndim == 0:

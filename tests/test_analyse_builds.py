@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 
 import h5py
@@ -403,3 +404,141 @@ def test_kesort_of_pooled_fronts_takes_the_builds_of_each(ps_front, tmp_path):
     np.testing.assert_array_equal(feasible, stored[rows] & (share[rows] >= 0.95))
     said = " ".join(res.output.split())
     assert said.count(f"{int((share < 0.95).sum())} of {len(share)} designs have fewer") == 2
+
+
+def _with_batch(front, dst, *labels, name="made"):
+    """A copy of ``front`` whose stored config gives the variables ``labels`` the batch
+    ``name``."""
+    shutil.copyfile(front, dst)
+    with h5py.File(dst, "r+") as h5:
+        text = h5.attrs["config"]
+        for label in labels:
+            old = f"{{name: {label}, path:"
+            assert text.count(old) == 1
+            text = text.replace(old, f"{{name: {label}, batch: {name}, path:")
+        h5.attrs["config"] = text
+    return dst
+
+
+def test_the_parts_of_one_batch_are_off_alike_each_within_its_own_band(ps_front, tmp_path):
+    """``--batch K_v,C_v``: in every build both variables are off by the same fraction of
+    their own band (K_v ±5 %, C_v ±15 %), the first one's draw is that of a run without the
+    batch, bit for bit, and the static deflection still follows m g / K_v (Eq 8.2). The file
+    names each variable's batch; the report says which parts are off alike and gives the
+    batch one share of each spread, the one both columns of ``contribution`` hold."""
+    front, _ = ps_front
+    alone, together = tmp_path / "alone.h5", tmp_path / "together.h5"
+    bands = ["--tolerance", "K_v=5", "--tolerance", "C_v=15", "--samples", 30]
+    assert _invoke("analyse", "builds", front, "-o", alone, *bands).exit_code == 0
+    res = _invoke("analyse", "builds", front, "-o", together, *bands, "--batch", "K_v, C_v")
+    assert res.exit_code == 0, res.output
+    with h5py.File(front) as h5:
+        X0, F0 = h5["pareto/X"][()], h5["pareto/F"][()]
+    with h5py.File(alone) as h5:
+        X_alone = h5["builds/X"][()]
+        assert h5["builds/batch"][()].astype(str).tolist() == ["", ""]
+    with h5py.File(together) as h5:
+        X, F, r2 = h5["builds/X"][()], h5["builds/F"][()], h5["builds/contribution"][()]
+        assert h5["builds/batch"][()].astype(str).tolist() == ["K_v+C_v", "K_v+C_v"]
+        assert [s.name for s in h5["builds/batch"].dims[0].values()] == ["/builds/variable"]
+    u = (X / X0 - 1) / np.array([0.05, 0.15])
+    np.testing.assert_allclose(u[..., 1], u[..., 0], rtol=0, atol=1e-12)
+    assert np.abs(u).max() > 0.9 and u[..., 0].std() > 0.3
+    assert X[..., 0].tobytes() == X_alone[..., 0].tobytes()
+    assert not np.allclose(X[..., 1], X_alone[..., 1])
+    np.testing.assert_allclose(F[..., 1], F0[:, 1] * X0[:, 0] / X[..., 0], rtol=1e-9)
+    np.testing.assert_allclose(r2[:, 0], r2[:, 1], rtol=1e-9)
+    said = " ".join(res.output.split())
+    assert "(seed 1), the parts of one batch off alike (K_v and C_v);" in said
+    drivers = said.split("what drives each objective's spread")[1].split(" wrote ")[0]
+    assert re.findall(r"(\S+) \d\.\d\d", drivers) == ["K_v+C_v", "K_v+C_v"], drivers
+
+
+def test_the_stored_configs_batches_are_drawn_unless_batch_says_none(ps_front, tmp_path):
+    """``design_variables[i].batch`` in the stored config makes the variables of one name a
+    batch, as ``--batch`` does; ``--batch none`` draws every variable alone, the builds of
+    a config without batches bit for bit."""
+    front, _ = ps_front
+    own = _with_batch(front, tmp_path / "own.h5", "K_v", "C_v")
+    runs = {}
+    for key, source, given in (
+        ("plain", front, []),
+        ("stored", own, []),
+        ("option", front, ["--batch", "K_v,C_v"]),
+        ("none", own, ["--batch", "none"]),
+    ):
+        out = tmp_path / f"{key}.h5"
+        res = _invoke("analyse", "builds", source, "-o", out, "--samples", 8, *given)
+        assert res.exit_code == 0, res.output
+        with h5py.File(out) as h5:
+            runs[key] = (h5["builds/X"][()], h5["builds/batch"][()].astype(str).tolist())
+    assert runs["stored"][0].tobytes() == runs["option"][0].tobytes()
+    assert runs["stored"][1] == ["made", "made"] and runs["option"][1] == ["K_v+C_v"] * 2
+    assert runs["none"][0].tobytes() == runs["plain"][0].tobytes()
+    assert runs["none"][1] == ["", ""]
+    assert not np.array_equal(runs["stored"][0], runs["plain"][0])
+
+
+def test_validate_refuses_a_batch_of_one_variable_at_its_line(tmp_path):
+    """A batch is two variables or more: a batch name given to one variable alone (a
+    misspelt name) is refused by ``validate`` at its line, and the same batch named by both
+    is accepted."""
+    from suspopt.templates import template_text
+
+    text = template_text("spectral")
+    old = "{name: C_v, path: seat.damping,"
+    assert text.count(old) == 1
+    config = tmp_path / "study.yaml"
+    config.write_text(text.replace(old, "{name: C_v, batch: made, path: seat.damping,"))
+    res = _invoke("validate", config)
+    line = 1 + text[: text.index(old)].count("\n")
+    assert res.exit_code == 2, res.output
+    assert f"study.yaml:{line}: design_variables[1].batch: batch 'made' has this" in res.output
+    assert len(res.output.strip().splitlines()) == 1
+    both = text.replace(old, "{name: C_v, batch: made, path: seat.damping,")
+    both = both.replace("{name: K_v, path:", "{name: K_v, batch: made, path:")
+    config.write_text(both)
+    res = _invoke("validate", config)
+    assert res.exit_code == 0, res.output
+
+
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        (["--batch", "K_v"], "--batch K_v: batch 'K_v' has one design variable"),
+        (["--batch", "K_v,k_v"], "--batch K_v,k_v: ps_front.h5 has no design variable 'k_v'"),
+        (["--batch", "K_v,K_v"], "--batch K_v,K_v: K_v is in two batches (K_v+K_v, K_v+K_v)"),
+        (["--batch", "K_v,C_v", "--batch", "C_v,K_v"], "C_v is in two batches (K_v+C_v, C_v+K_v)"),
+        (["--batch", "K_v,"], "--batch 'K_v,': give the names of two design variables or more"),
+        (["--batch", "none", "--batch", "K_v,C_v"], "--batch 'none': give the names"),
+        (["--batch", ""], "--batch '': give the names of two design variables or more"),
+        (["--batch", "x" * 5000], "has no design variable 'xxxxxxxx"),
+    ],
+)
+def test_bad_batches_are_one_line(ps_front, tmp_path, args, said):
+    front = shutil.copyfile(ps_front[0], tmp_path / "ps_front.h5")
+    out = tmp_path / "builds.h5"
+    res = _invoke("analyse", "builds", front, "-o", out, *args)
+    assert res.exit_code == 2 and not out.exists(), res.output
+    assert res.output.strip().startswith("error: ") and said in res.output
+    assert len(res.output.strip().splitlines()) == 1
+
+
+def test_a_stored_batch_of_one_variable_is_the_files_fault_in_one_line(ps_front, tmp_path):
+    """A file whose stored config was edited to give one variable a batch of its own is bad
+    input, named, with or without ``--batch`` (its designs are evaluated under that config,
+    which ``validate`` refuses: at its line); ``--batch`` is an option of builds alone."""
+    own = _with_batch(ps_front[0], tmp_path / "own.h5", "C_v")
+    out = tmp_path / "builds.h5"
+    res = _invoke("analyse", "builds", own, "-o", out, "--samples", 3)
+    assert res.exit_code == 2 and not out.exists(), res.output
+    assert f"{own}: the stored config's design_variables: batch 'made' has one" in res.output
+    assert len(res.output.strip().splitlines()) == 1
+    res = _invoke("analyse", "builds", own, "-o", out, "--samples", 3, "--batch", "none")
+    assert res.exit_code == 2 and not out.exists(), res.output  # (the evaluation's check)
+    assert (
+        f"{own}:config:" in res.output and "design_variables[1].batch: batch 'made'" in res.output
+    )
+    assert len(res.output.strip().splitlines()) == 1
+    res = _invoke("analyse", "tolerances", own, "--batch", "K_v,C_v")
+    assert res.exit_code == 2 and "analyse tolerances does not take --batch" in res.output

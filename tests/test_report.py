@@ -546,6 +546,36 @@ def test_a_design_of_an_analyse_builds_file_shows_the_spread_of_its_builds(
         )
         within = f"each variable within its tolerance ({first} ±7.5 %, {second} ±10 %)"
         assert note == f"12 builds, {within} (normal)"
+    # the parts of one batch (--batch): one driver, named by the batch, and the note says so
+    batched, page = tmp_path / "batched.h5", tmp_path / "batched.html"
+    res = _invoke(
+        "analyse", "builds", files["front"], "--samples", 12, "--batch", f"{first},{second}",
+        "-o", batched,
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert _invoke("report", batched, "-o", page).exit_code == 0
+    with h5py.File(batched) as h5:
+        r2 = h5["builds/contribution"][()]
+        variables = list(h5["builds/X"].attrs["names"].astype(str))
+    browser.get(page.resolve().as_uri())
+    _wait(browser, "return document.body.getAttribute('data-rendered')", "the plots rendered")
+    browser.execute_script("window.suspoptReport.select(0, 0)")
+    rows = browser.execute_script(
+        "return [...document.querySelectorAll('#design-0 tr')]"
+        ".map(tr => [...tr.cells].map(c => c.textContent))"
+    )
+    notes = {r[0]: r[3] if len(r) > 3 else "" for r in rows}
+    for j, name in enumerate(names):
+        shares = [f"{r2[0, i, j]:.2f}" for i in range(len(variables))]
+        alone = [f"{v} {c}" for v, c in zip(variables[2:], shares[2:])]
+        drivers = sorted(
+            [f"{first}+{second} {shares[0]}", *alone], key=lambda d: -float(d.split()[-1])
+        )
+        assert notes[f"{name}, built 5-95 %"] == "spread from: " + ", ".join(drivers)
+    note = browser.execute_script(
+        "return document.querySelector('#design-0 > div.note').textContent"
+    )
+    assert note.endswith(f"; the parts of one batch off alike ({first} and {second})")
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,6 @@
 """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--tolerance NAME=T]
-[--seed S] [--distribution uniform|normal] [--pick NAMES]``: a front's designs as many parts
-built to their tolerances at once.
+[--seed S] [--distribution uniform|normal] [--pick NAMES] [--batch NAME,NAME]``: a front's
+designs as many parts built to their tolerances at once.
 
 ``analyse tolerances`` moves one design variable at a time to the edge of its band; a built
 suspension has every part off at once, by an amount nobody chose. This analysis builds each
@@ -16,10 +16,17 @@ It reports, per design, the spread of each objective's change over its builds (5
 percentile, ``100 (f_built - f_stored)/f_stored``) and the share of builds that meet every
 constraint. The thesis has no such analysis; it is ours.
 
+Parts of one batch: the design variables the stored config gives one
+``design_variables[i].batch`` name, or ``--batch NAME,NAME`` names together (repeatable;
+``--batch none``: every variable alone), are off alike in every build: they take the offset
+``u`` drawn for the first of them, each within its own band (two dampers made in one
+batch, off by the same fraction of their tolerance). The other variables' draws are those
+of a run without batches, bit for bit. Which of the two a real process is lies between:
+the two runs bound it.
+
 Choices: a uniform draw by default, since a tolerance band says where a part may lie and
 nothing of how often (the normal one narrows the spread, as a capable process does);
-independent variables (two springs of one batch may well be off alike, which this does not
-model). A
+variables drawn independently unless they are of one batch. A
 value the draw would take outside what its config field accepts is held at the field's
 limit, and the report says how many (as ``analyse tolerances`` does). Each design's draws
 come from a stream of its own, ``numpy.random.default_rng([seed, the 64 bits of each of its
@@ -39,7 +46,8 @@ HDF5 layout (root attributes as every suspopt file, ``config`` = the stored conf
 
 - ``/pareto``: the stored front, as :mod:`.pseudo` writes it (X, F, feasible, picks, S);
 - ``/builds`` with attributes ``samples`` and ``distribution``; ``/builds/tolerance
-  (variable,)`` [%] each variable's tolerance;
+  (variable,)`` [%] each variable's tolerance; ``/builds/batch (variable,)`` the batch of
+  each (text: its name, empty for a variable drawn alone);
   ``/builds/X (sample, design, variable)`` the built designs (the variables' units),
   ``F (sample, design, objective)``, ``S (sample, design, supplementary)`` (if any),
   ``change (sample, design, objective)`` [%], ``feasible`` and ``failed (sample, design)``
@@ -65,6 +73,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import ConfigError
+from ..config.optimise import batches as config_batches
 from ..io import atomic_h5, write_dataset
 from ..params import MAX_SWEEP_DESIGNS
 from ..picks import read_front
@@ -76,6 +85,7 @@ from .tolerances import Tolerances, bands, inside, variable_limits, variable_tol
 __all__ = [
     "SAMPLES",
     "Builds",
+    "variable_batches",
     "draw_builds",
     "builds",
     "write_builds",
@@ -101,8 +111,8 @@ class Builds:
     ``feasible`` and ``failed (N, D)``, ``G (N, D, k)`` their constraints (``g <= 0`` is
     met; ``constraint_names``, ``constraint_units``); ``stored`` the front's designs under
     the stored config (``names``, ``units``), ``held (n,)`` how many values of each variable
-    were held at its field's limit; ``tolerance (n,)`` [%], ``seed`` and ``distribution`` as
-    drawn."""
+    were held at its field's limit; ``tolerance (n,)`` [%], ``seed``, ``distribution`` and
+    ``batches`` ((name, the indices of its variables), :func:`variable_batches`) as drawn."""
 
     pareto: ParetoSet
     stored: DesignSet
@@ -117,10 +127,21 @@ class Builds:
     G: np.ndarray
     constraint_names: tuple[str, ...]
     constraint_units: tuple[str, ...]
+    batches: tuple[tuple[str, tuple[int, ...]], ...] = ()
 
     @property
     def m(self) -> int:
         return self.pareto.F.shape[1]
+
+    @property
+    def batch_of(self) -> list[str]:
+        """(n,) the batch of each design variable (its name; "" for a variable drawn
+        alone)."""
+        out = [""] * self.X.shape[-1]
+        for name, columns in self.batches:
+            for j in columns:
+                out[j] = name
+        return out
 
     @property
     def reference(self) -> np.ndarray:
@@ -138,7 +159,8 @@ class Builds:
         builds that goes with each design variable: their squared correlation over the
         builds that did not fail (the variables are drawn independently, so this is the
         share a linear fit gives each; what no variable explains alone, through a curved or
-        joint effect, is left over). NaN where a variable or an objective did not vary."""
+        joint effect, is left over). The variables of one batch are drawn as one, so each
+        of them has the batch's share. NaN where a variable or an objective did not vary."""
         ok = ~self.failed[..., None]  # (N, D, 1)
         count = ok.sum(axis=0)  # (D, 1)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -195,18 +217,71 @@ def design_key(seed: int, x: np.ndarray) -> list[int]:
     return [int(seed), *np.ascontiguousarray(x, dtype=np.float64).view(np.uint64).tolist()]
 
 
+def variable_batches(
+    pareto: ParetoSet, batch: Sequence[str] | str | None = None
+) -> tuple[tuple[str, tuple[int, ...]], ...]:
+    """The batches of the design variables of ``pareto``: (name, the columns of its
+    variables) each. ``batch`` None: the stored config's ``design_variables[i].batch``;
+    else ``--batch`` as given, one ``"NAME,NAME[,...]"`` per batch (named by its variables
+    joined with ``+``), or ``"none"``: every variable drawn alone. ConfigError naming the
+    option (or the file) for a name that is no design variable, a variable in two batches
+    or a batch of one."""
+    if batch is None:
+        where = f"{pareto.path}: the stored config's design_variables"
+        variables = pareto.config().design_variables
+        groups = [
+            (name, [variables[i].label for i in members], where)
+            for name, members in config_batches(variables).items()
+        ]
+    else:
+        given = [batch] if isinstance(batch, str) else list(batch)
+        if [str(g).strip() for g in given] == ["none"]:
+            return ()
+        groups = []
+        for text in given:
+            names = [part.strip() for part in str(text).split(",")]
+            if "none" in names or "" in names:
+                raise ConfigError(
+                    f"--batch {text!r}: give the names of two design variables or more, "
+                    f"comma-separated (or none alone: every variable drawn alone)"
+                )
+            groups.append(("+".join(names), names, f"--batch {text}"))
+    out: list[tuple[str, tuple[int, ...]]] = []
+    seen: dict[str, str] = {}
+    for name, members, where in groups:
+        for label in members:
+            if label not in pareto.var_names:
+                raise ConfigError(
+                    f"{where}: {pareto.path.name} has no design variable {label!r}; it has "
+                    f"{', '.join(pareto.var_names)}"
+                )
+            if label in seen:
+                raise ConfigError(f"{where}: {label} is in two batches ({seen[label]}, {name})")
+            seen[label] = name
+        if len(members) < 2:
+            raise ConfigError(
+                f"{where}: batch {name!r} has one design variable: a batch is two or more"
+            )
+        out.append((name, tuple(pareto.var_names.index(label) for label in members)))
+    return tuple(out)
+
+
 def draw_builds(
     pareto: ParetoSet,
     samples: int,
     tolerance: float | np.ndarray,
     seed: int,
     distribution: str = "uniform",
+    batches: Sequence[tuple[str, Sequence[int]]] = (),
 ) -> tuple[np.ndarray, np.ndarray]:
     """``samples`` builds of every design of ``pareto`` (module docstring), each variable
     within ``tolerance`` [%] (one for all, or ``(n,)`` one each): ``X (N, D, n)`` and how
     many values of each variable were held at its field's limit ``(n,)``. Each
     design's offsets come from ``default_rng(design_key(seed, x))``, ``(N, n)`` in one call:
-    the first N of a longer run are those of a run of N."""
+    the first N of a longer run are those of a run of N. The variables of one of
+    ``batches`` ((name, columns), :func:`variable_batches`) take the offset drawn for the
+    first of them, as a fraction of each one's own band; the other variables' draws are
+    those of a run without batches, bit for bit."""
     shape = (samples, pareto.X.shape[1])
     # one stream per design, keyed by its values: its builds are the same whichever front,
     # pick or order it is built in (a loop over random streams, not over simulations)
@@ -219,6 +294,8 @@ def draw_builds(
         low = ndtr(-3.0)
         drawn = np.stack([rng.random(shape) for rng in streams], axis=1)
         u = ndtri(low + drawn * (1.0 - 2.0 * low)) / 3.0
+    for _, columns in batches:  # (made together: off alike)
+        u[..., list(columns[1:])] = u[..., [columns[0]]]
     wanted = pareto.X * (1.0 + u * tolerance / 100.0)
     X = np.empty_like(wanted)
     for j, limits in enumerate(variable_limits(pareto)):  # (per variable: its field's range)
@@ -233,12 +310,14 @@ def builds(
     tolerance: Tolerances = None,
     seed=None,
     distribution=None,
+    batch: Sequence[str] | str | None = None,
 ) -> Builds:
     """Draw and evaluate ``samples`` builds (int) of every design of ``pareto``, each design
     variable within its tolerance [%] (``tolerance`` as
     :func:`.tolerances.variable_tolerances` takes it), from the streams of ``seed`` (int;
     None: the stored config's ``optimiser.seed``), ``distribution`` ``"uniform"`` (None) or
-    ``"normal"`` (module docstring)."""
+    ``"normal"`` (module docstring), the variables of one batch off alike (``batch`` as
+    :func:`variable_batches` takes it)."""
     distribution = "uniform" if distribution is None else distribution
     if distribution not in DISTRIBUTIONS:
         raise ConfigError(
@@ -247,7 +326,8 @@ def builds(
     t = variable_tolerances(pareto, tolerance)
     N = _checked_samples(samples, len(pareto.X))
     s = _checked_seed(seed, pareto)
-    X, held = draw_builds(pareto, N, t, s, distribution)
+    together = variable_batches(pareto, batch)
+    X, held = draw_builds(pareto, N, t, s, distribution, together)
     stored = evaluate_pareto(pareto)
     flat = replace(pareto, X=X.reshape(-1, X.shape[-1]))
     built = evaluate_pareto(flat, pareto.config(), "builds")  # (one batch of N D designs)
@@ -269,6 +349,7 @@ def builds(
         G=(np.zeros((len(F), 0)) if built.G is None else built.G).reshape(shape + (-1,)),
         constraint_names=built.constraint_names,
         constraint_units=built.constraint_units,
+        batches=together,
     )
 
 
@@ -285,6 +366,7 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
         three = ("sample", "design")
         write_dataset(g, "X", b.X, list(p.var_units), three + ("variable",), names=p.var_names)
         write_dataset(g, "tolerance", b.tolerance, "%", ("variable",))
+        write_dataset(g, "batch", b.batch_of, "1", ("variable",))
         write_dataset(g, "F", b.F[..., :m], units[:m], three + ("objective",), names=names[:m])
         if len(names) > m:
             extra = names[m:]
@@ -308,6 +390,16 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
 def _within(b: Builds) -> str:
     band = bands(b.pareto.var_names, b.tolerance)
     return f"{band} of its value" if band.startswith("±") else f"its tolerance ({band})"
+
+
+def _alike(b: Builds) -> str:
+    """What the report says of the batches: which variables are off alike."""
+    if not b.batches:
+        return ""
+    each = "; ".join(
+        " and ".join(b.pareto.var_names[j] for j in columns) for _, columns in b.batches
+    )
+    return f", the parts of one batch off alike ({each})"
 
 
 def _designs(n: int) -> str:
@@ -344,11 +436,15 @@ def _drivers(b: Builds) -> str:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # (nothing varied: NaN)
         share = np.nanmedian(b.contributions, axis=0)  # (n, M)
+    label = list(b.pareto.var_names)
+    for batch, columns in b.batches:  # (drawn as one: the batch is one driver)
+        label[columns[0]] = batch
+        share[list(columns[1:])] = np.nan
     parts = []
     for j, name in enumerate(b.stored.names):
         order = [i for i in np.argsort(-np.nan_to_num(share[:, j], nan=-1.0)) if share[i, j] >= 0]
         if order:
-            each = ", ".join(f"{b.pareto.var_names[i]} {share[i, j]:.2f}" for i in order)
+            each = ", ".join(f"{label[i]} {share[i, j]:.2f}" for i in order)
             parts.append(f"{name}: {each}")
     return (
         "what drives each objective's spread (squared correlation with each variable over "
@@ -374,8 +470,8 @@ def _report(b: Builds, title: str) -> Report:
     notes = [
         f"{len(b.X)} builds of each of {_designs(len(p.X))} of {p.path.name}: every design "
         f"variable off at once by a {DRAWS[b.distribution]} within {_within(b)} "
-        f"(seed {b.seed}); change = (f_built - f_stored)/f_stored, its 5th to 95th "
-        f"percentile over the builds",
+        f"(seed {b.seed}){_alike(b)}; change = (f_built - f_stored)/f_stored, its 5th to "
+        f"95th percentile over the builds",
         *p.picked_note(),
         *b.stored.notes,
     ]
@@ -433,16 +529,19 @@ def run_builds(
     seed: int | None = None,
     distribution: str | None = None,
     pick: Sequence[str] | None = None,
+    batch: Sequence[str] | None = None,
 ) -> Report:
     """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--tolerance
-    NAME=T] [--seed S] [--distribution uniform|normal] [--pick NAMES]`` (module
-    docstring)."""
+    NAME=T] [--seed S] [--distribution uniform|normal] [--pick NAMES] [--batch NAME,NAME]``
+    (module docstring)."""
     from .. import plots
 
     if plot is not None:
         plots.check_path(plot)
     pareto = read_front(Path(source), pick)
-    b = builds(pareto, samples, tolerance=tolerance, seed=seed, distribution=distribution)
+    b = builds(
+        pareto, samples, tolerance=tolerance, seed=seed, distribution=distribution, batch=batch
+    )
     title = f"builds: {pareto.path.name} as built to {bands(pareto.var_names, b.tolerance)}"
     if output is not None:
         write_builds(output, b)
@@ -481,4 +580,6 @@ def feasible_builds(path: str | Path, front: str | Path) -> np.ndarray:
     return share
 
 
-KINDS["builds"] = Kind(run_builds, options=("tolerance", "samples", "seed", "distribution", "pick"))
+KINDS["builds"] = Kind(
+    run_builds, options=("tolerance", "samples", "seed", "distribution", "pick", "batch")
+)

@@ -20,6 +20,7 @@ _ANALYSE_OPTIONS = {
     "seed": "--seed",
     "distribution": "--distribution",
     "pick": "--pick",
+    "batch": "--batch",
 }
 
 
@@ -35,6 +36,13 @@ _PICK_HELP = (
     "designs of the file (knee, best_<objective>, chosen of a kesort file, or row numbers; "
     "comma-separated or repeated), from any file simulate --pick reads; scenarios: these "
     "designs of its robust front"
+)
+
+
+_BATCH_HELP = (
+    "builds: design variables made in one batch, off alike in every build: NAME,NAME "
+    "(repeatable, one batch each); none: every variable alone; without it the config's "
+    "design_variables[i].batch"
 )
 
 
@@ -117,6 +125,7 @@ def analyse(
         None, "--distribution", help="builds: uniform (default) or normal (σ = t/3, cut at ±t)"
     ),
     pick: list[str] | None = typer.Option(None, "--pick", help=_PICK_HELP),
+    batch: list[str] | None = typer.Option(None, "--batch", help=_BATCH_HELP),
     *,
     run: base.RunOptions,
 ) -> None:
@@ -136,6 +145,7 @@ def analyse(
         "seed": seed,
         "distribution": distribution,
         "pick": pick or None,
+        "batch": batch or None,
     }
     spec, options = _checked(kind, sources, given)
     try:

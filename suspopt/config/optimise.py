@@ -19,6 +19,7 @@ Design variables are numeric config fields by dotted path; derived quantities (a
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
@@ -33,6 +34,7 @@ __all__ = [
     "Algorithm",
     "ALGORITHMS",
     "DesignVariable",
+    "batches",
     "Objective",
     "Constraint",
     "Objectives",
@@ -50,6 +52,11 @@ Tolerance = Annotated[float, Field(gt=0.0, lt=100.0, allow_inf_nan=False)]
 _TOLERANCE = (
     "how far a built part may be off its value [%] (analyse tolerances and builds, unless "
     "their --tolerance says otherwise; default 10)"
+)
+_BATCH = (
+    "parts of one batch: the design variables given the same batch name are off alike in "
+    "every build of analyse builds (one draw, each within its own tolerance), unless its "
+    "--batch says otherwise; a batch names two variables or more"
 )
 
 
@@ -110,6 +117,7 @@ class DesignVariable(Section):
         None, description="short label for tables and HDF5 (default: the path)"
     )
     tolerance: Tolerance | None = Field(None, description=_TOLERANCE)
+    batch: str | None = Field(None, min_length=1, max_length=64, description=_BATCH)
 
     @model_validator(mode="after")
     def _check_bounds(self) -> DesignVariable:
@@ -133,6 +141,16 @@ class DesignVariable(Section):
     @property
     def label(self) -> str:
         return self.name or self.path
+
+
+def batches(variables: Sequence[DesignVariable]) -> dict[str, list[int]]:
+    """The batches of ``variables``: {batch name: the indices of its variables}, in the order
+    first named (the variables without a ``batch`` are left out)."""
+    out: dict[str, list[int]] = {}
+    for i, v in enumerate(variables):
+        if v.batch is not None:
+            out.setdefault(v.batch, []).append(i)
+    return out
 
 
 class Objective(MetricSpec):

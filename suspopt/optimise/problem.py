@@ -31,7 +31,7 @@ from pymoo.core.problem import Problem as _PymooProblem
 from .. import execution, streaming
 from ..config import Config, ConfigError
 from ..config.loader import require_config
-from ..config.optimise import DesignVariable, Objective
+from ..config.optimise import DesignVariable, Objective, batches
 from ..config.scenarios import CONSTRAINT_DEFAULT, OBJECTIVE_DEFAULT
 from ..control.controller import build_controller
 from ..params import ParamView, field_unit, numeric_paths, one_per_run
@@ -165,6 +165,7 @@ class Problem(_PymooProblem):
         if cfg.objectives is None:
             raise cfg.error(("objectives",), "required key is missing: give the main objectives")
         _check_paths(cfg)
+        _check_batches(cfg)
         available, unit_of, corners = _signals_at_bounds(cfg)
 
         def compile_all(specs, loc, objective):
@@ -486,6 +487,18 @@ def _check_paths(cfg: Config) -> None:
         if var.path in seen:
             raise cfg.error(loc, f"{var.path} is already design_variables[{seen[var.path]}]")
         seen[var.path] = i
+
+
+def _check_batches(cfg: Config) -> None:
+    """Every ``batch`` of the design variables names two of them or more (a batch of one is
+    a variable drawn alone: most likely a misspelt name)."""
+    for name, members in batches(cfg.design_variables).items():
+        if len(members) == 1:
+            raise cfg.error(
+                ("design_variables", members[0], "batch"),
+                f"batch {name!r} has this variable alone: a batch is the parts of two design "
+                f"variables or more that are made together (give the other its name too)",
+            )
 
 
 def _signals_at_bounds(cfg: Config):

@@ -197,7 +197,8 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
     """What an ``analyse builds`` file says of each design's builds
     (:mod:`suspopt.analyse.builds`): the 5th and 95th percentiles of each objective, the share
     of feasible builds, what drives each objective's spread, how many builds and within which
-    tolerance [%] (one per variable)."""
+    tolerance [%] (one per variable), and the batch of each variable ("" alone; a file
+    written before batches has none)."""
     from ..analyse.builds import DISTRIBUTIONS, DRIVER_SAMPLES
     from ..params import MAX_SWEEP_DESIGNS
 
@@ -222,8 +223,10 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
             f"{h5.where}: /builds: attribute 'distribution': {distribution[:40]!r} is not one of "
             f"{', '.join(DISTRIBUTIONS)}"
         )
+    batch = h5.texts("builds/batch", n) if h5._node("builds/batch") is not None else [""] * n
     return {
         "samples": h5.int_attr("builds", "samples", 1, MAX_SWEEP_DESIGNS),
+        "batch": batch,
         "tolerance": _list(tolerance),
         "distribution": distribution,
         "low": _list(low),

@@ -100,7 +100,9 @@ SCRIPT = r"""
     d.objectives.forEach((n, j) => {
       const tr = el("tr", null, t); el("td", n + ", built 5-95 %", tr);
       el("td", fmt(b.low[row][j]) + " to " + fmt(b.high[row][j]), tr); el("td", d.objective_units[j], tr);
-      const r2 = d.variables.map((v, i) => [v, b.contribution[row][i][j]]).filter(([, c]) => c !== null)
+      const seen = new Set();  // (a batch's variables are drawn as one: one driver)
+      const r2 = d.variables.map((v, i) => [b.batch[i] || v, b.contribution[row][i][j]])
+        .filter(([v, c]) => c !== null && !seen.has(v) && seen.add(v))
         .sort((a, c) => c[1] - a[1]).map(([v, c]) => v + " " + c.toFixed(2)).join(", ");
       if (b.samples >= b.driver_samples && r2) el("td", "spread from: " + r2, tr).className = "note";
     });
@@ -109,7 +111,9 @@ SCRIPT = r"""
     const one = b.tolerance.every(t => t === b.tolerance[0]);
     const within = one ? "every variable within ±" + b.tolerance[0] + " % of its value"
       : "each variable within its tolerance (" + d.variables.map((v, i) => v + " ±" + b.tolerance[i] + " %").join(", ") + ")";
-    el("div", b.samples + " builds, " + within + " (" + b.distribution + ")", box).className = "note";
+    const batches = [...new Set(b.batch.filter(x => x))].map(x => d.variables.filter((v, i) => b.batch[i] === x).join(" and "));
+    const alike = batches.length ? "; the parts of one batch off alike (" + batches.join("; ") + ")" : "";
+    el("div", b.samples + " builds, " + within + " (" + b.distribution + ")" + alike, box).className = "note";
   }
   function showBaseline(i, d, box) {  // the config's own design (an optimise file's /baseline)
     box.textContent = "";
