@@ -616,6 +616,10 @@ def _set(group, key, value):
             lambda g: g.attrs.__delitem__("distribution"),
             "attribute 'distribution' of /builds: missing",
         ),
+        (lambda g: _set(g, "batch", np.zeros(2)), "/builds/batch: expected 2 entries of text"),
+        (lambda g: _set(g, "batch", np.array([b"a"])), "/builds/batch: expected 2 entries"),
+        (lambda g: _set(g, "batch", np.array([[b"a", b"a"]])), "/builds/batch: expected 2"),
+        (lambda g: _set(g, "batch", np.array([b"\xff", b""])), "/builds/batch: not UTF-8 text"),
     ],
 )
 def test_a_damaged_builds_file_is_one_line_and_no_page(builds_file, tmp_path, damage, message):
@@ -628,6 +632,17 @@ def test_a_damaged_builds_file_is_one_line_and_no_page(builds_file, tmp_path, da
     assert res.output.startswith(f"error: {broken}: ") and message in res.output
     assert "/builds" in res.output
     assert len(res.output.strip().splitlines()) == 1
+
+
+def test_a_builds_file_of_before_batches_is_shown_with_every_variable_alone(builds_file, tmp_path):
+    """A builds file written before ``/builds/batch`` existed is read as one whose
+    variables were drawn alone."""
+    old, page = tmp_path / "old.h5", tmp_path / "page.html"
+    shutil.copyfile(builds_file, old)
+    with h5py.File(old, "r+") as h5:
+        del h5["builds/batch"]
+    assert _invoke("report", old, "-o", page).exit_code == 0
+    assert _payload(page.read_text())["studies"][0]["data"]["builds"]["batch"] == ["", ""]
 
 
 @pytest.mark.browser
