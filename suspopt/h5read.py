@@ -335,11 +335,14 @@ class H5Reader:
                 f"{self.where}: /{name}: shape {ds.shape} is larger than "
                 f"{MAX_DATASET_BYTES >> 20} MB: not a file of suspopt's"
             )
+        return np.asarray(self._values(ds, name), dtype=np.int64 if integer else np.float64)
+
+    def _values(self, ds, name: str):
+        """What the dataset ``ds`` (``/name``) holds; ConfigError when it cannot be read."""
         try:
-            values = ds[()]
+            return ds[()]
         except (OSError, ValueError, RuntimeError):
             raise ConfigError(f"{self.where}: /{name}: damaged, cannot be read") from None
-        return np.asarray(values, dtype=np.int64 if integer else np.float64)
 
     def texts(self, name: str, count: int) -> list[str]:
         """The 1-D text dataset ``/name``, checked to hold ``count`` entries of
@@ -350,11 +353,7 @@ class H5Reader:
                 f"{self.where}: /{name}: expected {count} entries of text, got {ds.dtype} "
                 f"values of shape {ds.shape}"
             )
-        try:
-            values = ds[()]
-        except (OSError, ValueError, RuntimeError):
-            raise ConfigError(f"{self.where}: /{name}: damaged, cannot be read") from None
-        return [self.text(v, f"/{name}") for v in values]
+        return [self.text(v, f"/{name}") for v in self._values(ds, name)]
 
     def text(self, value, name: str) -> str:
         """``value`` (an attribute or dataset element) as text."""

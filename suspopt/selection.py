@@ -29,6 +29,9 @@ HDF5 layout, every dataset with a ``units`` attribute (one per column for F and 
   ``/kesort/row (N,)`` (its row in that file's ``/pareto``), ``/kesort/feasible (N,)``;
   ``/kesort/picks/<best_f1 ... knee>`` (indices); ``/kesort/sets/{file, label, config}``:
   each Pareto set's file, case label and the YAML text of the config that evaluated it.
+- ``/kesort/F_as_built (N, m)`` (``kesort --as-built Q``): the values the designs were
+  sorted and picked on, each objective's ``percentile`` (its attribute, [%]) over the
+  design's builds; ``F`` then holds their nominal values.
 - attributes of ``/kesort``: ``epsilon (m,)`` in the objectives' units, ``P`` (NaN for an
   absolute ε), ``P_auto``, ``normalisation``, ``unique``, ``cases`` (the labels in order).
 - with several cases, ``/kesort/cases/<label>/`` holds the sort of that case alone:
@@ -45,6 +48,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -132,7 +136,9 @@ class DesignSet:
     (every constraint ``g <= 0``); ``failed (N,)`` (the simulation diverged or gave NaN);
     ``resimulated``: whether the designs were simulated again; ``notes`` for the report;
     ``G (N, k)`` the constraints (``g <= 0`` is met; ``constraint_names``,
-    ``constraint_units``)."""
+    ``constraint_units``); ``F_as_built (N, m)``, when given, the values :func:`select`
+    sorts on instead of ``F``: each objective's ``as_built`` percentile [%] over the
+    design's builds (``kesort --as-built``)."""
 
     label: str
     source: Path
@@ -150,6 +156,8 @@ class DesignSet:
     G: np.ndarray | None = None
     constraint_names: tuple[str, ...] = ()
     constraint_units: tuple[str, ...] = ()
+    F_as_built: np.ndarray | None = None
+    as_built: float | None = None
 
 
 @dataclass(frozen=True)
@@ -193,6 +201,14 @@ class Selection:
     picks: dict[str, int]
     case_sorts: dict[str, CaseSort] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    F_as_built: np.ndarray | None = None
+    as_built: float | None = None
+
+    @property
+    def F_sorted(self) -> np.ndarray:
+        """The values the designs were sorted and picked on: ``F_as_built`` when given,
+        else ``F``."""
+        return self.F if self.F_as_built is None else self.F_as_built
 
     @property
     def chosen(self) -> int:
@@ -430,6 +446,11 @@ def select(
     if not sets:
         raise ConfigError("give at least one design set (load_design_sets)")
     names, units = _common_objectives(sets)
+    if len({(s.F_as_built is None, s.as_built) for s in sets}) > 1:
+        raise ConfigError(
+            f"{', '.join(str(s.source) for s in sets)}: sorted as built (F_as_built) and "
+            f"not, or at different percentiles: give every set the same"
+        )
     var_names, var_units = [], []
     for s in sets:
         for n, u in zip(s.var_names, s.var_units):
@@ -447,7 +468,8 @@ def select(
                 f"or is infeasible){hint}"
             )
     pooled = _pooled(sets, keep, names, var_names)
-    F, case = pooled["F"], pooled["case"]
+    case = pooled["case"]
+    F = pooled["F"] if pooled["F_as_built"] is None else pooled["F_as_built"]  # (what is sorted)
     options = dict(eps=eps, P=P, normalise=normalise, names=names, P_range=P_range, P_step=P_step)
     try:
         pool = kesort(F, **options)
@@ -471,18 +493,25 @@ def select(
         case_sorts=case_sorts,
         sets=sets,
         notes=notes,
+        as_built=sets[0].as_built,
     )
 
 
 def _pooled(
     sets: list[DesignSet], keep: list[np.ndarray], names: list[str], var_names: list[str]
-) -> dict[str, np.ndarray]:
-    """The kept designs of ``sets`` in one pool (:class:`Selection`'s ``F``, ``X``, ``case``,
-    ``source``, ``row`` and ``feasible``): the objectives ``names`` and the variables
-    ``var_names`` in that order."""
+) -> dict[str, Any]:
+    """The kept designs of ``sets`` in one pool (:class:`Selection`'s ``F``, ``F_as_built``
+    (None unless every set has it), ``X``, ``case``, ``source``, ``row`` and ``feasible``):
+    the objectives ``names`` and the variables ``var_names`` in that order."""
     pairs = list(zip(sets, keep))
+    as_built = None
+    if all(s.F_as_built is not None for s in sets):
+        as_built = np.vstack(
+            [np.asarray(s.F_as_built)[k][:, [s.names.index(n) for n in names]] for s, k in pairs]
+        )
     return {
         "F": np.vstack([s.F[k][:, [s.names.index(n) for n in names]] for s, k in pairs]),
+        "F_as_built": as_built,
         "X": np.vstack([_columns(s.X[k], s.var_names, var_names) for s, k in pairs]),
         "case": np.concatenate([np.full(k.sum(), s.label, dtype=object) for s, k in pairs]),
         "source": np.concatenate([np.full(k.sum(), i) for i, k in enumerate(keep)]),
@@ -531,6 +560,11 @@ def write_selection(path: str | Path, selection: Selection, command: str | None 
     with atomic_h5(path, s.sets[0].config, command, inputs=inputs) as h5:
         grp = h5.create_group("kesort")
         write_dataset(grp, "F", s.F, s.units, dims=("design", "objective"), names=s.names)
+        if s.F_as_built is not None:
+            write_dataset(
+                grp, "F_as_built", s.F_as_built, s.units, dims=("design", "objective"),
+                names=s.names, percentile=s.as_built,
+            )  # fmt: skip
         write_dataset(grp, "X", s.X, s.var_units, dims=("design", "variable"), names=s.var_names)
         write_dataset(grp, "case", list(s.case), "1", dims=("design",))
         write_dataset(grp, "source", s.source, "1", dims=("design",))

@@ -9,7 +9,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from conftest import optimised_front
+from conftest import CONFIGS, optimised_front
 from typer.testing import CliRunner
 
 from suspopt.analyse.builds import builds, draw_builds
@@ -542,3 +542,182 @@ def test_a_stored_batch_of_one_variable_is_the_files_fault_in_one_line(ps_front,
     assert len(res.output.strip().splitlines()) == 1
     res = _invoke("analyse", "tolerances", own, "--batch", "K_v,C_v")
     assert res.exit_code == 2 and "analyse tolerances does not take --batch" in res.output
+
+
+@pytest.fixture(scope="module")
+def ps_builds(ps_front, tmp_path_factory):
+    """40 builds (±8 %) of every design of the PS seat front."""
+    path = tmp_path_factory.mktemp("as_built") / "builds.h5"
+    res = _invoke("analyse", "builds", ps_front[0], "-o", path, "--samples", 40, "--tolerance", 8)
+    assert res.exit_code == 0, res.output
+    return path
+
+
+def test_kesort_as_built_sorts_and_picks_on_a_percentile_of_each_designs_builds(
+    ps_front, ps_builds, tmp_path
+):
+    """``kesort FRONT --builds B --as-built 90``: each design is judged by the 90th
+    percentile of each objective over its builds. Its static deflection as built is m g /
+    K_v of each build (Eq 8.2), so that percentile is the one of ``X_ST K_v / K_v_built``.
+    The k-ε levels and picks are those of these values; ``/kesort/F`` keeps the nominal
+    ones, which ``simulate --pick chosen`` reproduces, and the report says how it was
+    sorted."""
+    front, _ = ps_front
+    out = tmp_path / "ke.h5"
+    res = _invoke("kesort", front, "--builds", ps_builds, "--as-built", 90, "-o", out)
+    assert res.exit_code == 0, res.output
+    with h5py.File(front) as h5:
+        X0, F0 = h5["pareto/X"][()], h5["pareto/F"][()]
+    with h5py.File(ps_builds) as h5:
+        X, F = h5["builds/X"][()], h5["builds/F"][()]
+        assert not h5["builds/failed"][()].any()
+    with h5py.File(out) as h5:
+        rows, built, nominal = h5["kesort/row"][()], h5["kesort/F_as_built"][()], h5["kesort/F"][()]
+        assert h5["kesort/F_as_built"].attrs["percentile"] == 90
+        assert h5["kesort/F_as_built"].attrs["units"].astype(str).tolist() == ["m/s^2", "m"]
+        k_eps, picks = (
+            h5["kesort/k_eps"][()],
+            {k: int(v[()]) for k, v in h5["kesort/picks"].items()},
+        )
+        chosen = int(h5["kesort/chosen"][()])
+    np.testing.assert_array_equal(nominal, F0[rows])
+    np.testing.assert_allclose(built, np.percentile(F, 90, axis=0)[rows], rtol=1e-12)
+    X_ST = np.percentile(F0[:, 1] * X0[:, 0] / X[..., 0], 90, axis=0)
+    np.testing.assert_allclose(built[:, 1], X_ST[rows], rtol=1e-9)
+    assert (built > nominal).any(axis=1).all()  # (a 90th percentile: worse than nominal)
+    assert picks["best_X_ST"] == int(np.argmin(built[:, 1]))
+    assert picks["best_RC_se"] == int(np.argmin(built[:, 0]))
+    plain = tmp_path / "plain.h5"
+    assert _invoke("kesort", front, "--builds", ps_builds, "-o", plain).exit_code == 0
+    with h5py.File(plain) as h5:
+        assert "F_as_built" not in h5["kesort"]
+        assert not np.array_equal(h5["kesort/k_eps"][()], k_eps)
+    said = " ".join(res.output.split())
+    assert "note: sorted as built: each objective's 90th percentile over each design's" in said
+    assert "X_ST, as built (p90)" in said
+    res = _invoke("simulate", out, "--pick", "chosen", "-o", tmp_path / "chosen.h5")
+    assert res.exit_code == 0, res.output
+    with h5py.File(tmp_path / "chosen.h5") as h5:
+        np.testing.assert_allclose(h5["objectives/F"][0], nominal[chosen], rtol=1e-9)
+    page = tmp_path / "ke.html"
+    assert _invoke("report", out, "-o", page).exit_code == 0
+    assert "sorted as built: the k-ε levels and picks rank each objective" in page.read_text()
+
+
+def test_kesort_as_built_leaves_out_a_design_none_of_whose_builds_simulated(
+    ps_front, ps_builds, tmp_path
+):
+    """A design every build of which failed to simulate has no as-built value: it is left
+    out of the sort, and a note says so."""
+    front, _ = ps_front
+    broken, out = tmp_path / "broken.h5", tmp_path / "ke.h5"
+    shutil.copyfile(ps_builds, broken)
+    with h5py.File(broken, "r+") as h5:
+        h5["builds/failed"][:, 0] = 1
+        h5["builds/failed"][:-1, 1] = 1  # (one build left: its values)
+        F = h5["builds/F"][()]
+    res = _invoke(
+        "kesort", front, "--builds", broken, "--as-built", 50, "--keep-infeasible", "-o", out
+    )
+    assert res.exit_code == 0, res.output
+    with h5py.File(out) as h5:
+        rows, built = list(h5["kesort/row"][()]), h5["kesort/F_as_built"][()]
+    assert 0 not in rows and 1 in rows
+    np.testing.assert_array_equal(built[rows.index(1)], F[-1, 1])
+    said = " ".join(res.output.split())
+    assert f"note: 1 designs of {front} have no build that simulated ({broken})" in said
+
+
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        (["--as-built", "95"], "--as-built: give --builds too"),
+        (["--builds", "{builds}", "--as-built", "101"], "--as-built 101: give a percentile from"),
+        (["--builds", "{builds}", "--as-built", "-1"], "--as-built -1: give a percentile from 0"),
+        (["--builds", "{builds}", "--as-built", "nan"], "--as-built nan: give a percentile"),
+        (["--builds", "{builds}", "--as-built", "inf"], "--as-built inf: give a percentile"),
+        (["--builds", "{builds}", "--as-built", "95", "--config", "{config}"], "give one or the"),
+        (["--builds", "{renamed}", "--as-built", "95"], "holds no builds of X_ST (it has RC_se, x"),
+        (["--builds", "{flat}", "--as-built", "95"], "/builds/F: expected 3 dimensions"),
+        (["--builds", "{short}", "--as-built", "95"], "/builds/failed: shape (40, 2), not (b"),
+        (["--builds", "{infinite}", "--as-built", "95"], "X_ST of build 3 of design 1 is inf, "),
+    ],
+)
+def test_kesort_as_built_of_bad_input_is_one_line(ps_front, ps_builds, tmp_path, args, said):
+    front, _ = ps_front
+    paths = {"builds": ps_builds, "config": CONFIGS / "ch8" / "pareto_ps_class_a.yaml"}
+    for key, edit in (
+        ("renamed", lambda h5: h5["builds/F"].attrs.__setitem__("names", ["RC_se", "x"])),
+        ("flat", lambda h5: _replace(h5, "builds/F", h5["builds/F"][0])),
+        ("short", lambda h5: _replace(h5, "builds/failed", h5["builds/failed"][:, :2])),
+        ("infinite", lambda h5: h5["builds/F"].__setitem__((3, 1, 1), np.inf)),
+    ):
+        paths[key] = tmp_path / f"{key}.h5"
+        shutil.copyfile(ps_builds, paths[key])
+        with h5py.File(paths[key], "r+") as h5:
+            edit(h5)
+    out = tmp_path / "ke.h5"
+    res = _invoke("kesort", front, *[a.format(**paths) for a in args], "-o", out)
+    assert res.exit_code == 2 and not out.exists(), res.output
+    assert res.output.startswith("error: ") and said in " ".join(res.output.split())
+    assert len(res.output.strip().splitlines()) == 1
+
+
+def _replace(h5, name, values):
+    del h5[name]
+    h5[name] = values
+
+
+def test_kesort_as_built_of_pooled_fronts_takes_each_sets_own_builds(ps_front, ps_builds, tmp_path):
+    """Pooled fronts sorted as built: each set's values are the percentiles of its own
+    builds file, and each case's sort ranks them too (its levels are those of the case's
+    designs sorted alone on the same values)."""
+    from suspopt.kesort import kesort
+
+    front, _ = ps_front
+    twin, out = tmp_path / "twin.h5", tmp_path / "ke.h5"
+    shutil.copyfile(front, twin)
+    other = tmp_path / "other_builds.h5"
+    res = _invoke("analyse", "builds", twin, "-o", other, "--samples", 40, "--seed", 9)
+    assert res.exit_code == 0, res.output
+    pool = [front, twin, "--label", "a", "--label", "b", "--builds", ps_builds, "--builds", other]
+    res = _invoke("kesort", *pool, "--as-built", 75, "--keep-infeasible", "-o", out)
+    assert res.exit_code == 0, res.output
+    percentiles = []
+    for path in (ps_builds, other):
+        with h5py.File(path) as h5:
+            percentiles.append(np.percentile(h5["builds/F"][()], 75, axis=0))
+    with h5py.File(out) as h5:
+        rows, source = h5["kesort/row"][()], h5["kesort/source"][()]
+        built, P = h5["kesort/F_as_built"][()], float(h5["kesort"].attrs["P"])
+        case_rows = h5["kesort/cases/b/rows"][()]
+        case_levels, case_P = h5["kesort/cases/b/k_eps"][()], float(h5["kesort/cases/b"].attrs["P"])
+    for i in (0, 1):
+        mine = source == i
+        np.testing.assert_allclose(built[mine], percentiles[i][rows[mine]], rtol=1e-12)
+    assert not np.allclose(built[source == 0], built[source == 1])
+    alone = kesort(built[case_rows], P=case_P)
+    np.testing.assert_allclose(case_levels, alone.k_eps, rtol=1e-12)
+    assert np.isfinite(P)
+
+
+@pytest.mark.parametrize("value", ["x", np.nan, 200.0, None, True])
+def test_a_damaged_as_built_percentile_is_one_line_of_the_report(
+    ps_front, ps_builds, tmp_path, value
+):
+    front, _ = ps_front
+    out, page = tmp_path / "ke.h5", tmp_path / "ke.html"
+    assert (
+        _invoke("kesort", front, "--builds", ps_builds, "--as-built", 95, "-o", out).exit_code == 0
+    )
+    with h5py.File(out, "r+") as h5:
+        attrs = h5["kesort/F_as_built"].attrs
+        if value is None:
+            del attrs["percentile"]
+        else:
+            attrs["percentile"] = value
+    res = _invoke("report", out, "-o", page)
+    assert res.exit_code == 2 and not page.exists(), res.output
+    said = " ".join(res.output.split())
+    assert f"error: {out}: /kesort/F_as_built: attribute 'percentile': missing or not a" in said
+    assert len(res.output.strip().splitlines()) == 1

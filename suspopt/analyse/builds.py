@@ -77,10 +77,18 @@ from ..config.optimise import batches as config_batches
 from ..io import atomic_h5, write_dataset
 from ..params import MAX_SWEEP_DESIGNS
 from ..picks import read_front
-from ..selection import DesignSet, ParetoSet, evaluate_pareto, read_pareto
+from ..selection import DesignSet, ParetoSet, evaluate_pareto
 from . import KINDS, Kind, Report, relative_change
+from .builds_file import feasible_builds
 from .pseudo import is_comfort, table_designs, write_stored_front
-from .tolerances import Tolerances, bands, inside, variable_limits, variable_tolerances
+from .tolerances import (
+    Tolerances,
+    bands,
+    inside,
+    known_variable,
+    variable_limits,
+    variable_tolerances,
+)
 
 __all__ = [
     "SAMPLES",
@@ -250,11 +258,7 @@ def variable_batches(
     seen: dict[str, str] = {}
     for name, members, where in groups:
         for label in members:
-            if label not in pareto.var_names:
-                raise ConfigError(
-                    f"{where}: {pareto.path.name} has no design variable {label!r}; it has "
-                    f"{', '.join(pareto.var_names)}"
-                )
+            known_variable(pareto, label, where)
             if label in seen:
                 raise ConfigError(f"{where}: {label} is in two batches ({seen[label]}, {name})")
             seen[label] = name
@@ -548,36 +552,6 @@ def run_builds(
     if plot is not None:
         plot_builds(b, plot, title)
     return _report(b, title)
-
-
-def feasible_builds(path: str | Path, front: str | Path) -> np.ndarray:
-    """``(D,)`` the share of feasible builds of each design of the Pareto file ``front``, from
-    the ``analyse builds`` file ``path`` of that front (``suspopt kesort --builds``);
-    ConfigError naming the file when it is no builds file, or one of another front (its
-    ``/pareto/X`` differs from the front's)."""
-    from ..h5read import H5Reader
-
-    with H5Reader(path, where=f"--builds {path}") as h5:
-        if not h5.has_attr("analysis") or h5.text_attr("analysis") != "builds":
-            raise ConfigError(f"--builds {path}: not a file of suspopt analyse builds")
-        X = h5.array("pareto/X", ndim=2)
-        share = h5.array("builds/feasible_share", ndim=1)
-        if "pareto/source_row" in h5.file:
-            raise ConfigError(
-                f"--builds {path}: holds the builds of {len(X)} picked design(s) (--pick); "
-                f"kesort needs the builds of every design of {front}: build them all"
-            )
-    own = read_pareto(front).X
-    if X.shape != own.shape or not np.array_equal(X, own):
-        raise ConfigError(
-            f"--builds {path}: its designs (/pareto/X) are not those of {front}: give the "
-            f"builds of that front"
-        )
-    if len(share) != len(own) or not ((share >= 0) & (share <= 1)).all():
-        raise ConfigError(
-            f"--builds {path}: /builds/feasible_share: not one share in [0, 1] per design"
-        )
-    return share
 
 
 KINDS["builds"] = Kind(

@@ -42,6 +42,7 @@ __all__ = [
     "TOLERANCE",
     "checked_tolerance",
     "variable_tolerances",
+    "known_variable",
     "bands",
     "inside",
     "variable_limits",
@@ -101,11 +102,7 @@ def variable_tolerances(pareto: ParetoSet, tolerance: Tolerances = None) -> np.n
                 )
             default = checked_tolerance(value)
             continue
-        if name not in pareto.var_names:
-            raise ConfigError(
-                f"--tolerance {name}={value}: {pareto.path.name} has no design variable "
-                f"{name!r}; it has {', '.join(pareto.var_names)}"
-            )
+        known_variable(pareto, name, f"--tolerance {name}={value}")
         if name in each:
             raise ConfigError(f"--tolerance {name}=: give each variable's tolerance once")
         each[name] = checked_tolerance(value, f"--tolerance {name}=")
@@ -117,6 +114,17 @@ def variable_tolerances(pareto: ParetoSet, tolerance: Tolerances = None) -> np.n
         ],
         dtype=float,
     )
+
+
+def known_variable(pareto: ParetoSet, name: str, where: str) -> int:
+    """The column of the design variable ``name`` in ``pareto.X``; ConfigError starting with
+    ``where`` (the option that names it) when the file has no such variable."""
+    if name not in pareto.var_names:
+        raise ConfigError(
+            f"{where}: {pareto.path.name} has no design variable {name!r}; it has "
+            f"{', '.join(pareto.var_names)}"
+        )
+    return pareto.var_names.index(name)
 
 
 def bands(names: Sequence[str], tolerance: np.ndarray) -> str:

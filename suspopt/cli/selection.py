@@ -55,12 +55,18 @@ def _kesort_tables(sel) -> list[Table]:
     )
     for j, (name, unit) in enumerate(zip(sel.names, sel.units)):
         table.add_row(name, unit, *(f"{sel.F[i, j]:.4g}" for i in rows))
+        if sel.F_as_built is not None:  # (what the sort ranked)
+            built = f"{name}, as built (p{sel.as_built:g})"
+            table.add_row(built, unit, *(f"{sel.F_as_built[i, j]:.4g}" for i in rows))
     for j, (name, unit) in enumerate(zip(sel.var_names, sel.var_units)):
         table.add_row(
             name, unit, *("-" if np.isnan(sel.X[i, j]) else f"{sel.X[i, j]:.5g}" for i in rows)
         )
     table.add_row("feasible", "", *("yes" if sel.feasible[i] else "no" for i in rows))
-    picks = base.new_table("Pareto picks among all (Fig. 8.21: edges and knee)")
+    title = "Pareto picks among all (Fig. 8.21: edges and knee)"
+    if sel.F_as_built is not None:
+        title += f", as built: the {sel.as_built:g}th percentiles they were picked on"
+    picks = base.new_table(title)
     for col in ("pick", "design #", "case", "k-ε level"):
         picks.add_column(col, justify="left" if col in ("pick", "case") else "right")
     for name, unit in zip(sel.names, sel.units):
@@ -71,7 +77,7 @@ def _kesort_tables(sel) -> list[Table]:
             str(i),
             str(sel.case[i]),
             f"{sel.sort.k_eps[i]:.3f}",
-            *(f"{v:.4g}" for v in sel.F[i]),
+            *(f"{v:.4g}" for v in sel.F_sorted[i]),
         )
     return [table, picks]
 
@@ -133,11 +139,29 @@ def _with_supplementary(cfg, X, variables: list[str], F, names: list[str]):
     return np.hstack([F, S]), names + problem.supplementary_names
 
 
-def _builds_options(pareto: list[Path], builds: list[Path], least: float | None) -> float:
+def _builds_options(
+    pareto: list[Path],
+    builds: list[Path],
+    least: float | None,
+    as_built: float | None = None,
+    config: list[Path] | None = None,
+) -> float:
     """``--min-feasible-builds`` [%] (None: :data:`MIN_FEASIBLE_BUILDS`), checked with
-    ``--builds`` (one per Pareto file) before any design is evaluated."""
+    ``--builds`` (one per Pareto file) and ``--as-built`` (a percentile, with ``--builds``
+    and without ``--config``: the builds were evaluated under each file's own config) before
+    any design is evaluated."""
     import math
 
+    if as_built is not None:
+        if not builds:
+            raise ConfigError("--as-built: give --builds too (the builds it takes a percentile of)")
+        if not (math.isfinite(as_built) and 0 <= as_built <= 100):
+            raise ConfigError(f"--as-built {as_built:g}: give a percentile from 0 to 100")
+        if config:
+            raise ConfigError(
+                "--as-built: the builds were evaluated under each Pareto file's own config; "
+                "--config evaluates the designs under another: give one or the other"
+            )
     if not builds and least is not None:
         raise ConfigError("--min-feasible-builds: give --builds too (the builds it counts)")
     least = MIN_FEASIBLE_BUILDS if least is None else least
@@ -150,13 +174,19 @@ def _builds_options(pareto: list[Path], builds: list[Path], least: float | None)
     return least
 
 
-def _as_built(sets, pareto: list[Path], builds: list[Path], least: float):
+def _as_built(
+    sets, pareto: list[Path], builds: list[Path], least: float, percentile: float | None = None
+):
     """``sets`` with a design counted infeasible where fewer than ``least`` % of its builds
     (the ``analyse builds`` file of its Pareto file, ``builds[i]`` of ``pareto[i]``) are
-    feasible, and the notes that say how many; ``sets`` and no note without ``builds``."""
+    feasible and, with ``percentile``, sorted on that percentile of each objective over its
+    builds (a design all of whose builds failed counted failed), and the notes that say so;
+    ``sets`` and no note without ``builds``."""
     from dataclasses import replace
 
-    from ..analyse.builds import feasible_builds
+    import numpy as np
+
+    from ..analyse.builds_file import as_built_objectives, feasible_builds
 
     if not builds:
         return sets, []
@@ -166,7 +196,23 @@ def _as_built(sets, pareto: list[Path], builds: list[Path], least: float):
         f"builds feasible ({b}): counted infeasible"
         for short, b in zip(shorts, builds)
     ]
-    return [replace(s, feasible=s.feasible & ~short) for s, short in zip(sets, shorts)], notes
+    sets = [replace(s, feasible=s.feasible & ~short) for s, short in zip(sets, shorts)]
+    if percentile is None:
+        return sets, notes
+    for i, (b, p) in enumerate(zip(builds, pareto)):
+        values = as_built_objectives(b, p, sets[i].names, percentile)
+        lost = np.isnan(values).any(axis=1)
+        sets[i] = replace(
+            sets[i], F_as_built=values, as_built=percentile, failed=sets[i].failed | lost
+        )
+        if lost.any():
+            notes.append(f"{int(lost.sum())} designs of {p} have no build that simulated ({b})")
+    notes.append(
+        f"sorted as built: each objective's {percentile:g}th percentile over each design's "
+        f"builds ({', '.join(map(str, builds))}), kept in /kesort/F_as_built; /kesort/F "
+        f"holds the nominal values, the ones simulate --pick reproduces"
+    )
+    return sets, notes
 
 
 def _threshold_line(sort, label: str) -> str:
@@ -188,6 +234,10 @@ _BUILDS_HELP = (
 )
 _MIN_FEASIBLE_BUILDS_HELP = (
     "with --builds: the share of a design's builds that must be feasible, in % (default 95)"
+)
+_AS_BUILT_HELP = (
+    "with --builds: sort and pick the designs on this percentile of each objective over "
+    "their builds (95: how the worst 5 % of builds perform), not on their nominal values"
 )
 _EPS_HELP = (
     "absolute thresholds in the objectives' SI units: one value, or one per objective "
@@ -233,6 +283,7 @@ def kesort(
     min_feasible_builds: float | None = typer.Option(
         None, "--min-feasible-builds", help=_MIN_FEASIBLE_BUILDS_HELP
     ),
+    as_built: float | None = typer.Option(None, "--as-built", help=_AS_BUILT_HELP),
     output: Path | None = typer.Option(None, "-o", "--output", help="HDF5 file for /kesort"),
     plot: Path | None = typer.Option(
         None, "--plot", help="figure of the k-ε levels over the front (.png or .svg)"
@@ -248,7 +299,7 @@ def kesort(
     with run.outputs(output, plot, inputs=inputs):
         _kesort(
             pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output,
-            plot, (builds, min_feasible_builds),
+            plot, (builds, min_feasible_builds, as_built),
         )  # fmt: skip
 
 
@@ -279,9 +330,10 @@ def _kesort(
         message = str(exc).replace("P_range", "--P-range").replace("P_step", "--P-step")
         base.fail(f"kesort options: {message}")
     try:
-        least = _builds_options(pareto, *by_builds)
+        builds, least, percentile = by_builds
+        least = _builds_options(pareto, builds, least, percentile, config)
         sets = load_design_sets(pareto, config, label)
-        sets, built = _as_built(sets, pareto, by_builds[0], least)
+        sets, built = _as_built(sets, pareto, builds, least, percentile)
         selection = select(sets, eps_values, feasible_only=not keep_infeasible, **options)
     except ConfigError as exc:
         base.fail(str(exc))
@@ -302,7 +354,8 @@ def _kesort(
         out.print(f"note: {note}")
     against = _optimum_against_baseline(selection)
     if against is not None:
-        out.print(f"the k-ε optimum {against}")
+        nominal = "" if selection.as_built is None else " (its nominal values)"
+        out.print(f"the k-ε optimum{nominal} {against}")
     bounds = _optimum_bounds_note(selection)
     if bounds is not None:
         out.print(f"note: the k-ε optimum is {bounds}")

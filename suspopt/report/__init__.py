@@ -113,6 +113,12 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
         **extra,
     }
     study = Study(path.name, kind, data)
+    if "as_built" in data:
+        study.notes.append(
+            f"sorted as built: the k-ε levels and picks rank each objective's "
+            f"{data['as_built']:g}th percentile over each design's builds "
+            f"(/kesort/F_as_built); the values shown are the nominal ones (/kesort/F)"
+        )
     _search_bounds(table, data, study.notes)
     rows = sorted(
         set(table.picks.values()) | {table.resolve(r, "--with-signals") for r in with_signals}
@@ -145,6 +151,19 @@ def _search_bounds(table, data: dict[str, Any], notes: list[str]) -> None:
     ]
 
 
+def _percentile(h5, name: str) -> float:
+    """The ``percentile`` attribute [%] of dataset ``/name``: a number from 0 to 100."""
+    label = f"/{name}: attribute 'percentile'"
+    value = h5.attribute(h5.dataset(name), "percentile", label)
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+        raise ConfigError(f"{h5.where}: {label}: missing or not a number from 0 to 100")
+    if not 0 <= float(value) <= 100:  # (NaN fails too)
+        raise ConfigError(f"{h5.where}: {label}: missing or not a number from 0 to 100")
+    return float(value)
+
+
 def _extras(h5, table) -> dict[str, Any]:
     """Feasibility, constraints, k-ε levels, cases, history and pseudo-fronts, where the
     file has them."""
@@ -171,6 +190,8 @@ def _extras(h5, table) -> dict[str, Any]:
         out["feasible"] = [bool(v) for v in h5.array("kesort/feasible", ndim=1)]
         case = h5.dataset("kesort/case")[()]
         out["case"] = [h5.text(v, "kesort/case") for v in np.atleast_1d(case)]
+        if h5._node("kesort/F_as_built") is not None:  # (kesort --as-built)
+            out["as_built"] = _percentile(h5, "kesort/F_as_built")
     if h5._node("history/generation") is not None:
         history = {"generation": _list(h5.array("history/generation", ndim=1))}
         for key in ("hypervolume", "feasible"):
