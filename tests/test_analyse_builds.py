@@ -721,3 +721,29 @@ def test_a_damaged_as_built_percentile_is_one_line_of_the_report(
     said = " ".join(res.output.split())
     assert f"error: {out}: /kesort/F_as_built: attribute 'percentile': missing or not a" in said
     assert len(res.output.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    "edit, said",
+    [
+        (lambda v: v[:-1], "/kesort/F_as_built: "),
+        (lambda v: v[:, :1], "/kesort/F_as_built: expected 2 columns, got 1"),
+        (lambda v: v.astype("S8"), "/kesort/F_as_built: holds |S8 values, not numbers"),
+    ],
+)
+def test_damaged_as_built_values_are_one_line_of_the_report(
+    ps_front, ps_builds, tmp_path, edit, said
+):
+    front, _ = ps_front
+    out, page = tmp_path / "ke.h5", tmp_path / "ke.html"
+    assert (
+        _invoke("kesort", front, "--builds", ps_builds, "--as-built", 95, "-o", out).exit_code == 0
+    )
+    with h5py.File(out, "r+") as h5:
+        values, attrs = h5["kesort/F_as_built"][()], dict(h5["kesort/F_as_built"].attrs)
+        _replace(h5, "kesort/F_as_built", edit(values))
+        h5["kesort/F_as_built"].attrs["percentile"] = attrs["percentile"]
+    res = _invoke("report", out, "-o", page)
+    assert res.exit_code == 2 and not page.exists(), res.output
+    assert f"error: {out}: {said}" in " ".join(res.output.split())
+    assert len(res.output.strip().splitlines()) == 1

@@ -647,6 +647,42 @@ def test_a_builds_file_of_before_batches_is_shown_with_every_variable_alone(buil
 
 @pytest.mark.browser
 @pytest.mark.slow
+def test_a_design_of_a_kesort_as_built_file_shows_its_as_built_values(
+    files, builds_file, browser, tmp_path
+):
+    """A kesort file sorted as built (``--as-built 95``): a clicked design's panel gives
+    each objective's nominal value and, under it, the percentile the sort ranked; the
+    study's notes say how it was sorted."""
+    choice, page = tmp_path / "choice.h5", tmp_path / "choice.html"
+    res = _invoke(
+        "kesort", files["front"], "--builds", builds_file, "--as-built", 95,
+        "--min-feasible-builds", 0, "-o", choice,
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert _invoke("report", choice, "-o", page).exit_code == 0
+    with h5py.File(choice) as h5:
+        F, built = h5["kesort/F"][()], h5["kesort/F_as_built"][()]
+        names = list(h5["kesort/F"].attrs["names"].astype(str))
+        chosen = int(h5["kesort/chosen"][()])
+    browser.get(page.resolve().as_uri())
+    _wait(browser, "return document.body.getAttribute('data-rendered')", "the plots rendered")
+    browser.execute_script("window.suspoptReport.select(0, arguments[0])", chosen)
+    rows = browser.execute_script(
+        "return [...document.querySelectorAll('#design-0 tr')]"
+        ".map(tr => [...tr.cells].map(c => c.textContent))"
+    )
+    labels, cells = [r[0] for r in rows], {r[0]: r[1] for r in rows}
+    for j, name in enumerate(names):
+        i = labels.index(name)
+        assert labels[i + 1] == f"{name}, as built (p95)"
+        assert float(cells[name]) == pytest.approx(F[chosen, j], rel=1e-4)
+        assert float(cells[labels[i + 1]]) == pytest.approx(built[chosen, j], rel=1e-4)
+        assert built[chosen, j] != F[chosen, j]
+    assert "sorted as built" in page.read_text()
+
+
+@pytest.mark.browser
+@pytest.mark.slow
 def test_the_brushed_designs_command_lists_at_most_its_cap_of_rows(
     files, browser, tmp_path, monkeypatch
 ):

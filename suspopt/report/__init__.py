@@ -117,7 +117,8 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
         study.notes.append(
             f"sorted as built: the k-ε levels and picks rank each objective's "
             f"{data['as_built']:g}th percentile over each design's builds "
-            f"(/kesort/F_as_built); the values shown are the nominal ones (/kesort/F)"
+            f"(/kesort/F_as_built); the front shows the nominal values (/kesort/F), a "
+            f"design's panel both"
         )
     _search_bounds(table, data, study.notes)
     rows = sorted(
@@ -192,6 +193,10 @@ def _extras(h5, table) -> dict[str, Any]:
         out["case"] = [h5.text(v, "kesort/case") for v in np.atleast_1d(case)]
         if h5._node("kesort/F_as_built") is not None:  # (kesort --as-built)
             out["as_built"] = _percentile(h5, "kesort/F_as_built")
+            built = h5.array("kesort/F_as_built", ndim=2, columns=table.F.shape[1])
+            if len(built) != N:
+                raise ConfigError(f"{h5.where}: /kesort/F_as_built: {len(built)} rows, not {N}")
+            out["F_as_built"] = _list(built)
     if h5._node("history/generation") is not None:
         history = {"generation": _list(h5.array("history/generation", ndim=1))}
         for key in ("hypervolume", "feasible"):

@@ -78,7 +78,10 @@ SCRIPT = r"""
       if (note) el("td", note, tr).className = "note";
     }
     const side = { "-": "at lower bound", "+": "at upper bound" };
-    d.objectives.forEach((n, j) => add(n, d.F[row][j], d.objective_units[j]));
+    d.objectives.forEach((n, j) => {
+      add(n, d.F[row][j], d.objective_units[j]);
+      if (d.F_as_built) add(n + ", as built (p" + d.as_built + ")", d.F_as_built[row][j], d.objective_units[j]);
+    });
     if (d.builds) showBuilds(d, row, t, box);
     d.variables.forEach((n, j) => add(n, d.X[row][j], d.variable_units[j],
                                       d.at_bound && side[d.at_bound[j][row]]));
