@@ -1550,6 +1550,27 @@ OPTION_BASES = [
     ["analyse", "masses", "{path}/front.h5", "-o", "{out}"],
     ["analyse", "builds", "{path}/front.h5", "--samples", "3", "-o", "{out}"],
     ["analyse", "builds", "{path}/choice.h5", "--pick", "chosen", "--samples", "3", "-o", "{out}"],
+    [
+        "analyse",
+        "builds",
+        "{path}/front.h5",
+        "--samples",
+        "3",
+        "--batch",
+        "C_F1,C_R1",
+        "-o",
+        "{out}",
+    ],
+    [
+        "kesort",
+        "{path}/front.h5",
+        "--builds",
+        "{path}/builds.h5",
+        "--as-built",
+        "95",
+        "-o",
+        "{out}",
+    ],
     ["analyse", "models", "{path}/study.yaml", "{path}/study2.yaml"],
     ["analyse", "transmissibility", "{path}/front.h5"],
     ["analyse", "scenarios", "{path}/robust.h5"],
@@ -1558,8 +1579,8 @@ OPTION_BASES = [
 
 def option_fixtures(folder: Path) -> Path:
     """The inputs of :data:`OPTION_BASES` in ``folder``: the ``kesort`` starter config with a
-    tiny budget, its front, the front's k-ε choice, a robust front, a second config, a road
-    config and a FIFO (made by ``python -m suspopt``, as a user would)."""
+    tiny budget, its front, the front's k-ε choice and builds, a robust front, a second
+    config, a road config and a FIFO (made by ``python -m suspopt``, as a user would)."""
     folder.mkdir(parents=True, exist_ok=True)
 
     def suspopt(*args: str) -> None:
@@ -1582,6 +1603,7 @@ def option_fixtures(folder: Path) -> Path:
         (folder / f"{config}.yaml").write_text(text)
         suspopt("optimise", f"{config}.yaml", "-o", f"{front}.h5")
     suspopt("kesort", "front.h5", "-o", "choice.h5")
+    suspopt("analyse", "builds", "front.h5", "--samples", "4", "-o", "builds.h5")
     (folder / "study2.yaml").write_text((folder / "study.yaml").read_text())
     (folder / "road.yaml").write_text((CONFIGS / "quickstart.yaml").read_text())
     os.mkfifo(folder / "fifo")
@@ -1608,7 +1630,7 @@ def option_cases(fixtures: Path, values: list[str] | None = None) -> list[Case]:
 
     tree = typer.main.get_command(app)
     cases = []
-    for base in OPTION_BASES:
+    for b, base in enumerate(OPTION_BASES):
         command = tree.commands[base[0]]
         slots = [
             (param.opts[0], None)
@@ -1624,7 +1646,8 @@ def option_cases(fixtures: Path, values: list[str] | None = None) -> list[Case]:
                     argv[index] = value
                 cases.append(
                     Case(
-                        id=_case_id("opt", _command_name(base), slot, f"{k:02d}"),
+                        # (the base's number: two bases may run one command)
+                        id=_case_id("opt", f"{b:02d}", _command_name(base), slot, f"{k:02d}"),
                         family="options",
                         label=f"{' '.join(base[:2])} {slot} {short(value, 30)!r}",
                         setup={"kind": "folder", "path": str(fixtures)},
@@ -1959,6 +1982,10 @@ def run_cases(
     ``SUSPOPT_FUZZ_WORKERS`` says otherwise); {case id: result}."""
     if workers is None:
         workers = int(os.environ.get("SUSPOPT_FUZZ_WORKERS", min(2, os.cpu_count() or 1)))
+    ids = [case.id for case in cases]
+    if len(set(ids)) != len(ids):  # (results are kept by id: one would hide the other)
+        twice = sorted({i for i in ids if ids.count(i) > 1})
+        raise ValueError(f"{len(twice)} case ids given twice, e.g. {twice[:3]}")
     todo: queue.Queue = queue.Queue()
     for case in cases:
         todo.put(case)
