@@ -446,11 +446,7 @@ def select(
     if not sets:
         raise ConfigError("give at least one design set (load_design_sets)")
     names, units = _common_objectives(sets)
-    if len({(s.F_as_built is None, s.as_built) for s in sets}) > 1:
-        raise ConfigError(
-            f"{', '.join(str(s.source) for s in sets)}: sorted as built (F_as_built) and "
-            f"not, or at different percentiles: give every set the same"
-        )
+    _check_as_built(sets)
     var_names, var_units = [], []
     for s in sets:
         for n, u in zip(s.var_names, s.var_units):
@@ -495,6 +491,23 @@ def select(
         notes=notes,
         as_built=sets[0].as_built,
     )
+
+
+def _check_as_built(sets: list[DesignSet]) -> None:
+    """Every set sorted as built at one percentile, with values of its ``F``'s shape, or
+    none (ValueError naming the sets otherwise)."""
+    if len({(s.F_as_built is None, s.as_built) for s in sets}) > 1:
+        raise ConfigError(
+            f"{', '.join(str(s.source) for s in sets)}: sorted as built (F_as_built) and "
+            f"not, or at different percentiles: give every set the same"
+        )
+    for s in (s for s in sets if s.F_as_built is not None):
+        shape, q = np.asarray(s.F_as_built).shape, s.as_built
+        if shape != s.F.shape or q is None or not 0 <= q <= 100:
+            raise ValueError(
+                f"{s.source} ({s.label}): F_as_built of shape {shape} at percentile {q!r}: "
+                f"give one value per design and objective ({s.F.shape}), at 0 to 100"
+            )
 
 
 def _pooled(

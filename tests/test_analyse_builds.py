@@ -625,7 +625,7 @@ def test_kesort_as_built_leaves_out_a_design_none_of_whose_builds_simulated(
     assert 0 not in rows and 1 in rows
     np.testing.assert_array_equal(built[rows.index(1)], F[-1, 1])
     said = " ".join(res.output.split())
-    assert f"note: 1 designs of {front} have no build that simulated ({broken})" in said
+    assert f"note: 1 design(s) of {front} with no build that simulated ({broken}): left out" in said
 
 
 @pytest.mark.parametrize(
@@ -747,3 +747,27 @@ def test_damaged_as_built_values_are_one_line_of_the_report(
     assert res.exit_code == 2 and not page.exists(), res.output
     assert f"error: {out}: {said}" in " ".join(res.output.split())
     assert len(res.output.strip().splitlines()) == 1
+
+
+def test_select_refuses_as_built_values_that_do_not_fit_its_sets(ps_front):
+    """From Python: values as built of another shape than the set's objectives, a
+    percentile outside 0-100, and sets of which only some are sorted as built are refused,
+    named."""
+    from dataclasses import replace
+
+    from suspopt.selection import load_design_sets, select
+
+    front, _ = ps_front
+    (s,) = load_design_sets([front])
+    with pytest.raises(
+        ValueError, match=r"F_as_built of shape \(2,\) at percentile 95: give one value"
+    ):
+        select([replace(s, F_as_built=np.zeros(2), as_built=95)])
+    with pytest.raises(
+        ValueError, match="at percentile 101: give one value per design and objective"
+    ):
+        select([replace(s, F_as_built=s.F, as_built=101)])
+    with pytest.raises(ValueError, match="sorted as built .F_as_built. and not"):
+        select([replace(s, F_as_built=s.F, as_built=95), s])
+    for q in (0, 50, 100):  # (the values themselves: the sort of F)
+        assert select([replace(s, F_as_built=s.F, as_built=q)]).chosen == select([s]).chosen

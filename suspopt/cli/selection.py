@@ -206,7 +206,9 @@ def _as_built(
             sets[i], F_as_built=values, as_built=percentile, failed=sets[i].failed | lost
         )
         if lost.any():
-            notes.append(f"{int(lost.sum())} designs of {p} have no build that simulated ({b})")
+            notes.append(
+                f"{int(lost.sum())} design(s) of {p} with no build that simulated ({b}): left out"
+            )
     notes.append(
         f"sorted as built: each objective's {percentile:g}th percentile over each design's "
         f"builds ({', '.join(map(str, builds))}), kept in /kesort/F_as_built; /kesort/F "
