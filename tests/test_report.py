@@ -679,6 +679,22 @@ def test_a_design_of_a_kesort_as_built_file_shows_its_as_built_values(
         assert float(cells[labels[i + 1]]) == pytest.approx(built[chosen, j], rel=1e-4)
         assert built[chosen, j] != F[chosen, j]
     assert "sorted as built" in page.read_text()
+    # the front drawn at the values as built: the axes offer them beside the nominal ones
+    options = browser.execute_script(
+        "return [...document.getElementById('x-0').options].map(o => [o.value, o.textContent])"
+    )
+    assert [v for v, _ in options if v.startswith("B:")] == [f"B:{j}" for j in range(len(names))]
+    assert dict(options)["B:1"] == f"{names[1]}, as built (p95)"
+    drawn = browser.execute_script(
+        "for (const a of ['x', 'y']) { const e = document.getElementById(a + '-0');"
+        " e.value = a === 'x' ? 'B:0' : 'B:1'; e.dispatchEvent(new Event('change')); }"
+        " const t = document.getElementById('front-0').data[0];"
+        " return [t.x, t.y, document.getElementById('front-0').layout.xaxis.title.text]"
+    )
+    assert drawn[0] == pytest.approx(built[:, 0].tolist()) and drawn[1] == pytest.approx(
+        built[:, 1].tolist()
+    )
+    assert drawn[2].startswith(f"{names[0]}, as built (p95) [")
 
 
 @pytest.mark.browser

@@ -117,8 +117,8 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
         study.notes.append(
             f"sorted as built: the k-ε levels and picks rank each objective's "
             f"{data['as_built']:g}th percentile over each design's builds "
-            f"(/kesort/F_as_built); the front shows the nominal values (/kesort/F), a "
-            f"design's panel both"
+            f"(/kesort/F_as_built, offered as axes); the front is drawn at the nominal "
+            f"values (/kesort/F), and a design's panel gives both"
         )
     _search_bounds(table, data, study.notes)
     rows = sorted(

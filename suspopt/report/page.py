@@ -46,18 +46,20 @@ SCRIPT = r"""
     return e;
   }
   function fmt(v) { return v === null ? "-" : Number(v).toPrecision(5); }
+  // a column by key: "F:j" objective j, "B:j" its value as built (kesort --as-built), "X:j" variable j
   function column(study, key) {
     const d = study.data, [kind, j] = key.split(":");
-    const rows = kind === "F" ? d.F : d.X;
+    const rows = kind === "F" ? d.F : kind === "B" ? d.F_as_built : d.X;
     return rows.map(r => r[Number(j)]);
   }
   function name(study, key) {
     const d = study.data, [kind, j] = key.split(":");
+    if (kind === "B") return d.objectives[j] + ", as built (p" + d.as_built + ")";
     return kind === "F" ? d.objectives[j] : d.variables[j];
   }
   function label(study, key) {
     const d = study.data, [kind, j] = key.split(":");
-    return name(study, key) + " [" + (kind === "F" ? d.objective_units[j] : d.variable_units[j]) + "]";
+    return name(study, key) + " [" + (kind === "X" ? d.variable_units[j] : d.objective_units[j]) + "]";
   }
   function select(el_, options, value) {
     for (const [k, text] of options) {
@@ -370,6 +372,7 @@ SCRIPT = r"""
   const done = [];
   data.studies.forEach((study, i) => {
     const d = study.data, keys = d.objectives.map((n, j) => ["F:" + j, n])
+      .concat(d.F_as_built ? d.objectives.map((n, j) => ["B:" + j, name(study, "B:" + j)]) : [])
       .concat(d.variables.map((n, j) => ["X:" + j, n]));
     const xs = document.getElementById("x-" + i), ys = document.getElementById("y-" + i);
     select(xs, keys, d.objectives.length > 1 ? "F:0" : "X:0");
