@@ -309,9 +309,10 @@ class Result:
         F_T parts, Eq 2.28-2.29), with the controller's damping where it has one."""
         if group not in self._forces:
             damping = self.damping_history if group == "suspension" else None
-            self._forces[group] = self.model.network.group(group).parts_at(
-                self.deformation(group), self.deformation(group, rate=True), damping
-            )
+            with np.errstate(over="ignore", invalid="ignore"):  # (a diverging design: inf)
+                self._forces[group] = self.model.network.group(group).parts_at(
+                    self.deformation(group), self.deformation(group, rate=True), damping
+                )
         return self._forces[group]
 
     def acceleration(self) -> np.ndarray:

@@ -88,11 +88,13 @@ def _case(duration: float, P: int, diverging: bool = False):
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("error::RuntimeWarning")
 @pytest.mark.parametrize("diverging", [False, True])
 def test_the_generated_reductions_give_the_bits_of_the_general_loops(monkeypatch, diverging):
     """70 designs take the fused step and the reductions generated for their accumulators;
     the same designs with every run walking the network take the general loops: the same
-    bits, diverged designs' NaN included."""
+    bits, diverged designs' NaN included, and no warning (a diverging design's forces
+    overflow: ``Result.diverged`` says so, not a RuntimeWarning)."""
     from suspopt.integrator import _fused, compiled
 
     cfg, params = _case(1.2, 70, diverging)
