@@ -771,3 +771,17 @@ def test_select_refuses_as_built_values_that_do_not_fit_its_sets(ps_front):
         select([replace(s, F_as_built=s.F, as_built=95), s])
     for q in (0, 50, 100):  # (the values themselves: the sort of F)
         assert select([replace(s, F_as_built=s.F, as_built=q)]).chosen == select([s]).chosen
+
+
+def test_kesort_as_built_plots_the_front_at_the_values_it_sorted(ps_front, ps_builds, tmp_path):
+    """``kesort --as-built 90 --plot`` draws the levels over the values as built, and its
+    axes say so (SVG text)."""
+    front, _ = ps_front
+    figure = tmp_path / "ke.svg"
+    res = _invoke("kesort", front, "--builds", ps_builds, "--as-built", 90, "--plot", figure)
+    assert res.exit_code == 0, res.output
+    text = figure.read_text()
+    assert "RC_se, as built (p90) [m/s^2]" in text and "X_ST, as built (p90) [m]" in text
+    plain = tmp_path / "plain.svg"
+    assert _invoke("kesort", front, "--builds", ps_builds, "--plot", plain).exit_code == 0
+    assert "as built" not in plain.read_text() and "X_ST [m]" in plain.read_text()

@@ -182,14 +182,17 @@ def plot_kesort(selection, path: str | Path) -> Path:
     case, coloured by the pool's k-ε level; the pool's optimum is a star, each case's own
     optimum an open square, the Pareto picks (edges and knee, Fig. 8.21) are labelled. Right:
     the k-ε level of every design against the first objective (Fig. 6.7). With one objective
-    only the right panel is drawn.
+    only the right panel is drawn. A selection sorted as built (``kesort --as-built``) is
+    drawn at the values it was sorted on (``F_as_built``), as its axes say.
     """
     from ..errors import require
     from ..selection import Selection
 
     s = require(selection, Selection, "selection", "from suspopt.selection.select(sets)")
     path = check_path(path)
-    F, levels, names, units = s.F, s.sort.k_eps, s.names, s.units
+    F, levels, units = s.F_sorted, s.sort.k_eps, s.units
+    built = "" if s.as_built is None else f", as built (p{s.as_built:g})"
+    names = [name + built for name in s.names]
     markers = "os^Dv<>phX*"
     two = F.shape[1] > 1
     fig, axes = new_figure(2 if two else 1, panel_size=(6.0, 5.0))
