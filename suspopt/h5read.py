@@ -415,20 +415,26 @@ class H5Reader:
 
     def int_attr(self, node: str, key: str, low: int, high: int) -> int:
         """The whole-number attribute ``key`` of ``/node``, in ``[low, high]``."""
-        obj = self._node(node)
+        return int(self.number_attr(node, key, low, high, integer=True))
+
+    def number_attr(
+        self, node: str, key: str, low: float, high: float, integer: bool = False
+    ) -> int | float:
+        """The numeric attribute ``key`` of ``/node`` (a whole number with ``integer``), in
+        ``[low, high]`` (NaN is not)."""
         label = f"/{node}: attribute {key!r}"
-        value = self.attribute(obj, key, label)
+        value = self.attribute(self._node(node), key, label)
         if isinstance(value, np.ndarray) and value.ndim == 0:
             value = value[()]
+        kinds = (int, np.integer) if integer else (int, float, np.integer, np.floating)
         if (
-            not isinstance(value, (int, np.integer))
-            or isinstance(value, bool)
+            not isinstance(value, kinds)
+            or isinstance(value, (bool, np.bool_))
             or not low <= value <= high
         ):
-            raise ConfigError(
-                f"{self.where}: {label}: missing or not a whole number in [{low}, {high}]"
-            )
-        return int(value)
+            what = "a whole number" if integer else "a number"
+            raise ConfigError(f"{self.where}: {label}: missing or not {what} in [{low}, {high}]")
+        return int(value) if integer else float(value)
 
     def labels(
         self, name: str, key: str, columns: int, *, kind: str = "Dataset", of: str = "columns"

@@ -257,8 +257,8 @@ def variable_batches(
     out: list[tuple[str, tuple[int, ...]]] = []
     seen: dict[str, str] = {}
     for name, members, where in groups:
+        columns = tuple(known_variable(pareto, label, where) for label in members)
         for label in members:
-            known_variable(pareto, label, where)
             if label in seen:
                 raise ConfigError(f"{where}: {label} is in two batches ({seen[label]}, {name})")
             seen[label] = name
@@ -266,7 +266,7 @@ def variable_batches(
             raise ConfigError(
                 f"{where}: batch {name!r} has one design variable: a batch is two or more"
             )
-        out.append((name, tuple(pareto.var_names.index(label) for label in members)))
+        out.append((name, columns))
     return tuple(out)
 
 

@@ -152,19 +152,6 @@ def _search_bounds(table, data: dict[str, Any], notes: list[str]) -> None:
     ]
 
 
-def _percentile(h5, name: str) -> float:
-    """The ``percentile`` attribute [%] of dataset ``/name``: a number from 0 to 100."""
-    label = f"/{name}: attribute 'percentile'"
-    value = h5.attribute(h5.dataset(name), "percentile", label)
-    if isinstance(value, np.ndarray) and value.ndim == 0:
-        value = value[()]
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
-        raise ConfigError(f"{h5.where}: {label}: missing or not a number from 0 to 100")
-    if not 0 <= float(value) <= 100:  # (NaN fails too)
-        raise ConfigError(f"{h5.where}: {label}: missing or not a number from 0 to 100")
-    return float(value)
-
-
 def _extras(h5, table) -> dict[str, Any]:
     """Feasibility, constraints, k-ε levels, cases, history and pseudo-fronts, where the
     file has them."""
@@ -192,7 +179,7 @@ def _extras(h5, table) -> dict[str, Any]:
         case = h5.dataset("kesort/case")[()]
         out["case"] = [h5.text(v, "kesort/case") for v in np.atleast_1d(case)]
         if h5._node("kesort/F_as_built") is not None:  # (kesort --as-built)
-            out["as_built"] = _percentile(h5, "kesort/F_as_built")
+            out["as_built"] = float(h5.number_attr("kesort/F_as_built", "percentile", 0, 100))
             built = h5.array("kesort/F_as_built", ndim=2, columns=table.F.shape[1])
             if len(built) != N:
                 raise ConfigError(f"{h5.where}: /kesort/F_as_built: {len(built)} rows, not {N}")
