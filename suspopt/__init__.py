@@ -24,6 +24,7 @@ _EXPORTS = {
     "ConfigError": "config",
     "config_schema": "config",
     "load_config": "config",
+    "load_template": "templates",
     "Result": "simulate",
     "simulate": "simulate",
     "build_vehicle": "vehicle",
@@ -71,4 +72,5 @@ if TYPE_CHECKING:
     from .memory import reuse_memory
     from .optimise import Problem
     from .simulate import Result, simulate
+    from .templates import load_template
     from .vehicle import build_vehicle, frequency_response, modal_analysis

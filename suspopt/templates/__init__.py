@@ -13,7 +13,13 @@ from importlib import resources
 
 from ..errors import check_known
 
-__all__ = ["TEMPLATES", "template_names", "template_description", "template_text"]
+__all__ = [
+    "TEMPLATES",
+    "template_names",
+    "template_description",
+    "template_text",
+    "load_template",
+]
 
 #: Template kinds in the order ``suspopt init --help`` lists them, with one line each.
 TEMPLATES: dict[str, str] = {
@@ -46,3 +52,28 @@ def template_text(kind: str) -> str:
     kinds for an unknown one."""
     check_known("template", kind, TEMPLATES)
     return resources.files(__name__).joinpath(f"{kind}.yaml").read_text(encoding="utf-8")
+
+
+def load_template(kind: str):
+    """The starter config of ``kind`` (``suspopt init KIND``) loaded, as
+    :func:`suspopt.load_config` loads a file: what a script or a notebook starts from without
+    writing the YAML out first.
+
+    Parameters
+    ----------
+    kind : str
+        One of :data:`TEMPLATES` (``quarter``, ``half_pitch``, ``kesort``, ...).
+
+    Returns
+    -------
+    Config
+        The validated config, quantities in SI units.
+
+    Raises
+    ------
+    ValueError
+        For an unknown kind, naming the closest kinds.
+    """
+    from ..config.loader import load_config_text
+
+    return load_config_text(template_text(kind), f"{kind}.yaml")
