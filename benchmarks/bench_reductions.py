@@ -44,7 +44,7 @@ def _same(a, b) -> bool:
 def main() -> None:
     loops = integrator.compiled_reductions()
     if loops is None:
-        raise SystemExit("needs numba: pip install 'suspopt[fast]'")
+        raise SystemExit("needs numba: pip install numba")
     print(f"suspopt {suspopt.__version__}, {platform.processor() or platform.machine()}")
     wk = weighting_filter("Wk", 1000.0)
     jobs = {

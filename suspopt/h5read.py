@@ -461,14 +461,15 @@ def open_dataset(path: str | Path, group: str | None = None):
     ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
     pandas DataFrame. A file that is missing, not HDF5 or damaged is a ConfigError naming it
     (:class:`H5Reader`), a group the file lacks a KeyError listing the
-    groups it has. Needs ``pip install 'suspopt[xarray]'`` (ModuleNotFoundError naming it
-    otherwise)."""
+    groups it has. Needs xarray and h5netcdf, dependencies of suspopt (a
+    ModuleNotFoundError naming them where they cannot be imported)."""
     try:
         import h5netcdf  # noqa: F401
         import xarray
     except ImportError:
         raise ModuleNotFoundError(
-            "suspopt.io.open_dataset needs xarray and h5netcdf: pip install 'suspopt[xarray]'"
+            "suspopt.io.open_dataset needs xarray and h5netcdf, dependencies of suspopt that "
+            "cannot be imported here: pip install xarray h5netcdf"
         ) from None
 
     def load(name: str | None):

@@ -3,7 +3,7 @@
 :func:`signal_table` is every signal a run of a model has, name -> :class:`Signal` (its SI
 unit and how it is computed from the result), in the order the HDF5 files list them: the
 vehicle's (body, wheels, each corner's suspension, tyre and road), the controller's records
-(per corner) and each attachment's (the seat and the passenger, :class:`Attachment`, which
+(per corner) and each attachment's (the seat and the passenger, :class:`!Attachment`, which
 contribute their own entries). :class:`SignalMap` computes a signal the first time it is read
 and keeps it.
 """
@@ -209,7 +209,7 @@ class Result:
     metric_units : dict of str to str
         SI unit of each metric.
     engine : str
-        The integrator that ran: ``numpy`` or ``compiled`` (:mod:`suspopt.integrator`).
+        The integrator that ran: ``numpy`` or ``compiled`` (:mod:`!suspopt.integrator`).
     """
 
     config: Config
@@ -248,7 +248,7 @@ class Result:
         return _row(self._table, name).unit
 
     def metric(self, spec, name: str) -> np.ndarray:
-        """The (P,) values of metric spec ``spec`` on signal ``name`` (:mod:`suspopt.specs`)."""
+        """The (P,) values of metric spec ``spec`` on signal ``name`` (:mod:`!suspopt.specs`)."""
         from .specs import METRICS
 
         return METRICS[spec.metric].compute(spec, self, name)
@@ -328,7 +328,7 @@ class Result:
 
     def attachment_signal(self, j: int, compute: Callable[..., np.ndarray]) -> np.ndarray:
         """A signal of attachment ``j`` (P, T) from its states and the floor's
-        (``compute(q, v, acc, base, base_vel, base_acc)``, :class:`Attachment`)."""
+        (``compute(q, v, acc, base, base_vel, base_acc)``, :class:`!Attachment`)."""
         nv = self.model.n_dof
         start = nv + sum(len(a.dof_names) for a in self.attachments[:j])
         sl = slice(start, start + len(self.attachments[j].dof_names))

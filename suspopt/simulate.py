@@ -107,12 +107,27 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:
     prepared = prepare(cfg, params)
     pv, model, _, attachments = prepared
     check_memory(cfg, model, attachments, pv.P, signals=len(cfg.metrics))
-    result = _run(cfg, prepared)
+    result = _run(with_engine(cfg, pv.P), prepared)
     for spec in cfg.metrics:
         for name, values, unit in evaluate_spec(spec, result, result.signal_unit):
             result.metrics[name] = values
             result.metric_units[name] = unit
     return result
+
+
+def with_engine(cfg: Config, designs: int, evaluation: bool = False) -> Config:
+    """``cfg`` with ``simulation.engine: auto`` resolved for a batch of ``designs``
+    (:func:`suspopt.integrator.auto_engine`; an ``evaluation`` of objectives, or a config with
+    an ``optimiser:`` section, runs compiled), as a copy; ``cfg`` itself for any other
+    engine. Resolved once for the whole batch, before it is cut into chunks, so that every
+    executor and chunk width runs the same engine."""
+    sim = cfg.simulation
+    if sim.engine != "auto":
+        return cfg
+    from .integrator import auto_engine
+
+    engine = auto_engine(sim.n_steps, designs, evaluation or cfg.optimiser is not None)
+    return cfg.model_copy(update={"simulation": sim.model_copy(update={"engine": engine})})
 
 
 def run_memory(

@@ -563,9 +563,10 @@ def reduce(
     config's road (robust design, one batch for several roads on one time grid). A run with
     a controller is one window (its hold keeps records over the run)."""
     from . import integrator
-    from .simulate import _result, _setup, check_memory, prepare
+    from .simulate import _result, _setup, check_memory, prepare, with_engine
 
     pv, model, controller, attachments = prepare(cfg, params)
+    cfg = with_engine(cfg, pv.P, evaluation=True)
     streams = _Streams(requests)
     if controller is not None:
         width = None

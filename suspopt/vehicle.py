@@ -468,7 +468,7 @@ def modal_analysis(model: VehicleModel) -> ModalResult:
 
     Solved as the symmetric problem M^-1/2 K M^-1/2 (M diagonal), batched over designs. The
     Duffing term has zero stiffness at equilibrium and does not enter. Each mode is labelled
-    by the DOFs that carry its kinetic energy (:class:`ModalResult`): on a full car the wheel
+    by the DOFs that carry its kinetic energy (:class:`!ModalResult`): on a full car the wheel
     hop modes are collective (a pair of wheels in or against phase), so no single wheel names
     them.
 

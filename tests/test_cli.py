@@ -70,7 +70,7 @@ def test_help_prints_each_text_as_written():
     """Every command's docstring paragraphs and every argument's help appear in ``--help``
     as written: each paragraph on one line of a wide terminal (typer's markup kept the
     docstring's line breaks) and nothing in brackets dropped (``pip install
-    'suspopt[report]'`` came out as ``'suspopt'``)."""
+    'suspopt[dask]'`` came out as ``'suspopt'``)."""
     import inspect
     import re
 
@@ -96,7 +96,7 @@ def test_help_prints_each_text_as_written():
         for text in [*flowed, *helps]:
             for token in re.findall(r"\S*\[[^\]]*\]\S*", text.replace("\\[", "[")):
                 assert token in output, (name, token)
-    assert "suspopt[report]" in runner.invoke(app, ["report", "--help"]).output
+    assert "suspopt[dask]" in runner.invoke(app, ["optimise", "--help"]).output
 
 
 @pytest.mark.slow

@@ -225,10 +225,68 @@ def test_the_compiled_engine_without_numba_is_bad_input(monkeypatch, tmp_path):
     )
     path = tmp_path / "fast.yaml"
     path.write_text(text)
-    with pytest.raises(ConfigError, match=r"simulation.engine.*suspopt\[fast\]"):
+    with pytest.raises(ConfigError, match=r"simulation.engine.*pip install numba"):
         suspopt.load_config(path)
     path.write_text(text.replace("engine: compiled", "engine: auto"))
     assert suspopt.load_config(path).simulation.engine == "auto"
+
+
+def test_auto_without_numba_runs_numpy_and_says_so_once(monkeypatch):
+    """On a platform without numba's wheels ``engine: auto`` runs on numpy, and says which
+    engine and why once per process: to a listener (the command line's note on stderr),
+    else as a UserWarning."""
+    import warnings
+
+    import suspopt.integrator as integrator
+    from suspopt import _notices
+
+    monkeypatch.setattr(integrator, "compiled_available", lambda: False)
+    monkeypatch.setattr(integrator, "_fallback_told", [])
+    told = []
+
+    def listener(kind, **data):
+        told.append((kind, data))
+
+    _notices.listen(listener)
+    try:
+        cfg = suspopt.load_template("half_pitch")
+        results = [suspopt.simulate(cfg, params=_designs(cfg, 3)) for _ in range(2)]
+    finally:
+        _notices.unlisten(listener)
+    assert [r.engine for r in results] == ["numpy", "numpy"]
+    assert [kind for kind, _ in told] == ["engine-fallback"]
+    assert "numba cannot be imported" in told[0][1]["message"]
+    monkeypatch.setattr(integrator, "_fallback_told", [])
+    with pytest.warns(UserWarning, match="runs on the numpy engine"):
+        assert integrator.auto_engine(100, 1, evaluation=True) == "numpy"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert integrator.auto_engine(100, 1, evaluation=True) == "numpy"  # (once)
+
+
+def test_the_rule_of_auto():
+    """``auto``: compiled for evaluations and optimisation configs, else from
+    ``AUTO_STEPS`` steps, fewer for a batch (docs/guide/engines.md#the-rule-of-auto)."""
+    from suspopt.integrator import AUTO_DESIGNS, AUTO_STEPS, auto_engine
+    from suspopt.simulate import with_engine
+
+    assert auto_engine(10, 1, evaluation=True) == "compiled"
+    assert auto_engine(AUTO_STEPS - 100, 1, evaluation=False) == "numpy"
+    assert auto_engine(AUTO_STEPS, 0, evaluation=False) == "compiled"
+    assert auto_engine(AUTO_STEPS // 2, AUTO_DESIGNS, evaluation=False) == "compiled"
+    quick = suspopt.load_config(CONFIGS / "quickstart.yaml")  # 3,000 steps, no optimiser
+    assert quick.simulation.engine == "auto"  # (the default)
+    assert with_engine(quick, 1).simulation.engine == "numpy"
+    assert with_engine(quick, 10 * AUTO_DESIGNS).simulation.engine == "compiled"
+    assert with_engine(quick, 1, evaluation=True).simulation.engine == "compiled"
+    study = suspopt.load_template("kesort")  # an optimisation: compiled whatever its batch
+    assert with_engine(study, 1).simulation.engine == "compiled"
+    assert study.simulation.engine == "auto"  # (a copy: the config is left as it was)
+    assert with_engine(quick, 1)._text == quick._text
+    fixed = quick.model_copy(
+        update={"simulation": quick.simulation.model_copy(update={"engine": "numpy"})}
+    )
+    assert with_engine(fixed, 10**6) is fixed
 
 
 def _agree_with_records(numpy_run, compiled_run) -> None:

@@ -25,11 +25,14 @@ SCANNED = (
 #: from matching itself): the design notes, the list of the thesis's slips, the standards'
 #: facts, the shared folder they sit in, and the slips list cited by its bare name.
 OUTSIDE = re.compile(
-    r"\b(?:DESIG[N]|ERRAT[A]|standard[s])\.md|\.\./share[d]|\breferenc[e]/"
+    r"\b(?:DESIG[N]|ERRAT[A]|standard[s])\.md|\.\./share[d]|\breferenc[e]/\d{3}_"
     r"|\bERRAT[A]\b"
 )
-#: A cited docs page, optionally with an anchor: ``docs/thesis-slips.md#eq-2104``.
-DOCS_CITATION = re.compile(r"\bdocs/([\w-]+\.md)(?:#([\w-]+))?")
+#: A cited docs page, optionally with an anchor: ``docs/thesis-slips.md#eq-2104``,
+#: ``docs/guide/engines.md#the-rule-of-auto``.
+DOCS_CITATION = re.compile(r"\bdocs/((?:[\w-]+/)*[\w-]+\.md)(?:#([\w-]+))?")
+#: Folders of docs/ that the site's build writes (not sources).
+BUILT = ("_build", "gallery", "generated")
 #: A markdown link ``[text](target)``; images too.
 MARKDOWN_LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
 FENCE = re.compile(r"^\s*(```|~~~)")
@@ -41,7 +44,10 @@ def _text_files() -> list[Path]:
         path = ROOT / name
         candidates = [path] if path.is_file() else sorted(path.rglob("*"))
         for file in candidates:
+            built = file.is_relative_to(ROOT / "docs") and any(p in BUILT for p in file.parts)
             if file.is_file() and "__pycache__" not in file.parts and file.suffix != ".h5":
+                if built:
+                    continue
                 try:
                     file.read_text(encoding="utf-8")
                 except UnicodeDecodeError:
@@ -50,12 +56,14 @@ def _text_files() -> list[Path]:
     return files
 
 
+def _docs_pages() -> list[Path]:
+    """The Markdown pages of the documentation site (docs/, not what its build writes)."""
+    pages = sorted((ROOT / "docs").rglob("*.md"))
+    return [p for p in pages if not any(part in BUILT for part in p.relative_to(ROOT).parts)]
+
+
 def _markdown_files() -> list[Path]:
-    return [
-        ROOT / "README.md",
-        ROOT / "configs" / "README.md",
-        *sorted((ROOT / "docs").glob("*.md")),
-    ]
+    return [ROOT / "README.md", ROOT / "configs" / "README.md", *_docs_pages()]
 
 
 def github_anchor(heading: str) -> str:
@@ -127,7 +135,7 @@ def test_no_file_cites_a_path_outside_the_repository():
 
 def test_cited_docs_pages_and_anchors_exist():
     """Every ``docs/<file>.md#anchor`` in code, configs, tests, examples and docs."""
-    pages = {page.name: anchors(page) for page in (ROOT / "docs").glob("*.md")}
+    pages = {page.relative_to(ROOT / "docs").as_posix(): anchors(page) for page in _docs_pages()}
     assert {"architecture.md", "thesis-slips.md", "iso-facts.md"} <= set(pages)
     broken, cited = [], 0
     for file in _text_files():
@@ -159,7 +167,16 @@ def test_relative_links_resolve(markdown):
     assert not broken, "\n".join(broken)
 
 
-def test_readme_links_every_docs_page():
+def test_readme_links_the_site_and_each_of_its_sections():
+    """The README is the front door: it links the site's home and each section's first page
+    (the sections are the entries of the home page's table of contents)."""
     readme = {target.partition("#")[0] for _, target in _links(ROOT / "README.md")}
-    pages = {f"docs/{page.name}" for page in (ROOT / "docs").glob("*.md")}
-    assert pages <= readme, f"README links none of {sorted(pages - readme)}"
+    home = (ROOT / "docs" / "index.md").read_text(encoding="utf-8")
+    toc = home[home.index("```{toctree}") :].split("```")[1]
+    entries = [e.strip() for e in toc.splitlines()[1:] if e.strip() and ":" not in e]
+    sections = {"docs/index.md"}
+    for entry in entries:
+        source = ROOT / "docs" / f"{entry}.md"
+        if source.exists():  # (the gallery's index is built from examples/gallery)
+            sections.add(source.relative_to(ROOT).as_posix())
+    assert sections <= readme, f"README links none of {sorted(sections - readme)}"

@@ -239,7 +239,7 @@ def test_write_dataset_keeps_one_length_per_dimension(tmp_path):
 
 def test_open_dataset_names_the_extra_when_xarray_is_missing(files, monkeypatch):
     monkeypatch.setitem(sys.modules, "xarray", None)
-    with pytest.raises(ModuleNotFoundError, match=r"suspopt\[xarray\]"):
+    with pytest.raises(ModuleNotFoundError, match=r"pip install xarray h5netcdf"):
         open_dataset(files["front"], "pareto")
 
 

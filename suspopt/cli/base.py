@@ -140,8 +140,8 @@ def max_memory_option():
 
 
 EXECUTOR_HELP = (
-    "where designs are simulated: local (this process), processes (a local pool) or dask; "
-    "wins over the config's execution: section"
+    "where designs are simulated: local (this process), processes (a local pool) or dask "
+    "(pip install 'suspopt[dask]'); wins over the config's execution: section"
 )
 
 
@@ -305,8 +305,11 @@ def _main(
     ),
 ) -> None:
     """Simulate, optimise and select vehicle and seat suspensions from YAML."""
+    from .. import _notices
     from ..memory import reuse_memory
+    from .notices import notices
 
+    _notices.listen(notices)  # the compiled kernel's first compile, auto's fallback
     out.quiet = quiet
     VERBOSE[0] = verbose and not quiet
     reuse_memory()  # a command's repeated batches reuse their memory (suspopt.memory)

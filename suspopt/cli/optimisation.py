@@ -10,6 +10,7 @@ import typer
 from ..errors import ConfigError
 from . import base
 from .base import app, err, out
+from .notices import notices
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -208,7 +209,8 @@ def _optimise(
     bar, report, chunk_done = _progress(cfg)
     try:
         lost = _resume_hint(config, output, "the last generation's checkpoint", "continue", sets)
-        with bar, options.executing(progress=chunk_done, lost_hint=lost + " (on any executor)"):
+        executing = options.executing(progress=chunk_done, lost_hint=lost + " (on any executor)")
+        with bar, executing, notices.beside(bar):  # (a compile's indicator: a line of the bar)
             result = run(cfg, output, resume=resume, callback=report, command=base.command_line())
     except WriteError as exc:  # (a full disk: the file holds the last generation it took)
         hint = "make room, then continue"

@@ -33,7 +33,7 @@ def report(
     """Write one self-contained HTML page to explore the fronts of result files.
 
     The page holds the front and parallel coordinates, each design's row on click, the picks'
-    signals, the history and the provenance. It needs plotly: pip install 'suspopt[report]'."""
+    signals, the history and the provenance; it opens offline in any browser."""
     from ..report import build_report
 
     rows = [r.strip() for item in with_signals for r in item.split(",") if r.strip()]

@@ -318,7 +318,7 @@ def _kesort(
         if plot.suffix.lower() not in (".png", ".svg"):
             base.fail(f"--plot {plot}: give a .png or .svg file")
         if importlib.util.find_spec("matplotlib") is None:
-            base.fail("--plot needs matplotlib: pip install 'suspopt[plot]'")
+            base.fail("--plot needs matplotlib, a dependency of suspopt: pip install matplotlib")
     if P is not None and P != "auto":
         P = _floats("--P", P)[0]
     P_lo_hi = _floats("--P-range", P_range)

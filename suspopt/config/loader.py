@@ -317,7 +317,7 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
 
 def load_config(path: str | Path) -> Config:
     """Read and validate a YAML config file (a regular UTF-8 file of at most
-    :data:`~suspopt.config.yamlio.MAX_CONFIG_BYTES`).
+    ``suspopt.config.yamlio.MAX_CONFIG_BYTES``, 1 MB).
 
     Parameters
     ----------
@@ -391,7 +391,7 @@ def config_schema() -> dict:
 
     It is pydantic's schema of :class:`Config` with one change, made here on the finished
     dict: the corners' keys that ``vehicle.corner_defaults`` may give are optional
-    (:func:`~suspopt.config.vehicle.corner_defaults_schema`). The schema checks keys, types
+    (:func:`!suspopt.config.vehicle.corner_defaults_schema`). The schema checks keys, types
     and ranges; rules between keys (``c_max >= c_min``, a preset's body fields, RK4
     stability, ...) are the loader's and ``suspopt validate``'s.
 

@@ -38,11 +38,12 @@ class Simulation(Section):
         None, description="output sample interval [s], a whole multiple of dt (default dt)"
     )
     engine: Annotated[Literal["numpy", "compiled", "auto"], AfterValidator(_installed)] = Field(
-        "numpy",
-        description="the integrator: numpy (the reference), compiled (numba, pip install "
-        '"suspopt[fast]": every vehicle, seat, road and controller; a non-linear element '
-        "without a compiled law runs on numpy), or auto (compiled when numba is installed); "
-        "the two agree to rounding",
+        "auto",
+        description="the integrator: auto (compiled where it pays end to end: every "
+        "evaluation of objectives and every run of a config with an optimiser, other runs "
+        "from 6,000 steps (fewer for a batch); numpy where numba cannot be imported), numpy (the reference) or "
+        "compiled (numba: every vehicle, seat, road and controller; a non-linear element "
+        "without a compiled law runs on numpy); the two agree to rounding",
     )
     method: Literal["time", "spectral"] = Field(
         "time",

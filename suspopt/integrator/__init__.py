@@ -4,14 +4,17 @@ rounding (``simulation.engine``):
 
 - ``numpy`` (:mod:`.rk4`, the reference): each stage is a few whole-population numpy
   operations; it covers every model, controller and road.
-- ``compiled`` (:mod:`.compiled`, needs numba: ``pip install "suspopt[fast]"``): the whole
+- ``compiled`` (:mod:`.compiled`, numba, a dependency of suspopt): the whole
   run in one compiled call, the element network as sparse loops, designs in blocks of lanes
   the compiler vectorises, the blocks spread over the cores. It covers the networks whose
   non-linear parts have a compiled law (Duffing springs, tyre lift-off, the seats' exact and
   Taylor mechanisms), with or without a semi-active controller (asked at its samples, its
   actuator lag applied in the kernel); any other run goes to the numpy engine, and
   :attr:`Trajectory.engine` says which one ran.
-- ``auto``: ``compiled`` when numba is installed, else ``numpy``.
+- ``auto`` (the default): ``compiled`` where it pays end to end, else ``numpy``
+  (:func:`auto_engine`: every evaluation of objectives and every run of an optimisation's
+  config, and other simulations from :data:`AUTO_STEPS` steps); ``numpy`` where numba cannot
+  be imported, said once (:mod:`suspopt._notices`).
 
 Both take the same steps, samples, road edges (split steps with their exact impulses) and
 divergence rule; see :mod:`.rk4` for what those are.
@@ -49,6 +52,9 @@ __all__ += [
     "compiled_available",
     "compiled_reductions",
     "compiled_runs",
+    "auto_engine",
+    "AUTO_STEPS",
+    "AUTO_DESIGNS",
 ]
 
 #: A window's samples are a multiple of this (the compiled kernel's sample buffer).
@@ -57,7 +63,7 @@ WINDOW_MULTIPLE = 32
 ENGINES = ("numpy", "compiled", "auto")
 
 #: How to install the compiled engine.
-INSTALL_FAST = 'pip install "suspopt[fast]"'
+INSTALL_FAST = "pip install numba (a dependency of suspopt; this platform may lack its wheels)"
 
 
 @functools.cache
@@ -67,6 +73,64 @@ def compiled_available() -> bool:
     import importlib.util
 
     return importlib.util.find_spec("numba") is not None
+
+
+#: ``auto``'s rule for a simulation that is not an evaluation (:func:`auto_engine`): the
+#: compiled engine from this many integration steps of one design, fewer as the designs grow
+#: (each :data:`AUTO_DESIGNS` designs count as another run). Measured end to end, whole
+#: processes, the kernel cached, on the 2-core development machine
+#: (``benchmarks/bench_engines.py``; docs/performance.md): the numpy engine costs about
+#: 0.12 ms per step of a few designs, more as the batch grows, and the compiled engine about
+#: 1 s more to start (numba's import and its cache's load); one design of the half car
+#: breaks even between 3,000 steps (numpy 12 % faster) and 10,000 (compiled 38 % faster),
+#: and 100 designs over 3,000 steps take the same time on both.
+AUTO_STEPS = 6_000
+#: The designs that count as one more run of :data:`AUTO_STEPS` (the numpy engine's time per
+#: step grows with the batch, the compiled engine's per design much less).
+AUTO_DESIGNS = 100
+
+_fallback_told: list[bool] = []
+
+
+def auto_engine(steps: int, designs: int, evaluation: bool) -> str:
+    """The engine that ``simulation.engine: auto`` runs: ``compiled`` where numba can be
+    imported and the run is worth it, else ``numpy``.
+
+    Parameters
+    ----------
+    steps : int
+        Integration steps of the run (``simulation.duration / dt``).
+    designs : int
+        Designs of the whole batch (not of a chunk: every executor then runs one engine).
+    evaluation : bool
+        Whether the run evaluates objectives of an optimisation's config (``optimise``,
+        ``kesort``, the analyses of a front, or a simulation of a config with an
+        ``optimiser:`` section): always compiled, so that every command of one study runs
+        one engine and a design's values repeat bit for bit from one command to the next.
+
+    Returns
+    -------
+    str
+        ``"compiled"`` or ``"numpy"``. Without numba, ``"numpy"`` and one notice per
+        process (:mod:`suspopt._notices` ``engine-fallback``, else a ``UserWarning``).
+    """
+    if not compiled_available():
+        if not _fallback_told:
+            _fallback_told.append(True)
+            message = (
+                "simulation.engine auto runs on the numpy engine: numba cannot be imported on "
+                "this machine (the compiled engine needs it; pip install numba)"
+            )
+            from .. import _notices
+
+            if not _notices.tell("engine-fallback", message=message):
+                import warnings
+
+                warnings.warn(message, stacklevel=3)
+        return "numpy"
+    if evaluation or steps * (1 + designs / AUTO_DESIGNS) >= AUTO_STEPS:
+        return "compiled"
+    return "numpy"
 
 
 def compiled_reductions() -> Any:

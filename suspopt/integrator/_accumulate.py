@@ -41,7 +41,7 @@ import numpy as np
 
 from . import _fused, _numba_cache
 
-_numba_cache.heal()  # (a damaged file of numba's cache compiles again: ._numba_cache)
+_numba_cache.prepare()  # (cached for the machine, damaged files compiled again: ._numba_cache)
 
 __all__ = ["accumulate", "fused", "summed", "source", "ACCUMULATE", "PER_SIGNAL", "PER_PAIR"]
 

@@ -173,11 +173,11 @@ def source(idx: np.ndarray, lay: np.ndarray) -> str:
 
 
 def cache_dir() -> Path:
-    """Where the generated modules (and numba's compiled copies) are kept."""
-    if os.environ.get("SUSPOPT_CACHE_DIR"):  # ("~/cache" from a file that no shell expanded)
-        return Path(os.environ["SUSPOPT_CACHE_DIR"]).expanduser() / "fused"
-    xdg = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(xdg) / "suspopt" / "fused"
+    """Where the generated modules (and numba's compiled copies) are kept: ``fused`` in
+    suspopt's cache folder (:func:`._numba_cache.cache_root`)."""
+    from ._numba_cache import cache_root
+
+    return cache_root() / "fused"
 
 
 #: The functions loaded in this process, by packed structure.
@@ -221,6 +221,8 @@ def load(text: str, names: tuple[str, ...]) -> tuple | None:
     sys.modules[module.__name__] = module  # (numba's cache finds the module by its name)
     from . import _numba_cache
 
-    _numba_cache.heal()  # (numba's damaged copy of the module: compiled again)
-    exec(compile(text, str(path), "exec"), module.__dict__)
+    _numba_cache.prepare()  # (numba's damaged copy of the module: compiled again)
+    what = "the kernel's reductions" if "accumulate" in names else "the fused step"
+    with _numba_cache.compiling(f"{what} of this network"):
+        exec(compile(text, str(path), "exec"), module.__dict__)
     return tuple(getattr(module, name) for name in names)

@@ -37,7 +37,7 @@ from ..control.laws import LAWS
 from . import _numba_cache
 from ._accumulate import accumulate, no_accumulate, no_first, no_regular
 
-_numba_cache.heal()  # (a damaged file of numba's cache compiles again: ._numba_cache)
+_numba_cache.prepare()  # (cached for the machine, damaged files compiled again: ._numba_cache)
 _jit = numba.njit(cache=True, nogil=True)
 #: A helper compiled into its one caller (no call, no reference counts).
 _inline = numba.njit(cache=True, nogil=True, inline="always")

@@ -29,7 +29,7 @@ import numpy as np
 
 from . import _numba_cache
 
-_numba_cache.heal()  # (a damaged file of numba's cache compiles again: ._numba_cache)
+_numba_cache.prepare()  # (cached for the machine, damaged files compiled again: ._numba_cache)
 _jit = numba.njit(cache=True, nogil=True)
 
 

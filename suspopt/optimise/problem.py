@@ -2,7 +2,7 @@
 
 ``Problem.from_config(cfg)`` reads ``design_variables``, ``objectives`` and ``constraints``
 (:mod:`suspopt.config.optimise`); ``evaluate(X)`` runs ONE batched simulation for the
-whole population ``X (N, n_var)`` (in batches of at most :data:`MAX_BATCH` designs, or fewer
+whole population ``X (N, n_var)`` (in batches of at most :data:`!MAX_BATCH` designs, or fewer
 when memory asks), keeping no (P, T) signal its metrics do not need
 (:func:`suspopt.streaming.reduce`), and returns ``F (N, n_obj)`` and ``G (N, n_ieq_constr)``
 (``G <= 0`` feasible, Eq 6.3).
@@ -13,9 +13,9 @@ variables rounded). ``xl``/``xu`` are in the same coordinates.
 
 Failed designs never stop a run. A design whose simulation diverges, or whose objectives or
 constraints come out NaN or infinite (an undefined seat geometry, Sec 8.2.2), gets every
-objective set to :data:`PENALTY` and the last constraint, ``simulation_failed``, set to
-:data:`PENALTY` (it is -1 for a sound design); its other non-finite constraints are
-:data:`PENALTY` too. Constrained algorithms therefore rank it below every sound design.
+objective set to :data:`!PENALTY` and the last constraint, ``simulation_failed``, set to
+:data:`!PENALTY` (it is -1 for a sound design); its other non-finite constraints are
+:data:`!PENALTY` too. Constrained algorithms therefore rank it below every sound design.
 """
 
 from __future__ import annotations
@@ -245,9 +245,9 @@ class Problem(_PymooProblem):
         return self._objectives + self._constraints + self._supplementary
 
     def batch_width(self) -> int:
-        """Designs simulated in one batch: as many as fit in :data:`BATCH_BYTES` (or half of
-        ``--max-memory`` when that is smaller) by :func:`suspopt.simulate.run_memory`, at
-        least one, at most :data:`MAX_BATCH` (so that the time per design does not grow with
+        """Designs simulated in one batch: as many as fit in :data:`!BATCH_BYTES` (or half of
+        ``--max-memory`` when that is smaller) by :func:`!suspopt.simulate.run_memory`, at
+        least one, at most :data:`!MAX_BATCH` (so that the time per design does not grow with
         the population). It depends on the config (and an explicit memory limit) only, never
         on the memory free at the moment, so that a run repeats bit for bit."""
         if self._width is None:
@@ -368,7 +368,7 @@ class Problem(_PymooProblem):
     def scenario_values(self, values) -> tuple[np.ndarray, np.ndarray]:
         """``FS (N, S, m)``, ``GS (N, S, k)``: the objectives and constraint margins of the
         designs of physical ``values (N, n_var)`` under every scenario (NaN where one failed,
-        and ``simulation_failed`` :data:`PENALTY` there), from the evaluations that found
+        and ``simulation_failed`` :data:`!PENALTY` there), from the evaluations that found
         them, else simulated now."""
         if self.scenarios is None:
             raise ValueError("scenario_values: this problem's config has no scenarios: section")

@@ -1,5 +1,4 @@
-"""Figures of the analyses, drawn from arrays (matplotlib, optional: ``pip install
-'suspopt[plot]'``).
+"""Figures of the analyses, drawn from arrays (matplotlib).
 
 The analyses compute and write HDF5; this module draws what they hand it, so a figure can be
 redrawn from a file (the simulation figure computes the Welch PSDs and ISO 2631-1 weighted

@@ -89,7 +89,10 @@ def figure_class():
     try:
         from matplotlib.figure import Figure
     except ImportError:
-        raise ValueError("--plot needs matplotlib: pip install 'suspopt[plot]'") from None
+        raise ValueError(
+            "--plot needs matplotlib, a dependency of suspopt that cannot be imported here: "
+            "pip install matplotlib"
+        ) from None
     return Figure
 
 

@@ -4,7 +4,7 @@
 roads|masses|controllers|tolerances`` and ``analyse transmissibility`` of a Pareto file, the files that
 hold a design table (:func:`suspopt.picks.read_table`; each a *study*: :func:`collect`), and writes
 one self-contained HTML page (:mod:`.page`): every script and style inline, plotly.js
-included (the optional extra ``pip install 'suspopt[report]'``), so it opens offline in any
+included (plotly, a dependency), so it opens offline in any
 browser and makes no network request. Per study:
 
 - the front as a scatter of any two columns (objectives or design variables) chosen from

@@ -1,6 +1,6 @@
 """The report's HTML page: plotly.js, the studies as JSON and the page's own script, inline.
 
-:func:`render` needs plotly (``pip install 'suspopt[report]'``) for its JavaScript only: the
+:func:`render` needs plotly (a dependency of suspopt) for its JavaScript only: the
 figures are drawn in the browser by :data:`SCRIPT` from the data, so that the drop-downs can
 redraw them. The data are JSON in a ``<script type="application/json">`` element with every
 ``<``, ``>`` and ``&`` escaped, and every name from a file is shown with ``textContent``,
@@ -411,7 +411,8 @@ def _plotly_js() -> str:
         from plotly.offline import get_plotlyjs
     except ImportError:
         raise ConfigError(
-            "report: needs plotly for its page's plots: pip install 'suspopt[report]'"
+            "report: needs plotly for its page's plots, a dependency of suspopt that cannot be "
+            "imported here: pip install plotly"
         ) from None
     return get_plotlyjs()
 

@@ -4,7 +4,7 @@ Each template is a real config in SI units that validates and runs as it is: its
 what every key means and which thesis table or equation its numbers come from, and its run is
 short (a comment says how to make it longer). The files sit beside this module as
 ``<kind>.yaml``; to add a template, add the file and its one-line description to
-:data:`TEMPLATES` (tests/test_templates.py checks, validates and runs every entry).
+:data:`!TEMPLATES` (tests/test_templates.py checks, validates and runs every entry).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ TEMPLATES: dict[str, str] = {
 
 
 def template_names() -> list[str]:
-    """The template kinds, in the order of :data:`TEMPLATES`."""
+    """The template kinds, in the order of :data:`!TEMPLATES`."""
     return list(TEMPLATES)
 
 
@@ -62,7 +62,7 @@ def load_template(kind: str):
     Parameters
     ----------
     kind : str
-        One of :data:`TEMPLATES` (``quarter``, ``half_pitch``, ``kesort``, ...).
+        One of :data:`!TEMPLATES` (``quarter``, ``half_pitch``, ``kesort``, ...).
 
     Returns
     -------
