@@ -2,13 +2,13 @@
 straightforward per-design ``scipy.integrate.solve_ivp`` evaluation of the same designs.
 
 The problem is configs/ch5/case4_s1.yaml: Table 5.1 half car with Duffing springs over the
-half-sine bump (0.05 m, base 1 m, 40 km/h), 3 s at dt = 1 ms, objectives f1-f3 (Eq 5.4-5.6) and
+half-sine bump (0.05 m, base 1 m, 40 km/h), 3 s at dt = 2 ms, objectives f1-f3 (Eq 5.4-5.6) and
 constraints Eq 5.2-5.3. Designs are drawn uniformly inside the Table 5.2 bounds.
 
 The per-design path writes the HC2 right-hand side here from the model's parameter arrays
 (``suspopt.build_vehicle(cfg, ParamView(cfg, params))``: masses, travel map, spring, damper
 and tyre coefficients) and the bump from the road section, integrates it with RK45
-(``rtol = 1e-4``, ``max_step`` a quarter of the bump's duration), samples it on the same 1 ms
+(``rtol = 1e-4``, ``max_step`` a quarter of the bump's duration), samples it on the same 2 ms
 grid and computes the same objectives and constraints with the public metric functions. It runs
 on the first ``--per-design`` designs (default 40) and its rate is per design. The batched
 path is timed as the best of ``REPEATS`` calls on the whole population, each engine's after a

@@ -5,7 +5,7 @@ one chunk costs each executor on empty work (a task that returns at once).
 
 The problem is configs/ch6/part_b.yaml (the Ch. 5 half car on the bump with the PS seat and
 the seated passenger, passive) at population ``--population`` (default 1000), in chunks of ``--chunk`` designs
-(default the config's, 100). Each executor first evaluates the population once (its start:
+(default the config's: 250 for configs/ch6/part_b.yaml). Each executor first evaluates the population once (its start:
 processes and imports, the problem sent to every worker), then the best of ``REPEATS`` calls
 counts. The objectives of every executor are compared bit for bit with ``local``'s.
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The reproduction report of the thesis in one command, from a clean checkout (after
-# `python -m pip install -e ".[test]"`):
+# `python -m pip install -e .`):
 #
 #   examples/reproduce_thesis.sh [OUT] [REPORT]
 #
@@ -20,8 +20,8 @@
 #   Ch. 6-8    the configs' population 100 and 100 generations (Ch. 6-8 state no budget).
 # SUSPOPT_QUICK=1 runs everything on a tiny budget (population 8, 2 generations, 3 s runs;
 # examples/budget_config.sh) and writes the whole report structure in a few minutes, for CI.
-# About 25 minutes on a 2-core machine (Ch. 8's ten fronts take 6 of them); run it under
-# `nice -n 10` on a shared one.
+# Its wall times on the 2-core development machine are on docs/performance.md; run it under
+# `nice -n 10` on a shared machine.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 out="${1:-out/report}"

@@ -66,7 +66,8 @@ class Threshold(Section):
     distribution: Literal["student_t", "normal", "empirical"] = Field(
         "student_t",
         description="fit of the condition history: student_t (the thesis's, "
-        "location-scale t by EM), normal (mean and standard deviation) or empirical (the "
+        "location-scale t by a Newton maximum-likelihood fit of a fixed-size summary of the "
+        "history), normal (mean and standard deviation) or empirical (the "
         "sample quantile)",
     )
 

@@ -3,7 +3,7 @@
 They work on any vectorised pymoo ``Problem`` (``evaluate(X)`` of a whole batch), not only on
 :class:`suspopt.Problem`, and draw every random number from the ``numpy.random.Generator`` given
 to ``setup``. Stepping one generation at a time lets a run report progress, write a
-checkpoint (a pickle of the optimiser) and resume to the same result as an uninterrupted run.
+checkpoint (data only: every evaluated batch) and resume to the same result as an uninterrupted run.
 
 - :class:`PymooOptimiser`: a pymoo algorithm (GA for one objective, Ch. 5 S1/S2; NSGA-II for
   Pareto fronts, Ch. 6-8; SMS-EMOA, GDE3; see ``suspopt.config.optimise.ALGORITHMS``).
@@ -177,7 +177,7 @@ class Gradient(Optimiser):
     One ``next()`` is one SLSQP iteration. scipy's SLSQP cannot pause, so ``next()`` re-runs it
     from the start with one more allowed iteration; the cache of evaluated points replays the
     earlier iterations without evaluating anything (SLSQP is deterministic), which also makes
-    the pickled cache an exact checkpoint.
+    the cache of evaluated points an exact checkpoint.
     """
 
     def __init__(
