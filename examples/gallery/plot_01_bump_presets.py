@@ -39,7 +39,6 @@ corner = {
 results = {}
 for preset in ("quarter", "half_roll", "half_pitch", "full"):
     cfg = suspopt.load_template(preset)
-    cfg.simulation.engine = "numpy"
     if preset == "half_pitch":
         cfg.vehicle.body = {"mass": 542.5, "pitch_inertia": 550.0, "a_front": 1.4, "a_rear": 1.47}
         cfg.vehicle.corners = {"F1": corner, "R1": corner}

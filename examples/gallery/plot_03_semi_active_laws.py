@@ -23,7 +23,6 @@ import suspopt
 # ---------------------------------
 
 base = suspopt.load_template("semi_active")
-base.simulation.engine = "numpy"
 base.simulation.duration = 10.0  # [s]: 139 m of road
 base.control.threshold = None  # the base laws
 base.metrics = [

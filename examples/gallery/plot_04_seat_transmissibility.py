@@ -23,7 +23,6 @@ from suspopt.analyse.transmissibility import seat_transmissibility
 # -------------------------------
 
 cfg = suspopt.load_template("seat")
-cfg.simulation.engine = "numpy"
 cfg.simulation.duration = 30.0  # [s]: 1 km of road, as Ch. 8 drives
 cfg.metrics = []
 damping = np.array([500.0, 1000.0, 2000.0])  # C_v [N s/m], inside Table 8.2's 200-2500

@@ -26,7 +26,6 @@ from suspopt.optimise import optimise
 # ---------
 
 cfg = suspopt.load_template("spectral")
-cfg.simulation.engine = "numpy"
 cfg.optimiser.population = 40
 cfg.optimiser.generations = 20  # 800 evaluations: a second or two by the spectral method
 with tempfile.TemporaryDirectory() as tmp:

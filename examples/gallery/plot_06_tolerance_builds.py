@@ -33,7 +33,6 @@ from suspopt.picks import read_front
 # file holds the edits.
 
 cfg = suspopt.load_template("spectral")
-cfg.simulation.engine = "numpy"
 cfg.optimiser.population = 40
 cfg.optimiser.generations = 20
 TOLERANCE = {"K_v": 5.0, "C_v": 15.0}  # [%]

@@ -28,7 +28,6 @@ from suspopt.optimise import optimise
 # ---------------------------------
 
 robust = suspopt.load_template("robust")
-robust.simulation.engine = "numpy"
 nominal = robust.model_copy(deep=True)
 nominal.scenarios = None  # the config alone: class A at 120 km/h, 95 kg
 

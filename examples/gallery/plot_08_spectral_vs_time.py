@@ -26,7 +26,6 @@ import suspopt
 # designs by the config's method.
 
 cfg = suspopt.load_template("spectral")
-cfg.simulation.engine = "numpy"
 cfg.simulation.duration = 30.0  # [s]: 1 km of road at 120 km/h
 signals = ["body.heave_acc", "seat.acc", "travel", "tyre_deflection"]
 cfg.objectives.main = [

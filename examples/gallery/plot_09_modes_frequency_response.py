@@ -21,7 +21,6 @@ from suspopt.params import ParamView
 # ------------------------
 
 cfg = suspopt.load_template("quarter")
-cfg.simulation.engine = "numpy"
 damping = np.array([400.0, 800.0, 1600.0])  # c [N s/m]
 model = suspopt.build_vehicle(cfg, ParamView(cfg, {"vehicle.corners.F1.damper.c": damping}))
 modes = suspopt.modal_analysis(model)
