@@ -212,7 +212,7 @@ def chapter6() -> None:
 CONTROL_CH7 = "control: {sample_time: 0.004}   # Delta T = 4 ms (Sec 4.2)\n"
 
 # Sec 7.2.2 states no learning time for the CDF cases: the 7.2 s run learns for 2 s (the base
-# law), then refits every 2 s, from the empirical distribution as configs/ch4 (see README).
+# law), then refits every 2 s, from the empirical distribution as configs/ch4 (see configs/README.md).
 CONTROL_CH7_CDF = """\
 control:                 # Delta T = 4 ms (Sec 4.2); CDF strategy of Ch. 4 (Fig. 4.4)
   sample_time: 0.004

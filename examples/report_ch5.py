@@ -566,7 +566,7 @@ class _Chapter5(Chapter):
             f"{span(s2_gain, lambda v: md.num(v, 2))} %, {late_gain_sentence(s2_gain)}.",
             "Our wall times are",
             f"{span(time_share, lambda v: md.num(v, 2))} %",
-            "of the thesis's (batched numpy RK4 against MATLAB; the machine: README.md).",
+            "of the thesis's (batched numpy RK4 against MATLAB; the machine: docs/performance.md).",
         )
         c5_vs_c1 = 100 * max(
             abs(perf[5, s]["f1"][0] / perf[1, s]["f1"][0] - 1) for s in range(1, 6)

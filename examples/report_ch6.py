@@ -140,7 +140,7 @@ class _Chapter6(Chapter):
         doc.para(
             "n/c: no common unit (below). Part A's optimum is "
             f"`{chosen['Part A'][0].stem}`. The thesis prints no levels for these optima (its",
-            "level convention: README, kesort).",
+            "level convention: docs/guide/kesort.md).",
         )
 
     def variables(self, doc: Doc) -> None:

@@ -3,7 +3,7 @@ selenium): waits until its plots have rendered, checks that the console has no e
 that the page asked the network for nothing, and writes a screenshot beside it
 (``PAGE.png``). Run: ``python examples/report_screenshots.py PAGE.html ... [--brush STUDY:AXIS:LO:HI ...]
 [--crop SELECTOR=OUT.png ...]`` (``--crop``: also the element the CSS selector finds in the
-first page, e.g. ``#front-0`` for the README's pictures; ``--brush``: first, on the first
+first page, e.g. ``#front-0`` for the docs' pictures; ``--brush``: first, on the first
 page, the range LO..HI brushed along axis AXIS (0: the first objective) of study STUDY's
 parallel coordinates); exit 1 with the page and the problem on the first that fails."""
 

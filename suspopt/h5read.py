@@ -223,7 +223,7 @@ def _from_h5py(kind, tb) -> bool:
 
 
 #: The top-level groups that tell what a suspopt file holds (the first one found names it),
-#: for a file without the root attribute ``analysis``: the layouts of the README.
+#: for a file without the root attribute ``analysis``: the layouts of docs/guide/results.md.
 _HOLDS = (
     ("kesort", "a k-ε selection (suspopt kesort)"),
     ("pareto", "a Pareto front (suspopt optimise)"),

@@ -30,7 +30,7 @@ draws nothing). Every dataset carries a ``units`` attribute.
 is attached to an HDF5 dimension scale, the netCDF-4 way, so that xarray (engine
 ``h5netcdf``), netCDF tools and pandas see named dimensions with coordinates: ``time`` [s],
 ``design`` (row numbers), ``objective``, ``variable``, ``constraint`` (names, as text) and the
-like (README, "Signals and HDF5 layout"). A dimension's scale is a 1-D dataset of that name in
+like (docs/guide/results.md). A dimension's scale is a 1-D dataset of that name in
 the dataset's group or a group above it; one name means one length along every path of groups,
 so the whole file also opens as an ``xarray.DataTree``. Names, text data and text attributes
 are variable-length UTF-8 strings. :func:`open_dataset` reads a group back as an
@@ -56,7 +56,7 @@ import numpy as np
 from . import __version__
 from .config import Config, ConfigError
 from .files import Unreadable, kind_of, status
-from .h5read import open_dataset  # (suspopt.io.open_dataset, where the README reads it)
+from .h5read import open_dataset  # (suspopt.io.open_dataset, as docs/guide/results.md reads it)
 from .signature import CONFIG_SUFFIXES, signature_state
 
 __all__ = [
@@ -503,7 +503,7 @@ def write_simulation(
     command: str | None = None,
     extra=None,
 ) -> Path:
-    """Write a simulation ``Result`` (README, "Signals and HDF5 layout").
+    """Write a simulation ``Result`` (docs/guide/results.md).
 
     ``/time (T,)`` [s] and ``/design (P,)`` (row numbers) are the dimension scales ``time``
     and ``design``; ``/signals/<name> (design, time)``, ``/metrics/<name> (design,)``,

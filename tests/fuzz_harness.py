@@ -4,7 +4,7 @@ Shared by ``tests/test_fuzz.py`` (configs), ``tests/test_fuzz_h5.py`` (Pareto fi
 ``benchmarks/fuzz_configs.py`` (long runs). It never touches the library's code: it writes
 inputs, runs the commands and judges what they did.
 
-The contract every case is held to (README, "Exit codes"): exit 0, or exit 2 with exactly one
+The contract every case is held to (docs/guide/errors.md): exit 0, or exit 2 with exactly one
 line on stderr that names the input file (and, for a Pareto file, the dataset at fault) and no
 ``Traceback``; never another exit code; never longer than :data:`LIMIT` seconds per command;
 and a config that ``validate`` accepts must ``simulate -o OUT.h5`` (exit 0, the file written).

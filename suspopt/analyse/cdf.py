@@ -121,7 +121,7 @@ def _write(
 ) -> None:
     """``/cdf_sensitivity``: the shares asked for and achieved, the final thresholds (in the
     laws' condition unit) and the metrics of the base law, with the CDF threshold and their
-    reduction [%] (layout: README, "HDF5 files")."""
+    reduction [%] (layout: docs/guide/analyses.md)."""
     with atomic_h5(output, cfg) as h5:
         grp = h5.create_group("cdf_sensitivity")
         grp.attrs["laws"] = ",".join(laws)

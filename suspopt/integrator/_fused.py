@@ -223,6 +223,6 @@ def load(text: str, names: tuple[str, ...]) -> tuple | None:
 
     _numba_cache.prepare()  # (numba's damaged copy of the module: compiled again)
     what = "the kernel's reductions" if "accumulate" in names else "the fused step"
-    with _numba_cache.compiling(f"{what} of this network"):
+    with _numba_cache.compiling(f"{what} of this network", folder):
         exec(compile(text, str(path), "exec"), module.__dict__)
     return tuple(getattr(module, name) for name in names)

@@ -218,10 +218,11 @@ _depth = threading.local()
 
 
 @contextlib.contextmanager
-def compiling(what: str) -> Iterator[None]:
+def compiling(what: str, cache: Path | None = None) -> Iterator[None]:
     """A stretch of code that may compile ``what`` (or load it from the cache): told as
-    ``compile-start`` and ``compile-end`` (:mod:`suspopt._notices`) with its wall time; an
-    inner stretch inside an outer one is part of it."""
+    ``compile-start`` and ``compile-end`` (:mod:`suspopt._notices`) with its wall time and
+    the folder that keeps it (``cache``, default :func:`kernel_cache`); an inner stretch
+    inside an outer one is part of it."""
     depth = getattr(_depth, "value", 0)
     _depth.value = depth + 1
     start = time.perf_counter()
@@ -233,7 +234,7 @@ def compiling(what: str) -> Iterator[None]:
         _depth.value = depth
         if depth == 0:
             seconds = time.perf_counter() - start
-            cache = kernel_cache()
+            cache = cache if cache is not None else kernel_cache()
             told = _notices.tell("compile-end", what=what, seconds=seconds, cache=cache)
             if not told and seconds >= LOGGED_SECONDS:
                 _log.info("compiled %s in %.1f s (kept in %s)", what, seconds, cache)

@@ -1,4 +1,4 @@
-"""The groups of an optimisation's HDF5 output (layout: README, "HDF5 files"): the optimum
+"""The groups of an optimisation's HDF5 output (layout: docs/guide/results.md): the optimum
 ``/pareto``, the ``/history`` per generation and the data-only ``/checkpoint`` that a
 ``--resume`` replays."""
 
