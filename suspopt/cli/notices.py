@@ -96,7 +96,7 @@ class Notices:
                 text = self._text(what, time.perf_counter() - start)
                 if task is not None:
                     progress.update(task, description=text)
-                else:
+                elif status is not None:
                     status.update(text)
         finally:
             if task is not None:

@@ -97,6 +97,7 @@ class Config(Section):
     _source: Path | None = PrivateAttr(None)
     _text: str = PrivateAttr("")
     _lines: dict = PrivateAttr(default_factory=dict)
+    _loaded: dict | None = PrivateAttr(None)  # the values as loaded from _text
 
     def error(self, loc: tuple, message: str) -> ConfigError:
         """A ConfigError for a problem found after validation, located like a load error."""
@@ -111,12 +112,15 @@ class Config(Section):
 
     @property
     def text(self) -> str:
-        """The YAML text as written (recorded in every output file)."""
-        return (
-            self._text
-            if self._text
-            else yaml.safe_dump(self.model_dump(mode="json"), sort_keys=False)
-        )
+        """The YAML text of this config, recorded in every output file: as written (its
+        comments kept) while the values are those it was loaded with; once a value was
+        changed in Python (``cfg.simulation.duration = 10``), or for a config built in
+        Python, the values as they are now, so that a file records the config that ran."""
+        values = self.model_dump(mode="json")
+        if self._text and (self._loaded is None or values == self._loaded):
+            return self._text
+        where = f"{self._source} as edited in Python" if self._text else "built in Python"
+        return f"# {where}\n" + yaml.safe_dump(values, sort_keys=False)
 
     @property
     def base_dir(self) -> Path:
@@ -312,6 +316,7 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
     cfg._source = source
     cfg._text = text
     cfg._lines = lines
+    cfg._loaded = cfg.model_dump(mode="json")
     return cfg
 
 

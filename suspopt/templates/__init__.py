@@ -74,6 +74,8 @@ def load_template(kind: str):
     ValueError
         For an unknown kind, naming the closest kinds.
     """
+    from pathlib import Path
+
     from ..config.loader import load_config_text
 
-    return load_config_text(template_text(kind), f"{kind}.yaml")
+    return load_config_text(template_text(kind), Path(f"{kind}.yaml"))
