@@ -397,7 +397,7 @@ def use(
     leaves a setting to the config), ``progress(done, total)`` hears of every finished chunk,
     and the executors opened are closed at its end (the command line's ``--executor``,
     ``--scheduler``, ``--workers``). Settings it cannot run are a ValueError first
-    (:func:`check_settings`)."""
+    (:func:`!check_settings`)."""
     check_settings(executor, scheduler, workers, chunk)
     given = {"executor": executor, "scheduler": scheduler, "workers": workers, "chunk": chunk}
     saved = dict(_OVERRIDES), list(_PROGRESS)

@@ -191,7 +191,7 @@ def write_csv(h5_path: str | Path, folder: str | Path, force: bool = False) -> l
     """Write every table of the suspopt HDF5 file ``h5_path`` as a CSV file in ``folder``
     (made if missing; its parent must exist) and return their paths (module docstring).
 
-    The files are written atomically (:func:`suspopt.io.atomic_file`), and together: none
+    The files are written atomically (:func:`!suspopt.io.atomic_file`), and together: none
     is renamed into place before every one is written. A file of that name in
     ``folder`` that suspopt did not write is not replaced unless ``force``: every target is
     checked before any is written. ConfigError (naming the file) for a file that is not a

@@ -1,7 +1,7 @@
 """Reading HDF5 files that suspopt wrote, as untrusted input.
 
 A file given to ``kesort``, ``analyse`` or ``optimise --resume`` may be truncated, foreign or
-crafted. :class:`H5Reader` reads it so that every problem is a
+crafted. :class:`!H5Reader` reads it so that every problem is a
 :class:`~suspopt.config.ConfigError` naming the file and the dataset or attribute at fault:
 only regular files are opened; a dataset is read only if it is numeric, has the expected
 number of dimensions (and columns) and fits in :data:`MAX_DATASET_BYTES` (a dataset may
@@ -460,7 +460,7 @@ def open_dataset(path: str | Path, group: str | None = None):
     and ``design`` for ``/signals``), and each variable's attributes (``units``, ``names``).
     ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
     pandas DataFrame. A file that is missing, not HDF5 or damaged is a ConfigError naming it
-    (:class:`H5Reader`), a group the file lacks a KeyError listing the
+    (:class:`!H5Reader`), a group the file lacks a KeyError listing the
     groups it has. Needs xarray and h5netcdf, dependencies of suspopt (a
     ModuleNotFoundError naming them where they cannot be imported)."""
     try:

@@ -9,9 +9,9 @@
    that needs a simulation (supplementary objectives, another config) the designs are
    re-simulated in ONE batch through :meth:`suspopt.Problem.evaluate`, the optimiser's own
    objective code; otherwise the file's ``F`` and ``G`` are used as they are.
-3. :func:`select` pools the sets (Fig. 7.6), keeps the case each design came from, drops the
+3. :func:`!select` pools the sets (Fig. 7.6), keeps the case each design came from, drops the
    designs whose simulation failed (and, unless asked, the infeasible ones), sorts the pool
-   and each case alone by k-ε optimality (:func:`suspopt.kesort.kesort`; Fig. 7.5: the
+   and each case alone by k-ε optimality (:func:`!suspopt.kesort.kesort`; Fig. 7.5: the
    optimum of each case, Fig. 7.6: the optimum among all; each sort normalises over its own
    designs, Eq 7.11-7.12) and takes the Pareto-theory picks (:func:`~suspopt.kesort.pareto_picks`).
 4. :func:`write_selection` writes ``/kesort`` atomically (:func:`suspopt.io.atomic_h5`).
@@ -136,7 +136,7 @@ class DesignSet:
     (every constraint ``g <= 0``); ``failed (N,)`` (the simulation diverged or gave NaN);
     ``resimulated``: whether the designs were simulated again; ``notes`` for the report;
     ``G (N, k)`` the constraints (``g <= 0`` is met; ``constraint_names``,
-    ``constraint_units``); ``F_as_built (N, m)``, when given, the values :func:`select`
+    ``constraint_units``); ``F_as_built (N, m)``, when given, the values :func:`!select`
     sorts on instead of ``F``: each objective's ``as_built`` percentile [%] over the
     design's builds (``kesort --as-built``)."""
 
@@ -351,7 +351,7 @@ def _relative_gap(a: np.ndarray, b: np.ndarray) -> float:
 def load_design_sets(
     files: Sequence[str | Path], configs: Sequence[str | Path] = (), labels: Sequence[str] = ()
 ) -> list[DesignSet]:
-    """Read and evaluate Pareto files for :func:`select`, as ``suspopt kesort`` takes them.
+    """Read and evaluate Pareto files for :func:`!select`, as ``suspopt kesort`` takes them.
 
     ``configs``: none (each file's own), one (for every file) or one per file. ``labels``: none
     or one per file; files with the same label form one case. Default labels are the config's
@@ -437,7 +437,7 @@ def select(
     P_step: float = 0.01,
 ) -> Selection:
     """Pool ``sets`` and sort them by k-ε optimality (see the module docstring); ``eps``,
-    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`suspopt.kesort.kesort`.
+    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`!suspopt.kesort.kesort`.
     ConfigError when the sets have different objectives or no design is left to sort."""
     sets = [
         require(s, DesignSet, f"sets[{i}]", "from load_design_sets(paths)")

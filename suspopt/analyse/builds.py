@@ -7,7 +7,7 @@ suspension has every part off at once, by an amount nobody chose. This analysis 
 design of the front ``--samples`` times: every design variable of every build is its
 design's value times ``1 + u t/100``, ``u`` drawn from [-1, 1] independently for each
 variable, design and build (``t`` the variable's tolerance [%], as ``analyse
-tolerances`` takes it: :func:`.tolerances.variable_tolerances`): uniformly, or with
+tolerances`` takes it: :func:`!.tolerances.variable_tolerances`): uniformly, or with
 ``--distribution normal`` from a normal distribution of standard deviation 1/3 cut at ±1
 (the band is ±3 σ: a process of capability 1, its parts outside the band rejected), by
 the inverse of its distribution function. All builds of all designs are evaluated under
@@ -120,7 +120,7 @@ class Builds:
     met; ``constraint_names``, ``constraint_units``); ``stored`` the front's designs under
     the stored config (``names``, ``units``), ``held (n,)`` how many values of each variable
     were held at its field's limit; ``tolerance (n,)`` [%], ``seed``, ``distribution`` and
-    ``batches`` ((name, the indices of its variables), :func:`variable_batches`) as drawn."""
+    ``batches`` ((name, the indices of its variables), :func:`!variable_batches`) as drawn."""
 
     pareto: ParetoSet
     stored: DesignSet
@@ -283,7 +283,7 @@ def draw_builds(
     many values of each variable were held at its field's limit ``(n,)``. Each
     design's offsets come from ``default_rng(design_key(seed, x))``, ``(N, n)`` in one call:
     the first N of a longer run are those of a run of N. The variables of one of
-    ``batches`` ((name, columns), :func:`variable_batches`) take the offset drawn for the
+    ``batches`` ((name, columns), :func:`!variable_batches`) take the offset drawn for the
     first of them, as a fraction of each one's own band; the other variables' draws are
     those of a run without batches, bit for bit."""
     shape = (samples, pareto.X.shape[1])
@@ -318,10 +318,10 @@ def builds(
 ) -> Builds:
     """Draw and evaluate ``samples`` builds (int) of every design of ``pareto``, each design
     variable within its tolerance [%] (``tolerance`` as
-    :func:`.tolerances.variable_tolerances` takes it), from the streams of ``seed`` (int;
+    ``tolerances.variable_tolerances`` takes it), from the streams of ``seed`` (int;
     None: the stored config's ``optimiser.seed``), ``distribution`` ``"uniform"`` (None) or
     ``"normal"`` (module docstring), the variables of one batch off alike (``batch`` as
-    :func:`variable_batches` takes it)."""
+    :func:`!variable_batches` takes it)."""
     distribution = "uniform" if distribution is None else distribution
     if distribution not in DISTRIBUTIONS:
         raise ConfigError(

@@ -204,7 +204,7 @@ def optimise(
 
     ``resume`` continues from the checkpoint in ``output``, which must have been written for
     the same config text, or for one that differs only in the budget
-    (``optimiser.generations``, ``max_evaluations``; :func:`.output.read_checkpoint`): a
+    (``optimiser.generations``, ``max_evaluations``; :func:`!.output.read_checkpoint`): a
     finished run resumed with a longer budget goes on to the longer run's result. Raises
     ConfigError for bad input before any simulation, and KeyboardInterrupt only when
     interrupted before the first generation completed.
