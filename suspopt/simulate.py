@@ -127,7 +127,10 @@ def with_engine(cfg: Config, designs: int, evaluation: bool = False) -> Config:
     from .integrator import auto_engine
 
     engine = auto_engine(sim.n_steps, designs, evaluation or cfg.optimiser is not None)
-    return cfg.model_copy(update={"simulation": sim.model_copy(update={"engine": engine})})
+    resolved = cfg.model_copy(update={"simulation": sim.model_copy(update={"engine": engine})})
+    if cfg.text == cfg._text:  # (unedited: its text, engine auto as written, stays the record)
+        resolved._loaded = resolved.model_dump(mode="json")
+    return resolved
 
 
 def run_memory(
