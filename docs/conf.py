@@ -51,6 +51,9 @@ templates_path = ["_templates"]
 myst_enable_extensions = ["colon_fence", "deflist", "dollarmath"]
 myst_heading_anchors = 4
 
+# GitHub's anchors, which the pages' links and the code's citations use (tests/test_docs.py)
+myst_heading_slug_func = "suspopt_docs.github_slug"
+
 # numpydoc and autosummary: one page per public name, no per-member stub tables
 autosummary_generate = True
 autosummary_imported_members = True
@@ -86,7 +89,6 @@ sphinx_gallery_conf = {
 
 html_theme = "pydata_sphinx_theme"
 html_title = f"suspopt {release}"
-html_static_path = ["_static"]
 html_theme_options = {
     "navbar_align": "left",
     "show_toc_level": 2,

@@ -49,6 +49,13 @@ class Table:
     rows: list[Row]
 
 
+def github_slug(heading: str) -> str:
+    """GitHub's anchor of a heading: punctuation dropped (letters, digits, ``_``, ``-`` and
+    spaces kept), lower case, each space a hyphen; MyST's anchors of the site's headings, so
+    that a page's links work on GitHub and in the site alike."""
+    return re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+
+
 def _ref(node: dict) -> str | None:
     ref = node.get("$ref")
     return ref.rsplit("/", 1)[-1] if ref else None
