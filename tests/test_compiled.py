@@ -482,40 +482,6 @@ def test_an_evaluation_on_the_fused_step_gives_the_walked_networks_objectives(mo
     assert F.tobytes() == F0.tobytes() and G.tobytes() == G0.tobytes()
 
 
-def test_a_damaged_file_of_numbas_cache_is_compiled_again_and_a_sound_one_is_read(
-    monkeypatch, tmp_path
-):
-    """numba raised EOFError or an unpickling error on a truncated or overwritten file of its
-    cache, in every later process, where a missing file makes it compile again; with
-    ``_numba_cache.heal`` (which the compiled modules call) such a file is a miss, written
-    anew, and a sound cache is still read (a hit, no compilation)."""
-    import sys
-    import types
-
-    from suspopt.integrator import _numba_cache
-
-    _numba_cache.heal()
-    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "cache"))
-    source = tmp_path / "cached_add.py"
-    source.write_text("import numba\n\n@numba.njit(cache=True)\ndef add(x):\n    return x + 1\n")
-
-    def compiled_from_cache() -> bool:
-        module = types.ModuleType("cached_add")
-        module.__file__ = str(source)
-        monkeypatch.setitem(sys.modules, module.__name__, module)
-        exec(compile(source.read_text(), str(source), "exec"), module.__dict__)
-        assert module.add(1) == 2
-        return sum(module.add.stats.cache_hits.values()) == 1
-
-    assert not compiled_from_cache()  # (the first: compiled, and kept)
-    assert compiled_from_cache()
-    for suffix, damage in ((".nbi", b""), (".nbi", b"\x80\x04garbage"), (".nbc", b"\x00")):
-        (kept,) = (tmp_path / "cache").rglob(f"*{suffix}")
-        kept.write_bytes(damage)
-        assert not compiled_from_cache()  # (compiled again, where numba raised)
-        assert compiled_from_cache()  # (and its cache written anew)
-
-
 def test_the_fused_modules_cache_folder_expands_a_home_that_no_shell_expanded(monkeypatch):
     """``SUSPOPT_CACHE_DIR=~/cache`` from an environment file (no shell to expand ``~``)
     made a folder named ``~`` in the working folder."""

@@ -113,3 +113,23 @@ def test_auto_falling_back_is_one_note_on_the_command_line(capsys):
 
     notices("engine-fallback", message="simulation.engine auto runs on the numpy engine: x")
     assert capsys.readouterr().err == "note: simulation.engine auto runs on the numpy engine: x\n"
+
+
+def test_a_damaged_file_of_numbas_cache_is_compiled_again_and_a_sound_one_is_read(
+    monkeypatch, tmp_path
+):
+    """numba raised EOFError or an unpickling error on a truncated or overwritten file of its
+    cache, in every later process, where a missing file makes it compile again; with
+    ``_numba_cache.heal`` (which the compiled modules call) such a file is a miss, written
+    anew, and a sound cache is still read (a hit, no compilation)."""
+    _numba_cache.heal()
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "cache"))
+    source = tmp_path / "cached_add.py"
+    source.write_text(SOURCE)
+    assert not _load(source, monkeypatch)  # (the first: compiled, and kept)
+    assert _load(source, monkeypatch)
+    for suffix, damage in ((".nbi", b""), (".nbi", b"\x80\x04garbage"), (".nbc", b"\x00")):
+        (kept,) = (tmp_path / "cache").rglob(f"*{suffix}")
+        kept.write_bytes(damage)
+        assert not _load(source, monkeypatch)  # (compiled again, where numba raised)
+        assert _load(source, monkeypatch)  # (and its cache written anew)
