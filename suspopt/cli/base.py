@@ -447,15 +447,28 @@ def claim_output(
     inputs: Sequence[tuple[str, Path]] = (),
 ) -> None:
     """Check an output (not one of the command's ``inputs``: ``(option, path)`` pairs) and
-    hold its writer's lock for the rest of the command (:func:`suspopt.io.claim`)."""
+    hold its writer's lock for the rest of the command (:func:`suspopt.io.claim`); what a
+    killed run had left beside it is said at once (:func:`say_io_notes`)."""
     from ..io import claim
 
     if path is None:
         return
     try:
-        stack.enter_context(claim(path, force, option, inputs))
+        stack.enter_context(claim(path, force, option, inputs, command=command_line()))
     except ConfigError as exc:
         fail(str(exc))
+    finally:
+        say_io_notes()
+
+
+def say_io_notes() -> None:
+    """Print, on stderr, a ``note: ...`` line for each lock and temporary files of a killed
+    run that the outputs' writers removed (:func:`suspopt.locks.take_notes`)."""
+    locks = sys.modules.get("suspopt.locks")  # (not imported: nothing was written or claimed)
+    if locks is None:
+        return
+    for note in locks.take_notes():
+        err.print(f"note: {note}", soft_wrap=True)
 
 
 def read_config(path: Path):
