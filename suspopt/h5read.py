@@ -24,7 +24,13 @@ from .config import ConfigError
 from .config.yamlio import MAX_CONFIG_BYTES
 from .files import kind_of
 
-__all__ = ["H5Reader", "MAX_DATASET_BYTES", "MAX_ATTRIBUTE_BYTES", "open_dataset"]
+__all__ = [
+    "H5Reader",
+    "MAX_DATASET_BYTES",
+    "MAX_ATTRIBUTE_BYTES",
+    "LOWEST_OBJECTIVE",
+    "open_dataset",
+]
 
 #: Largest dataset read from an input file [bytes]. A Pareto set of a million designs with a
 #: hundred columns is 800 MB.
@@ -41,6 +47,10 @@ PROBE_BYTES_PER_SECOND = 50e6
 #: heap's size wrong.
 PROBE_MEMORY = 64 << 20
 PROBE_MEMORY_PER_BYTE = 8
+#: Lowest objective value a file may hold: minus the optimiser's penalty value
+#: (:data:`suspopt.optimise.problem.PENALTY`, what a failed design gets). No objective of a
+#: simulation comes near it; a damaged file's -1e308 broke the figures and the knee.
+LOWEST_OBJECTIVE = -1.0e10
 #: Files this process has probed: (device, inode, size, modification time).
 _PROBED: set[tuple[int, int, int, int]] = set()
 #: Largest attribute read from an input file [bytes]: a damaged attribute may declare a shape
@@ -336,6 +346,20 @@ class H5Reader:
                 f"{MAX_DATASET_BYTES >> 20} MB: not a file of suspopt's"
             )
         return np.asarray(self._values(ds, name), dtype=np.int64 if integer else np.float64)
+
+    def objectives(self, name: str, values: np.ndarray, labels) -> None:
+        """ConfigError naming ``/name`` and the column when a column of the objectives
+        ``values`` holds a value at or below :data:`LOWEST_OBJECTIVE`, which no objective
+        suspopt writes does (a failed design has the penalty value, +1e10): a damaged file's
+        -1e308 overflowed the figures' axes and, beside a 1e308, the knee's normalisation."""
+        with np.errstate(invalid="ignore"):
+            low = values <= LOWEST_OBJECTIVE
+        for j in np.flatnonzero(low.any(axis=0)):
+            lowest = float(np.min(values[:, j][low[:, j]]))
+            raise ConfigError(
+                f"{self.where}: /{name}: {labels[j]} holds {lowest:g}, at or below "
+                f"{LOWEST_OBJECTIVE:g} (not values suspopt wrote)"
+            )
 
     def _values(self, ds, name: str):
         """What the dataset ``ds`` (``/name``) holds; ConfigError when it cannot be read."""

@@ -13,8 +13,9 @@ the command's inputs is bad input even with ``force`` (:func:`claim`).
 **One writer** (:func:`claim`): a writer holds an exclusive ``flock`` on ``.NAME.suspopt-lock``
 beside the target for as long as it writes (``suspopt optimise``: the whole run), so a second
 run on the same output fails at once with the first one's process id. Holding the lock, it
-removes the temporary files ``.NAME.*.suspopt-tmp`` that a killed run left behind: no live
-writer can own them.
+removes what a killed run left behind, its lock and the temporary files ``.NAME.*.suspopt-tmp``
+(no live writer can own them), and says so in one line that the command line prints as
+``note: ...`` (:func:`take_notes`; the lock file's contents: :mod:`suspopt.locks`).
 
 **Atomic writes** (:func:`atomic_file`, :func:`atomic_h5`): the file is written to a temporary
 file created exclusively, with an unpredictable name, in the target's folder, through the
@@ -41,7 +42,6 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import fcntl
 import os
 import stat
 import sys
@@ -57,10 +57,13 @@ from . import __version__
 from .config import Config, ConfigError
 from .files import Unreadable, kind_of, status
 from .h5read import open_dataset  # (suspopt.io.open_dataset, as docs/guide/results.md reads it)
+from .locks import take_lock, take_notes, this_command
 from .signature import CONFIG_SUFFIXES, signature_state
 
 __all__ = [
     "OUTPUT_MARKER",
+    "take_notes",
+    "this_command",
     "WRITE_ERRNOS",
     "WriteError",
     "check_target",
@@ -82,7 +85,7 @@ __all__ = [
 #: Written into every non-HDF5 file suspopt makes (figure metadata, a comment), so that it
 #: can tell its own outputs from other files.
 OUTPUT_MARKER = "suspopt"
-_LOCK, _TMP = ".suspopt-lock", ".suspopt-tmp"
+_TMP = ".suspopt-tmp"
 _HEAD = 4096
 #: Locks this process holds: resolved target -> [descriptor, depth, force].
 _held: dict[Path, list] = {}
@@ -167,10 +170,6 @@ def check_target(path: str | Path, force: bool = False, option: str = "-o") -> P
     return path
 
 
-def _lock_path(path: Path) -> Path:
-    return path.with_name(f".{path.name}{_LOCK}")
-
-
 def _key(path: Path) -> Path:
     return path.parent.resolve() / path.name
 
@@ -212,13 +211,18 @@ def claim(
     force: bool = False,
     option: str = "-o",
     inputs: Iterable[tuple[str, str | Path]] = (),
+    command: str | None = None,
 ) -> Iterator[Path]:
     """Check ``path`` (:func:`check_target`), hold the writer's lock of it (module docstring)
     and clear the temporary files of dead writers; ConfigError when another process writes
     it, or when it is one of the command's ``inputs`` (``(option, path)`` pairs: a file the
     command reads, or its other output), which writing would replace or overwrite, whatever
     ``force`` says (``kesort front.h5 -o front.h5`` replaced the front). Re-entrant in one
-    process; a write inside the block may replace the file when ``force`` was given here."""
+    process; a write inside the block may replace the file when ``force`` was given here.
+
+    What a killed run left (its lock and temporary files) is removed and said in a line for
+    :func:`take_notes`. ``command``: what the lock file says this run is (default: this
+    process's command line, :func:`this_command`)."""
     check_not_input(path, inputs, option)
     path = check_target(path, force, option)
     key = _key(path)
@@ -229,41 +233,7 @@ def claim(
         finally:
             _held[key][1] -= 1
         return
-    lock = _lock_path(path)
-    while True:
-        try:
-            fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
-        except OSError as exc:
-            raise ConfigError(f"{path}: cannot write in {path.parent} ({exc.strerror})") from None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as exc:
-            owner = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
-            os.close(fd)
-            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                raise ConfigError(
-                    f"{path}: another suspopt run (process {owner}) is writing "
-                    f"it; wait for it to finish or choose another output"
-                ) from None
-            raise
-        try:  # the lock file may have been removed and made anew
-            same = os.stat(lock, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
-        except FileNotFoundError:
-            same = False
-        if same:
-            break
-        os.close(fd)
-    try:
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-    except OSError as exc:  # (a full disk: even the lock's few bytes do not fit)
-        lock.unlink(missing_ok=True)
-        os.close(fd)
-        raise ConfigError(
-            f"{option} {path}: cannot write in {path.parent} ({exc.strerror})"
-        ) from None
-    for stale in path.parent.glob(f".{_glob_escape(path.name)}.*{_TMP}"):
-        stale.unlink(missing_ok=True)
+    lock, fd = take_lock(path, option, command, _TMP)
     _held[key] = [fd, 1, force]
     try:
         yield path
@@ -279,10 +249,6 @@ def _umask() -> int:
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
-
-
-def _glob_escape(name: str) -> str:
-    return "".join(f"[{c}]" if c in "*?[" else c for c in name)
 
 
 class WriteError(ConfigError):

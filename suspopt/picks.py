@@ -147,6 +147,7 @@ def read_table(path: str | Path) -> DesignTable:
         var_units = h5.labels(f"{table}/X", "units", X.shape[1])
         obj_names = h5.labels(f"{table}/F", "names", F.shape[1])
         obj_units = h5.labels(f"{table}/F", "units", F.shape[1])
+        h5.objectives(f"{table}/F", F, obj_names)
         picks: dict[str, int] = {}
         stored = True  # (the file says which design each pick is; else they are computed)
         if table == "kesort":

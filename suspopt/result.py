@@ -324,7 +324,8 @@ class Result:
         """Body displacement (velocity, acceleration) at attachment ``j``'s point, (P, T),
         from the vehicle rows of ``x (n_vehicle, P, T)``."""
         row = self.model.point_map(*self.attachments[j].point)
-        return np.tensordot(row, x[: self.model.n_dof], axes=1)
+        with np.errstate(over="ignore", invalid="ignore"):  # (a diverging design: inf, NaN)
+            return np.tensordot(row, x[: self.model.n_dof], axes=1)
 
     def attachment_signal(self, j: int, compute: Callable[..., np.ndarray]) -> np.ndarray:
         """A signal of attachment ``j`` (P, T) from its states and the floor's

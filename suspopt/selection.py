@@ -252,6 +252,7 @@ def read_pareto(path: str | Path) -> ParetoSet:
                     f"{path}: /pareto/{key}: values must be finite (a failed "
                     f"design has the penalty values, never NaN)"
                 )
+        h5.objectives("pareto/F", data["F"][0], data["F"][1])
         if not h5.has_attr("config"):
             raise ConfigError(
                 f"{path}: attribute 'config' (the YAML text) is missing; give --config"

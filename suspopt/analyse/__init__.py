@@ -27,7 +27,14 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     import numpy as np
 
-__all__ = ["Report", "Kind", "KINDS", "SUMMARIES", "analysis_kinds", "relative_change"]
+__all__ = [
+    "Report",
+    "Kind",
+    "KINDS",
+    "SUMMARIES",
+    "analysis_kinds",
+    "relative_change",
+]
 
 
 @dataclass
@@ -54,12 +61,17 @@ class Kind:
 
 
 def relative_change(value, reference) -> np.ndarray:
-    """``100 (value - reference) / reference`` [%], NaN or inf where the reference is 0 or NaN
-    (the percentages of Tables 3.3-3.21, 4.2-4.3, 8.12-8.13; their signs are each table's)."""
+    """``100 (value - reference) / reference`` [%] (the percentages of Tables 3.3-3.21,
+    4.2-4.3, 8.12-8.13; their signs are each table's), NaN where it cannot be computed: the
+    reference is 0 or NaN (a failed design's), the value NaN, or the change beyond the
+    floating-point range (a stored value of 1e-308 or 1e308: a damaged file). Computed
+    without a floating-point warning; a table shows NaN as ``n/a``
+    (:func:`suspopt.analyse.cells.percent`)."""
     import numpy as np
 
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return 100.0 * (np.asarray(value, dtype=float) - reference) / reference
+    with np.errstate(all="ignore"):
+        change = (np.asarray(value, dtype=float) - reference) / reference * 100.0
+    return np.where(np.isfinite(change), change, np.nan)
 
 
 #: kind name -> Kind

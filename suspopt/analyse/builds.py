@@ -80,6 +80,15 @@ from ..picks import read_front
 from ..selection import DesignSet, ParetoSet, evaluate_pareto
 from . import KINDS, Kind, Report, relative_change
 from .builds_file import feasible_builds
+from .cells import (
+    NOT_COMPUTED,
+    NOT_COMPUTED_NOTE,
+    failed_stored_note,
+    percent,
+    stored_cells,
+    stored_failed,
+    stored_reference,
+)
 from .pseudo import is_comfort, table_designs, write_stored_front
 from .tolerances import (
     Tolerances,
@@ -153,8 +162,14 @@ class Builds:
 
     @property
     def reference(self) -> np.ndarray:
-        """(D, m + s): the file's main objectives, then the re-simulated supplementary ones."""
-        return np.hstack([self.pareto.F, self.stored.F[:, self.m :]])
+        """(D, m + s): the file's main objectives, then the re-simulated supplementary ones;
+        NaN for a design that failed (:func:`.cells.stored_reference`)."""
+        return stored_reference(self.pareto.F, self.stored)
+
+    @property
+    def stored_failed(self) -> np.ndarray:
+        """(D,) the stored designs that failed: their changes cannot be computed."""
+        return stored_failed(self.pareto.F, self.stored)
 
     @cached_property
     def change(self) -> np.ndarray:
@@ -171,7 +186,7 @@ class Builds:
         of them has the batch's share. NaN where a variable or an objective did not vary."""
         ok = ~self.failed[..., None]  # (N, D, 1)
         count = ok.sum(axis=0)  # (D, 1)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(all="ignore"):  # (objectives of 1e160 and up: their square is inf)
             x = np.where(ok, self.X, 0.0)
             y = np.where(ok, self.F, 0.0)
             x = np.where(ok, x - x.sum(axis=0) / count, 0.0)  # (N, D, n), centred
@@ -410,8 +425,14 @@ def _designs(n: int) -> str:
     return f"{n} design" + ("" if n == 1 else "s")
 
 
-def _spread(low: float, high: float) -> str:
-    return "failed" if math.isnan(low) else f"{low:+.1f} to {high:+.1f} %"
+def _spread(low: float, high: float, failed: bool) -> str:
+    """A cell of the 5-95 % spread: "failed" where every build failed, :data:`NOT_COMPUTED`
+    where the change cannot be computed."""
+    if failed:
+        return "failed"
+    if math.isnan(low) or math.isnan(high):
+        return NOT_COMPUTED
+    return f"{percent(low, suffix='')} to {percent(high)}"
 
 
 def _broken(b: Builds) -> str:
@@ -464,13 +485,15 @@ def _report(b: Builds, title: str) -> Report:
     columns = ["#", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
     columns += [f"{n}: 5-95 % (change)" for n in names] + ["feasible builds"]
     picks = table_designs(len(p.X), p.marks_by_row())
+    lost, every = b.stored_failed, np.asarray(b.failed.all(axis=0), dtype=bool)  # (D,) each
     rows = [
         [str(k), picked]
-        + [f"{f:.4g}" for f in p.F[k]]
-        + [_spread(lo, hi) for lo, hi in zip(low[k], high[k])]
+        + stored_cells(p.F[k], lost[k])
+        + [_spread(lo, hi, every[k]) for lo, hi in zip(low[k], high[k])]
         + [f"{100 * share[k]:.0f} %"]
         for k, picked in picks
     ]
+    shown = {cell for row in rows for cell in row}
     notes = [
         f"{len(b.X)} builds of each of {_designs(len(p.X))} of {p.path.name}: every design "
         f"variable off at once by a {DRAWS[b.distribution]} within {_within(b)} "
@@ -479,8 +502,12 @@ def _report(b: Builds, title: str) -> Report:
         *p.picked_note(),
         *b.stored.notes,
     ]
+    if lost.any():
+        notes.append(failed_stored_note(lost))
+    if NOT_COMPUTED in shown:
+        notes.append(NOT_COMPUTED_NOTE)
     worst = [
-        f"{name} {high[k, j]:+.3g} % (design {k})"
+        f"{name} {percent(high[k, j], '.3g')} (design {k})"
         for j, name in enumerate(names)
         if np.isfinite(high[:, j]).any()
         for k in [int(np.nanargmax(high[:, j]))]
@@ -512,7 +539,8 @@ def plot_builds(b: Builds, path: str | Path, title: str) -> Path:
 
     p, m = b.pareto, b.m
     low, _, high = b.percentiles(b.F[..., :m])
-    curves = [(f"optimised ({p.path.name})", p.F), ("builds: 5th percentile", low)]
+    stored = np.where(b.stored_failed[:, None], np.nan, p.F)  # (not the penalty values)
+    curves = [(f"optimised ({p.path.name})", stored), ("builds: 5th percentile", low)]
     curves.append(("builds: 95th percentile", high))
     variables = [(n, u, p.X[:, j]) for j, (n, u) in enumerate(zip(p.var_names, p.var_units))]
     objectives = list(zip(b.stored.names[:m], b.stored.units[:m]))

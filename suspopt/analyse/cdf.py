@@ -33,6 +33,7 @@ from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..result import Result
 from ..simulate import simulate
 from . import KINDS, Kind, Report, relative_change
+from .cells import NOT_COMPUTED, NOT_COMPUTED_NOTE, percent
 
 __all__ = ["SHARES", "METRIC_UNITS", "c_max_share", "semi_active_metrics", "run"]
 
@@ -189,7 +190,7 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
             f"{100 * s:.0f}",
             f"{100 * a:.1f}",
             " ".join(f"{x:.3g}" for x in thr),
-            *(f"{reduction[k][i]:+.1f}" for k in METRIC_UNITS),
+            *(percent(reduction[k][i], suffix="") for k in METRIC_UNITS),
         ]
         for i, (s, a, thr) in enumerate(zip(SHARES, values["share"][1:], threshold))
     ]
@@ -200,6 +201,8 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
         "reduction = (X_base - X_CDF) / X_base * 100 % (thesis Sec 4.3): positive = smaller "
         "with the CDF threshold; shares counted after the first fit",
     ]
+    if any(NOT_COMPUTED in row for row in rows):
+        notes.append(NOT_COMPUTED_NOTE)
     return Report(
         title=title,
         columns=[

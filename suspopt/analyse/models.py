@@ -58,6 +58,7 @@ from ..simulate import Result, simulate
 from ..specs import METRICS, evaluate_spec
 from ..vehicle import modal_analysis
 from . import KINDS, Kind, Report, relative_change
+from .cells import NOT_COMPUTED_NOTE, percent
 
 __all__ = [
     "ModelResponse",
@@ -357,29 +358,30 @@ def run(
     if plot is not None:
         plot_models(comparison, plot, title)
     columns = ["metric", "unit"] + [f"{m.label} (Δ %)" for m in models]
-    rows = []
+    rows, shown_na = [], False
     for name in comparison.metric_names:
         row = [name, comparison.metric_units[name]]
+        known = not np.isnan(_reference_value(models[comparison.reference], name))
         for i, value in enumerate(comparison.value[name]):
             d = comparison.difference[name][i]
-            row.append(
-                _cell(value)
-                + (
-                    ""
-                    if np.isnan(value)
-                    else " (ref)"
-                    if i == comparison.reference
-                    else ""
-                    if np.isnan(d)
-                    else f" ({d:+.1f})"
-                )
-            )
+            if np.isnan(value):
+                after = ""
+            elif i == comparison.reference:
+                after = " (ref)"
+            elif np.isnan(d) and not known:  # (the reference has no such metric)
+                after = ""
+            else:  # (n/a: a reference of 0, or a change beyond the floating-point range)
+                after = f" ({percent(d, suffix='')})"
+                shown_na |= bool(np.isnan(d))
+            row.append(_cell(value) + after)
         rows.append(row)
     notes = [
         f"Δ = (X - X_ref)/X_ref · 100 % against {ref.label} (Sec 3.2.1; Tables 3.3-3.21 "
         f"print the opposite sign); a quarter car's only corner stands for every corner",
         "times are absolute (t_p, t_s); settling band 2 %; natural frequencies undamped; SI units",
     ]
+    if shown_na:
+        notes.append(NOT_COMPUTED_NOTE)
     diverged = [m.label for m in models if m.diverged]
     if diverged:
         notes.append(f"diverged (NaN samples; try a smaller simulation.dt): {', '.join(diverged)}")

@@ -25,8 +25,12 @@ The Pareto file is read and its designs evaluated by :mod:`suspopt.selection` (t
 (:func:`~suspopt.selection.evaluate_pareto`). The change of each objective is
 ``100 (f_changed - f_stored) / f_stored`` in % (Tables 8.12-8.13: positive when the objective
 grows). A design whose simulation fails under the change gets NaN objectives and
-``failed = 1`` (the optimiser's penalty values are not reported). The file holds no
-supplementary objectives (Eq 7.7-7.10 in Ch. 7), so when the config has some, the stored
+``failed = 1`` (the optimiser's penalty values are not reported). A change that cannot be
+computed is NaN in the file and ``n/a`` in the table, with a note: the stored value is 0, or
+the change is beyond the floating-point range (a damaged file's 1e-308), or the stored design
+failed (the file holds the optimiser's penalty values for it, ``1e10`` or more: its stored
+values show as ``failed``). Nothing is computed with a floating-point warning. The file holds
+no supplementary objectives (Eq 7.7-7.10 in Ch. 7), so when the config has some, the stored
 designs are simulated once more with the stored config for theirs, to compare them too.
 
 HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text, plus
@@ -67,7 +71,7 @@ from ..picks import read_front
 from ..plots.runs import evenly_spaced
 from ..seat import build_seat, passenger_mass_change
 from ..selection import DesignSet, ParetoSet, evaluate_pareto
-from . import KINDS, Kind, Report, relative_change
+from . import KINDS, Kind, Report, cells, relative_change
 
 __all__ = [
     "Variant",
@@ -129,8 +133,15 @@ class PseudoFronts:
 
     @property
     def reference(self) -> np.ndarray:
-        """(N, m + s): the file's main objectives, then the re-simulated supplementary ones."""
-        return np.hstack([self.pareto.F, self.stored.F[:, self.m :]])
+        """(N, m + s): the file's main objectives, then the re-simulated supplementary ones;
+        NaN for a design that failed (:func:`.cells.stored_reference`)."""
+        return cells.stored_reference(self.pareto.F, self.stored)
+
+    @property
+    def stored_failed(self) -> np.ndarray:
+        """(N,) the stored designs that failed (the file's penalty values, or their
+        re-simulation): their changes cannot be computed."""
+        return cells.stored_failed(self.pareto.F, self.stored)
 
     def values(self, i: int) -> np.ndarray:
         """(N, m + s) objectives under variant ``i`` (NaN where the simulation failed)."""
@@ -455,7 +466,8 @@ def plot_pseudo_fronts(
     front (:func:`suspopt.plots.pareto_fronts`); ``marks`` (name -> design, default the
     picks) are starred."""
     p, m = fronts.pareto, fronts.m
-    curves = [(f"optimised ({p.path.name})", p.F)]
+    stored = np.where(fronts.stored_failed[:, None], np.nan, p.F)  # (not the penalty values)
+    curves = [(f"optimised ({p.path.name})", stored)]
     curves += [(v.label, fronts.values(i)[:, :m]) for i, v in enumerate(fronts.variants)]
     variables = [
         (name, unit, p.X[:, j]) for j, (name, unit) in enumerate(zip(p.var_names, p.var_units))
@@ -490,13 +502,16 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
     values = [fronts.values(i) for i in range(len(fronts.sets))]
     changes = [fronts.change(i) for i in range(len(fronts.sets))]
     rows = []
+    lost = fronts.stored_failed
+    shown_na = False
     for k, picks in table_designs(len(p.X), p.marks_by_row()):
-        row = [str(k), picks] + [f"{f:.4g}" for f in p.F[k]]
+        row = [str(k), picks] + cells.stored_cells(p.F[k], lost[k])
         for s, value, change in zip(fronts.sets, values, changes):
             row += [
-                "failed" if s.failed[k] else f"{f:.4g} ({c:+.0f} %)"
+                "failed" if s.failed[k] else f"{f:.4g} ({cells.percent(c, '.0f')})"
                 for f, c in zip(value[k, :m], change[k, :m])
             ]
+            shown_na |= not s.failed[k] and bool(np.isnan(change[k, :m]).any())
         rows.append(row)
     shown = p.picked_note() or [
         f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}, with "
@@ -506,13 +521,13 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
         f"{shown[0]}; change = (f - f_stored)/f_stored (Tables 8.12-8.13)",
         *fronts.stored.notes,
     ]
+    if lost.any():
+        notes.append(cells.failed_stored_note(lost))
+    if shown_na:
+        notes.append(cells.NOT_COMPUTED_NOTE)
     for v, s, change in zip(fronts.variants, fronts.sets, changes):
         change = change[~s.failed]
-        spans = [
-            f"{name} {np.min(c):+.1f} to {np.max(c):+.1f} % (median {np.median(c):+.1f} %)"
-            for name, c in zip(names, change.T)
-            if c.size
-        ]
+        spans = [cells.change_span(name, c) for name, c in zip(names, change.T) if c.size]
         notes.append(
             f"{v.label}: {int(s.feasible.sum())} of {len(p.X)} designs feasible, "
             f"{int(s.failed.sum())} failed; " + "; ".join(spans)

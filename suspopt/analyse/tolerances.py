@@ -36,6 +36,7 @@ from ..files import listed
 from ..params import field_range
 from ..selection import ParetoSet
 from . import KINDS, Kind, Report
+from .cells import NOT_COMPUTED, percent
 from .pseudo import PseudoFronts, Variant, run_variants
 
 __all__ = [
@@ -180,11 +181,13 @@ def _largest_changes(fronts: PseudoFronts) -> str:
     parts = []
     for j, name in enumerate(fronts.stored.names):
         changes = np.array([fronts.change(i)[:, j] for i in range(len(fronts.variants))])
-        if not np.isfinite(changes).any():
+        if not np.isfinite(changes).any():  # (NaN where it cannot be computed)
             continue
         i, row = np.unravel_index(np.nanargmax(np.abs(changes)), changes.shape)
-        parts.append(f"{name} {changes[i, row]:+.3g} % ({fronts.variants[i].label}, design {row})")
-    return "largest change of each objective: " + "; ".join(parts)
+        parts.append(
+            f"{name} {percent(changes[i, row], '.3g')} ({fronts.variants[i].label}, design {row})"
+        )
+    return "largest change of each objective: " + ("; ".join(parts) or NOT_COMPUTED)
 
 
 def _held_notes(variants: Sequence[Variant]) -> list[str]:

@@ -345,17 +345,28 @@ def _folding_table() -> type:
 
 def against_baseline(names, values, baseline, feasible: bool) -> str:
     """``against the config's own design (feasible): f1 -13.4 %, ...``: each objective of
-    ``names`` in ``values`` as a change from ``baseline`` (one where that is 0 or not
-    finite left out), the config's design ``feasible`` or not."""
+    ``names`` in ``values`` as a change from ``baseline`` (one that cannot be computed left
+    out: a baseline of 0 or not finite, or a change beyond the floating-point range, as a
+    damaged file's /baseline can give), the config's design ``feasible`` or not; a baseline
+    of the optimiser's penalty values is a design that failed to simulate."""
     import math
 
-    changes = [
-        f"{name} {100 * (new - old) / abs(old):+.3g} %"
-        for name, new, old in zip(names, values, baseline)
-        if old != 0 and math.isfinite(old)
-    ]
+    from ..optimise.problem import PENALTY
+
+    old_values = [float(old) for old in baseline]
+    if any(old >= PENALTY for old in old_values):
+        return "the config's own design failed to simulate (diverged or gave NaN)"
+    changes = []
+    for name, new, old in zip(names, values, old_values):
+        if old == 0 or not math.isfinite(old):
+            continue
+        change = (float(new) - old) / abs(old) * 100.0  # (Python floats: inf, no warning)
+        if math.isfinite(change):
+            changes.append(f"{name} {change:+.3g} %")
     state = "feasible" if feasible else "infeasible"
-    return f"against the config's own design ({state}): " + ", ".join(changes)
+    return f"against the config's own design ({state}): " + (
+        ", ".join(changes) or "no change can be computed"
+    )
 
 
 def show_table(table: Table, keys: int = 1) -> None:
@@ -439,15 +450,28 @@ def claim_output(
     inputs: Sequence[tuple[str, Path]] = (),
 ) -> None:
     """Check an output (not one of the command's ``inputs``: ``(option, path)`` pairs) and
-    hold its writer's lock for the rest of the command (:func:`suspopt.io.claim`)."""
+    hold its writer's lock for the rest of the command (:func:`suspopt.io.claim`); what a
+    killed run had left beside it is said at once (:func:`say_io_notes`)."""
     from ..io import claim
 
     if path is None:
         return
     try:
-        stack.enter_context(claim(path, force, option, inputs))
+        stack.enter_context(claim(path, force, option, inputs, command=command_line()))
     except ConfigError as exc:
         fail(str(exc))
+    finally:
+        say_io_notes()
+
+
+def say_io_notes() -> None:
+    """Print, on stderr, a ``note: ...`` line for each lock and temporary files of a killed
+    run that the outputs' writers removed (:func:`suspopt.locks.take_notes`)."""
+    locks = sys.modules.get("suspopt.locks")  # (not imported: nothing was written or claimed)
+    if locks is None:
+        return
+    for note in locks.take_notes():
+        err.print(f"note: {note}", soft_wrap=True)
 
 
 def read_config(path: Path):

@@ -18,6 +18,7 @@ from .base import (
     force_option,
     max_memory_option,
     out,
+    say_io_notes,
     set_memory_limit,
     verbose_info,
 )
@@ -144,7 +145,11 @@ def export(
 
                 if pick:
                     fail("--csv writes every table of the file; --pick is for -o")
-                for path in write_csv(source, csv, force=force):
+                try:
+                    written = write_csv(source, csv, force=force)
+                finally:
+                    say_io_notes()  # (a killed run's leftovers beside a table)
+                for path in written:
                     out.print(f"wrote {path}")
                 return
             from ..io import atomic_file

@@ -160,7 +160,7 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
             base.fail("--sweep takes a config; with --pick the designs are the picked ones")
         picked = read_picks(source, split_picks(pick))
         cfg = apply_sets(picked.config, sets)
-        params = picked.params()
+        params: dict | None = picked.params()
     else:
         picked = None
         if pick:
@@ -358,11 +358,9 @@ def _picks_table(picked, F, names, units) -> Table:
                 if objective in picked.obj_names
                 else np.nan
             )
-            change = (
-                ""
-                if not np.isfinite(stored) or stored == 0
-                else f"{(F[i, j] - stored) / abs(stored):+.1e}"
-            )
+            with np.errstate(all="ignore"):  # (a damaged file's 1e-308: beyond the range)
+                relative = (F[i, j] - stored) / abs(stored) if stored != 0 else np.nan
+            change = f"{relative:+.1e}" if np.isfinite(relative) else ""
             table.add_row(
                 name if j == 0 else "",
                 str(int(picked.rows[i])) if j == 0 else "",

@@ -39,6 +39,9 @@ __all__ = [
     "resolve_road_file",
     "read_profile",
     "MAX_PROFILE_BYTES",
+    "MAX_PROFILE_HEIGHT",
+    "MAX_PROFILE_DISTANCE",
+    "MAX_PROFILE_SLOPE",
     "MIN_BUMP_HEIGHT",
 ]
 
@@ -253,6 +256,15 @@ def resolve_road_file(cfg: FileRoad, base_dir: Path | str | None) -> Path:
 
 #: Largest road profile read [bytes]: 100 km at 1 cm spacing.
 MAX_PROFILE_BYTES = 256 << 20
+#: Largest height of a road profile, either way, before ``road.scale`` [m]: 1000 km, or 1 m
+#: of a profile written in micrometres (``scale: 1.0e-6``).
+MAX_PROFILE_HEIGHT = 1e6
+#: Largest distance of a road profile, either way [m].
+MAX_PROFILE_DISTANCE = 1e9
+#: Steepest a road profile may rise or fall between two rows, before ``road.scale``: its
+#: height change over its distance [m/m] (a 10 cm kerb over 0.1 um). The wheel's vertical
+#: speed is this times the vehicle's; a steeper one (two rows 1e-300 m apart) overflows it.
+MAX_PROFILE_SLOPE = 1e6
 
 
 def read_profile(path: Path) -> tuple:
@@ -260,7 +272,9 @@ def read_profile(path: Path) -> tuple:
 
     The file is a regular UTF-8 text file of at most :data:`MAX_PROFILE_BYTES`, with an
     optional header line, then rows ``distance,height``: two finite numbers each, at least two
-    rows, distances strictly increasing. ValueError (FileNotFoundError for a missing file)
+    rows, distances strictly increasing, within :data:`MAX_PROFILE_DISTANCE`, heights within
+    :data:`MAX_PROFILE_HEIGHT`, no steeper than :data:`MAX_PROFILE_SLOPE` from one row to the
+    next (a file of 1e308 heights gave the simulation overflows and NaN). ValueError (FileNotFoundError for a missing file)
     names the file and the line, never the line's content: the file may be anything.
 
     Its first 1000 lines are read line by line (a bad one is named at once); then a
@@ -334,11 +348,14 @@ def _fast_rows(data: bytes, text: str, header: int):
             )
     except (ValueError, TypeError, MemoryError):
         return None
+    if table.shape[1] != 2 or len(table) < 2 or not np.isfinite(table).all():
+        return None
+    distance, height = table[:, 0], table[:, 1]
     ok = (
-        table.shape[1] == 2
-        and len(table) >= 2
-        and bool(np.isfinite(table).all())
-        and bool((np.diff(table[:, 0]) > 0).all())
+        bool((np.abs(distance) <= MAX_PROFILE_DISTANCE).all())
+        and bool((np.abs(height) <= MAX_PROFILE_HEIGHT).all())
+        and bool((np.diff(distance) > 0).all())
+        and bool((np.abs(np.diff(height)) <= MAX_PROFILE_SLOPE * np.diff(distance)).all())
     )
     return table if ok else None
 
@@ -373,8 +390,23 @@ def _rows_line_by_line(path: Path, text: str, header: int, lines: int | None = N
             )
         if not (math.isfinite(row[0]) and math.isfinite(row[1])):
             raise ValueError(f"road profile {path}:{number}: values must be finite")
+        if not abs(row[0]) <= MAX_PROFILE_DISTANCE:
+            raise ValueError(
+                f"road profile {path}:{number}: distances must be within "
+                f"±{MAX_PROFILE_DISTANCE:g} m"
+            )
+        if not abs(row[1]) <= MAX_PROFILE_HEIGHT:
+            raise ValueError(
+                f"road profile {path}:{number}: heights must be within "
+                f"±{MAX_PROFILE_HEIGHT:g} m (before road.scale)"
+            )
         if distance and not row[0] > distance[-1]:
             raise ValueError(f"road profile {path}:{number}: distances must increase strictly")
+        if distance and abs(row[1] - height[-1]) > MAX_PROFILE_SLOPE * (row[0] - distance[-1]):
+            raise ValueError(
+                f"road profile {path}:{number}: the height changes by more than "
+                f"{MAX_PROFILE_SLOPE:g} times the distance from the row before (too steep)"
+            )
         distance.append(row[0])
         height.append(row[1])
     if len(distance) < 2 and lines is None:

@@ -23,12 +23,13 @@ def nonlinear_spring_usage(
     ratios of two nearly equal ``x²`` may be one unit in the last place out of order), a
     NaN or infinite travel giving NaN as the ratio of every sample would.
     """
-    x2 = np.square(np.asarray(travel, dtype=float))
     k_l = np.asarray(k_linear, dtype=float)[..., None]
     k_nl = np.asarray(k_nonlinear, dtype=float)[..., None]
-    if np.all(k_l > 0.0) and np.all(k_nl >= 0.0):
-        x2 = np.max(x2, axis=-1, keepdims=True)
-    cubic = k_nl * x2
-    with np.errstate(invalid="ignore", divide="ignore"):
+    # (a diverging design's travel of 1e160 m squares to inf: its ratio is NaN, silently)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        x2 = np.square(np.asarray(travel, dtype=float))
+        if np.all(k_l > 0.0) and np.all(k_nl >= 0.0):
+            x2 = np.max(x2, axis=-1, keepdims=True)
+        cubic = k_nl * x2
         ratio = np.where(cubic != 0.0, cubic / (k_l + cubic), 0.0)
     return np.max(ratio, axis=-1)
