@@ -49,6 +49,17 @@ def kind_of(mode: int) -> str | None:
     return "an unknown kind of file"
 
 
+def link_kind(path) -> tuple[bool, str | None]:
+    """``(exists, kind)`` of the name ``path`` itself, a link not followed: whether it exists
+    and, where it is no regular file, what it is (:func:`kind_of`); an OSError other than a
+    missing name passes."""
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return False, None
+    return True, kind_of(mode)
+
+
 def _reason(exc: OSError) -> str:
     return exc.strerror or exc.__class__.__name__
 

@@ -55,7 +55,7 @@ import numpy as np
 
 from . import __version__
 from .config import Config, ConfigError
-from .files import Unreadable, kind_of, status
+from .files import Unreadable, link_kind, status
 from .h5read import open_dataset  # (suspopt.io.open_dataset, as docs/guide/results.md reads it)
 from .locks import take_lock, take_notes, this_command
 from .signature import CONFIG_SUFFIXES, signature_state
@@ -150,12 +150,11 @@ def check_target(path: str | Path, force: bool = False, option: str = "-o") -> P
     if not exists:
         raise ConfigError(f"{option} {path}: folder {folder} does not exist")
     try:
-        mode = os.lstat(path).st_mode
-    except FileNotFoundError:
-        return path
+        exists, kind = link_kind(path)
     except OSError as exc:
         raise ConfigError(f"{option} {path}: cannot inspect it ({exc.strerror})") from None
-    kind = kind_of(mode)
+    if not exists:
+        return path
     if kind is not None:
         raise ConfigError(
             f"{option} {path}: is {kind}; an output must be a regular file or a new name"

@@ -35,7 +35,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from .config import ConfigError
-from .files import kind_of
+from .files import link_kind
 
 __all__ = [
     "LOCK_SUFFIX",
@@ -97,11 +97,9 @@ def _lock_owner(head: bytes) -> str:
         return "its lock file does not say which run it was"
     said = f"process {int(pid)}"
     started = lines[1].strip() if len(lines) > 1 else ""
-    try:
-        if started and len(started) <= 40:
+    if started and len(started) <= 40:
+        with contextlib.suppress(ValueError):  # (a time that does not parse is left out)
             said += f", started {datetime.fromisoformat(started).isoformat()}"
-    except ValueError:
-        pass
     command = " ".join(lines[2].translate(_CONTROL).split()) if len(lines) > 2 else ""
     if command:
         cut = command[:LOCK_COMMAND_CHARS]
@@ -194,12 +192,9 @@ def _check_lock_kind(path: Path, lock: Path) -> None:
     """ConfigError when the lock's name is taken by something that is not a regular file
     (a directory, a FIFO, a symbolic link): not suspopt's lock, and not to be opened."""
     try:
-        mode = os.lstat(lock).st_mode
-    except FileNotFoundError:
-        return
+        _, kind = link_kind(lock)
     except OSError as exc:
         raise ConfigError(f"{path}: cannot inspect {lock} ({exc.strerror})") from None
-    kind = kind_of(mode)
     if kind is not None:
         raise ConfigError(
             f"{path}: {lock} is {kind}, not suspopt's lock file; remove it or choose another output"

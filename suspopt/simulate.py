@@ -128,8 +128,9 @@ def with_engine(cfg: Config, designs: int, evaluation: bool = False) -> Config:
 
     engine = auto_engine(sim.n_steps, designs, evaluation or cfg.optimiser is not None)
     resolved = cfg.model_copy(update={"simulation": sim.model_copy(update={"engine": engine})})
-    if cfg.text == cfg._text:  # (unedited: its text, engine auto as written, stays the record)
-        resolved._loaded = resolved.model_dump(mode="json")
+    loaded = cfg._loaded
+    if loaded is not None:  # (the engine resolved is no edit: the record stays the text)
+        resolved._loaded = {**loaded, "simulation": {**loaded["simulation"], "engine": engine}}
     return resolved
 
 

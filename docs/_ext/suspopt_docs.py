@@ -47,6 +47,7 @@ class Table:
     path: str
     definition: str
     rows: list[Row]
+    label: str = ""  # the id of its section in the page (:func:`reference_rst`)
 
 
 def github_slug(heading: str) -> str:
@@ -263,7 +264,7 @@ def reference_rst(schema: dict) -> str:
     labels: set[str] = set()
     for table in found:
         label = _label(table.title if table.path else "Top-level keys")
-        table.label = label  # type: ignore[attr-defined]
+        table.label = label
         labels.add(label)
         if table.definition and table.definition not in where:
             where[table.definition] = label
