@@ -247,6 +247,52 @@ class Result:
         """SI unit of a signal of this result."""
         return _row(self._table, name).unit
 
+    def to_xarray(
+        self, group: str = "signals", signals: Sequence[str] | None = None, float32: bool = False
+    ):
+        """This result as an ``xarray.Dataset``, without a file: the one
+        ``suspopt.io.open_dataset(path, group)`` reads from the file
+        ``suspopt.io.write_simulation(path, result, signals, float32)`` writes
+        (:mod:`suspopt.layout`; docs/guide/results.md). ``group``: ``signals`` (every signal,
+        or ``signals``, ``(design, time)`` in its SI unit), ``metrics``, ``designs``,
+        ``modal`` or ``""`` (the root: ``diverged_at``); the dimensions ``design`` and
+        ``time`` [s] with their coordinates, ``units`` in each variable's attrs, and the
+        provenance in the Dataset's (``suspopt_version``, ``config``, ``seed``, ``command``
+        and ``created``, now). KeyError for a group there is not."""
+        from .io import root_attrs
+        from .layout import group_dataset, group_name, simulation_tables
+
+        groups = simulation_tables(self, signals, float32, only={"", group_name(group)})
+        return group_dataset(groups, group, {"": root_attrs(self.config)}, "this Result")
+
+    def to_dataframe(self, group: str = "signals", signals: Sequence[str] | None = None):
+        """:meth:`to_xarray` of ``group`` as a tidy pandas DataFrame
+        (:func:`suspopt.layout.frame`), each column's SI unit in ``df.attrs["units"]``:
+        ``signals`` long, one row per (design, time [s]) and a column per signal; ``metrics``,
+        ``designs`` (a column per parameter) and ``""`` (``diverged_at``) one row per
+        design."""
+        from .layout import frame
+
+        return frame(self.to_xarray(group, signals))
+
+    def plot(
+        self,
+        signals: Sequence[str] | None = None,
+        designs: Sequence[int] | None = None,
+        design_names: Sequence[str] | None = None,
+    ):
+        """The figure of ``suspopt simulate --plot`` (:func:`suspopt.plots.result_figure`), a
+        ``matplotlib.figure.Figure``: each of ``signals`` (default the body's heave
+        acceleration, each corner's travel and tyre deflection, the seat's) over time [s]
+        and its Welch PSD, a line per design of ``designs`` (indices; default all, or 12
+        evenly spaced), axes labelled ``name [unit]``, a legend naming the designs
+        (``design_names``, default ``#i`` and the parameters that vary); the ISO 2631-1
+        weighted r.m.s. of the accelerations a person feels. ``fig.savefig(path)`` writes
+        it. ValueError for an unknown signal or a design out of range."""
+        from .plots import result_figure
+
+        return result_figure(self, signals, designs, design_names)
+
     def metric(self, spec, name: str) -> np.ndarray:
         """The (P,) values of metric spec ``spec`` on signal ``name`` (:mod:`!suspopt.specs`)."""
         from .specs import METRICS
