@@ -18,12 +18,44 @@ __all__ = ["OptimisationResult"]
 
 @dataclass
 class OptimisationResult:
-    """The optimum (or Pareto set) of a run: ``X`` physical values (N, n), ``F (N, m)``,
-    ``G (N, k)``, their names and units; ``history`` as written to ``/history``; ``status``
-    finished or interrupted; ``path`` the file written, whose root attributes are ``attrs``
-    (provenance: ``suspopt_version``, ``created``, ``command``, ``config``, ``seed``, and the
-    run's ``status``, ``algorithm``, ...); ``problem`` the :class:`~suspopt.Problem` it
-    solved (layout of the file: :mod:`suspopt.optimise.run`)."""
+    """The optimum (or Pareto set) of a run, as :func:`suspopt.optimise.optimise` returns it
+    (its file's layout: :mod:`suspopt.optimise.run`).
+
+    :meth:`to_xarray`, :meth:`to_dataframe` and :meth:`plot` give it as an xarray Dataset, a
+    pandas DataFrame and the ``--plot`` figure without reading the file.
+
+    Attributes
+    ----------
+    X : ndarray
+        The designs' variables ``(N, n)``, physical values in ``var_units``.
+    F : ndarray
+        Their objectives ``(N, m)``, in ``obj_units``.
+    G : ndarray
+        Their constraint margins ``(N, k)`` (G <= 0 feasible), in the constraints' units.
+    var_names, var_units : list of str
+        The design variables' names and SI units.
+    obj_names, obj_units : list of str
+        The objectives' names and SI units.
+    constraint_names : list of str
+        The constraints' names (``RC <= 1.4``, ..., ``simulation_failed``).
+    history : dict of str to ndarray
+        ``/history`` per generation: ``generation``, ``best``, ``hypervolume``,
+        ``evaluations``, ``time`` [s], ``feasible``.
+    status : str
+        ``finished``, ``interrupted``, ``running`` or ``failed``.
+    path : Path
+        The file written.
+    weights : ndarray or None
+        The weighted sum's weights (units 1), None without one.
+    baseline : Solutions or None
+        The config's own design, evaluated (X, F, G as above), or None.
+    problem : Problem or None
+        The :class:`~suspopt.Problem` the run solved.
+    attrs : dict
+        The file's root attributes: ``suspopt_version``, ``created``, ``command``,
+        ``config``, ``seed`` (units 1), ``status``, ``algorithm``, ``optimiser_seed``,
+        ``generations``, ``evaluations``.
+    """
 
     X: np.ndarray
     F: np.ndarray
@@ -67,13 +99,23 @@ class OptimisationResult:
         return groups
 
     def to_xarray(self, group: str = "pareto"):
-        """This result as an ``xarray.Dataset``, without reading its file: the one
-        ``suspopt.io.open_dataset(result.path, group)`` reads (:mod:`suspopt.layout`).
-        ``group``: ``pareto`` (``X``, ``F``, ``G`` over ``design`` and ``variable``,
-        ``objective``, ``constraint``, the names as coordinates and each column's SI unit
-        in ``units``), ``history`` (per ``generation``), ``baseline``, ``pareto/scenarios``
-        (a robust run) or ``""`` (the root); the file's root attributes in the Dataset's.
-        KeyError for a group the result does not hold (``checkpoint``: read the file)."""
+        """This result as an ``xarray.Dataset``, without reading its file
+        (:mod:`suspopt.layout`): the one ``suspopt.io.open_dataset(result.path, group)``
+        reads, the file's root attributes (provenance) in its attrs.
+
+        Parameters
+        ----------
+        group : str
+            ``pareto``: ``X``, ``F``, ``G`` over ``design`` and ``variable``, ``objective``,
+            ``constraint`` (the names as coordinates, each column's SI unit in ``units``);
+            ``history`` (per ``generation``); ``baseline``; ``pareto/scenarios`` (a robust
+            run); ``""`` (the root).
+
+        Returns
+        -------
+        xarray.Dataset
+            KeyError for a group the result does not hold (``checkpoint``: read the file).
+        """
         from ..layout import group_dataset, group_name
 
         name = group_name(group)
@@ -85,21 +127,43 @@ class OptimisationResult:
 
     def to_dataframe(self, group: str = "pareto"):
         """:meth:`to_xarray` of ``group`` as a tidy pandas DataFrame
-        (:func:`suspopt.layout.frame`): ``pareto`` one row per design, a column per design
-        variable, objective and constraint (``X[name]`` where two tables share a name);
-        ``history`` one row per generation; each column's SI unit in ``df.attrs["units"]``."""
+        (:func:`suspopt.layout.frame`).
+
+        Parameters
+        ----------
+        group : str
+            ``pareto`` and ``baseline``: one row per design, a column per design variable,
+            objective and constraint (``X[name]`` where two tables share a name);
+            ``history``: one row per generation (``best[f1]``, ``hypervolume``, ...).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Each column's SI unit in ``df.attrs["units"]`` (column -> unit).
+        """
         from ..layout import frame
 
         return frame(self.to_xarray(group))
 
     def plot(self, picks: Mapping[str, int] | None = None):
         """The figure of ``suspopt optimise --plot``
-        (:func:`suspopt.plots.optimisation_result_figure`), a ``matplotlib.figure.Figure``:
-        the front as every pair of objectives (feasible designs filled, infeasible hollow;
-        axes ``name [unit]``), or the best value per generation for one objective, then the
-        hypervolume and the feasible share per generation. ``picks`` (name -> row, e.g.
-        ``suspopt.pareto_picks(result.F, result.obj_names)``) are starred and named on the
-        front. ``fig.savefig(path)`` writes it."""
+        (:func:`suspopt.plots.optimisation_result_figure`).
+
+        Two objectives or more: the front as every pair of objectives (feasible designs
+        filled, infeasible hollow; axes ``name [unit]``), then the hypervolume and the
+        feasible share per generation; one objective: the best value per generation.
+
+        Parameters
+        ----------
+        picks : dict of str to int, optional
+            Designs to star and name on the front, name -> row (indices of ``F``), e.g.
+            ``suspopt.pareto_picks(result.F, result.obj_names)``.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            ``fig.savefig("front.png")`` writes it.
+        """
         from ..plots import optimisation_result_figure
 
         return optimisation_result_figure(self, picks)

@@ -1,0 +1,165 @@
+"""Results from Python without files (issue 59): ``Result.to_xarray()`` / ``to_dataframe()``
+give what ``open_dataset`` reads from the file the result writes, and ``Result.plot()`` /
+``OptimisationResult.plot()`` return the ``--plot`` figures, drawn from the result's arrays."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+from conftest import TINY
+
+import suspopt
+from suspopt.config.loader import load_config_text
+from suspopt.io import open_dataset, write_simulation
+from suspopt.templates import template_text
+
+K = np.array([8.0e3, 1.2e4, 2.0e4])  # three designs of the quarter car's spring [N/m]
+
+
+@pytest.fixture(scope="module")
+def quarter(tmp_path_factory):
+    """A quarter car over an ISO 8608 road (seed 1), 1 s, three designs, its metrics, and
+    the file ``suspopt.io.write_simulation`` writes of it."""
+    text = template_text("quarter").replace("duration: 20.0", "duration: 1.0")
+    assert "duration: 1.0" in text
+    res = suspopt.simulate(
+        load_config_text(text, Path("quarter.yaml")),
+        params={"vehicle.corners.F1.spring.linear": K},
+    )
+    return res, write_simulation(tmp_path_factory.mktemp("quarter") / "q.h5", res)
+
+
+@pytest.fixture(scope="module")
+def robust(tmp_path_factory):
+    """A tiny robust optimisation (two scenarios) of the half car, its result and file."""
+    from suspopt.optimise import optimise
+
+    text = TINY.replace("generations: 4", "generations: 2")
+    text += "scenarios:\n  cases: [{name: high, set: {road.height: 0.07}}]\n"
+    out = tmp_path_factory.mktemp("robust") / "front.h5"
+    return optimise(load_config_text(text, Path("case.yaml")), out)
+
+
+def _same(mine: xr.Dataset, read: xr.Dataset) -> None:
+    """``mine`` is ``read``: variables, coordinates, dims, every attribute; ``created`` (the
+    moment each was made) is the only attribute allowed to differ."""
+    assert set(mine.attrs) == set(read.attrs)
+    xr.testing.assert_identical(mine.assign_attrs(created=read.attrs["created"]), read)
+
+
+@pytest.mark.parametrize("group", ["signals", "metrics", "designs", "modal", ""])
+def test_a_simulation_in_memory_is_the_dataset_its_file_reads_as(quarter, group):
+    res, path = quarter
+    mine, read = res.to_xarray(group), open_dataset(path, group)
+    _same(mine, read)
+    assert mine.attrs["seed"] == 1 and mine.attrs["config"] == res.config.text
+    assert mine.attrs["suspopt_version"] == suspopt.__version__
+    if group == "signals":
+        assert mine["body.heave_acc"].dims == ("design", "time")
+        assert mine["body.heave_acc"].attrs["units"] == "m/s^2"
+        np.testing.assert_array_equal(mine["time"], res.time)
+        np.testing.assert_array_equal(mine["travel.F1"], res.signals["travel.F1"])
+
+
+def test_chosen_signals_as_float32_are_the_file_of_the_same_choice(quarter, tmp_path):
+    res, _ = quarter
+    names = ["body.heave_acc", "tyre_force.F1"]
+    path = write_simulation(tmp_path / "some.h5", res, signals=names, float32=True)
+    mine = res.to_xarray(signals=names, float32=True)
+    _same(mine, open_dataset(path, "signals"))
+    assert list(mine.data_vars) == names and mine["tyre_force.F1"].dtype == np.float32
+
+
+def test_a_group_the_result_has_not_is_a_key_error_listing_its_groups(quarter):
+    res, _ = quarter
+    with pytest.raises(KeyError, match="no group 'signal'; it has 'signals', 'metrics'"):
+        res.to_xarray("signal")
+    with pytest.raises(TypeError, match="group must be a str"):
+        res.to_xarray(3)
+
+
+def test_the_dataframes_are_tidy_with_their_units(quarter):
+    res, _ = quarter
+    signals = res.to_dataframe(signals=["body.heave_acc", "travel.F1"])
+    assert signals.index.names == ["design", "time"]
+    assert list(signals.columns) == ["body.heave_acc", "travel.F1"]
+    assert signals.attrs["units"] == {"body.heave_acc": "m/s^2", "travel.F1": "m"}
+    np.testing.assert_array_equal(
+        signals.loc[2, "travel.F1"].to_numpy(), res.signals["travel.F1"][2]
+    )
+    np.testing.assert_array_equal(signals.loc[1].index.to_numpy(), res.time)
+    metrics = res.to_dataframe("metrics")
+    assert metrics.index.name == "design" and list(metrics.columns) == list(res.metrics)
+    np.testing.assert_array_equal(metrics["RC"], res.metrics["RC"])
+    assert metrics.attrs["units"]["RC"] == res.metric_units["RC"] == "m/s^2"
+    designs = res.to_dataframe("designs")
+    np.testing.assert_array_equal(designs["vehicle.corners.F1.spring.linear"], K)
+    assert designs.attrs["units"] == {"vehicle.corners.F1.spring.linear": "N/m"}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("group", ["pareto", "pareto/scenarios", "history", "baseline", ""])
+def test_an_optimisation_in_memory_is_the_dataset_its_file_reads_as(robust, group):
+    mine, read = robust.to_xarray(group), open_dataset(robust.path, group)
+    xr.testing.assert_identical(mine, read)  # (the file's own attributes, created included)
+    assert mine.attrs["status"] == "finished" and mine.attrs["config"].startswith("vehicle:")
+    if group == "pareto":
+        assert list(mine["objective"].values) == robust.obj_names
+        assert mine["F"].attrs["over_scenarios"] == ["mean", "mean"]
+        np.testing.assert_array_equal(mine["X"], robust.X)
+
+
+@pytest.mark.slow
+def test_the_front_as_a_dataframe_is_one_row_per_design(robust):
+    front = robust.to_dataframe()
+    assert len(front) == len(robust.F) and front.index.name == "design"
+    assert list(front.columns) == [*robust.var_names, *robust.obj_names, *robust.constraint_names]
+    np.testing.assert_array_equal(front[robust.obj_names].to_numpy(), robust.F)
+    assert [front.attrs["units"][n] for n in robust.var_names] == robust.var_units
+    history = robust.to_dataframe("history")
+    assert history.index.name == "generation" and "best[f1]" in history.columns
+    assert history.attrs["units"]["time"] == "s"
+
+
+@pytest.mark.slow
+def test_result_plot_draws_the_result_s_arrays_with_units(quarter):
+    from matplotlib.figure import Figure
+
+    res, _ = quarter
+    fig = res.plot(signals=["body.heave_acc", "travel.F1"], designs=[0, 2])
+    assert isinstance(fig, Figure)
+    heave = next(ax for ax in fig.axes if ax.get_ylabel() == "body.heave_acc [m/s^2]")
+    assert heave.get_xlabel() == "time [s]"
+    lines = heave.get_lines()
+    assert len(lines) == 2
+    for line, design in zip(lines, [0, 2]):
+        np.testing.assert_array_equal(line.get_xdata(), res.time)
+        np.testing.assert_array_equal(line.get_ydata(), res.signals["body.heave_acc"][design])
+    assert any(ax.get_ylabel() == "travel.F1 [m]" for ax in fig.axes)
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert len(labels) == 2 and labels[0].startswith("#0") and labels[1].startswith("#2")
+    with pytest.raises(ValueError, match="unknown signal 'travel'; did you mean"):
+        res.plot(signals=["travel"])
+
+
+@pytest.mark.slow
+def test_optimisation_plot_draws_the_front_and_marks_the_picks(robust):
+    from matplotlib.figure import Figure
+
+    picks = suspopt.pareto_picks(robust.F, robust.obj_names)
+    fig = robust.plot(picks)
+    assert isinstance(fig, Figure)
+    front = fig.axes[0]
+    assert front.get_xlabel() == "f1 [(m/s^2)^2]" and front.get_ylabel() == "f3 [m^2]"
+    feasible = (robust.G <= 0).all(axis=1)
+    drawn = np.vstack([c.get_offsets() for c in front.collections[: 1 + (~feasible).any()]])
+    np.testing.assert_allclose(np.sort(drawn, axis=0), np.sort(robust.F[:, :2], axis=0), rtol=1e-12)
+    stars = {t.get_text(): t.xy for t in front.texts}
+    assert set(stars) == set(picks)
+    for name, row in picks.items():
+        np.testing.assert_allclose(stars[name], robust.F[row, :2], rtol=1e-12)
+    with pytest.raises(ValueError, match="picks: 'knee': 99 is not a row"):
+        robust.plot({"knee": 99})
