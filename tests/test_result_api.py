@@ -32,15 +32,26 @@ def quarter(tmp_path_factory):
     return res, write_simulation(tmp_path_factory.mktemp("quarter") / "q.h5", res)
 
 
-@pytest.fixture(scope="module")
-def robust(tmp_path_factory):
-    """A tiny robust optimisation (two scenarios) of the half car, its result and file."""
+def _optimised(folder: Path, text: str):
     from suspopt.optimise import optimise
 
+    return optimise(load_config_text(text, Path("case.yaml")), folder / "front.h5")
+
+
+@pytest.fixture(scope="module")
+def front(tmp_path_factory):
+    """A tiny optimisation of the half car (two objectives): a front of several designs."""
+    run = _optimised(tmp_path_factory.mktemp("front"), TINY)
+    assert len(run.F) >= 3
+    return run
+
+
+@pytest.fixture(scope="module")
+def robust(tmp_path_factory):
+    """A tiny robust optimisation (two scenarios) of the half car."""
     text = TINY.replace("generations: 4", "generations: 2")
     text += "scenarios:\n  cases: [{name: high, set: {road.height: 0.07}}]\n"
-    out = tmp_path_factory.mktemp("robust") / "front.h5"
-    return optimise(load_config_text(text, Path("case.yaml")), out)
+    return _optimised(tmp_path_factory.mktemp("robust"), text)
 
 
 def _same(mine: xr.Dataset, read: xr.Dataset) -> None:
@@ -101,26 +112,42 @@ def test_the_dataframes_are_tidy_with_their_units(quarter):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("group", ["pareto", "pareto/scenarios", "history", "baseline", ""])
-def test_an_optimisation_in_memory_is_the_dataset_its_file_reads_as(robust, group):
-    mine, read = robust.to_xarray(group), open_dataset(robust.path, group)
+@pytest.mark.parametrize("group", ["pareto", "history", "baseline", ""])
+def test_an_optimisation_in_memory_is_the_dataset_its_file_reads_as(front, group):
+    mine, read = front.to_xarray(group), open_dataset(front.path, group)
     xr.testing.assert_identical(mine, read)  # (the file's own attributes, created included)
     assert mine.attrs["status"] == "finished" and mine.attrs["config"].startswith("vehicle:")
     if group == "pareto":
-        assert list(mine["objective"].values) == robust.obj_names
-        assert mine["F"].attrs["over_scenarios"] == ["mean", "mean"]
-        np.testing.assert_array_equal(mine["X"], robust.X)
+        assert list(mine["objective"].values) == front.obj_names == ["f1", "f3"]
+        assert mine["F"].attrs["units"] == front.obj_units
+        np.testing.assert_array_equal(mine["X"], front.X)
+    with pytest.raises(KeyError, match="no group 'checkpoint'"):
+        front.to_xarray("checkpoint")
 
 
 @pytest.mark.slow
-def test_the_front_as_a_dataframe_is_one_row_per_design(robust):
-    front = robust.to_dataframe()
-    assert len(front) == len(robust.F) and front.index.name == "design"
-    assert list(front.columns) == [*robust.var_names, *robust.obj_names, *robust.constraint_names]
-    np.testing.assert_array_equal(front[robust.obj_names].to_numpy(), robust.F)
-    assert [front.attrs["units"][n] for n in robust.var_names] == robust.var_units
-    history = robust.to_dataframe("history")
+@pytest.mark.parametrize("group", ["pareto", "pareto/scenarios"])
+def test_a_robust_optimisation_in_memory_has_its_scenarios(robust, group):
+    mine, read = robust.to_xarray(group), open_dataset(robust.path, group)
+    xr.testing.assert_identical(mine, read)
+    if group == "pareto":
+        assert mine["F"].attrs["over_scenarios"] == ["mean", "mean"]
+    else:
+        assert list(mine["scenario"].values) == ["nominal", "high"]
+        assert mine["F"].dims == ("design", "scenario", "objective")
+
+
+@pytest.mark.slow
+def test_the_front_as_a_dataframe_is_one_row_per_design(front):
+    df = front.to_dataframe()
+    assert len(df) == len(front.F) and df.index.name == "design"
+    assert list(df.columns) == [*front.var_names, *front.obj_names, *front.constraint_names]
+    np.testing.assert_array_equal(df[front.obj_names].to_numpy(), front.F)
+    np.testing.assert_array_equal(df[front.constraint_names].to_numpy(), front.G)
+    assert [df.attrs["units"][n] for n in front.var_names] == front.var_units
+    history = front.to_dataframe("history")
     assert history.index.name == "generation" and "best[f1]" in history.columns
+    np.testing.assert_array_equal(history["best[f3]"], front.history["best"][:, 1])
     assert history.attrs["units"]["time"] == "s"
 
 
@@ -146,20 +173,23 @@ def test_result_plot_draws_the_result_s_arrays_with_units(quarter):
 
 
 @pytest.mark.slow
-def test_optimisation_plot_draws_the_front_and_marks_the_picks(robust):
+def test_optimisation_plot_draws_the_front_and_marks_the_picks(front):
     from matplotlib.figure import Figure
 
-    picks = suspopt.pareto_picks(robust.F, robust.obj_names)
-    fig = robust.plot(picks)
+    picks = suspopt.pareto_picks(front.F, front.obj_names)
+    fig = front.plot(picks)
     assert isinstance(fig, Figure)
-    front = fig.axes[0]
-    assert front.get_xlabel() == "f1 [(m/s^2)^2]" and front.get_ylabel() == "f3 [m^2]"
-    feasible = (robust.G <= 0).all(axis=1)
-    drawn = np.vstack([c.get_offsets() for c in front.collections[: 1 + (~feasible).any()]])
-    np.testing.assert_allclose(np.sort(drawn, axis=0), np.sort(robust.F[:, :2], axis=0), rtol=1e-12)
-    stars = {t.get_text(): t.xy for t in front.texts}
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "f1 [(m/s^2)^2]" and ax.get_ylabel() == "f3 [m^2]"
+    feasible = (front.G <= 0).all(axis=1)
+    kinds = [feasible] + ([~feasible] if (~feasible).any() else [])
+    for points, rows in zip(ax.collections, kinds):  # feasible filled, then infeasible
+        np.testing.assert_array_equal(points.get_offsets(), front.F[rows][:, :2])
+    stars = {name: t.xy for t in ax.texts for name in t.get_text().split(", ")}
     assert set(stars) == set(picks)
     for name, row in picks.items():
-        np.testing.assert_allclose(stars[name], robust.F[row, :2], rtol=1e-12)
+        np.testing.assert_array_equal(stars[name], front.F[row, :2])
+    one = front.plot({"a": 0, "b": 0, "c": 1})  # the names of one design: one label
+    assert sorted(t.get_text() for t in one.axes[0].texts) == ["a, b", "c"]
     with pytest.raises(ValueError, match="picks: 'knee': 99 is not a row"):
-        robust.plot({"knee": 99})
+        front.plot({"knee": 99})

@@ -27,15 +27,19 @@ class OptimisationResult:
     Attributes
     ----------
     X : ndarray
-        The designs' variables ``(N, n)``, physical values in ``var_units``.
+        The designs' variables ``(N, n)``, physical values (SI units: ``var_units``).
     F : ndarray
-        Their objectives ``(N, m)``, in ``obj_units``.
+        Their objectives ``(N, m)`` (SI units: ``obj_units``).
     G : ndarray
         Their constraint margins ``(N, k)`` (G <= 0 feasible), in the constraints' units.
-    var_names, var_units : list of str
-        The design variables' names and SI units.
-    obj_names, obj_units : list of str
-        The objectives' names and SI units.
+    var_names : list of str
+        The design variables' names.
+    var_units : list of str
+        Their SI units.
+    obj_names : list of str
+        The objectives' names.
+    obj_units : list of str
+        Their SI units.
     constraint_names : list of str
         The constraints' names (``RC <= 1.4``, ..., ``simulation_failed``).
     history : dict of str to ndarray

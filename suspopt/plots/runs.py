@@ -327,7 +327,8 @@ def optimisation_figure(
     """The figure of :func:`plot_optimisation` from arrays, unsaved: the optimum ``F (N,
     m)`` with constraints ``G (N, k)`` (G <= 0 feasible) over objectives ``names`` and
     ``units``, and the ``history`` of ``/history`` (generation, best, hypervolume,
-    feasible, ...); ``marks`` (name -> row of F) starred and named on each pair's panel.
+    feasible, ...); ``marks`` (name -> row of F) starred on each pair's panel, the names
+    of one design in one label.
 
     Two objectives or more: the front as every pair of objectives (one panel for two, a
     panel per pair for more; feasible designs filled, infeasible ones hollow), then the
@@ -360,6 +361,9 @@ def optimisation_figure(
         draw_history(axes[0], generation, best, f"best {name}", unit, summary)
     else:
         pairs = [(i, j) for i in range(m) for j in range(i + 1, m)]
+        by_row: dict[int, list[str]] = {}  # (one label per design: "best_f1, knee")
+        for name, k in (marks or {}).items():
+            by_row.setdefault(int(k), []).append(name)
         fig, axes = new_figure(len(pairs) + 2, columns=3, panel_size=(4.2, 3.4))
         other = ~feasible & ~failed
         for ax, (i, j) in zip(axes, pairs):
@@ -371,7 +375,7 @@ def optimisation_figure(
                 fronts,
                 axis_label(names[i], units[i]),
                 axis_label(names[j], units[j]),
-                {name: (F[k, i], F[k, j]) for name, k in (marks or {}).items()},
+                {", ".join(named): (F[k, i], F[k, j]) for k, named in by_row.items()},
                 legend=False,
             )
             ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
