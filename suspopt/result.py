@@ -250,7 +250,7 @@ class Result:
     def to_xarray(
         self, group: str = "signals", signals: Sequence[str] | None = None, float32: bool = False
     ):
-        """This result as an ``xarray.Dataset``, without a file (:mod:`suspopt.layout`).
+        """This result as an ``xarray.Dataset``, without a file (:mod:`!suspopt.layout`).
 
         It is the Dataset ``suspopt.io.open_dataset(path, group)`` reads from the file that
         ``suspopt.io.write_simulation(path, result, signals, float32)`` writes
@@ -284,7 +284,7 @@ class Result:
 
     def to_dataframe(self, group: str = "signals", signals: Sequence[str] | None = None):
         """:meth:`to_xarray` of ``group`` as a tidy pandas DataFrame
-        (:func:`suspopt.layout.frame`).
+        (:func:`!suspopt.layout.frame`).
 
         Parameters
         ----------
@@ -310,7 +310,7 @@ class Result:
         designs: Sequence[int] | None = None,
         design_names: Sequence[str] | None = None,
     ):
-        """The figure of ``suspopt simulate --plot`` (:func:`suspopt.plots.result_figure`).
+        """The figure of ``suspopt simulate --plot`` (:func:`!suspopt.plots.result_figure`).
 
         One row per signal: its time history [s] (left), a line per design, and its Welch
         PSD (right); axes labelled ``name [unit]``, a legend naming the designs below; then

@@ -19,7 +19,7 @@ __all__ = ["OptimisationResult"]
 @dataclass
 class OptimisationResult:
     """The optimum (or Pareto set) of a run, as :func:`suspopt.optimise.optimise` returns it
-    (its file's layout: :mod:`suspopt.optimise.run`).
+    (its file's layout: :mod:`!suspopt.optimise.run`).
 
     :meth:`to_xarray`, :meth:`to_dataframe` and :meth:`plot` give it as an xarray Dataset, a
     pandas DataFrame and the ``--plot`` figure without reading the file.
@@ -79,7 +79,7 @@ class OptimisationResult:
 
     def _groups(self, only: Collection[str]) -> dict[str, list]:
         """The file's groups that the result holds (``/checkpoint`` is the file's only),
-        group -> its tables, those of ``only`` computed (:mod:`suspopt.layout`)."""
+        group -> its tables, those of ``only`` computed (:mod:`!suspopt.layout`)."""
         from .output import baseline_tables, history_tables, pareto_tables, scenario_tables
 
         if self.problem is None:
@@ -104,7 +104,7 @@ class OptimisationResult:
 
     def to_xarray(self, group: str = "pareto"):
         """This result as an ``xarray.Dataset``, without reading its file
-        (:mod:`suspopt.layout`): the one ``suspopt.io.open_dataset(result.path, group)``
+        (:mod:`!suspopt.layout`): the one ``suspopt.io.open_dataset(result.path, group)``
         reads, the file's root attributes (provenance) in its attrs.
 
         Parameters
@@ -131,7 +131,7 @@ class OptimisationResult:
 
     def to_dataframe(self, group: str = "pareto"):
         """:meth:`to_xarray` of ``group`` as a tidy pandas DataFrame
-        (:func:`suspopt.layout.frame`).
+        (:func:`!suspopt.layout.frame`).
 
         Parameters
         ----------
@@ -151,7 +151,7 @@ class OptimisationResult:
 
     def plot(self, picks: Mapping[str, int] | None = None):
         """The figure of ``suspopt optimise --plot``
-        (:func:`suspopt.plots.optimisation_result_figure`).
+        (:func:`!suspopt.plots.optimisation_result_figure`).
 
         Two objectives or more: the front as every pair of objectives (feasible designs
         filled, infeasible hollow; axes ``name [unit]``), then the hypervolume and the
