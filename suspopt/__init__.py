@@ -31,6 +31,7 @@ _EXPORTS = {
     "modal_analysis": "vehicle",
     "frequency_response": "vehicle",
     "Problem": "optimise",
+    "OptimisationResult": "optimise",
     "kesort": "kesort",
     "KEpsilonSort": "kesort",
     "pareto_picks": "kesort",
@@ -70,7 +71,7 @@ if TYPE_CHECKING:
     from .config import Config, ConfigError, config_schema, load_config
     from .kesort import KEpsilonSort, kesort, pareto_picks
     from .memory import reuse_memory
-    from .optimise import Problem
+    from .optimise import OptimisationResult, Problem
     from .simulate import Result, simulate
     from .templates import load_template
     from .vehicle import build_vehicle, frequency_response, modal_analysis

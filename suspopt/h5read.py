@@ -481,7 +481,10 @@ def open_dataset(path: str | Path, group: str | None = None):
     """The datasets of ``group`` (default the root; ``"pareto"``, ``"kesort/cases/A"``) of a
     suspopt HDF5 file as an ``xarray.Dataset`` (lazy, through xarray's ``h5netcdf`` engine):
     named dimensions with their coordinates, those held by the groups above included (``time``
-    and ``design`` for ``/signals``), and each variable's attributes (``units``, ``names``).
+    and ``design`` for ``/signals``), each variable's attributes (``units``, ``names``), and the
+    root's attributes (``suspopt_version``, ``created``, ``command``, ``config``, ``seed``, ...)
+    under the group's own, which win where both have one. :func:`suspopt.layout.as_dataset`
+    gives the same Dataset from a result in memory (``Result.to_xarray()``).
     ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
     pandas DataFrame. A file that is missing, not HDF5 or damaged is a ConfigError naming it
     (:class:`!H5Reader`), a group the file lacks a KeyError listing the
@@ -531,4 +534,7 @@ def open_dataset(path: str | Path, group: str | None = None):
                 if d in above.coords and above.sizes[d] == ds.sizes[d]
             }
         ds = ds.assign_coords(found)
+    if parts:  # the provenance, under the group's own attributes
+        with load(None) as root:
+            ds.attrs = {**root.attrs, **ds.attrs}
     return ds

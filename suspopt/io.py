@@ -77,6 +77,8 @@ __all__ = [
     "write_attrs",
     "text_array",
     "write_simulation",
+    "write_tables",
+    "root_attrs",
     "read_simulation_signals",
     "open_dataset",
     "is_suspopt_output",
@@ -327,12 +329,20 @@ def atomic_h5(
 
     with atomic_file(path, force, [*config_inputs(cfg), *inputs]) as stream:
         with h5py.File(stream, "w") as h5:
-            h5.attrs["suspopt_version"] = __version__
-            h5.attrs["created"] = datetime.now(UTC).isoformat(timespec="seconds")
-            h5.attrs["command"] = command if command is not None else " ".join(sys.argv)
-            h5.attrs["config"] = cfg.text
-            h5.attrs["seed"] = _seed_of(cfg)
+            h5.attrs.update(root_attrs(cfg, command))
             yield h5
+
+
+def root_attrs(cfg: Config, command: str | None = None) -> dict:
+    """The root attributes of every suspopt HDF5 file (module docstring), written now:
+    ``command`` default this process's command line."""
+    return {
+        "suspopt_version": __version__,
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+        "command": command if command is not None else " ".join(sys.argv),
+        "config": cfg.text,
+        "seed": _seed_of(cfg),
+    }
 
 
 def config_inputs(cfg: Config) -> list[tuple[str, Path]]:
@@ -460,6 +470,15 @@ def write_dataset(
     return ds
 
 
+def write_tables(group, tables) -> None:
+    """Write each :class:`suspopt.layout.Table` of ``tables`` into ``group``
+    (:func:`write_dataset`)."""
+    for t in tables:
+        write_dataset(
+            group, t.name, t.data, t.units, dims=t.dims, coords=t.coords, names=t.names, **t.attrs
+        )
+
+
 def write_simulation(
     path: str | Path,
     result,
@@ -468,7 +487,8 @@ def write_simulation(
     command: str | None = None,
     extra=None,
 ) -> Path:
-    """Write a simulation ``Result`` (docs/guide/results.md).
+    """Write a simulation ``Result`` (docs/guide/results.md), its groups as
+    :func:`suspopt.layout.simulation_tables` declares them.
 
     ``/time (T,)`` [s] and ``/design (P,)`` (row numbers) are the dimension scales ``time``
     and ``design``; ``/signals/<name> (design, time)``, ``/metrics/<name> (design,)``,
@@ -479,62 +499,17 @@ def write_simulation(
     (design 0's DOF of most energy per mode), ``/modal/label (design, mode)`` (what each mode
     is) and ``/modal/energy_share (design, mode, dof)`` (each DOF's share of each mode's
     kinetic energy, attr ``dofs``, scale ``/modal/dof``): :func:`suspopt.vehicle.modal_analysis`.
-    ``/modal/mode`` numbers the modes.
+    ``/modal/mode`` numbers the modes. ``extra(h5)`` adds the caller's groups (the picks)
+    before ``/modal``.
     """
-    from .vehicle import modal_analysis
+    from .layout import simulation_tables
 
-    names = list(result.signals) if signals is None else list(signals)
-    dtype = np.float32 if float32 else np.float64
+    groups = simulation_tables(result, None if signals is None else list(signals), float32)
     with atomic_h5(path, result.config, command) as h5:
-        write_dataset(h5, "time", result.time, "s", dims=("time",))
-        write_dataset(h5, "design", np.arange(len(result.diverged_at)), "1", dims=("design",))
-        grp = h5.create_group("signals")
-        for name in names:
-            write_dataset(
-                grp,
-                name,
-                np.asarray(result.signals[name], dtype=dtype),
-                result.signal_unit(name),
-                dims=("design", "time"),
-            )
-        met = h5.create_group("metrics")
-        for name, value in result.metrics.items():
-            write_dataset(met, name, np.asarray(value), result.metric_units[name], dims=("design",))
-        write_dataset(h5, "diverged_at", result.diverged_at, "s", dims=("design",))
-        if result.designs:
-            from .params import field_unit
-
-            X = np.column_stack([result.designs[k] for k in result.designs])
-            write_dataset(
-                h5.create_group("designs"),
-                "X",
-                X,
-                [field_unit(result.config, k) for k in result.designs],
-                dims=("design", "variable"),
-                names=list(result.designs),
-            )
-        if extra is not None:  # what the caller adds (e.g. the picks)
-            extra(h5)
-        modes = modal_analysis(result.model)
-        modal = h5.create_group("modal")
-        write_dataset(
-            modal,
-            "frequency",
-            modes.frequency,
-            "Hz",
-            dims=("design", "mode"),
-            dominant=list(modes.dominant[0]),
-        )
-        write_dataset(modal, "label", modes.label, "1", dims=("design", "mode"))
-        write_dataset(
-            modal,
-            "energy_share",
-            modes.energy,
-            "1",
-            dims=("design", "mode", "dof"),
-            coords={"dof": list(modes.dof_names)},
-            dofs=list(modes.dof_names),
-        )
+        for name, tables in groups.items():
+            if name == "modal" and extra is not None:  # what the caller adds (e.g. the picks)
+                extra(h5)
+            write_tables(h5.create_group(name) if name else h5, tables)
     return Path(path)
 
 

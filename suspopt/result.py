@@ -247,6 +247,95 @@ class Result:
         """SI unit of a signal of this result."""
         return _row(self._table, name).unit
 
+    def to_xarray(
+        self, group: str = "signals", signals: Sequence[str] | None = None, float32: bool = False
+    ):
+        """This result as an ``xarray.Dataset``, without a file (:mod:`!suspopt.layout`).
+
+        It is the Dataset ``suspopt.io.open_dataset(path, group)`` reads from the file that
+        ``suspopt.io.write_simulation(path, result, signals, float32)`` writes
+        (docs/guide/results.md): the same variables, dimensions ``design`` and ``time``
+        with their coordinates, ``units`` in each variable's attrs, and the provenance in
+        the Dataset's attrs (``suspopt_version``, ``config``, ``seed``, ``command``, and
+        ``created``: now).
+
+        Parameters
+        ----------
+        group : str
+            ``signals`` (each ``(design, time)`` in its SI unit), ``metrics`` (``(design,)``),
+            ``designs`` (``X (design, variable)``, when design parameters were given),
+            ``modal`` (``frequency`` [Hz], ``label``, ``energy_share``) or ``""`` (the root:
+            ``diverged_at`` [s]).
+        signals : list of str, optional
+            The signals of ``signals`` (default every signal of the result).
+        float32 : bool
+            Signals as float32, as ``output.float32: true`` writes them.
+
+        Returns
+        -------
+        xarray.Dataset
+            KeyError for a group the result has not.
+        """
+        from .io import root_attrs
+        from .layout import group_dataset, group_name, simulation_tables
+
+        groups = simulation_tables(self, signals, float32, only={"", group_name(group)})
+        return group_dataset(groups, group, {"": root_attrs(self.config)}, "this Result")
+
+    def to_dataframe(self, group: str = "signals", signals: Sequence[str] | None = None):
+        """:meth:`to_xarray` of ``group`` as a tidy pandas DataFrame
+        (:func:`!suspopt.layout.frame`).
+
+        Parameters
+        ----------
+        group : str
+            ``signals``: long, one row per (design, time [s]), a column per signal;
+            ``metrics``, ``designs`` (a column per parameter) and ``""`` (``diverged_at``):
+            one row per design; ``modal``: one row per (design, mode, dof).
+        signals : list of str, optional
+            The signals (default every signal of the result).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Each column's SI unit in ``df.attrs["units"]`` (column -> unit).
+        """
+        from .layout import frame
+
+        return frame(self.to_xarray(group, signals))
+
+    def plot(
+        self,
+        signals: Sequence[str] | None = None,
+        designs: Sequence[int] | None = None,
+        design_names: Sequence[str] | None = None,
+    ):
+        """The figure of ``suspopt simulate --plot`` (:func:`!suspopt.plots.result_figure`).
+
+        One row per signal: its time history [s] (left), a line per design, and its Welch
+        PSD (right); axes labelled ``name [unit]``, a legend naming the designs below; then
+        the ISO 2631-1 weighted r.m.s. of the accelerations a person feels (Annex C.2.3).
+
+        Parameters
+        ----------
+        signals : list of str, optional
+            Signal names (default the body's heave acceleration, each corner's travel and
+            tyre deflection, and the seat's and head's acceleration where there is a seat).
+        designs : list of int, optional
+            Design indices to draw (default every design, or 12 evenly spaced by index).
+        design_names : list of str, optional
+            One name per design of the result, in the legend instead of ``#i``.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            ``fig.savefig("run.png")`` writes it. ValueError for an unknown signal or a
+            design out of range.
+        """
+        from .plots import result_figure
+
+        return result_figure(self, signals, designs, design_names)
+
     def metric(self, spec, name: str) -> np.ndarray:
         """The (P,) values of metric spec ``spec`` on signal ``name`` (:mod:`!suspopt.specs`)."""
         from .specs import METRICS

@@ -10,7 +10,8 @@ import numpy as np
 
 from ..config import Config, ConfigError
 from ..files import Unreadable, status
-from ..io import text_array, write_dataset
+from ..io import write_dataset, write_tables
+from ..layout import Table
 from .problem import Problem
 
 #: Format of the ``/checkpoint`` group: every evaluated design and its objectives, in batches.
@@ -32,50 +33,71 @@ def _tables(problem: Problem, x_units):
     )
 
 
+def pareto_tables(problem: Problem, optimum) -> list[Table]:
+    """The tables of ``/pareto``: X, F, G of the optimum designs (physical variables, SI
+    units), F's and G's rule over the scenarios (``over_scenarios``) in a robust run."""
+    values = {"X": optimum.X, "F": optimum.F, "G": optimum.G}
+    rules = dict(zip("FG", problem.aggregation())) if problem.scenarios is not None else {}
+    return [
+        Table(
+            key,
+            values[key],
+            units,
+            ("design", dim),
+            names=names,
+            attrs={"over_scenarios": rules[key]} if key in rules else {},
+        )
+        for key, _, units, dim, names in _tables(problem, problem.var_units)
+    ]
+
+
 def write_pareto(h5, problem: Problem, optimum, weights) -> None:
-    """``/pareto/X, F, G`` of the optimum designs (physical variables, SI units)."""
+    """``/pareto`` (:func:`pareto_tables`), its ``weights`` and, in a robust run, its
+    ``scenarios`` (:func:`scenario_tables`)."""
     pareto = h5.create_group("pareto")
     if weights is not None:
         pareto.attrs["weights"] = weights
-    values = {"X": optimum.X, "F": optimum.F, "G": optimum.G}
-    for key, _, units, dim, names in _tables(problem, problem.var_units):
-        write_dataset(pareto, key, values[key], units, dims=("design", dim), names=names)
+    write_tables(pareto, pareto_tables(problem, optimum))
     if problem.scenarios is not None:
-        write_scenarios(pareto, problem, optimum.X)
+        write_tables(pareto.create_group("scenarios"), scenario_tables(problem, optimum.X))
+
+
+def baseline_tables(problem: Problem, baseline) -> list[Table]:
+    """``/baseline/X, F, G`` (one row each, as ``/pareto``'s): the config's own design
+    (:func:`suspopt.optimise.run.config_design`), evaluated as the run's designs are."""
+    values = {"X": baseline.X, "F": baseline.F, "G": baseline.G}
+    return [
+        Table(key, values[key], units, ("design", dim), names=names)
+        for key, _, units, dim, names in _tables(problem, problem.var_units)
+    ]
 
 
 def write_baseline(h5, problem: Problem, baseline) -> None:
-    """``/baseline/X, F, G`` (one row each, as ``/pareto``'s): the config's own design
-    (:func:`suspopt.optimise.run.config_design`), evaluated as the run's designs are."""
-    group = h5.create_group("baseline")
-    values = {"X": baseline.X, "F": baseline.F, "G": baseline.G}
-    for key, _, units, dim, names in _tables(problem, problem.var_units):
-        write_dataset(group, key, values[key], units, dims=("design", dim), names=names)
+    """``/baseline`` (:func:`baseline_tables`)."""
+    write_tables(h5.create_group("baseline"), baseline_tables(problem, baseline))
 
 
-def write_scenarios(pareto, problem: Problem, X) -> None:
+def scenario_tables(problem: Problem, X) -> list[Table]:
     """``/pareto/scenarios``: the objectives ``F (N, S, m)`` and constraint margins
     ``G (N, S, k)`` of the designs ``X`` (physical values) under each scenario, the scenarios'
     names (dimension ``scenario``) and ``weight (S,)``; ``/pareto/F`` and ``G`` hold their
     aggregates, each column's rule in the attribute ``over_scenarios``."""
     assert problem.scenarios is not None
-    group = pareto.create_group("scenarios")
     FS, GS = problem.scenario_values(X)
-    names = problem.scenarios.names
-    rules = problem.aggregation()
-    write_dataset(group, "scenario", names, "1", dims=("scenario",))
-    write_dataset(group, "weight", problem.scenarios.weights, "1", dims=("scenario",))
-    for (key, _, units, dim, columns), data, rule in zip(
-        _tables(problem, problem.var_units)[1:], (FS, GS), rules
+    tables = [
+        Table("scenario", problem.scenarios.names, "1", ("scenario",)),
+        Table("weight", problem.scenarios.weights, "1", ("scenario",)),
+    ]
+    for (key, _, units, dim, columns), data in zip(
+        _tables(problem, problem.var_units)[1:], (FS, GS)
     ):
-        write_dataset(group, key, data, units, dims=("design", "scenario", dim), names=columns)
-        pareto[key].attrs["over_scenarios"] = text_array(rule)
+        tables.append(Table(key, data, units, ("design", "scenario", dim), names=columns))
+    return tables
 
 
-def write_history(h5, history: dict, best_names, best_units) -> None:
+def history_tables(history: dict, best_names, best_units) -> list[Table]:
     """``/history``: per generation the best objectives (or weighted sum), the hypervolume,
     the evaluations, the time [s] and the feasible share."""
-    hist = h5.create_group("history")
     units = {
         "generation": "1",
         "hypervolume": "1",
@@ -83,14 +105,20 @@ def write_history(h5, history: dict, best_names, best_units) -> None:
         "time": "s",
         "feasible": "1",
     }
-    write_dataset(hist, "generation", history["generation"], "1", dims=("generation",))
+    tables = [Table("generation", history["generation"], "1", ("generation",))]
     for key, values in history.items():
         if key == "best":
             best = np.reshape(values, (len(values), len(best_names)))  # (zero generations too)
             dims = ("generation", "objective")
-            write_dataset(hist, key, best, best_units, dims=dims, names=best_names)
+            tables.append(Table(key, best, best_units, dims, names=best_names))
         elif key != "generation":
-            write_dataset(hist, key, values, units[key], dims=("generation",))
+            tables.append(Table(key, values, units[key], ("generation",)))
+    return tables
+
+
+def write_history(h5, history: dict, best_names, best_units) -> None:
+    """``/history`` (:func:`history_tables`)."""
+    write_tables(h5.create_group("history"), history_tables(history, best_names, best_units))
 
 
 def write_checkpoint(h5, problem: Problem, batches: list, generations: int) -> None:

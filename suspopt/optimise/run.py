@@ -72,6 +72,7 @@ from .output import (
     write_pareto,
 )
 from .problem import PENALTY, Problem
+from .result import OptimisationResult
 
 __all__ = ["optimise", "build_optimiser", "Progress", "OptimisationResult"]
 
@@ -100,27 +101,6 @@ class Progress:
     elapsed: float  # [s], including time before a resume
     time_left: float | None  # [s], from the budget; None without one
     phase: str  # the algorithm running now
-
-
-@dataclass
-class OptimisationResult:
-    """The optimum (or Pareto set) of a run: ``X`` physical values (N, n), ``F (N, m)``,
-    ``G (N, k)``, their names and units; ``history`` as written to ``/history``; ``status``
-    finished or interrupted."""
-
-    X: np.ndarray
-    F: np.ndarray
-    G: np.ndarray
-    var_names: list[str]
-    var_units: list[str]
-    obj_names: list[str]
-    obj_units: list[str]
-    constraint_names: list[str]
-    history: dict[str, np.ndarray]
-    status: str
-    path: Path
-    weights: np.ndarray | None = None
-    baseline: algorithms.Solutions | None = None
 
 
 class _Recorder(_PymooProblem):
@@ -561,6 +541,7 @@ def _write(
         write_checkpoint(h5, problem, run_batches[: snap.batches], snap.generation)
         if baseline is not None:
             write_baseline(h5, problem, baseline)
+        attrs = {k: h5.attrs[k] for k in h5.attrs}
     o = snap.optimum
     return OptimisationResult(
         status=status,
@@ -576,4 +557,6 @@ def _write(
         constraint_names=problem.constraint_names,
         history=snap.history,
         baseline=baseline,
+        problem=problem,
+        attrs=attrs,
     )

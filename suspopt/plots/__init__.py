@@ -28,9 +28,11 @@ Figures of the thesis they correspond to:
   :class:`suspopt.selection.Selection`;
 - :func:`plot_simulation`: a :class:`suspopt.simulate.Result`'s signals over time, their
   Welch PSD and the ISO 2631-1 weighted r.m.s. of its accelerations against the comfort
-  reactions (Annex C.2.3), one or several designs (``suspopt simulate --plot``);
+  reactions (Annex C.2.3), one or several designs (``suspopt simulate --plot``; the figure
+  :func:`result_figure`, which ``Result.plot()`` returns);
 - :func:`plot_optimisation`: an :class:`suspopt.optimise.OptimisationResult`'s front (or
-  best value) and its history per generation (``suspopt optimise --plot``).
+  best value) and its history per generation (``suspopt optimise --plot``; the figure
+  :func:`optimisation_result_figure`, which ``OptimisationResult.plot()`` returns).
 """
 
 from __future__ import annotations
@@ -58,8 +60,10 @@ from .runs import (
     default_signals,
     design_labels,
     optimisation_figure,
+    optimisation_result_figure,
     plot_optimisation,
     plot_simulation,
+    result_figure,
     simulation_figure,
 )
 from .style import (
@@ -98,9 +102,11 @@ __all__ = [
     "plot_kesort",
     "simulation_figure",
     "plot_simulation",
+    "result_figure",
     "default_signals",
     "optimisation_figure",
     "plot_optimisation",
+    "optimisation_result_figure",
     "chosen_designs",
     "design_labels",
 ]

@@ -259,20 +259,32 @@ def plot_simulation(
     designs: Sequence[int] | None = None,
     design_names: Sequence[str] | None = None,
 ) -> Path:
-    """Draw a :class:`suspopt.simulate.Result` (:func:`simulation_figure`) to ``path`` (.png
-    or .svg): ``signals`` (default :func:`default_signals`) of the ``designs`` (indices;
+    """Draw :func:`result_figure` of a :class:`suspopt.simulate.Result` to ``path`` (.png or
+    .svg; ``suspopt simulate --plot``)."""
+    path = check_path(path)
+    return save(result_figure(result, signals, designs, design_names), path)
+
+
+def result_figure(
+    result,
+    signals: Sequence[str] | None = None,
+    designs: Sequence[int] | None = None,
+    design_names: Sequence[str] | None = None,
+):
+    """The figure of a :class:`suspopt.simulate.Result` (:func:`simulation_figure`),
+    unsaved: ``signals`` (default :func:`default_signals`) of the ``designs`` (indices;
     default every design, or :data:`MAX_DESIGNS` of them evenly spaced by index when there
     are more, which the title says). ``design_names`` (one per design of the result, e.g. the
     picks they came from) name the designs in the legend instead of ``#i``. ValueError for
     an unknown signal, a design out of range, more than :data:`MAX_DESIGNS` designs, design
-    names that are not one text per design, or no matplotlib."""
+    names that are not one text per design, or no matplotlib. :meth:`suspopt.Result.plot`
+    and ``suspopt simulate --plot`` (:func:`plot_simulation`) draw it."""
     import difflib
 
     from ..errors import require
     from ..result import Result
 
     require(result, Result, "result", "from suspopt.simulate(cfg)")
-    path = check_path(path)
     names = listed(signals) if signals is not None else default_signals(result)  # (one name: str)
     for name in names:
         if name not in result.signals:
@@ -299,7 +311,7 @@ def plot_simulation(
     fig = simulation_figure(
         result.time, data, {n: result.signal_unit(n) for n in names}, labels, title
     )
-    return save(fig, path)
+    return fig
 
 
 def optimisation_figure(
@@ -310,11 +322,13 @@ def optimisation_figure(
     history: Mapping[str, np.ndarray],
     title: str = "",
     weights: np.ndarray | None = None,
+    marks: Mapping[str, int] | None = None,
 ):
     """The figure of :func:`plot_optimisation` from arrays, unsaved: the optimum ``F (N,
     m)`` with constraints ``G (N, k)`` (G <= 0 feasible) over objectives ``names`` and
     ``units``, and the ``history`` of ``/history`` (generation, best, hypervolume,
-    feasible, ...).
+    feasible, ...); ``marks`` (name -> row of F) starred on each pair's panel, the names
+    of one design in one label.
 
     Two objectives or more: the front as every pair of objectives (one panel for two, a
     panel per pair for more; feasible designs filled, infeasible ones hollow), then the
@@ -347,6 +361,9 @@ def optimisation_figure(
         draw_history(axes[0], generation, best, f"best {name}", unit, summary)
     else:
         pairs = [(i, j) for i in range(m) for j in range(i + 1, m)]
+        by_row: dict[int, list[str]] = {}  # (one label per design: "best_f1, knee")
+        for name, k in (marks or {}).items():
+            by_row.setdefault(int(k), []).append(name)
         fig, axes = new_figure(len(pairs) + 2, columns=3, panel_size=(4.2, 3.4))
         other = ~feasible & ~failed
         for ax, (i, j) in zip(axes, pairs):
@@ -358,6 +375,7 @@ def optimisation_figure(
                 fronts,
                 axis_label(names[i], units[i]),
                 axis_label(names[j], units[j]),
+                {", ".join(named): (F[k, i], F[k, j]) for k, named in by_row.items()},
                 legend=False,
             )
             ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
@@ -375,13 +393,27 @@ def optimisation_figure(
 
 
 def plot_optimisation(result, path: str | Path) -> Path:
-    """Draw a :class:`suspopt.optimise.OptimisationResult` (:func:`optimisation_figure`) to
-    ``path`` (.png or .svg): the front or the best value, and the history per generation."""
+    """Draw :func:`optimisation_result_figure` of a
+    :class:`suspopt.optimise.OptimisationResult` to ``path`` (.png or .svg; ``suspopt
+    optimise --plot``)."""
+    path = check_path(path)
+    return save(optimisation_result_figure(result), path)
+
+
+def optimisation_result_figure(result, picks: Mapping[str, int] | None = None):
+    """The figure of a :class:`suspopt.optimise.OptimisationResult`
+    (:func:`optimisation_figure`), unsaved: the front or the best value, and the history per
+    generation; ``picks`` (name -> row of the front, e.g. :func:`suspopt.pareto_picks`)
+    starred and named on the front. :meth:`suspopt.optimise.OptimisationResult.plot` and
+    ``suspopt optimise --plot`` (:func:`plot_optimisation`) draw it."""
     from ..errors import require
     from ..optimise.run import OptimisationResult
 
     require(result, OptimisationResult, "result", "from suspopt.optimise.optimise(cfg, path)")
-    path = check_path(path)
+    N = len(np.atleast_2d(result.F))
+    for name, row in (picks or {}).items():
+        if isinstance(row, bool) or not isinstance(row, (int, np.integer)) or not 0 <= row < N:
+            raise ValueError(f"picks: {name!r}: {row!r} is not a row of the front (0 to {N - 1})")
     history = result.history
     generations = len(np.atleast_1d(history["generation"]))
     evaluations = int(history["evaluations"][-1]) if generations else 0
@@ -396,6 +428,13 @@ def plot_optimisation(result, path: str | Path) -> Path:
         f"generation{'s' if generations != 1 else ''}, {evaluations} evaluations"
     )
     fig = optimisation_figure(
-        result.F, result.G, result.obj_names, result.obj_units, history, title, result.weights
+        result.F,
+        result.G,
+        result.obj_names,
+        result.obj_units,
+        history,
+        title,
+        result.weights,
+        picks,
     )
-    return save(fig, path)
+    return fig
