@@ -193,6 +193,12 @@ def _extras(h5, table) -> dict[str, Any]:
             best = h5.array("history/best", ndim=2)
             history["best"] = _list(best.T)
             history["best_names"] = h5.labels("history/best", "names", best.shape[1])
+            units = h5.attribute(h5._node("history/best"), "units", "/history/best: units")
+            history["best_units"] = (
+                h5.labels("history/best", "units", best.shape[1])
+                if units is not None
+                else [""] * best.shape[1]
+            )
         out["history"] = history
     if group == "pareto" and h5._node("builds/feasible_share") is not None:
         out["builds"] = _builds(h5, N, table.X.shape[1], table.F.shape[1])
@@ -253,12 +259,16 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
 def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, Any]:
     """Time histories and spectra of the designs ``rows``, simulated in one batch per config
     of the table (each design with its own config)."""
-    from ..metrics.spectral import psd
+    from ..metrics.spectral import record_psd
     from ..picks import read_picks
+    from ..plots.style import PSD_BAND, spectrum_limits
     from ..plots.runs import default_signals
     from ..simulate import simulate
+    from ..specs import METRICS
 
-    out: dict[str, Any] = {"rows": [], "time": [], "signals": {}, "units": {}, "psd": {}}
+    out: dict[str, Any] = {
+        "rows": [], "time": [], "signals": {}, "units": {}, "psd": {}, "psd_units": {}, "psd_range": {}
+    }  # fmt: skip
     by_config: dict[int, list[int]] = {}
     for row in rows:
         by_config.setdefault(int(table.config_of[row]), []).append(row)
@@ -284,6 +294,7 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
         )
     out["time"] = _list(time[::step])
     fs = 1.0 / float(time[1] - time[0])
+    spectra: dict[str, list[np.ndarray]] = {}
     for group_rows, result in results:
         for i, row in enumerate(group_rows):
             out["rows"].append(row)
@@ -293,10 +304,16 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
                 y = np.asarray(result.signals[name][i], dtype=float)
                 out["signals"].setdefault(name, []).append(_list(y[::step]))
                 out["units"][name] = result.signal_unit(name)
-                f, p = psd(y, fs)
-                keep = max(1, -(-len(f) // MAX_SAMPLES))
-                out["psd"].setdefault(name, []).append(_list(p[::keep]))
-                out["psd_f"] = _list(f[::keep])
+                out["psd_units"][name] = METRICS["var"].unit(out["units"][name]) + "/Hz"
+                with np.errstate(invalid="ignore"):
+                    f, p = record_psd(y, fs)
+                band = (f >= PSD_BAND[0]) & (f <= PSD_BAND[1])
+                spectra.setdefault(name, []).append(p[band])
+                out["psd_f"] = _list(f[band])
+    for name, curves in spectra.items():
+        out["psd"][name] = [_list(p) for p in curves]
+        limits = spectrum_limits(np.array(curves))
+        out["psd_range"][name] = None if limits is None else list(limits)
     return out
 
 
