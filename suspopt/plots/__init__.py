@@ -35,6 +35,7 @@ Figures of the thesis they correspond to:
 
 from __future__ import annotations
 
+from ..metrics.spectral import PSD_SEGMENT
 from .figures import (
     model_comparison,
     model_figure,
@@ -65,7 +66,6 @@ from .runs import (
 from .style import (
     FORMATS,
     MAX_DESIGNS,
-    PSD_SEGMENT,
     check_path,
     curve_styles,
     mark_indices,

@@ -9,8 +9,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..metrics.spectral import PSD_SEGMENT
-
 #: Figure formats, by file suffix.
 FORMATS = {".png": "png", ".svg": "svg"}
 #: Line styles cycled with the colours (solid first, then dashes of distinct rhythms).

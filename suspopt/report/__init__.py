@@ -261,8 +261,8 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
     of the table (each design with its own config)."""
     from ..metrics.spectral import record_psd
     from ..picks import read_picks
-    from ..plots.style import PSD_BAND, spectrum_limits
     from ..plots.runs import default_signals
+    from ..plots.style import PSD_BAND, spectrum_limits
     from ..simulate import simulate
     from ..specs import METRICS
 

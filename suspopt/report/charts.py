@@ -25,11 +25,10 @@ SAME = 1e-12
 #: Fewest pixels between two label boxes.
 LABEL_GAP_PX = 2
 
-SCRIPT = (
-    r"""
+SCRIPT = r"""
 (function () {
   "use strict";
-  const SAME = %(same)r, GAP = %(gap)d;
+  const SAME = __SAME__, GAP = __GAP__;
 
   function peak(c) { return c.reduce((m, v) => (v === null ? m : Math.max(m, Math.abs(v))), 0); }
   function same(a, b) {
@@ -151,6 +150,4 @@ SCRIPT = (
 
   window.suspoptCharts = { distinct: distinct, lines: lines, history: history, placeLabels: placeLabels };
 })();
-"""
-    % {"same": SAME, "gap": LABEL_GAP_PX}
-)
+""".replace("__SAME__", repr(SAME)).replace("__GAP__", str(LABEL_GAP_PX))
