@@ -164,7 +164,8 @@ def test_the_transmissibility_legend_has_one_entry_per_distinct_curve(page, show
 
 
 def test_the_time_histories_merge_only_identical_curves(page, shown):
-    """The time histories of the picks: one line per distinct history over the whole run."""
+    """The time histories of the picks: one line per distinct history over the whole run,
+    thinned with the highest and lowest values kept."""
     signals = _payload(page)["studies"][1]["data"]["signals"]
     _select_signal(shown, "seat.acc")
     names, x_range = shown.execute_script(
@@ -174,6 +175,14 @@ def test_the_time_histories_merge_only_identical_curves(page, shown):
     groups = _groups(signals["signals"]["seat.acc"])
     assert names == [", ".join(f"row {signals['rows'][k]}" for k in g) for g in groups]
     assert x_range[0] <= signals["time"][0] and x_range[1] >= signals["time"][-1]
+    import suspopt
+    from suspopt.picks import read_picks
+
+    picked = read_picks(page.with_name("picks.h5"), [str(signals["rows"][0])])
+    y = suspopt.simulate(picked.config, picked.params()).signals["seat.acc"][0]
+    drawn = np.array(signals["signals"]["seat.acc"][0], dtype=float)
+    assert len(drawn) == len(signals["time"]) < len(y)  # (thinned, its peaks kept)
+    assert [drawn.min(), drawn.max()] == pytest.approx([y.min(), y.max()], rel=1e-12)
 
 
 def _labels(driver, i: int) -> list:

@@ -21,8 +21,11 @@ browser and makes no network request. Per study:
   commands that take it on (the file's path as given, quoted for a POSIX shell);
 - the picks' (and ``with_signals`` rows') time histories and power spectral densities
   [unit²/Hz], simulated when the report is built (from each design's own config, in one
-  batch per config), thinned to at most :data:`MAX_SAMPLES` samples per signal (the page
-  says when); where there is a seat, their transmissibility from the floor to the seat and
+  batch per config), each history thinned to at most about :data:`MAX_SAMPLES` samples with
+  its peaks kept (:func:`_envelope`; the page says when), each spectrum the one the
+  ``--plot`` figure draws (:func:`suspopt.metrics.spectral.record_psd`, 0.1-30 Hz, its
+  axis at most :data:`suspopt.plots.style.PSD_DECADES` decades deep); curves the same to
+  1e-12 drawn as one (:mod:`.charts`); where there is a seat, their transmissibility from the floor to the seat and
   to the head (STHT, Eq 2.86) of the seat linearised about its static equilibrium;
 - pseudo-fronts (``analyse roads|masses|controllers|tolerances``): each changed front over the stored
   one, with a line from each design to its moved point;
@@ -289,10 +292,12 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
     step = max(1, -(-len(time) // MAX_SAMPLES))
     if step > 1:
         notes.append(
-            f"time histories thinned for size: one sample in {step} of {len(time)} shown "
-            f"(the spectra are computed from all of them)"
+            f"time histories thinned for size: of each {2 * step} of the {len(time)} samples, "
+            f"the lowest and the highest shown, in their order, each within {step} samples "
+            f"of its time (the spectra are computed from all of them)"
         )
-    out["time"] = _list(time[::step])
+    shown = np.minimum(np.arange(2 * -(-len(time) // (2 * step))) * step, len(time) - 1)
+    out["time"] = _list(time[shown] if step > 1 else time)
     fs = 1.0 / float(time[1] - time[0])
     spectra: dict[str, list[np.ndarray]] = {}
     for group_rows, result in results:
@@ -302,7 +307,7 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
                 if name not in result.signals:
                     continue
                 y = np.asarray(result.signals[name][i], dtype=float)
-                out["signals"].setdefault(name, []).append(_list(y[::step]))
+                out["signals"].setdefault(name, []).append(_list(_envelope(y, step)))
                 out["units"][name] = result.signal_unit(name)
                 out["psd_units"][name] = METRICS["var"].unit(out["units"][name]) + "/Hz"
                 with np.errstate(invalid="ignore"):
@@ -315,6 +320,22 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
         limits = spectrum_limits(np.array(curves))
         out["psd_range"][name] = None if limits is None else list(limits)
     return out
+
+
+def _envelope(y: np.ndarray, step: int) -> np.ndarray:
+    """``y (T,)`` thinned by ``step`` with its peaks kept: of each ``2 step`` samples (the
+    last padded with its last value), the lowest and the highest, in the order they come
+    (``2 ceil(T / 2 step)`` values, drawn at every ``step``-th time); NaN (a diverged
+    design's samples) only where a whole group is NaN. ``step`` 1: ``y`` itself."""
+    if step <= 1:
+        return y
+    groups = -(-y.size // (2 * step))
+    padded = np.concatenate([y, np.full(groups * 2 * step - y.size, y[-1])]).reshape(groups, -1)
+    low = np.argmin(np.where(np.isnan(padded), np.inf, padded), axis=1)
+    high = np.argmax(np.where(np.isnan(padded), -np.inf, padded), axis=1)
+    rows = np.arange(groups)[:, None]
+    pair = np.sort(np.stack([low, high], axis=1), axis=1)
+    return padded[rows, pair].ravel()
 
 
 def _transmissibility(picked, rows: list[int], out: dict) -> None:

@@ -64,8 +64,9 @@ SCRIPT = r"""
                      showlegend: false, height: height, margin: { t: 20, b: 50, l: 80, r: 20 } };
     const traces = panels.map(([y, name, unit], k) => {
       const id = k ? String(k + 1) : "";
-      layout["xaxis" + id] = { title: { text: "generation [1]" }, dtick: step, tick0: 0 };
-      layout["yaxis" + id] = Object.assign({ title: axisTitle(name, unit), exponentformat: "power" },
+      layout["xaxis" + id] = { title: { text: "generation [1]" }, dtick: step, tick0: 0, automargin: true };
+      layout["yaxis" + id] = Object.assign({ title: Object.assign(axisTitle(name, unit), { standoff: 8 }),
+                                             exponentformat: "power", automargin: true },
                                            name === "feasible share" ? { range: [-0.05, 1.05] } : {});
       return { type: "scatter", mode: "lines+markers", name: name, x: h.generation, y: y,
                xaxis: "x" + id, yaxis: "y" + id };

@@ -156,8 +156,9 @@ SCRIPT = r"""
 
   // the colour of the designs (the front's markers and the parallel coordinates' lines)
   function colouring(study, c) {
+    const named = /^[FX]:/.test(c) ? label(study, c) : (colours(study).find(o => o[0] === c) || [c, c])[1];
     const out = { color: colourValues(study, c), colorscale: "Viridis",
-                  colorbar: { title: { text: (colours(study).find(o => o[0] === c) || [c, c])[1] } } };
+                  colorbar: { title: { text: named }, exponentformat: "power" } };
     if (c === "feasible") Object.assign(out, { colorscale: [[0, "#d62728"], [1, "#1f77b4"]], cmin: 0, cmax: 1,
       colorbar: { title: { text: "feasible" }, tickvals: [0, 1], ticktext: ["no", "yes"] } });
     return out;
@@ -251,7 +252,8 @@ SCRIPT = r"""
                                       yaxis: { title: { text: label(study, "F:1") } },
                                       zaxis: { title: { text: label(study, "F:2") } } },
                              margin: { t: 20 }, legend: { orientation: "h", y: -0.05 } }
-                         : { xaxis: { title: { text: label(study, x) } }, yaxis: { title: { text: label(study, y) } },
+                         : { xaxis: { title: { text: label(study, x) }, exponentformat: "power" },
+                             yaxis: { title: { text: label(study, y) }, exponentformat: "power" },
                              margin: { t: 20 }, legend: { orientation: "h", y: -0.18 } };
     const div = document.getElementById("front-" + i);
     return Plotly.react(div, traces, layout, { displaylogo: false })
@@ -358,7 +360,7 @@ SCRIPT = r"""
     const f = [s.psd_f[0], s.psd_f[s.psd_f.length - 1]].map(Math.log10);
     return Promise.all([
       Plotly.react("signal-" + i, traces, { xaxis: { title: { text: "time [s]" } },
-        yaxis: { title: { text: pick + " [" + unit + "]" } }, margin: { t: 20 }, legend: below },
+        yaxis: { title: { text: pick + " [" + unit + "]" }, exponentformat: "power" }, margin: { t: 20 }, legend: below },
         { displaylogo: false }),
       Plotly.react("psd-" + i, spectra, { xaxis: { title: { text: "frequency [Hz]" }, type: "log", range: f },
         yaxis: Object.assign({ title: { text: "PSD of " + pick + " [" + s.psd_units[pick] + "]" }, type: "log",
