@@ -9,8 +9,10 @@ browser and makes no network request. Per study:
 
 - the front as a scatter of any two columns (objectives or design variables) chosen from
   drop-downs, in 3D for three objectives; colour by feasibility, k-ε level (kesort), case,
-  or any objective or variable; the picks (edges, knee, the k-ε optimum) marked, and the
-  config's own design (``/baseline`` of an optimise file) where the file has it;
+  or any objective or variable (the colour bar titled with its unit); the picks (edges,
+  knee, the k-ε optimum) marked, and the config's own design (``/baseline`` of an optimise
+  file) where the file has it, each marked point with one label naming its picks, placed
+  where it overlaps no other label (:mod:`.charts`);
 - a parallel-coordinates view of the objectives and variables, coloured as the front, each
   variable's axis spanning its search range (:func:`_search_bounds`);
   brushing ranges along its axes selects the designs inside all of them in the front,
@@ -29,7 +31,8 @@ browser and makes no network request. Per study:
   to the head (STHT, Eq 2.86) of the seat linearised about its static equilibrium;
 - pseudo-fronts (``analyse roads|masses|controllers|tolerances``): each changed front over the stored
   one, with a line from each design to its moved point;
-- the history per generation (best value, hypervolume, feasible share) and the run's
+- the history per generation, one panel per series on its own titled axis (best value of
+  each objective, hypervolume, feasible share: :mod:`.charts`), and the run's
   provenance (config, seeds, version, command) in a collapsible section.
 
 Nothing read from a file runs as code: the data go into the page as JSON (``<`` escaped) and
@@ -55,7 +58,8 @@ from ..files import listed
 
 __all__ = ["build_report", "collect", "Study", "MAX_SAMPLES", "MAX_BYTES"]
 
-#: The most samples a time history or spectrum keeps in the page (others are thinned).
+#: The most samples a time history keeps in the page (longer ones are thinned, their peaks
+#: kept: :func:`_envelope`; a spectrum keeps the points of its band, 240 at most).
 MAX_SAMPLES = 1000
 #: The page may not grow beyond this [bytes] (a 1000-design front with 5 picks' signals
 #: stays far below it).
