@@ -229,3 +229,12 @@ def test_pick_labels_do_not_overlap_and_name_every_pick(page, shown):
             for b in boxes[k + 1 :]:
                 assert not _overlap(a, b), labels
         assert any(", " in text for text, _ in labels)  # (picks that share a design: one label)
+        marks = shown.execute_script(  # (one marker per point, its hover naming its picks)
+            "const t = document.getElementById('front-1').data.find(t => t.name === 'picks');"
+            " return t.x.map((x, k) => [x, t.y[k], t.text[k]])"
+        )
+        assert sorted(marks) == sorted(
+            [a["x"], a["y"], a["text"]] for a in shown.execute_script(
+                "return document.getElementById('front-1').layout.annotations"
+            )
+        )  # fmt: skip

@@ -230,10 +230,11 @@ SCRIPT = r"""
         text: hover, hoverinfo: "text", marker: marker, selectedpoints: chosen,
         unselected: { marker: { opacity: 0.15 } } });
       const names = Object.keys(d.picks), pr = names.map(n => d.picks[n]);
-      traces.push({ type: "scatter", mode: "markers", name: "picks", x: pr.map(r => column(study, x)[r]),
-        y: pr.map(r => column(study, y)[r]), text: names, customdata: pr,
+      const marked = pickLabels(pr.map(r => column(study, x)[r]), pr.map(r => column(study, y)[r]), names, pr);
+      traces.push({ type: "scatter", mode: "markers", name: "picks", x: marked.map(l => l.x),
+        y: marked.map(l => l.y), text: marked.map(l => l.text), customdata: marked.map(l => l.row),
         hoverinfo: "text", marker: { symbol: "x", size: 12, color: "#d62728" } });
-      labels.push(...pickLabels(traces[traces.length - 1]));
+      labels.push(...marked);
       if (d.baseline) {
         traces.push(baselineTrace(d, x, y));
         labels.push({ x: traces[traces.length - 1].x[0], y: traces[traces.length - 1].y[0], text: "config" });
@@ -259,13 +260,13 @@ SCRIPT = r"""
     return Plotly.react(div, traces, layout, { displaylogo: false })
       .then(() => (use3d ? div : charts.placeLabels(div, labels)));
   }
-  function pickLabels(trace) {  // one label per point of the picks: the names of the picks there
+  function pickLabels(xs, ys, names, rows) {  // one per point of the picks, naming the picks there
     const at = new Map();
-    trace.x.forEach((x, k) => {
-      const y = trace.y[k], key = x + " " + y;
+    xs.forEach((x, k) => {
+      const y = ys[k], key = x + " " + y;
       if (x === null || y === null) return;
-      if (!at.has(key)) at.set(key, { x: x, y: y, names: [], color: "#d62728" });
-      at.get(key).names.push(trace.text[k]);
+      if (!at.has(key)) at.set(key, { x: x, y: y, names: [], row: rows[k], color: "#d62728" });
+      at.get(key).names.push(names[k]);
     });
     return [...at.values()].map(l => Object.assign(l, { text: l.names.join(", ") }));
   }
