@@ -78,6 +78,17 @@ def test_every_history_series_is_on_an_axis_that_shows_it(page, shown):
         if name != "feasible share":  # (a share keeps its 0-1 axis)
             assert np.ptp(values) >= 0.5 * (high - low), name
         assert x_title == "generation [1]" and x_range[0] < 1 and x_range[1] > 5
+    shown.execute_script(  # a best value that did not change: its axis about it, not about 0
+        "const div = document.createElement('div'); div.id = 'flat'; document.body.appendChild(div);"
+        " window.suspoptCharts.history(div, {generation: [1, 2, 3], best: [[null, 0.007, 0.007]],"
+        " best_names: ['X_ST'], best_units: ['m'], feasible: [0, 1, 1]})"
+        ".then(() => div.setAttribute('data-done', '1'))"
+    )
+    _wait(shown, "return document.getElementById('flat').hasAttribute('data-done')", "drawn")
+    low, high = shown.execute_script(
+        "return document.getElementById('flat')._fullLayout.yaxis.range"
+    )
+    assert 0.0065 <= low < 0.007 < high <= 0.0075
 
 
 def _select_signal(driver, name: str) -> None:

@@ -52,6 +52,14 @@ SCRIPT = r"""
   }
 
   function axisTitle(name, unit) { return { text: unit ? name + " [" + unit + "]" : name }; }
+  // a series of one value, about it (plotly's own range of one value may span [v - 1, v + 1],
+  // where 0.007 lies flat at 0)
+  function flat(y) {
+    const v = y.filter(x => x !== null);
+    if (!v.length || v.some(x => x !== v[0])) return {};
+    const pad = Math.abs(v[0]) * 0.05 || 1;
+    return { range: [v[0] - pad, v[0] + pad] };
+  }
   function history(div, h) {
     const panels = (h.best || []).map((b, j) => [b, "best " + h.best_names[j], (h.best_units || [])[j]]);
     if (h.hypervolume && h.hypervolume.some(v => v !== null))
@@ -67,7 +75,7 @@ SCRIPT = r"""
       layout["xaxis" + id] = { title: { text: "generation [1]" }, dtick: step, tick0: 0, automargin: true };
       layout["yaxis" + id] = Object.assign({ title: Object.assign(axisTitle(name, unit), { standoff: 8 }),
                                              exponentformat: "power", automargin: true },
-                                           name === "feasible share" ? { range: [-0.05, 1.05] } : {});
+                                           name === "feasible share" ? { range: [-0.05, 1.05] } : flat(y));
       return { type: "scatter", mode: "lines+markers", name: name, x: h.generation, y: y,
                xaxis: "x" + id, yaxis: "y" + id };
     });
