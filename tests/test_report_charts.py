@@ -176,7 +176,8 @@ def test_the_transmissibility_legend_has_one_entry_per_distinct_curve(page, show
 
 def test_the_time_histories_merge_only_identical_curves(page, shown):
     """The time histories of the picks: one line per distinct history over the whole run,
-    thinned with the highest and lowest values kept."""
+    thinned with the highest and lowest values kept; the spectrum record_psd's of the whole
+    history."""
     signals = _payload(page)["studies"][1]["data"]["signals"]
     _select_signal(shown, "seat.acc")
     names, x_range = shown.execute_script(
@@ -194,6 +195,9 @@ def test_the_time_histories_merge_only_identical_curves(page, shown):
     drawn = np.array(signals["signals"]["seat.acc"][0], dtype=float)
     assert len(drawn) == len(signals["time"]) < len(y)  # (thinned, its peaks kept)
     assert [drawn.min(), drawn.max()] == pytest.approx([y.min(), y.max()], rel=1e-12)
+    f, p = record_psd(y, picked.config.simulation.output_rate)  # (the spectrum: --plot's)
+    band = (f >= PSD_BAND[0]) & (f <= PSD_BAND[1])
+    assert signals["psd"]["seat.acc"][0] == pytest.approx(p[band].tolist(), rel=1e-9)
 
 
 def _labels(driver, i: int) -> list:
