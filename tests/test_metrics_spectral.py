@@ -62,3 +62,17 @@ def test_default_segment_scales_with_the_record():
     f_long, _ = psd(NOISE[0], FS)
     assert f_short[1] == pytest.approx(FS / 500)  # T/8 = 500 samples
     assert f_long[1] == pytest.approx(FS / 2**13)
+
+
+def test_record_psd_resolves_one_over_its_segment_or_the_record():
+    """Segments of PSD_SEGMENT seconds (spacing 1/8 Hz), or the whole of a shorter record
+    (a 3 s record: 1/3 Hz, where psd's default eighth gives 2.67 Hz)."""
+    from suspopt.metrics.spectral import PSD_SEGMENT, record_psd
+
+    fs = 1000.0
+    for duration, spacing in ((3.0, 1 / 3.0), (20.0, 1 / PSD_SEGMENT)):
+        x = np.random.default_rng(0).standard_normal(int(duration * fs))
+        f, p = record_psd(x, fs)
+        assert np.diff(f) == pytest.approx(spacing, rel=1e-3)
+        np.testing.assert_array_equal(p, psd(x, fs, min(x.size, round(PSD_SEGMENT * fs)))[1])
+    assert np.diff(psd(np.zeros(3000), fs)[0])[0] == pytest.approx(8 / 3.0)

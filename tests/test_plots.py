@@ -498,3 +498,36 @@ def test_an_unwritable_home_gives_matplotlib_a_private_folder(tmp_path, monkeypa
     else:
         assert os.environ["MPLCONFIGDIR"] == str(private)
         assert private.is_dir() and private.stat().st_mode & 0o777 == 0o700
+
+
+def test_the_psd_panel_has_the_record_psd_points_and_no_noise_floor():
+    """The simulation figure's PSD is :func:`record_psd`'s (segments of PSD_SEGMENT or the
+    record: 1/3 Hz for 3 s), within the band, and its value axis stops PSD_DECADES decades
+    below the highest value, however far the computed values fall."""
+    from suspopt.metrics.spectral import PSD_SEGMENT, record_psd
+    from suspopt.plots.style import PSD_BAND, PSD_DECADES
+
+    t = np.arange(0, 3.0, 0.001)
+    y = np.exp(-(((t - 1.5) / 0.1) ** 2))  # (a smooth pulse: its PSD falls to numerical noise)
+    fig = plots.simulation_figure(
+        t, {"body.heave_acc": y[None]}, {"body.heave_acc": "m/s^2"}, ["a"]
+    )
+    (line,) = fig.axes[1].get_lines()
+    f, p = record_psd(y, 1000.0)
+    band = (f >= PSD_BAND[0]) & (f <= PSD_BAND[1])
+    np.testing.assert_array_equal(line.get_xdata(), f[band])
+    assert np.diff(line.get_xdata()) == pytest.approx(1.0 / min(PSD_SEGMENT, 3.0))
+    low, high = fig.axes[1].get_ylim()
+    assert p[band].min() < low  # (the computed noise is off the axis)
+    assert np.log10(high / low) == pytest.approx(PSD_DECADES + 0.2)
+    assert high > p[band].max()
+
+
+def test_spectrum_limits_span_the_values_or_the_decades_below_the_highest():
+    from suspopt.plots.style import spectrum_limits
+
+    low, high = spectrum_limits(np.array([1e-3, 1e-2, 1.0, np.nan, 0.0]))
+    assert low == pytest.approx(1e-3 / 10**0.1) and high == pytest.approx(10**0.1)
+    low, _ = spectrum_limits(np.array([1e-16, 2.0]), decades=3)
+    assert low == pytest.approx(2e-3 / 10**0.1)
+    assert spectrum_limits(np.array([0.0, np.nan, -1.0])) is None

@@ -38,7 +38,7 @@ _MODULES = {
         "transient_metrics",
     ),
     "spectral": (
-        "psd", "transfer_function", "coherence", "transmissibility"
+        "psd", "record_psd", "PSD_SEGMENT", "transfer_function", "coherence", "transmissibility"
     ),
     "springs": (
         "nonlinear_spring_usage",

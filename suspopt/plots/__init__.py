@@ -37,6 +37,7 @@ Figures of the thesis they correspond to:
 
 from __future__ import annotations
 
+from ..metrics.spectral import PSD_SEGMENT
 from .figures import (
     model_comparison,
     model_figure,
@@ -69,7 +70,6 @@ from .runs import (
 from .style import (
     FORMATS,
     MAX_DESIGNS,
-    PSD_SEGMENT,
     check_path,
     curve_styles,
     mark_indices,

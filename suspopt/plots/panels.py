@@ -8,7 +8,15 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ..metrics import COMFORT_REACTIONS
-from .style import COMFORT_WEIGHTING, LABEL_GAP, axis_label, curve_styles, draw_curves
+from .style import (
+    COMFORT_WEIGHTING,
+    LABEL_GAP,
+    PSD_BAND,
+    axis_label,
+    curve_styles,
+    draw_curves,
+    spectrum_limits,
+)
 
 # --- panels --------------------------------------------------------------------------------
 
@@ -36,12 +44,14 @@ def draw_spectra(
     series: Sequence[tuple[str, np.ndarray, np.ndarray]],
     name: str,
     unit: str,
-    f_range: tuple[float, float] = (0.1, 30.0),
+    f_range: tuple[float, float] = PSD_BAND,
     styles: Sequence[dict] | None = None,
     legend: bool = True,
 ) -> None:
     """Spectra ``(label, f [Hz], value)`` on log-log axes, within ``f_range``, in ``styles``
-    (default :func:`curve_styles`); ``legend`` False leaves it to the figure."""
+    (default :func:`curve_styles`), the value axis over :func:`spectrum_limits` (at most
+    :data:`PSD_DECADES` decades below the highest value); ``legend`` False leaves it to the
+    figure."""
     band = [
         (
             label,
@@ -54,8 +64,10 @@ def draw_spectra(
     band = [(label, f, np.where(v > 0, v, np.nan)) for label, f, v in band]
     draw_curves(ax, band, styles, log=True)
     ax.set_xscale("log")
-    if any(np.isfinite(v).any() for _l, _f, v in band):
+    limits = spectrum_limits(np.concatenate([v for _l, _f, v in band])) if band else None
+    if limits is not None:
         ax.set_yscale("log")
+        ax.set_ylim(*limits)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(axis_label(name, unit))
     ax.grid(True, which="both", alpha=0.3)

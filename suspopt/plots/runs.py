@@ -15,7 +15,6 @@ from .style import (
     COMFORT_WEIGHTING,
     FAILED_VALUE,
     MAX_DESIGNS,
-    PSD_SEGMENT,
     SAME_STYLE,
     axis_label,
     check_path,
@@ -40,12 +39,11 @@ def _comfort_signals(names: Sequence[str], units: Mapping[str, str]) -> list[str
 def _signal_row(fig, left, right, time, name: str, values, unit: str, labels, styles) -> None:
     """One signal's time history (``left`` grid cell) and Welch PSD (``right``), ``values``
     ``(P, T)`` [unit] over ``time (T,)`` [s]."""
-    from ..metrics import psd
+    from ..metrics.spectral import record_psd
     from ..specs import METRICS
 
     P = len(values)
     fs = 1.0 / float(time[1] - time[0])
-    segment = min(time.size, round(PSD_SEGMENT * fs))
     # a signal the designs do not change (the body under a one-way seat) is one curve
     same = P > 1 and all(np.array_equal(v, values[0], equal_nan=True) for v in values)
     drawn, row_labels, row_styles = (
@@ -63,7 +61,7 @@ def _signal_row(fig, left, right, time, name: str, values, unit: str, labels, st
     if same:
         ax.set_title(f"the same for all {P} designs", fontsize=9)
     with np.errstate(invalid="ignore"):
-        f, spectrum = psd(drawn, fs, segment)
+        f, spectrum = record_psd(drawn, fs)
     ax = fig.add_subplot(right)
     draw_spectra(
         ax,
@@ -123,7 +121,7 @@ def simulation_figure(
     """The figure of :func:`plot_simulation` from arrays, unsaved: ``signals`` (name ->
     ``(P, T)`` over ``time (T,)`` [s]) with their ``units``, one design per row, ``labels``
     ``(P,)``. One row per signal: its time history (left) and its one-sided Welch PSD
-    (right; Hann segments of :data:`PSD_SEGMENT` or the record, 0.1-30 Hz); then, when
+    (right; :func:`suspopt.metrics.spectral.record_psd`, 0.1-30 Hz); then, when
     there are accelerations a person feels (:func:`_comfort_signals`) and the sampling rate
     is at least 100 Hz, their ISO 2631-1 :data:`COMFORT_WEIGHTING`-weighted r.m.s. against
     the comfort reactions (:func:`draw_weighted_rms`). Each design keeps one

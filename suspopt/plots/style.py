@@ -30,8 +30,12 @@ _THINNEST = 1.0
 SAME_STYLE = dict(color="k", ls="-", lw=1.0)
 #: Designs drawn at most on one simulation figure (more are unreadable).
 MAX_DESIGNS = 8
-#: Welch segment of the simulation figure's PSDs [s] (at most the record), as analyse models.
-PSD_SEGMENT = 8.0
+#: The band the figures draw spectra in [Hz] (the ride band of ISO 2631-1 and beyond).
+PSD_BAND = (0.1, 30.0)
+#: Decades a spectrum's axis shows below its highest value: the computed PSD of a smooth
+#: signal falls to numerical noise (about 1e-16 of its peak) at high frequency, which is no
+#: information but would squeeze every mode into the top of the axis.
+PSD_DECADES = 6.0
 #: The ISO 2631-1 weighting of the simulation figure's comfort panel (vertical, seated).
 COMFORT_WEIGHTING = "Wk"
 #: Fewest line heights between two comfort-level labels (closer ones are left out).
@@ -130,6 +134,19 @@ def axis_label(name: str, unit: str) -> str:
     if unit == "1":
         unit = "-"
     return f"{name} [{unit}]" if unit else name
+
+
+def spectrum_limits(values, decades: float = PSD_DECADES) -> tuple[float, float] | None:
+    """The range [unit of ``values``] of a log axis for the spectra ``values`` (any shape):
+    from the smallest positive finite value, but no lower than ``decades`` decades below the
+    highest, to the highest with a tenth of a decade above it; None when no value is
+    positive (nothing to draw on a log axis)."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v) & (v > 0)]
+    if not v.size:
+        return None
+    high = float(v.max())
+    return max(float(v.min()), high * 10.0**-decades) / 10**0.1, high * 10**0.1
 
 
 def curve_styles(n: int) -> list[dict]:

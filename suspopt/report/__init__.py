@@ -9,8 +9,10 @@ browser and makes no network request. Per study:
 
 - the front as a scatter of any two columns (objectives or design variables) chosen from
   drop-downs, in 3D for three objectives; colour by feasibility, k-ε level (kesort), case,
-  or any objective or variable; the picks (edges, knee, the k-ε optimum) marked, and the
-  config's own design (``/baseline`` of an optimise file) where the file has it;
+  or any objective or variable (the colour bar titled with its unit); the picks (edges,
+  knee, the k-ε optimum) marked, and the config's own design (``/baseline`` of an optimise
+  file) where the file has it, each marked point with one label naming its picks, placed
+  where it overlaps no other label (:mod:`.charts`);
 - a parallel-coordinates view of the objectives and variables, coloured as the front, each
   variable's axis spanning its search range (:func:`_search_bounds`);
   brushing ranges along its axes selects the designs inside all of them in the front,
@@ -21,12 +23,16 @@ browser and makes no network request. Per study:
   commands that take it on (the file's path as given, quoted for a POSIX shell);
 - the picks' (and ``with_signals`` rows') time histories and power spectral densities
   [unit²/Hz], simulated when the report is built (from each design's own config, in one
-  batch per config), thinned to at most :data:`MAX_SAMPLES` samples per signal (the page
-  says when); where there is a seat, their transmissibility from the floor to the seat and
+  batch per config), each history thinned to at most about :data:`MAX_SAMPLES` samples with
+  its peaks kept (:func:`_envelope`; the page says when), each spectrum the one the
+  ``--plot`` figure draws (:func:`suspopt.metrics.spectral.record_psd`, 0.1-30 Hz, its
+  axis at most :data:`suspopt.plots.style.PSD_DECADES` decades deep); curves the same to
+  1e-12 drawn as one (:mod:`.charts`); where there is a seat, their transmissibility from the floor to the seat and
   to the head (STHT, Eq 2.86) of the seat linearised about its static equilibrium;
 - pseudo-fronts (``analyse roads|masses|controllers|tolerances``): each changed front over the stored
   one, with a line from each design to its moved point;
-- the history per generation (best value, hypervolume, feasible share) and the run's
+- the history per generation, one panel per series on its own titled axis (best value of
+  each objective, hypervolume, feasible share: :mod:`.charts`), and the run's
   provenance (config, seeds, version, command) in a collapsible section.
 
 Nothing read from a file runs as code: the data go into the page as JSON (``<`` escaped) and
@@ -52,7 +58,8 @@ from ..files import listed
 
 __all__ = ["build_report", "collect", "Study", "MAX_SAMPLES", "MAX_BYTES"]
 
-#: The most samples a time history or spectrum keeps in the page (others are thinned).
+#: The most samples a time history keeps in the page (longer ones are thinned, their peaks
+#: kept: :func:`_envelope`; a spectrum keeps the points of its band, 240 at most).
 MAX_SAMPLES = 1000
 #: The page may not grow beyond this [bytes] (a 1000-design front with 5 picks' signals
 #: stays far below it).
@@ -193,6 +200,12 @@ def _extras(h5, table) -> dict[str, Any]:
             best = h5.array("history/best", ndim=2)
             history["best"] = _list(best.T)
             history["best_names"] = h5.labels("history/best", "names", best.shape[1])
+            units = h5.attribute(h5._node("history/best"), "units", "/history/best: units")
+            history["best_units"] = (
+                h5.labels("history/best", "units", best.shape[1])
+                if units is not None
+                else [""] * best.shape[1]
+            )
         out["history"] = history
     if group == "pareto" and h5._node("builds/feasible_share") is not None:
         out["builds"] = _builds(h5, N, table.X.shape[1], table.F.shape[1])
@@ -253,12 +266,16 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
 def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, Any]:
     """Time histories and spectra of the designs ``rows``, simulated in one batch per config
     of the table (each design with its own config)."""
-    from ..metrics.spectral import psd
+    from ..metrics.spectral import record_psd
     from ..picks import read_picks
     from ..plots.runs import default_signals
+    from ..plots.style import PSD_BAND, spectrum_limits
     from ..simulate import simulate
+    from ..specs import METRICS
 
-    out: dict[str, Any] = {"rows": [], "time": [], "signals": {}, "units": {}, "psd": {}}
+    out: dict[str, Any] = {
+        "rows": [], "time": [], "signals": {}, "units": {}, "psd": {}, "psd_units": {}, "psd_range": {}
+    }  # fmt: skip
     by_config: dict[int, list[int]] = {}
     for row in rows:
         by_config.setdefault(int(table.config_of[row]), []).append(row)
@@ -279,11 +296,14 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
     step = max(1, -(-len(time) // MAX_SAMPLES))
     if step > 1:
         notes.append(
-            f"time histories thinned for size: one sample in {step} of {len(time)} shown "
-            f"(the spectra are computed from all of them)"
+            f"time histories thinned for size: of each {2 * step} of the {len(time)} samples, "
+            f"the lowest and the highest shown, in their order, each within {step} samples "
+            f"of its time (the spectra are computed from all of them)"
         )
-    out["time"] = _list(time[::step])
+    shown = np.minimum(np.arange(2 * -(-len(time) // (2 * step))) * step, len(time) - 1)
+    out["time"] = _list(time[shown] if step > 1 else time)
     fs = 1.0 / float(time[1] - time[0])
+    spectra: dict[str, list[np.ndarray]] = {}
     for group_rows, result in results:
         for i, row in enumerate(group_rows):
             out["rows"].append(row)
@@ -291,13 +311,35 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
                 if name not in result.signals:
                     continue
                 y = np.asarray(result.signals[name][i], dtype=float)
-                out["signals"].setdefault(name, []).append(_list(y[::step]))
+                out["signals"].setdefault(name, []).append(_list(_envelope(y, step)))
                 out["units"][name] = result.signal_unit(name)
-                f, p = psd(y, fs)
-                keep = max(1, -(-len(f) // MAX_SAMPLES))
-                out["psd"].setdefault(name, []).append(_list(p[::keep]))
-                out["psd_f"] = _list(f[::keep])
+                out["psd_units"][name] = METRICS["var"].unit(out["units"][name]) + "/Hz"
+                with np.errstate(invalid="ignore"):
+                    f, p = record_psd(y, fs)
+                band = (f >= PSD_BAND[0]) & (f <= PSD_BAND[1])
+                spectra.setdefault(name, []).append(p[band])
+                out["psd_f"] = _list(f[band])
+    for name, curves in spectra.items():
+        out["psd"][name] = [_list(p) for p in curves]
+        limits = spectrum_limits(np.array(curves))
+        out["psd_range"][name] = None if limits is None else list(limits)
     return out
+
+
+def _envelope(y: np.ndarray, step: int) -> np.ndarray:
+    """``y (T,)`` thinned by ``step`` with its peaks kept: of each ``2 step`` samples (the
+    last padded with its last value), the lowest and the highest, in the order they come
+    (``2 ceil(T / 2 step)`` values, drawn at every ``step``-th time); NaN (a diverged
+    design's samples) only where a whole group is NaN. ``step`` 1: ``y`` itself."""
+    if step <= 1:
+        return y
+    groups = -(-y.size // (2 * step))
+    padded = np.concatenate([y, np.full(groups * 2 * step - y.size, y[-1])]).reshape(groups, -1)
+    low = np.argmin(np.where(np.isnan(padded), np.inf, padded), axis=1)
+    high = np.argmax(np.where(np.isnan(padded), -np.inf, padded), axis=1)
+    rows = np.arange(groups)[:, None]
+    pair = np.sort(np.stack([low, high], axis=1), axis=1)
+    return padded[rows, pair].ravel()
 
 
 def _transmissibility(picked, rows: list[int], out: dict) -> None:

@@ -14,6 +14,7 @@ import json
 from typing import Any
 
 from ..config import ConfigError
+from .charts import SCRIPT as CHARTS
 
 __all__ = ["render", "SCRIPT", "STYLE"]
 
@@ -36,6 +37,7 @@ SCRIPT = r"""
 (function () {
   "use strict";
   const data = JSON.parse(document.getElementById("suspopt-data").textContent);
+  const charts = window.suspoptCharts;  // (suspopt.report.charts)
   const api = { studies: [], selected: null, select: null };
   window.suspoptReport = api;
 
@@ -154,8 +156,9 @@ SCRIPT = r"""
 
   // the colour of the designs (the front's markers and the parallel coordinates' lines)
   function colouring(study, c) {
+    const named = /^[FX]:/.test(c) ? label(study, c) : (colours(study).find(o => o[0] === c) || [c, c])[1];
     const out = { color: colourValues(study, c), colorscale: "Viridis",
-                  colorbar: { title: { text: (colours(study).find(o => o[0] === c) || [c, c])[1] } } };
+                  colorbar: { title: { text: named }, exponentformat: "power" } };
     if (c === "feasible") Object.assign(out, { colorscale: [[0, "#d62728"], [1, "#1f77b4"]], cmin: 0, cmax: 1,
       colorbar: { title: { text: "feasible" }, tickvals: [0, 1], ticktext: ["no", "yes"] } });
     return out;
@@ -191,8 +194,8 @@ SCRIPT = r"""
 
   function baselineTrace(d, x, y) {  // the config's own design: where the run started
     const at = key => { const [kind, j] = key.split(":"); return (kind === "F" ? d.baseline.F : d.baseline.X)[Number(j)]; };
-    return { type: "scatter", mode: "markers+text", name: "the config's design", x: [at(x)], y: [at(y)],
-             text: ["config"], textposition: "bottom center", hoverinfo: "text+x+y", customdata: ["config"],
+    return { type: "scatter", mode: "markers", name: "the config's design", x: [at(x)], y: [at(y)],
+             text: ["config"], hoverinfo: "text+x+y", customdata: ["config"],
              marker: { symbol: "diamond-open", size: 12, color: "#000", line: { width: 2 } } };
   }
   function drawFront(i) {
@@ -203,7 +206,7 @@ SCRIPT = r"""
     const rows = d.F.map((_, r) => r);
     const hover = rows.map(r => "row " + r + "<br>" + d.objectives.map((n, j) => n + " " + fmt(d.F[r][j])).join("<br>"));
     const marker = Object.assign(colouring(study, c), { showscale: true, size: 7 });
-    const traces = [];
+    const traces = [], labels = [];
     const use3d = three && three.checked;
     const chosen = brushed(i);
     if (use3d) {  // (scatter3d has no selected points: the brushed rows and the rest as two traces)
@@ -227,10 +230,15 @@ SCRIPT = r"""
         text: hover, hoverinfo: "text", marker: marker, selectedpoints: chosen,
         unselected: { marker: { opacity: 0.15 } } });
       const names = Object.keys(d.picks), pr = names.map(n => d.picks[n]);
-      traces.push({ type: "scatter", mode: "markers+text", name: "picks", x: pr.map(r => column(study, x)[r]),
-        y: pr.map(r => column(study, y)[r]), text: names, textposition: "top center", customdata: pr,
+      const marked = pickLabels(pr.map(r => column(study, x)[r]), pr.map(r => column(study, y)[r]), names, pr);
+      traces.push({ type: "scatter", mode: "markers", name: "picks", x: marked.map(l => l.x),
+        y: marked.map(l => l.y), text: marked.map(l => l.text), customdata: marked.map(l => l.row),
         hoverinfo: "text", marker: { symbol: "x", size: 12, color: "#d62728" } });
-      if (d.baseline) traces.push(baselineTrace(d, x, y));
+      labels.push(...marked);
+      if (d.baseline) {
+        traces.push(baselineTrace(d, x, y));
+        labels.push({ x: traces[traces.length - 1].x[0], y: traces[traces.length - 1].y[0], text: "config" });
+      }
       for (const p of d.pseudo || []) {
         if (!x.startsWith("F:") || !y.startsWith("F:")) break;
         const jx = Number(x.slice(2)), jy = Number(y.slice(2)), lx = [], ly = [];
@@ -245,10 +253,22 @@ SCRIPT = r"""
                                       yaxis: { title: { text: label(study, "F:1") } },
                                       zaxis: { title: { text: label(study, "F:2") } } },
                              margin: { t: 20 }, legend: { orientation: "h", y: -0.05 } }
-                         : { xaxis: { title: { text: label(study, x) } }, yaxis: { title: { text: label(study, y) } },
+                         : { xaxis: { title: { text: label(study, x) }, exponentformat: "power" },
+                             yaxis: { title: { text: label(study, y) }, exponentformat: "power" },
                              margin: { t: 20 }, legend: { orientation: "h", y: -0.18 } };
     const div = document.getElementById("front-" + i);
-    return Plotly.react(div, traces, layout, { displaylogo: false });
+    return Plotly.react(div, traces, layout, { displaylogo: false })
+      .then(() => (use3d ? div : charts.placeLabels(div, labels)));
+  }
+  function pickLabels(xs, ys, names, rows) {  // one per point of the picks, naming the picks there
+    const at = new Map();
+    xs.forEach((x, k) => {
+      const y = ys[k], key = x + " " + y;
+      if (x === null || y === null) return;
+      if (!at.has(key)) at.set(key, { x: x, y: y, names: [], row: rows[k], color: "#d62728" });
+      at.get(key).names.push(names[k]);
+    });
+    return [...at.values()].map(l => Object.assign(l, { text: l.names.join(", ") }));
   }
 
   // Parallel coordinates are WebGL plots of three contexts each, and a browser keeps about 16
@@ -326,14 +346,7 @@ SCRIPT = r"""
 
   function drawHistory(i) {
     const h = data.studies[i].data.history;
-    if (!h) return Promise.resolve();
-    const traces = [];
-    (h.best || []).forEach((b, j) => traces.push({ type: "scatter", mode: "lines", name: "best " + h.best_names[j],
-      x: h.generation, y: b }));
-    if (h.hypervolume) traces.push({ type: "scatter", mode: "lines", name: "hypervolume", x: h.generation, y: h.hypervolume, yaxis: "y2" });
-    if (h.feasible) traces.push({ type: "scatter", mode: "lines", name: "feasible share", x: h.generation, y: h.feasible, yaxis: "y2" });
-    return Plotly.newPlot("history-" + i, traces, { xaxis: { title: { text: "generation" } },
-      yaxis2: { overlaying: "y", side: "right", range: [0, 1.05] }, margin: { t: 20 } }, { displaylogo: false });
+    return h ? charts.history(document.getElementById("history-" + i), h) : Promise.resolve();
   }
 
   function drawSignals(i) {
@@ -341,17 +354,19 @@ SCRIPT = r"""
     const names = Object.keys(s.signals);
     if (!names.length) return Promise.resolve();
     const pick = document.getElementById("s-" + i).value;
-    const traces = s.rows.map((row, k) => ({ type: "scatter", mode: "lines", name: "row " + row,
-      x: s.time, y: s.signals[pick][k] }));
-    const spectra = s.rows.map((row, k) => ({ type: "scatter", mode: "lines", name: "row " + row,
-      x: s.psd_f, y: s.psd[pick][k] }));
-    const unit = s.units[pick];
+    const labels = s.rows.map(row => "row " + row);
+    const traces = charts.lines(s.time, s.signals[pick], labels, "");
+    const spectra = charts.lines(s.psd_f, s.psd[pick], labels, "");
+    const unit = s.units[pick], range = s.psd_range[pick], below = { orientation: "h", y: -0.2 };
+    const f = [s.psd_f[0], s.psd_f[s.psd_f.length - 1]].map(Math.log10);
     return Promise.all([
       Plotly.react("signal-" + i, traces, { xaxis: { title: { text: "time [s]" } },
-        yaxis: { title: { text: pick + " [" + unit + "]" } }, margin: { t: 20 } }, { displaylogo: false }),
-      Plotly.react("psd-" + i, spectra, { xaxis: { title: { text: "frequency [Hz]" }, type: "log" },
-        yaxis: { title: { text: "PSD [(" + unit + ")^2/Hz]" }, type: "log" }, margin: { t: 20 } },
+        yaxis: { title: { text: pick + " [" + unit + "]" }, exponentformat: "power" }, margin: { t: 20 }, legend: below },
         { displaylogo: false }),
+      Plotly.react("psd-" + i, spectra, { xaxis: { title: { text: "frequency [Hz]" }, type: "log", range: f },
+        yaxis: Object.assign({ title: { text: "PSD of " + pick + " [" + s.psd_units[pick] + "]" }, type: "log",
+                               exponentformat: "power" }, range ? { range: range.map(Math.log10) } : {}),
+        margin: { t: 20 }, legend: below }, { displaylogo: false }),
     ]);
   }
 
@@ -360,13 +375,12 @@ SCRIPT = r"""
     if (!t) return Promise.resolve();
     const traces = [];
     for (const [dof, curves] of Object.entries(t.dofs)) {
-      curves.forEach((y, k) => traces.push({ type: "scatter", mode: "lines", x: t.f, y: y,
-        name: (dof === "head" ? "STHT (head)" : dof) + ", row " + t.rows[k],
-        line: { dash: dof === "head" ? "solid" : "dot" } }));
+      traces.push(...charts.lines(t.f, curves, t.rows.map(row => "row " + row),
+        (dof === "head" ? "STHT (head)" : dof) + ", ", { line: { dash: dof === "head" ? "solid" : "dot" } }));
     }
     return Plotly.newPlot("tr-" + i, traces, { xaxis: { title: { text: "frequency [Hz]" }, type: "log" },
-      yaxis: { title: { text: "|transmissibility| [1]" }, type: "log" }, margin: { t: 20 } },
-      { displaylogo: false });
+      yaxis: { title: { text: "|transmissibility| [1]" }, type: "log" }, margin: { t: 20 },
+      legend: { orientation: "h", y: -0.2 } }, { displaylogo: false });
   }
 
   const done = [];
@@ -498,6 +512,7 @@ def render(studies, title: str) -> str:
             *(_section(i, s) for i, s in enumerate(studies)),
             f"<script type='application/json' id='suspopt-data'>{_json(payload)}</script>",
             f"<script>{_plotly_js()}</script>",
+            f"<script>{CHARTS}</script>",
             f"<script>{SCRIPT}</script>",
             "</body></html>",
         ]
