@@ -53,7 +53,7 @@ from ..config import Config, ConfigError, load_config
 from ..config.metrics import MetricSpec
 from ..files import listed
 from ..io import atomic_h5, write_attrs, write_dataset
-from ..metrics import psd
+from ..metrics.spectral import PSD_SEGMENT, record_psd
 from ..simulate import Result, simulate
 from ..specs import METRICS, evaluate_spec
 from ..vehicle import modal_analysis
@@ -76,8 +76,6 @@ __all__ = [
 TIME_SIGNALS = ("body.heave_acc", "body.heave", "body.roll", "wheel.F1.heave_acc", "wheel.F1.heave")
 #: Signals whose Welch PSD is computed, where the model has them.
 PSD_SIGNALS = ("body.heave_acc", "body.roll_acc")
-#: Welch segment of the PSDs [s] (at most the record).
-PSD_SEGMENT = 8.0
 _BUMPS = ("bump_step", "bump_half_sine")
 _CORNERS = ("F1", "F2", "R1", "R2")
 #: Transient metrics (Sec 2.4.1) of an acceleration, which returns to 0 (no overshoot or new
@@ -175,7 +173,7 @@ def _response(
     frequency = np.empty(0)
     for name in PSD_SIGNALS:
         if name in sig:
-            frequency, spectra[name] = psd(sig[name][0], fs, int(round(PSD_SEGMENT * fs)))
+            frequency, spectra[name] = record_psd(sig[name][0], fs)
             units[f"PSD of {name}"] = METRICS["var"].unit(units[name]) + "/Hz"
     metrics, order = {}, {}
     for j, spec in enumerate(specs):
