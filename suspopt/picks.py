@@ -12,7 +12,9 @@ A *design table* is the table of designs a result file holds, with their variabl
 
 A *pick* names one row of it: ``knee``, ``best_<objective>`` (the edges of the front,
 :func:`suspopt.kesort.pareto_picks`, or the ones the file stored), ``chosen`` (the k-ε
-optimum of a kesort file) or a row number. :func:`read_picks` resolves picks into
+optimum of a kesort file) or a design's id (:mod:`suspopt.design_ids`: its row in the front
+it came from, ``NAME:ROW`` in a kesort file of several fronts), which names the same design
+in every file that holds it. :func:`read_picks` resolves picks into
 :class:`Picked` designs; :meth:`Picked.params` gives them to :func:`suspopt.simulate` in one
 batch, and :func:`design_config` writes one of them into its config as a standalone YAML.
 """
@@ -52,7 +54,7 @@ class DesignTable:
     """The designs of a result file: ``X (N, n)`` physical values, ``F (N, m)``, their names
     and units; ``picks`` by name (row indices); ``configs`` the YAML text of each row's
     config and ``config_of (N,)`` which one; ``table`` the group (``pareto``, ``kesort``,
-    ``designs``)."""
+    ``designs``); ``ids`` each row's design id (:func:`suspopt.design_ids.table_ids`)."""
 
     path: Path
     table: str
@@ -65,22 +67,21 @@ class DesignTable:
     picks: dict[str, int]
     configs: list[str]
     config_of: np.ndarray
+    ids: list[str]
 
     def resolve(self, pick: str, option: str = "--pick") -> int:
-        """The row of ``pick`` (a name or a row number); ConfigError, naming the command-line
+        """The row of ``pick`` (a name or a design id); ConfigError, naming the command-line
         ``option`` it came from, listing the choices."""
+        from .design_ids import describe_ids, find_id
+
         if pick in self.picks:
             return self.picks[pick]
-        try:
-            row = int(pick)
-        except ValueError:
-            known = ", ".join(list(self.picks) + ["a row number"])
+        row = find_id(self.ids, pick)
+        if row is None:
             raise ConfigError(
-                f"{option} {pick}: {self.path} has no such pick; it has {known}"
-            ) from None
-        if not 0 <= row < len(self.X):
-            raise ConfigError(
-                f"{option} {pick}: {self.path}: /{self.table} has rows 0 to {len(self.X) - 1}"
+                f"{option} {pick}: {self.path} has no such pick or design; it has "
+                f"{', '.join(self.picks) or 'no named picks'} and the designs "
+                f"{describe_ids(self.ids)}"
             )
         return row
 
@@ -88,7 +89,7 @@ class DesignTable:
 @dataclass
 class Picked:
     """Designs picked from one table, all of one config: ``names`` (the picks as given),
-    ``rows`` in the table, ``X (P, n)`` physical values of ``var_names`` at ``paths``,
+    ``rows`` in the table, ``ids`` their design ids (:mod:`suspopt.design_ids`), ``X (P, n)`` physical values of ``var_names`` at ``paths``,
     ``F (P, m)`` their stored objectives, and ``config`` (resolving relative paths from the
     file's folder)."""
 
@@ -104,23 +105,35 @@ class Picked:
     obj_names: list[str]
     obj_units: list[str]
     config: Config
+    ids: list[str]
 
     def params(self) -> dict[str, np.ndarray]:
         """``simulate``'s params: dotted path -> (P,) values."""
         return {path: self.X[:, j] for j, path in enumerate(self.paths)}
+
+    def labels(self) -> list[str]:
+        """Each design as a figure names it: the pick and its id (``knee (design 13)``), the
+        id alone where the pick was the id."""
+        from .design_ids import find_id
+
+        return [
+            f"design {i}" if find_id([i], name) == 0 else f"{name} (design {i})"
+            for name, i in zip(self.names, self.ids)
+        ]
 
 
 def split_picks(given: list[str]) -> list[str]:
     """``--pick`` values as given (repeatable, each may list several separated by commas)."""
     picks = [p.strip() for item in given for p in item.split(",") if p.strip()]
     if not picks:
-        raise ConfigError("--pick: name a design: knee, best_<objective>, chosen or a row number")
+        raise ConfigError("--pick: name a design: knee, best_<objective>, chosen or a design id")
     return picks
 
 
 def read_table(path: str | Path) -> DesignTable:
     """The design table of an optimise, kesort or analyse file (module docstring);
     ConfigError naming the file and the dataset for anything else."""
+    from .design_ids import table_ids
     from .h5read import H5Reader
     from .kesort import pareto_picks
 
@@ -175,11 +188,13 @@ def read_table(path: str | Path) -> DesignTable:
                 stored = False
         if ((config_of < 0) | (config_of >= len(configs))).any():
             raise ConfigError(f"{path}: /kesort/source: indices beyond /kesort/sets")
+        ids = table_ids(h5, table, len(X))
     if not stored and np.isfinite(F).all():
         picks = pareto_picks(F, obj_names)
     return DesignTable(
-        path, table, X, var_names, var_units, F, obj_names, obj_units, picks, configs, config_of
-    )
+        path, table, X, var_names, var_units, F, obj_names, obj_units, picks, configs, config_of,
+        ids,
+    )  # fmt: skip
 
 
 def _row_picks(h5, rows: int) -> list[str] | None:
@@ -252,6 +267,7 @@ def read_picks(path: str | Path, picks: str | Sequence[str]) -> Picked:
         obj_names=table.obj_names,
         obj_units=table.obj_units,
         config=cfg,
+        ids=[table.ids[r] for r in rows],
     )
 
 
@@ -288,8 +304,8 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
     )
     header = "\n".join(
         [
-            f"# Design {picked.names[i]!r} (row {int(picked.rows[i])} of /{picked.table}) of "
-            f"{picked.source}",
+            f"# Design {picked.names[i]!r} (design {picked.ids[i]}, row {int(picked.rows[i])} of "
+            f"/{picked.table}) of {picked.source}",
             f"# written by suspopt {__version__}: the stored config with the design's values in "
             f"place.",
             f"# stored objectives: {objectives}",
@@ -333,7 +349,7 @@ def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSe
         if row not in first:
             first[row] = len(keep)
             keep.append(i)
-        if not name.isdigit():  # (a row number names no design)
+        if not name.isdigit() and name not in picked.ids:  # (an id names no pick)
             marks.setdefault(name, first[row])
     cfg = picked.config
     main = Problem.from_config(cfg).obj_names
@@ -361,6 +377,7 @@ def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSe
         cfg.text,
         picked=marks,
         source_rows=np.array(list(first), dtype=np.int64),
+        ids=tuple(picked.ids[i] for i in keep),
     )
 
 

@@ -166,4 +166,4 @@ def export(
                 stream.write(signed_config(text).encode())
         except ConfigError as exc:
             fail(str(exc))
-    out.print(f"wrote {output} (design {names[0]!r}, row {int(picked.rows[0])} of {source})")
+    out.print(f"wrote {output} (design {picked.ids[0]} of {source}, --pick {names[0]})")

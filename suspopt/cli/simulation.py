@@ -225,7 +225,8 @@ def _under_scenario(cfg, params, picked, name: str):
 
 
 def _picks_writer(picked, objectives):
-    """Writes the picks' names, rows and objectives (new and stored) beside the signals."""
+    """Writes the picks' names, rows, ids (:mod:`suspopt.design_ids`) and objectives (new and
+    stored) beside the signals."""
     from ..io import write_dataset
 
     def extra(h5) -> None:
@@ -234,6 +235,7 @@ def _picks_writer(picked, objectives):
         designs.attrs["source"] = str(picked.source)
         write_dataset(designs, "pick", list(picked.names), "1", dims=("design",))
         write_dataset(designs, "row", picked.rows, "1", dims=("design",))
+        write_dataset(designs, "id", list(picked.ids), "1", dims=("design",))
         group = h5.create_group("objectives")
         write_dataset(group, "F", F, units, dims=("design", "objective"), names=names)
         write_dataset(
@@ -324,7 +326,7 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
     if plot is not None:
         from ..plots import plot_simulation
 
-        plot_simulation(result, plot, design_names=None if picked is None else picked.names)
+        plot_simulation(result, plot, design_names=None if picked is None else picked.labels())
         out.print(f"wrote {plot}")
 
 
@@ -349,7 +351,7 @@ def _picks_table(picked, F, names, units) -> Table:
     import numpy as np
 
     table = base.new_table(f"{picked.source.name}: the picked designs' objectives")
-    for col in ("pick", "row", "objective", "stored", "simulated", "change"):
+    for col in ("pick", "design", "objective", "stored", "simulated", "change"):
         table.add_column(col, justify="left" if col in ("pick", "objective") else "right")
     for i, name in enumerate(picked.names):
         for j, (objective, unit) in enumerate(zip(names, units)):
@@ -363,7 +365,7 @@ def _picks_table(picked, F, names, units) -> Table:
             change = f"{relative:+.1e}" if np.isfinite(relative) else ""
             table.add_row(
                 name if j == 0 else "",
-                str(int(picked.rows[i])) if j == 0 else "",
+                picked.ids[i] if j == 0 else "",
                 f"{objective} [{unit}]",
                 "" if np.isnan(stored) else f"{stored:.6g}",
                 f"{F[i, j]:.6g}",
