@@ -46,6 +46,7 @@ __all__ = [
     "read_front",
     "design_config",
     "split_picks",
+    "stored_scenario_values",
 ]
 
 
@@ -77,11 +78,20 @@ class DesignTable:
         if pick in self.picks:
             return self.picks[pick]
         row = find_id(self.ids, pick)
+        if row is None and pick.strip().isdigit():
+            raise ConfigError(
+                f"{option} {pick}: {self.path}: /{self.table} has "
+                + (
+                    f"rows 0 to {len(self.X) - 1}"
+                    if self.ids == [str(k) for k in range(len(self.X))]
+                    else f"no design {pick} (its designs: {describe_ids(self.ids)})"
+                )
+            )
         if row is None:
             raise ConfigError(
-                f"{option} {pick}: {self.path} has no such pick or design; it has "
-                f"{', '.join(self.picks) or 'no named picks'} and the designs "
-                f"{describe_ids(self.ids)}"
+                f"{option} {pick}: {self.path} has no such pick; it has "
+                f"{', '.join([*self.picks, 'a design id'])} (its designs: "
+                f"{describe_ids(self.ids)})"
             )
         return row
 
@@ -304,8 +314,8 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
     )
     header = "\n".join(
         [
-            f"# Design {picked.names[i]!r} (design {picked.ids[i]}, row {int(picked.rows[i])} of "
-            f"/{picked.table}) of {picked.source}",
+            f"# Design {picked.names[i]!r} (row {int(picked.rows[i])} of /{picked.table}, design "
+            f"id {picked.ids[i]}) of {picked.source}",
             f"# written by suspopt {__version__}: the stored config with the design's values in "
             f"place.",
             f"# stored objectives: {objectives}",
@@ -387,3 +397,77 @@ def _stores_constraints(path: Path) -> bool:
 
     with H5Reader(path) as h5:
         return "pareto/G" in h5.file
+
+
+def stored_scenario_values(
+    picked: Picked, scenario: int, names: Sequence[str]
+) -> tuple[np.ndarray, str]:
+    """The stored values ``(P, m)`` of the objectives of ``picked`` (its columns
+    ``obj_names``) under the scenario ``scenario`` (an index into the config's scenario
+    ``names``), and a note ("" when there is nothing to say): ``/pareto/scenarios/F`` of
+    the front each design came from at its row there. For a pick of a front, that is its own
+    file; for a pick of a kesort file, the front of its set (``/kesort/sets/file``, as
+    given to kesort or beside the kesort file) at its ``/kesort/row``, when that front still
+    holds the config kesort evaluated it with (otherwise its values are not the ones it was
+    sorted on). NaN where no value is stored (a front of no scenarios, a supplementary
+    objective, a front moved away; the note says which)."""
+    from .h5read import H5Reader
+
+    stored = np.full_like(picked.F, np.nan)
+    origins = _origins(picked)
+    if origins is None:
+        return stored, ""
+    notes = []
+    for front, text, at, rows in origins:
+        if front is None:
+            notes.append(f"{text}: not found; its stored scenario values are not shown")
+            continue
+        with H5Reader(front) as h5:
+            if h5._node("pareto/scenarios/F") is None:
+                continue
+            if text is not None and h5.text_attr("config") != text:
+                notes.append(
+                    f"{front} holds another config than the one {picked.source} sorted its "
+                    f"designs with; their stored scenario values are not shown"
+                )
+                continue
+            F = h5.array("pareto/F", ndim=2)
+            front_names = h5.labels("pareto/F", "names", F.shape[1])
+            FS = h5.array("pareto/scenarios/F", ndim=3, columns=F.shape[1])
+        if FS.shape[1] != len(names) or len(FS) <= rows.max():
+            raise ConfigError(
+                f"{front}: /pareto/scenarios/F: shape {FS.shape} does not fit /pareto/F and "
+                f"the config's {len(names)} scenarios"
+            )
+        for j, name in enumerate(picked.obj_names):
+            if name in front_names:
+                stored[at, j] = FS[rows, scenario, front_names.index(name)]
+    return stored, "; ".join(notes)
+
+
+def _origins(picked: Picked):
+    """Where the designs of ``picked`` came from: ``(front, config text or None, indices in
+    picked, rows in that front's /pareto)`` per front (``front`` None where a kesort
+    file's front is not found; ``config text`` the kesort file's for the set, to check);
+    None for a table that is neither /pareto nor /kesort."""
+    from .h5read import H5Reader
+
+    everything = np.arange(len(picked.rows))
+    if picked.table == "pareto":
+        return [(picked.source, None, everything, picked.rows)]
+    if picked.table != "kesort":
+        return None
+    with H5Reader(picked.source) as h5:
+        count = len(h5.dataset("kesort/sets/file"))
+        files = h5.texts("kesort/sets/file", count)
+        configs = h5.texts("kesort/sets/config", count)
+        source = h5.array("kesort/source", ndim=1, integer=True)[picked.rows]
+        row = h5.array("kesort/row", ndim=1, integer=True)[picked.rows]
+    out = []
+    for k in np.unique(source):
+        given = Path(files[k])
+        beside = picked.source.parent / given
+        front = given if given.is_file() else beside if beside.is_file() else None
+        at = np.flatnonzero(source == k)
+        out.append((front, configs[k] if front is not None else files[k], at, row[at]))
+    return out

@@ -175,11 +175,10 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
 def _under_scenario(cfg, params, picked, name: str):
     """The config and designs of ``simulate --scenario NAME``: the scenario's road and time
     grid, its per-design values over the designs' own; the picks' stored objectives become
-    that scenario's (``/pareto/scenarios/F``), or NaN where the file has none."""
+    that scenario's (:func:`suspopt.picks.stored_scenario_values`), or NaN where there are
+    none."""
     import dataclasses
     import difflib
-
-    import numpy as np
 
     from ..optimise.scenarios import Group, ScenarioSet
 
@@ -207,19 +206,11 @@ def _under_scenario(cfg, params, picked, name: str):
     P = len(next(iter(params.values()))) if params else 1
     params = scenarios.columns(alone, dict(params or {}), P) or None
     if picked is not None:
-        stored = np.full_like(picked.F, np.nan)
-        if picked.table == "pareto":
-            from ..h5read import H5Reader
+        from ..picks import stored_scenario_values
 
-            with H5Reader(picked.source) as h5:
-                if h5._node("pareto/scenarios/F") is not None:
-                    FS = h5.array("pareto/scenarios/F", ndim=3, columns=picked.F.shape[1])
-                    if FS.shape[1] != len(scenarios.names) or len(FS) <= picked.rows.max():
-                        raise ConfigError(
-                            f"{picked.source}: /pareto/scenarios/F: shape {FS.shape} does "
-                            f"not fit /pareto/F and the config's {len(scenarios.names)} scenarios"
-                        )
-                    stored = FS[picked.rows, s]
+        stored, note = stored_scenario_values(picked, s, scenarios.names)
+        if note:
+            err.print(f"note: {note}")
         picked = dataclasses.replace(picked, F=stored)
     return member_cfg, params, picked
 
@@ -310,6 +301,12 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
     if picked is not None:
         objectives = _pick_objectives(picked, cfg, result, params)
         base.show_table(_picks_table(picked, *objectives), keys=3)
+        if cfg.simulation.method == "spectral":  # (stored: stationary; here: in time)
+            out.print(
+                f"note: the stored values are the spectral method's (stationary); simulate "
+                f"integrates {cfg.simulation.duration:g} s in time: they differ by the finite "
+                f"road's error (docs/guide/spectral.md)"
+            )
         extra = _picks_writer(picked, objectives)
     if output is not None:
         started = time.perf_counter()
