@@ -91,9 +91,13 @@ def _optimum_table(result, rows: int = 12) -> Table:
     pick = evenly_spaced(N, rows)
     generations = result.history.get("generation", ())
     last = f"generation {int(generations[-1])}" if len(generations) else "the last generation"
+    shown = (
+        f", by {names[0]}"
+        if len(pick) == N
+        else (f"; {len(pick)} of them shown, evenly spaced by {names[0]}")
+    )
     table = base.new_table(
-        f"Pareto set: {N} non-dominated designs of {last}'s population; {len(pick)} of "
-        f"them, evenly spaced by {names[0]}" + suffix
+        f"Pareto set: the {N} non-dominated designs of {last}'s population{shown}" + suffix
     )
     table.add_column("design", justify="right")
     for name, unit in zip(names, units):
