@@ -349,7 +349,7 @@ def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSe
                 raise
             raise ConfigError(
                 f"{exc}; to analyse designs of it, give --pick (knee, best_<objective>, "
-                f"chosen or row numbers)"
+                f"chosen or design ids)"
             ) from None
     picked = read_picks(path, split_picks(list(picks)))
     first: dict[int, int] = {}  # source row -> row here

@@ -123,7 +123,8 @@ def export(
     pick: list[str] = typer.Option(
         [],
         "--pick",
-        help="the design to write as a config: knee, best_<objective>, chosen or a row number",
+        help="the design to write as a config: knee, best_<objective>, chosen or a design id "
+        "(its row in the front it came from)",
     ),
     output: Path | None = typer.Option(
         None, "-o", "--output", help="YAML file for the picked design"

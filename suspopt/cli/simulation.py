@@ -97,7 +97,8 @@ def _metrics_table(result, picked=None) -> Table:
 
 _PICK_HELP = (
     "designs of a result file to simulate: knee, best_<objective>, chosen (the k-ε "
-    "optimum of a kesort file) or a row number; repeatable, or separated by commas"
+    "optimum of a kesort file) or a design id (its row in the front it came from, NAME:ROW "
+    "when kesort pooled fronts); repeatable, or separated by commas"
 )
 
 
@@ -154,7 +155,7 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
         if not pick:
             base.fail(
                 f"{source} is a result file: name the designs to simulate with --pick "
-                f"(knee, best_<objective>, chosen or a row number)"
+                f"(knee, best_<objective>, chosen or a design id)"
             )
         if sweeps:
             base.fail("--sweep takes a config; with --pick the designs are the picked ones")
