@@ -122,7 +122,7 @@ def picked_note(pareto) -> list[str]:
         return []
     named = pareto.marks_by_row()
     each = [
-        f"design {i} ({', '.join(named.get(k, ['--pick']))})"
+        f"design {i}" + (f" ({', '.join(named[k])})" if k in named else "")
         for k, i in enumerate(front_ids(pareto))
     ]
     return [f"{len(pareto.X)} design(s) of {pareto.path.name} (--pick): " + "; ".join(each)]

@@ -300,15 +300,7 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
         base.show_table(_metrics_table(result, picked), keys=2)
     extra = None
     if picked is not None:
-        objectives = _pick_objectives(picked, cfg, result, params)
-        base.show_table(_picks_table(picked, *objectives), keys=3)
-        if cfg.simulation.method == "spectral":  # (stored: stationary; here: in time)
-            out.print(
-                f"note: the stored values are the spectral method's (stationary); simulate "
-                f"integrates {cfg.simulation.duration:g} s in time: they differ by the finite "
-                f"road's error (docs/guide/spectral.md)"
-            )
-        extra = _picks_writer(picked, objectives)
+        extra = _show_picks(picked, cfg, result, params)
     if output is not None:
         started = time.perf_counter()
         write_simulation(
@@ -326,6 +318,21 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
 
         plot_simulation(result, plot, design_names=None if picked is None else picked.labels())
         out.print(f"wrote {plot}")
+
+
+def _show_picks(picked, cfg, result, params):
+    """Show the picks' objectives, stored and simulated now (:func:`_picks_table`), with a
+    note where the stored ones are the spectral method's; return the writer of them
+    (:func:`_picks_writer`)."""
+    objectives = _pick_objectives(picked, cfg, result, params)
+    base.show_table(_picks_table(picked, *objectives), keys=3)
+    if cfg.simulation.method == "spectral":  # (stored: stationary; here: in time)
+        out.print(
+            f"note: the stored values are the spectral method's (stationary); simulate "
+            f"integrates {cfg.simulation.duration:g} s in time: they differ by the finite "
+            f"road's error (docs/guide/spectral.md)"
+        )
+    return _picks_writer(picked, objectives)
 
 
 def _pick_objectives(picked, cfg, result, params):
