@@ -184,3 +184,35 @@ def test_the_pareto_set_line_says_what_its_designs_are(walk):
     )
     assert str(_optimum_table(result).title).endswith(f"the {N} non-dominated designs of "
                                                       f"generation 2's population, by RC_se")  # fmt: skip
+
+
+@pytest.mark.slow
+def test_a_file_without_stored_ids_names_its_designs_by_their_rows(walk, tmp_path):
+    import shutil
+
+    _, _, ke, _ = walk
+    old = tmp_path / "old.h5"
+    shutil.copy(ke, old)
+    with h5py.File(old, "a") as h5:
+        del h5["kesort/id"]  # (as kesort wrote it before ids were stored)
+    table = read_table(old)
+    assert table.ids == [str(k) for k in range(len(table.X))]
+    assert np.array_equal(read_picks(old, ["0"]).X, table.X[[0]])
+    assert np.array_equal(read_picks(old, ["0"]).X, read_picks(ke, ["2"]).X)
+
+
+@pytest.mark.slow
+@pytest.mark.cli
+def test_a_builds_file_of_kesort_picks_names_them_by_their_ids(walk, capsys, tmp_path):
+    _, front, ke, _ = walk
+    table = read_table(ke)
+    chosen = table.ids[table.picks["chosen"]]
+    builds = tmp_path / "builds.h5"
+    code, out, err = cli(
+        capsys, "analyse", "builds", ke, "--pick", "chosen", "--samples", 4, "-o", builds
+    )
+    assert code == 0, err
+    assert rows_of(out, "builds:")[0][:2] == [chosen, "chosen"]
+    assert read_table(builds).ids == [chosen]
+    for pick in (chosen, "chosen"):
+        assert np.array_equal(read_picks(builds, [pick]).X, read_picks(front, [chosen]).X)
