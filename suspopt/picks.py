@@ -99,9 +99,9 @@ class DesignTable:
 @dataclass
 class Picked:
     """Designs picked from one table, all of one config: ``names`` (the picks as given),
-    ``rows`` in the table, ``ids`` their design ids (:mod:`suspopt.design_ids`), ``X (P, n)`` physical values of ``var_names`` at ``paths``,
-    ``F (P, m)`` their stored objectives, and ``config`` (resolving relative paths from the
-    file's folder)."""
+    ``rows`` in the table, ``ids`` their design ids (:mod:`suspopt.design_ids`), ``X (P,
+    n)`` physical values of ``var_names`` at ``paths``, ``F (P, m)`` their stored
+    objectives, and ``config`` (resolving relative paths from the file's folder)."""
 
     source: Path
     table: str
