@@ -12,7 +12,9 @@ A *design table* is the table of designs a result file holds, with their variabl
 
 A *pick* names one row of it: ``knee``, ``best_<objective>`` (the edges of the front,
 :func:`suspopt.kesort.pareto_picks`, or the ones the file stored), ``chosen`` (the k-ε
-optimum of a kesort file) or a row number. :func:`read_picks` resolves picks into
+optimum of a kesort file) or a design's id (:mod:`suspopt.design_ids`: its row in the front
+it came from, ``NAME:ROW`` in a kesort file of several fronts), which names the same design
+in every file that holds it. :func:`read_picks` resolves picks into
 :class:`Picked` designs; :meth:`Picked.params` gives them to :func:`suspopt.simulate` in one
 batch, and :func:`design_config` writes one of them into its config as a standalone YAML.
 """
@@ -44,6 +46,7 @@ __all__ = [
     "read_front",
     "design_config",
     "split_picks",
+    "stored_scenario_values",
 ]
 
 
@@ -52,7 +55,7 @@ class DesignTable:
     """The designs of a result file: ``X (N, n)`` physical values, ``F (N, m)``, their names
     and units; ``picks`` by name (row indices); ``configs`` the YAML text of each row's
     config and ``config_of (N,)`` which one; ``table`` the group (``pareto``, ``kesort``,
-    ``designs``)."""
+    ``designs``); ``ids`` each row's design id (:func:`suspopt.design_ids.table_ids`)."""
 
     path: Path
     table: str
@@ -65,22 +68,30 @@ class DesignTable:
     picks: dict[str, int]
     configs: list[str]
     config_of: np.ndarray
+    ids: list[str]
 
     def resolve(self, pick: str, option: str = "--pick") -> int:
-        """The row of ``pick`` (a name or a row number); ConfigError, naming the command-line
+        """The row of ``pick`` (a name or a design id); ConfigError, naming the command-line
         ``option`` it came from, listing the choices."""
+        from .design_ids import describe_ids, find_id
+
         if pick in self.picks:
             return self.picks[pick]
-        try:
-            row = int(pick)
-        except ValueError:
-            known = ", ".join(list(self.picks) + ["a row number"])
+        row = find_id(self.ids, pick)
+        if row is None and pick.strip().isdigit():
             raise ConfigError(
-                f"{option} {pick}: {self.path} has no such pick; it has {known}"
-            ) from None
-        if not 0 <= row < len(self.X):
+                f"{option} {pick}: {self.path}: /{self.table} has "
+                + (
+                    f"rows 0 to {len(self.X) - 1}"
+                    if self.ids == [str(k) for k in range(len(self.X))]
+                    else f"no design {pick} (its designs: {describe_ids(self.ids)})"
+                )
+            )
+        if row is None:
             raise ConfigError(
-                f"{option} {pick}: {self.path}: /{self.table} has rows 0 to {len(self.X) - 1}"
+                f"{option} {pick}: {self.path} has no such pick; it has "
+                f"{', '.join([*self.picks, 'a design id'])} (its designs: "
+                f"{describe_ids(self.ids)})"
             )
         return row
 
@@ -88,9 +99,9 @@ class DesignTable:
 @dataclass
 class Picked:
     """Designs picked from one table, all of one config: ``names`` (the picks as given),
-    ``rows`` in the table, ``X (P, n)`` physical values of ``var_names`` at ``paths``,
-    ``F (P, m)`` their stored objectives, and ``config`` (resolving relative paths from the
-    file's folder)."""
+    ``rows`` in the table, ``ids`` their design ids (:mod:`suspopt.design_ids`), ``X (P,
+    n)`` physical values of ``var_names`` at ``paths``, ``F (P, m)`` their stored
+    objectives, and ``config`` (resolving relative paths from the file's folder)."""
 
     source: Path
     table: str
@@ -104,23 +115,35 @@ class Picked:
     obj_names: list[str]
     obj_units: list[str]
     config: Config
+    ids: list[str]
 
     def params(self) -> dict[str, np.ndarray]:
         """``simulate``'s params: dotted path -> (P,) values."""
         return {path: self.X[:, j] for j, path in enumerate(self.paths)}
+
+    def labels(self) -> list[str]:
+        """Each design as a figure names it: the pick and its id (``knee (design 13)``), the
+        id alone where the pick was the id."""
+        from .design_ids import find_id
+
+        return [
+            f"design {i}" if find_id([i], name) == 0 else f"{name} (design {i})"
+            for name, i in zip(self.names, self.ids)
+        ]
 
 
 def split_picks(given: list[str]) -> list[str]:
     """``--pick`` values as given (repeatable, each may list several separated by commas)."""
     picks = [p.strip() for item in given for p in item.split(",") if p.strip()]
     if not picks:
-        raise ConfigError("--pick: name a design: knee, best_<objective>, chosen or a row number")
+        raise ConfigError("--pick: name a design: knee, best_<objective>, chosen or a design id")
     return picks
 
 
 def read_table(path: str | Path) -> DesignTable:
     """The design table of an optimise, kesort or analyse file (module docstring);
     ConfigError naming the file and the dataset for anything else."""
+    from .design_ids import table_ids
     from .h5read import H5Reader
     from .kesort import pareto_picks
 
@@ -175,11 +198,13 @@ def read_table(path: str | Path) -> DesignTable:
                 stored = False
         if ((config_of < 0) | (config_of >= len(configs))).any():
             raise ConfigError(f"{path}: /kesort/source: indices beyond /kesort/sets")
+        ids = table_ids(h5, table, len(X))
     if not stored and np.isfinite(F).all():
         picks = pareto_picks(F, obj_names)
     return DesignTable(
-        path, table, X, var_names, var_units, F, obj_names, obj_units, picks, configs, config_of
-    )
+        path, table, X, var_names, var_units, F, obj_names, obj_units, picks, configs, config_of,
+        ids,
+    )  # fmt: skip
 
 
 def _row_picks(h5, rows: int) -> list[str] | None:
@@ -252,6 +277,7 @@ def read_picks(path: str | Path, picks: str | Sequence[str]) -> Picked:
         obj_names=table.obj_names,
         obj_units=table.obj_units,
         config=cfg,
+        ids=[table.ids[r] for r in rows],
     )
 
 
@@ -288,8 +314,8 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
     )
     header = "\n".join(
         [
-            f"# Design {picked.names[i]!r} (row {int(picked.rows[i])} of /{picked.table}) of "
-            f"{picked.source}",
+            f"# Design {picked.names[i]!r} (row {int(picked.rows[i])} of /{picked.table}, design "
+            f"id {picked.ids[i]}) of {picked.source}",
             f"# written by suspopt {__version__}: the stored config with the design's values in "
             f"place.",
             f"# stored objectives: {objectives}",
@@ -323,7 +349,7 @@ def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSe
                 raise
             raise ConfigError(
                 f"{exc}; to analyse designs of it, give --pick (knee, best_<objective>, "
-                f"chosen or row numbers)"
+                f"chosen or design ids)"
             ) from None
     picked = read_picks(path, split_picks(list(picks)))
     first: dict[int, int] = {}  # source row -> row here
@@ -333,7 +359,7 @@ def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSe
         if row not in first:
             first[row] = len(keep)
             keep.append(i)
-        if not name.isdigit():  # (a row number names no design)
+        if not name.isdigit() and name not in picked.ids:  # (an id names no pick)
             marks.setdefault(name, first[row])
     cfg = picked.config
     main = Problem.from_config(cfg).obj_names
@@ -361,6 +387,7 @@ def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSe
         cfg.text,
         picked=marks,
         source_rows=np.array(list(first), dtype=np.int64),
+        ids=tuple(picked.ids[i] for i in keep),
     )
 
 
@@ -370,3 +397,77 @@ def _stores_constraints(path: Path) -> bool:
 
     with H5Reader(path) as h5:
         return "pareto/G" in h5.file
+
+
+def stored_scenario_values(
+    picked: Picked, scenario: int, names: Sequence[str]
+) -> tuple[np.ndarray, str]:
+    """The stored values ``(P, m)`` of the objectives of ``picked`` (its columns
+    ``obj_names``) under the scenario ``scenario`` (an index into the config's scenario
+    ``names``), and a note ("" when there is nothing to say): ``/pareto/scenarios/F`` of
+    the front each design came from at its row there. For a pick of a front, that is its own
+    file; for a pick of a kesort file, the front of its set (``/kesort/sets/file``, as
+    given to kesort or beside the kesort file) at its ``/kesort/row``, when that front still
+    holds the config kesort evaluated it with (otherwise its values are not the ones it was
+    sorted on). NaN where no value is stored (a front of no scenarios, a supplementary
+    objective, a front moved away; the note says which)."""
+    from .h5read import H5Reader
+
+    stored = np.full_like(picked.F, np.nan)
+    origins = _origins(picked)
+    if origins is None:
+        return stored, ""
+    notes = []
+    for front, text, at, rows in origins:
+        if front is None:
+            notes.append(f"{text}: not found; its stored scenario values are not shown")
+            continue
+        with H5Reader(front) as h5:
+            if h5._node("pareto/scenarios/F") is None:
+                continue
+            if text is not None and h5.text_attr("config") != text:
+                notes.append(
+                    f"{front} holds another config than the one {picked.source} sorted its "
+                    f"designs with; their stored scenario values are not shown"
+                )
+                continue
+            F = h5.array("pareto/F", ndim=2)
+            front_names = h5.labels("pareto/F", "names", F.shape[1])
+            FS = h5.array("pareto/scenarios/F", ndim=3, columns=F.shape[1])
+        if FS.shape[1] != len(names) or len(FS) <= rows.max():
+            raise ConfigError(
+                f"{front}: /pareto/scenarios/F: shape {FS.shape} does not fit /pareto/F and "
+                f"the config's {len(names)} scenarios"
+            )
+        for j, name in enumerate(picked.obj_names):
+            if name in front_names:
+                stored[at, j] = FS[rows, scenario, front_names.index(name)]
+    return stored, "; ".join(notes)
+
+
+def _origins(picked: Picked):
+    """Where the designs of ``picked`` came from: ``(front, config text or None, indices in
+    picked, rows in that front's /pareto)`` per front (``front`` None where a kesort
+    file's front is not found; ``config text`` the kesort file's for the set, to check);
+    None for a table that is neither /pareto nor /kesort."""
+    from .h5read import H5Reader
+
+    everything = np.arange(len(picked.rows))
+    if picked.table == "pareto":
+        return [(picked.source, None, everything, picked.rows)]
+    if picked.table != "kesort":
+        return None
+    with H5Reader(picked.source) as h5:
+        count = len(h5.dataset("kesort/sets/file"))
+        files = h5.texts("kesort/sets/file", count)
+        configs = h5.texts("kesort/sets/config", count)
+        source = h5.array("kesort/source", ndim=1, integer=True)[picked.rows]
+        row = h5.array("kesort/row", ndim=1, integer=True)[picked.rows]
+    out = []
+    for k in np.unique(source):
+        given = Path(files[k])
+        beside = picked.source.parent / given
+        front = given if given.is_file() else beside if beside.is_file() else None
+        at = np.flatnonzero(source == k)
+        out.append((front, configs[k] if front is not None else files[k], at, row[at]))
+    return out

@@ -26,9 +26,10 @@ HDF5 layout, every dataset with a ``units`` attribute (one per column for F and 
   variable); ``/kesort/k_eps (N,)``, ``/kesort/k (N,)`` (k-optimality), ``/kesort/chosen``
   (index of the pool's optimum), ``/kesort/ties``; ``/kesort/case (N,)`` labels,
   ``/kesort/source (N,)`` (the Pareto set it came from: index into ``/kesort/sets``),
-  ``/kesort/row (N,)`` (its row in that file's ``/pareto``), ``/kesort/feasible (N,)``;
-  ``/kesort/picks/<best_f1 ... knee>`` (indices); ``/kesort/sets/{file, label, config}``:
-  each Pareto set's file, case label and the YAML text of the config that evaluated it.
+  ``/kesort/row (N,)`` (its row in that file's ``/pareto``), ``/kesort/id (N,)`` (its id:
+  :mod:`suspopt.design_ids`), ``/kesort/feasible (N,)``; ``/kesort/picks/<best_f1 ...
+  knee>`` (indices); ``/kesort/sets/{file, label, config}``: each Pareto set's file, case
+  label and the YAML text of the config that evaluated it.
 - ``/kesort/F_as_built (N, m)`` (``kesort --as-built Q``): the values the designs were
   sorted and picked on, each objective's ``percentile`` (its attribute, [%]) over the
   design's builds; ``F`` then holds their nominal values.
@@ -54,6 +55,7 @@ import numpy as np
 
 from .config import Config, ConfigError, load_config
 from .config.loader import load_config_text
+from .design_ids import picked_note, selection_ids
 from .errors import require
 from .files import listed
 from .io import atomic_h5, write_attrs, write_dataset
@@ -82,9 +84,9 @@ class ParetoSet:
     ``F (N, m)``, ``G (N, k)``, their names and units, and the config's YAML text.
 
     Designs picked from a file (:func:`suspopt.picks.read_front`) have ``picked``, each
-    pick's name -> its row here, and ``source_rows (N,)``, their rows in the file's table;
-    ``G`` is None where the file does not store their constraints (they are evaluated
-    again)."""
+    pick's name -> its row here, ``source_rows (N,)``, their rows in the file's table, and
+    ``ids``, their ids (:func:`suspopt.design_ids.front_ids`); ``G`` is None where the file
+    does not store their constraints (they are evaluated again)."""
 
     path: Path
     X: np.ndarray
@@ -97,6 +99,7 @@ class ParetoSet:
     config_text: str
     picked: dict[str, int] | None = None
     source_rows: np.ndarray | None = None
+    ids: tuple[str, ...] | None = None
 
     def config(self) -> Config:
         """The config the set was optimised with; errors point into the file
@@ -118,15 +121,9 @@ class ParetoSet:
         return named
 
     def picked_note(self) -> list[str]:
-        """The report's note of the designs picked from the file (none for a whole front)."""
-        if self.source_rows is None:
-            return []
-        named = self.marks_by_row()
-        each = [
-            f"{k}: " + (f"{', '.join(named[k])} (row {int(r)})" if k in named else f"row {int(r)}")
-            for k, r in enumerate(self.source_rows)
-        ]
-        return [f"{len(self.X)} design(s) of {self.path.name} (--pick): " + "; ".join(each)]
+        """The report's note of the designs picked from the file, by id (none for a whole
+        front): :func:`suspopt.design_ids.picked_note`."""
+        return picked_note(self)
 
 
 @dataclass(frozen=True)
@@ -583,6 +580,7 @@ def write_selection(path: str | Path, selection: Selection, command: str | None 
         write_dataset(grp, "case", list(s.case), "1", dims=("design",))
         write_dataset(grp, "source", s.source, "1", dims=("design",))
         write_dataset(grp, "row", s.row, "1", dims=("design",))
+        write_dataset(grp, "id", list(selection_ids(s)), "1", dims=("design",))
         write_dataset(grp, "feasible", s.feasible, "1", dims=("design",))
         _write_sort(grp, s.sort, None, s.picks)
         write_attrs(grp, cases=list(s.cases))

@@ -307,7 +307,7 @@ def test_a_picked_design_is_built_as_it_is_in_its_whole_front(ps_front, tmp_path
         for key, values in whole.items():
             assert h5[f"builds/{key}"][()].tobytes() == values[:, [other, knee]].tobytes(), key
     said = " ".join(res.output.split())
-    assert f"2 design(s) of {front.name} (--pick): 0: row {other}; 1: knee (row {knee})" in said
+    assert f"2 design(s) of {front.name} (--pick): design {other}; design {knee} (knee)" in said
 
 
 def test_the_chosen_design_of_a_kesort_file_is_built_as_in_its_front(ps_front, tmp_path):

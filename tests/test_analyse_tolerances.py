@@ -116,7 +116,7 @@ def test_picked_designs_are_analysed_as_in_their_whole_front(ps_front, tmp_path)
         _invoke("analyse", "tolerances", ps_front, "-o", rows_file, "--pick", "0,1").exit_code == 0
     )
     res = _invoke("export", rows_file, "--pick", "knee", "-o", tmp_path / "no.yaml")
-    assert res.exit_code == 2 and "has no such pick; it has a row number" in res.output
+    assert res.exit_code == 2 and "has no such pick; it has a design id" in res.output
 
 
 def test_pick_is_an_option_of_the_front_analyses_alone(ps_front):

@@ -136,11 +136,12 @@ def test_the_designs_picked_are_analysed_and_keep_their_picks(tmp_path, ps_front
         "analyse", "transmissibility", ps_front.path, "-o", out, "--pick", f"{edge},{row},{edge}"
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert f"2 design(s) of {ps_front.path.name} (--pick): 0: {edge} (row " in " ".join(
+    edge_id = ps_front.picks[edge]  # (a front's designs: their rows are their ids)
+    assert f"2 design(s) of {ps_front.path.name} (--pick): design {edge_id} ({edge})" in " ".join(
         proc.stdout.split()
     )
     with h5py.File(out) as h5:
-        assert list(h5["designs"].attrs["picks"].astype(str)) == [edge, f"row {row}"]
+        assert list(h5["designs"].attrs["picks"].astype(str)) == [edge, f"design {row}"]
         np.testing.assert_array_equal(h5["designs/X"][()], ps_front.X[[ps_front.picks[edge], row]])
     res = run("export", out, "--pick", edge, "-o", tmp_path / "edge.yaml")
     assert res.returncode == 0, res.stdout + res.stderr

@@ -66,7 +66,8 @@ def test_a_kesort_knee_re_simulated_gives_its_stored_objectives(kesort_file, tmp
     )
     assert code == 0, err
     legend = figure.read_text()  # (the picks name the curves)
-    assert re.search(r"\bknee F1\.[\w.]+=", legend) and re.search(r"\bchosen F1\.[\w.]+=", legend)
+    named = r"\b{} \(design \d+\) F1\.[\w.]+="  # (each pick with its design id)
+    assert re.search(named.format("knee"), legend) and re.search(named.format("chosen"), legend)
     with h5py.File(ke) as h5:
         rows = [int(h5["kesort/picks/knee"][()]), int(h5["kesort/chosen"][()])]
         stored = h5["kesort/F"][rows]

@@ -312,7 +312,7 @@ def test_the_report_in_a_real_browser(files, chapters, browser, tmp_path, monkey
         "const box = document.getElementById('design-0');"
         " return [box.getAttribute('data-row'), box.textContent, window.suspoptReport.selected.row]"
     )
-    assert shown[0] == str(row) and f"row {row}" in shown[1] and shown[2] == row
+    assert shown[0] == str(row) and f"design {row}" in shown[1] and shown[2] == row
     study = _payload(page.read_text())["studies"][0]["data"]
     lower, upper = study["variable_bounds"]
     ranges = browser.execute_script(  # a variable's axis spans its search range

@@ -338,7 +338,7 @@ def test_simulate_a_pick_under_one_scenario(tmp_path):
     )  # fmt: skip
     assert res.exit_code == 0, res.output
     with h5py.File(report) as h5, h5py.File(front) as src:
-        assert [p.decode() for p in h5["scenarios/pick"][...]] == ["row 0", "knee"]
+        assert [p.decode() for p in h5["scenarios/pick"][...]] == ["design 0", "knee"]
         assert list(h5["scenarios/row"][...]) == [0, knee]
         assert np.array_equal(h5["scenarios/F"][...], src["pareto/scenarios/F"][...][[0, knee]])
     for command in (  # it holds no design set: each command says what it is and made from

@@ -74,6 +74,7 @@ import numpy as np
 
 from ..config import ConfigError
 from ..config.optimise import batches as config_batches
+from ..design_ids import front_ids, id_marks
 from ..io import atomic_h5, write_dataset
 from ..params import MAX_SWEEP_DESIGNS
 from ..picks import read_front
@@ -446,7 +447,7 @@ def _broken(b: Builds) -> str:
             k = int(np.argmax(share))
             parts.append(
                 f"{name} in {100 * broken[..., j].mean():.0f} % of all builds "
-                f"(design {k}: {100 * share[k]:.0f} %)"
+                f"(design {front_ids(b.pareto)[k]}: {100 * share[k]:.0f} %)"
             )
     return "constraints the builds break: " + ("; ".join(parts) if parts else "none")
 
@@ -482,12 +483,12 @@ def _report(b: Builds, title: str) -> Report:
     names, units = b.stored.names, b.stored.units
     low, _, high = b.percentiles(b.change)  # (D, m + s) each
     share = b.feasible.mean(axis=0)
-    columns = ["#", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
+    columns = ["design", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
     columns += [f"{n}: 5-95 % (change)" for n in names] + ["feasible builds"]
-    picks = table_designs(len(p.X), p.marks_by_row())
+    picks, ids = table_designs(len(p.X), p.marks_by_row()), front_ids(p)
     lost, every = b.stored_failed, np.asarray(b.failed.all(axis=0), dtype=bool)  # (D,) each
     rows = [
-        [str(k), picked]
+        [ids[k], picked]
         + stored_cells(p.F[k], lost[k])
         + [_spread(lo, hi, every[k]) for lo, hi in zip(low[k], high[k])]
         + [f"{100 * share[k]:.0f} %"]
@@ -503,11 +504,11 @@ def _report(b: Builds, title: str) -> Report:
         *b.stored.notes,
     ]
     if lost.any():
-        notes.append(failed_stored_note(lost))
+        notes.append(failed_stored_note(lost, ids))
     if NOT_COMPUTED in shown:
         notes.append(NOT_COMPUTED_NOTE)
     worst = [
-        f"{name} {percent(high[k, j], '.3g')} (design {k})"
+        f"{name} {percent(high[k, j], '.3g')} (design {ids[k]})"
         for j, name in enumerate(names)
         if np.isfinite(high[:, j]).any()
         for k in [int(np.nanargmax(high[:, j]))]
@@ -516,7 +517,7 @@ def _report(b: Builds, title: str) -> Report:
         notes.append("largest 95th percentile of each objective's change: " + "; ".join(worst))
     k = int(np.argmin(share))
     notes.append(
-        f"feasible builds: {100 * share[k]:.0f} % at the least (design {k}); "
+        f"feasible builds: {100 * share[k]:.0f} % at the least (design {ids[k]}); "
         f"every build feasible in {int((share == 1).sum())} of {_designs(len(p.X))}"
     )
     notes.append(_broken(b))
@@ -544,7 +545,7 @@ def plot_builds(b: Builds, path: str | Path, title: str) -> Path:
     curves.append(("builds: 95th percentile", high))
     variables = [(n, u, p.X[:, j]) for j, (n, u) in enumerate(zip(p.var_names, p.var_units))]
     objectives = list(zip(b.stored.names[:m], b.stored.units[:m]))
-    marks, comfort = p.marks(), is_comfort(p.config())
+    marks, comfort = id_marks(p, p.marks()), is_comfort(p.config())
     built = b.F[..., :m][~b.failed]  # (builds that did not fail, m)
     return plots.pareto_fronts(
         path, title, objectives, curves, variables, marks=marks, comfort=comfort,

@@ -13,6 +13,7 @@ are not computed (:func:`stored_reference`).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -91,10 +92,12 @@ def stored_cells(values, failed: bool) -> list[str]:
     return ["failed" if failed else f"{f:.4g}" for f in values]
 
 
-def failed_stored_note(failed: np.ndarray) -> str:
-    """The note of a report of a front some of whose stored designs ``failed`` (N,)."""
+def failed_stored_note(failed: np.ndarray, ids: Sequence[str] | None = None) -> str:
+    """The note of a report of a front some of whose stored designs ``failed`` (N,), named
+    by their ``ids`` (:mod:`suspopt.design_ids`; default their row numbers)."""
     rows = np.flatnonzero(failed)
-    shown = ", ".join(str(int(k)) for k in rows[:10]) + (", ..." if len(rows) > 10 else "")
+    name = (lambda k: str(int(k))) if ids is None else (lambda k: ids[int(k)])
+    shown = ", ".join(name(k) for k in rows[:10]) + (", ..." if len(rows) > 10 else "")
     return (
         f"{len(rows)} of {failed.size} stored designs failed (design {shown}: the file holds "
         f"the optimiser's penalty values, or their re-simulation failed); their changes "

@@ -37,8 +37,10 @@ HDF5 layout (root attributes as every suspopt file, ``config`` = the stored conf
 ``analysis`` (the kind) and ``source`` (the Pareto file)); every dataset has ``units`` (one per
 column for X, F, S, as ``suspopt optimise`` writes them; X, F, S also ``names``):
 
-- ``/pareto/X (N, n)``, ``/pareto/F (N, m)``: the stored front, ``/pareto/feasible (N,)``, and
-  ``/pareto/S (N, s)``, its supplementary objectives re-simulated (if the config has any);
+- ``/pareto/X (N, n)``, ``/pareto/F (N, m)``: the stored front, ``/pareto/feasible (N,)``,
+  ``/pareto/id (N,)`` the designs' ids (:mod:`suspopt.design_ids`; ``source_row`` their rows
+  in the file given, with ``--pick``), and ``/pareto/S (N, s)``, its supplementary objectives
+  re-simulated (if the config has any);
 - ``/pseudo`` with attribute ``labels``; per change ``/pseudo/<label>/``: ``F (N, m)``,
   ``S (N, s)`` (if any), ``change (N, m)`` and ``S_change (N, s)`` [%], ``feasible (N,)``,
   ``failed (N,)`` [1], and ``X (N, n)`` when the change alters the designs' own values;
@@ -65,6 +67,7 @@ import numpy as np
 from .. import plots
 from ..config import Config, ConfigError
 from ..config.loader import edit_config, line_of, set_path
+from ..design_ids import front_ids, id_marks
 from ..files import Unreadable, listed, status
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..picks import read_front
@@ -418,6 +421,7 @@ def write_stored_front(h5, kind: str, pareto: ParetoSet, stored: DesignSet) -> N
         write_dataset(picks, key, row, "1")
     if pareto.source_rows is not None:  # (designs picked from the file)
         write_dataset(grp, "source_row", pareto.source_rows, "1", dims=("design",))
+    write_dataset(grp, "id", front_ids(pareto), "1", dims=("design",))
     if len(names) > m:
         _columns(grp, "S", stored.F[:, m:], "supplementary", names[m:], units[m:])
 
@@ -479,7 +483,7 @@ def plot_pseudo_fronts(
         objectives,
         curves,
         variables,
-        marks=fronts.picks if marks is None else marks,
+        marks=id_marks(p, fronts.picks if marks is None else marks),
         comfort=is_comfort(p.config()),
     )
 
@@ -496,16 +500,16 @@ def table_designs(N: int, picked: Mapping[int, list[str]]) -> list[tuple[int, st
 def _report(fronts: PseudoFronts, title: str) -> Report:
     p, m = fronts.pareto, fronts.m
     names, units = fronts.stored.names, fronts.stored.units
-    columns = ["#", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
+    columns = ["design", "pick"] + [f"{n} [{u}]" for n, u in zip(names[:m], units[:m])]
     for v in fronts.variants:
         columns += [f"{v.label}: {n} (change)" for n in names[:m]]
     values = [fronts.values(i) for i in range(len(fronts.sets))]
     changes = [fronts.change(i) for i in range(len(fronts.sets))]
     rows = []
-    lost = fronts.stored_failed
+    lost, ids = fronts.stored_failed, front_ids(p)
     shown_na = False
     for k, picks in table_designs(len(p.X), p.marks_by_row()):
-        row = [str(k), picks] + cells.stored_cells(p.F[k], lost[k])
+        row = [ids[k], picks] + cells.stored_cells(p.F[k], lost[k])
         for s, value, change in zip(fronts.sets, values, changes):
             row += [
                 "failed" if s.failed[k] else f"{f:.4g} ({cells.percent(c, '.0f')})"
@@ -522,7 +526,7 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
         *fronts.stored.notes,
     ]
     if lost.any():
-        notes.append(cells.failed_stored_note(lost))
+        notes.append(cells.failed_stored_note(lost, ids))
     if shown_na:
         notes.append(cells.NOT_COMPUTED_NOTE)
     for v, s, change in zip(fronts.variants, fronts.sets, changes):

@@ -124,13 +124,17 @@ def run(
             f"{source.name}: the front's picks under each scenario",
             names,
             [
-                (name, unit, {f"{pick} (row {row})": FS[row, :, j] for pick, row in picks.items()})
+                (
+                    name,
+                    unit,
+                    {f"{pick} (design {row})": FS[row, :, j] for pick, row in picks.items()},
+                )
                 for j, (name, unit) in enumerate(zip(pareto.obj_names, units))
             ],
         )
     return Report(
         title=f"{source.name}: the picks under {len(names)} scenarios",
-        columns=["pick", "row", "objective", "combined", "min", "mean", "max",
+        columns=["pick", "design", "objective", "combined", "min", "mean", "max",
                  "worst scenario", "feasible in"],
         rows=table,
         notes=notes,
@@ -140,8 +144,8 @@ def run(
 def _picks(source: Path, F: np.ndarray, names: list[str], pick: Picks) -> dict[str, int]:
     """The designs reported, name -> row: the front's edges and knee
     (:func:`suspopt.kesort.pareto_picks`), or those ``pick`` names (``--pick``: names of the
-    file's table or row numbers, comma-separated or repeated; a row number is named ``row
-    R``), each name once."""
+    file's table or design ids, its rows, comma-separated or repeated; an id is named
+    ``design ID``), each name once."""
     if not pick:
         return pareto_picks(F, names)
     from ..picks import read_table, split_picks
@@ -150,7 +154,7 @@ def _picks(source: Path, F: np.ndarray, names: list[str], pick: Picks) -> dict[s
     chosen: dict[str, int] = {}
     for name in split_picks(list(pick)):
         row = table.resolve(name)
-        chosen.setdefault(f"row {row}" if name.isdigit() else name, row)
+        chosen.setdefault(f"design {row}" if name.isdigit() else name, row)
     return chosen
 
 

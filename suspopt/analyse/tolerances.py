@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from ..config import ConfigError
+from ..design_ids import front_ids
 from ..files import listed
 from ..params import field_range
 from ..selection import ParetoSet
@@ -185,7 +186,8 @@ def _largest_changes(fronts: PseudoFronts) -> str:
             continue
         i, row = np.unravel_index(np.nanargmax(np.abs(changes)), changes.shape)
         parts.append(
-            f"{name} {percent(changes[i, row], '.3g')} ({fronts.variants[i].label}, design {row})"
+            f"{name} {percent(changes[i, row], '.3g')} ({fronts.variants[i].label}, design "
+            f"{front_ids(fronts.pareto)[row]})"
         )
     return "largest change of each objective: " + ("; ".join(parts) or NOT_COMPUTED)
 

@@ -38,8 +38,9 @@ HDF5 layout (every dataset has a ``units`` attribute; root attributes as every s
 - ``/weighted_rms/<signal> (P,)`` [m/s^2]: ISO 2631-1 Wk r.m.s. of ``seat.acc`` and
   ``head.acc`` in the simulation;
 - for a Pareto file, ``/designs/X (P, n)`` and ``/designs/F (P, m)`` (with ``names``, one unit
-  per column), ``/designs/row (P,)`` [1] (the rows of the file's ``/pareto``) and the attribute
-  ``picks`` of ``/designs`` (each design's pick names, e.g. ``best_X_ST``, ``knee``).
+  per column), ``/designs/row (P,)`` [1] (the rows of the file's ``/pareto``), ``/designs/id
+  (P,)`` [1] (the designs' ids, :mod:`suspopt.design_ids`) and the attribute ``picks`` of
+  ``/designs`` (each design's pick names, e.g. ``best_X_ST``, ``knee``).
 - dimensions (:func:`suspopt.io.write_dataset`): ``/design (P,)`` (row numbers), the
   ``frequency`` of ``/linear`` and of ``/simulated``, ``/modal/mode`` (numbering the modes),
   ``/designs/variable`` and ``/designs/objective`` (the names of the columns of X and F).
@@ -48,7 +49,7 @@ HDF5 layout (every dataset has a ``units`` attribute; root attributes as every s
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +57,7 @@ import numpy as np
 from .. import plots
 from ..config import Config, ConfigError, load_config
 from ..config.loader import require_config
+from ..design_ids import front_ids
 from ..files import is_hdf5
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..metrics import coherence, transmissibility, weighted_rms
@@ -124,7 +126,8 @@ class SeatTransmissibility:
 class FrontDesigns:
     """Designs picked from a Pareto front: ``rows (P,)`` in the file's ``/pareto``, their
     ``X (P, n)`` physical values and ``F (P, m)`` objectives (names, SI units), and the
-    ``picks`` each design is (e.g. ``["best_X_ST"]``, ``["best_RC_se", "knee"]``)."""
+    ``picks`` each design is (e.g. ``["best_X_ST"]``, ``["best_RC_se", "knee"]``), and
+    ``ids`` their design ids (:mod:`suspopt.design_ids`)."""
 
     rows: np.ndarray
     picks: list[list[str]]
@@ -135,6 +138,7 @@ class FrontDesigns:
     obj_names: list[str]
     obj_units: list[str]
     paths: list[str]
+    ids: list[str] = field(default_factory=list)
 
     def params(self) -> dict[str, np.ndarray]:
         """``simulate``'s ``params`` of the picked designs (dotted path -> (P,))."""
@@ -191,13 +195,13 @@ def seat_transmissibility(
 def front_designs(pareto: ParetoSet) -> FrontDesigns:
     """The edges and the knee of ``pareto``'s front (:func:`suspopt.kesort.pareto_picks`),
     each design once, in the order of the picks; of designs picked from a file
-    (:func:`suspopt.picks.read_front`), every one, by the names it was picked by (``row
-    R`` for a row number)."""
+    (:func:`suspopt.picks.read_front`), every one, by the names it was picked by (``design
+    ID`` for an id)."""
     cfg = pareto.config()
     problem = Problem.from_config(cfg)
-    picks = pareto.marks_by_row()
+    picks, ids = pareto.marks_by_row(), front_ids(pareto)
     if pareto.source_rows is not None:
-        picks = {k: picks.get(k, [f"row {int(r)}"]) for k, r in enumerate(pareto.source_rows)}
+        picks = {k: picks.get(k, [f"design {ids[k]}"]) for k in range(len(pareto.source_rows))}
     rows = np.array(list(picks))
     path_of = {v.label: v.path for v in cfg.design_variables}
     if sorted(path_of) != sorted(pareto.var_names):
@@ -216,6 +220,7 @@ def front_designs(pareto: ParetoSet) -> FrontDesigns:
         obj_names=pareto.obj_names,
         obj_units=problem.obj_units,
         paths=[path_of[name] for name in pareto.var_names],
+        ids=[ids[k] for k in rows],
     )
 
 
@@ -292,6 +297,7 @@ def write_transmissibility(
             grp = h5.create_group("designs")
             write_attrs(grp, picks=[", ".join(p) for p in designs.picks])
             write_dataset(grp, "row", designs.rows, "1", dims=("design",))
+            write_dataset(grp, "id", designs.ids, "1", dims=("design",))
             for key, values, units, dim, names in (
                 ("X", designs.X, designs.var_units, "variable", designs.var_names),
                 ("F", designs.F, designs.obj_units, "objective", designs.obj_names),
@@ -352,7 +358,7 @@ def plot_front_transmissibility(
             (
                 p,
                 j,
-                f"{' = '.join(picks)} (#{designs.rows[p]}, X_ST "
+                f"{' = '.join(picks)} (design {designs.ids[p]}, X_ST "
                 f"{1e3 * data.static_deflection[p]:.1f} mm)",
                 f"{' = '.join(picks)} (simulated, H1)",
             )
@@ -415,7 +421,7 @@ def _run_front(
         rows.append(
             [
                 " = ".join(picks),
-                str(designs.rows[p]),
+                designs.ids[p],
                 *(f"{f:.4g}" for f in designs.F[p]),
                 f"{1e3 * data.static_deflection[p]:.2f}",
                 f"{lin[0]:.3f} @ {lin[1]:.2f}",
@@ -424,8 +430,8 @@ def _run_front(
             ]
         )
     columns = [
+        "pick",
         "design",
-        "#",
         *(f"{n} [{u}]" for n, u in zip(designs.obj_names, designs.obj_units)),
         "X_ST simulated [mm]",
         f"{label} peak, linear [- @ Hz]",

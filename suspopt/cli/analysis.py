@@ -33,7 +33,7 @@ _TOLERANCE_HELP = (
 
 _PICK_HELP = (
     "roads, masses, controllers, tolerances, builds, transmissibility: analyse only these "
-    "designs of the file (knee, best_<objective>, chosen of a kesort file, or row numbers; "
+    "designs of the file (knee, best_<objective>, chosen of a kesort file, or design ids; "
     "comma-separated or repeated), from any file simulate --pick reads; scenarios: these "
     "designs of its robust front"
 )

@@ -123,7 +123,8 @@ def export(
     pick: list[str] = typer.Option(
         [],
         "--pick",
-        help="the design to write as a config: knee, best_<objective>, chosen or a row number",
+        help="the design to write as a config: knee, best_<objective>, chosen or a design id "
+        "(its row in the front it came from)",
     ),
     output: Path | None = typer.Option(
         None, "-o", "--output", help="YAML file for the picked design"
@@ -166,4 +167,4 @@ def export(
                 stream.write(signed_config(text).encode())
         except ConfigError as exc:
             fail(str(exc))
-    out.print(f"wrote {output} (design {names[0]!r}, row {int(picked.rows[0])} of {source})")
+    out.print(f"wrote {output} (design {picked.ids[0]} of {source}, --pick {names[0]})")

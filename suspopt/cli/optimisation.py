@@ -60,7 +60,10 @@ def _baseline_line(result) -> str | None:
 
 def _optimum_table(result, rows: int = 12) -> Table:
     """The best design (one column), or up to ``rows`` designs spread along the Pareto front
-    (one row each)."""
+    (one row each; ``design``: its row in ``/pareto``, its id, :mod:`suspopt.design_ids`).
+    The Pareto set is the optimiser's optimum: the non-dominated designs of the last
+    generation's population (pymoo's ``opt``; the feasible ones where any is), which the
+    title says, with the generation."""
     import numpy as np
 
     N = len(result.X)
@@ -86,8 +89,17 @@ def _optimum_table(result, rows: int = 12) -> Table:
     from ..plots.runs import evenly_spaced
 
     pick = evenly_spaced(N, rows)
-    table = base.new_table(f"Pareto set: {len(pick)} of {N} designs, by {names[0]}" + suffix)
-    table.add_column("#", justify="right")
+    generations = result.history.get("generation", ())
+    last = f"generation {int(generations[-1])}" if len(generations) else "the last generation"
+    shown = (
+        f", by {names[0]}"
+        if len(pick) == N
+        else (f"; {len(pick)} of them shown, evenly spaced by {names[0]}")
+    )
+    table = base.new_table(
+        f"Pareto set: the {N} non-dominated designs of {last}'s population{shown}" + suffix
+    )
+    table.add_column("design", justify="right")
     for name, unit in zip(names, units):
         table.add_column(f"{name} [{unit}]", justify="right")
     table.add_column("feasible")

@@ -24,7 +24,7 @@ def report(
     with_signals: list[str] = typer.Option(
         [],
         "--with-signals",
-        help="designs (row numbers or pick names) whose signals to show besides the picks'; "
+        help="designs (design ids or pick names) whose signals to show besides the picks'; "
         "repeatable, or separated by commas",
     ),
     title: str | None = typer.Option(None, "--title", help="the page's title"),

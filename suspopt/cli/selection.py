@@ -25,8 +25,13 @@ def _floats(option: str, text: str) -> list[float]:
 
 def _kesort_tables(sel) -> list[Table]:
     """The optimum of each case and of the pool (the form of Tables 6.2-6.3, 7.5-7.6), then
-    the Pareto picks of the pool."""
+    the Pareto picks of the pool; each design named by its id (its row in the front it came
+    from, ``NAME:ROW`` when pooled: :mod:`suspopt.design_ids`), which ``--pick`` takes."""
     import numpy as np
+
+    from ..design_ids import selection_ids
+
+    ids = selection_ids(sel)
 
     columns = [(f"{label} optimum", cs.chosen) for label, cs in sel.case_sorts.items()]
     columns.append(("optimum among all" if sel.case_sorts else "k-ε optimum", sel.chosen))
@@ -39,7 +44,7 @@ def _kesort_tables(sel) -> list[Table]:
     rows = [i for _, i in columns]
     for title, _ in columns:
         table.add_column(title, justify="right")
-    table.add_row("design #", "", *(str(i) for i in rows))
+    table.add_row("design", "", *(ids[i] for i in rows))
     table.add_row("case", "", *(str(sel.case[i]) for i in rows))
     if sel.case_sorts:
         table.add_row("k-ε level in its case", "1", *(f"{sel.level_in_case(i):.3f}" for i in rows))
@@ -67,14 +72,14 @@ def _kesort_tables(sel) -> list[Table]:
     if sel.F_as_built is not None:
         title += f", as built: the {sel.as_built:g}th percentiles they were picked on"
     picks = base.new_table(title)
-    for col in ("pick", "design #", "case", "k-ε level"):
+    for col in ("pick", "design", "case", "k-ε level"):
         picks.add_column(col, justify="left" if col in ("pick", "case") else "right")
     for name, unit in zip(sel.names, sel.units):
         picks.add_column(f"{name} [{unit}]", justify="right")
     for key, i in sel.picks.items():
         picks.add_row(
             key,
-            str(i),
+            ids[i],
             str(sel.case[i]),
             f"{sel.sort.k_eps[i]:.3f}",
             *(f"{v:.4g}" for v in sel.F_sorted[i]),

@@ -97,7 +97,8 @@ def _metrics_table(result, picked=None) -> Table:
 
 _PICK_HELP = (
     "designs of a result file to simulate: knee, best_<objective>, chosen (the k-ε "
-    "optimum of a kesort file) or a row number; repeatable, or separated by commas"
+    "optimum of a kesort file) or a design id (its row in the front it came from, NAME:ROW "
+    "when kesort pooled fronts); repeatable, or separated by commas"
 )
 
 
@@ -154,7 +155,7 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
         if not pick:
             base.fail(
                 f"{source} is a result file: name the designs to simulate with --pick "
-                f"(knee, best_<objective>, chosen or a row number)"
+                f"(knee, best_<objective>, chosen or a design id)"
             )
         if sweeps:
             base.fail("--sweep takes a config; with --pick the designs are the picked ones")
@@ -175,11 +176,10 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
 def _under_scenario(cfg, params, picked, name: str):
     """The config and designs of ``simulate --scenario NAME``: the scenario's road and time
     grid, its per-design values over the designs' own; the picks' stored objectives become
-    that scenario's (``/pareto/scenarios/F``), or NaN where the file has none."""
+    that scenario's (:func:`suspopt.picks.stored_scenario_values`), or NaN where there are
+    none."""
     import dataclasses
     import difflib
-
-    import numpy as np
 
     from ..optimise.scenarios import Group, ScenarioSet
 
@@ -207,25 +207,18 @@ def _under_scenario(cfg, params, picked, name: str):
     P = len(next(iter(params.values()))) if params else 1
     params = scenarios.columns(alone, dict(params or {}), P) or None
     if picked is not None:
-        stored = np.full_like(picked.F, np.nan)
-        if picked.table == "pareto":
-            from ..h5read import H5Reader
+        from ..picks import stored_scenario_values
 
-            with H5Reader(picked.source) as h5:
-                if h5._node("pareto/scenarios/F") is not None:
-                    FS = h5.array("pareto/scenarios/F", ndim=3, columns=picked.F.shape[1])
-                    if FS.shape[1] != len(scenarios.names) or len(FS) <= picked.rows.max():
-                        raise ConfigError(
-                            f"{picked.source}: /pareto/scenarios/F: shape {FS.shape} does "
-                            f"not fit /pareto/F and the config's {len(scenarios.names)} scenarios"
-                        )
-                    stored = FS[picked.rows, s]
+        stored, note = stored_scenario_values(picked, s, scenarios.names)
+        if note:
+            err.print(f"note: {note}")
         picked = dataclasses.replace(picked, F=stored)
     return member_cfg, params, picked
 
 
 def _picks_writer(picked, objectives):
-    """Writes the picks' names, rows and objectives (new and stored) beside the signals."""
+    """Writes the picks' names, rows, ids (:mod:`suspopt.design_ids`) and objectives (new and
+    stored) beside the signals."""
     from ..io import write_dataset
 
     def extra(h5) -> None:
@@ -234,6 +227,7 @@ def _picks_writer(picked, objectives):
         designs.attrs["source"] = str(picked.source)
         write_dataset(designs, "pick", list(picked.names), "1", dims=("design",))
         write_dataset(designs, "row", picked.rows, "1", dims=("design",))
+        write_dataset(designs, "id", list(picked.ids), "1", dims=("design",))
         group = h5.create_group("objectives")
         write_dataset(group, "F", F, units, dims=("design", "objective"), names=names)
         write_dataset(
@@ -306,9 +300,7 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
         base.show_table(_metrics_table(result, picked), keys=2)
     extra = None
     if picked is not None:
-        objectives = _pick_objectives(picked, cfg, result, params)
-        base.show_table(_picks_table(picked, *objectives), keys=3)
-        extra = _picks_writer(picked, objectives)
+        extra = _show_picks(picked, cfg, result, params)
     if output is not None:
         started = time.perf_counter()
         write_simulation(
@@ -324,8 +316,23 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
     if plot is not None:
         from ..plots import plot_simulation
 
-        plot_simulation(result, plot, design_names=None if picked is None else picked.names)
+        plot_simulation(result, plot, design_names=None if picked is None else picked.labels())
         out.print(f"wrote {plot}")
+
+
+def _show_picks(picked, cfg, result, params):
+    """Show the picks' objectives, stored and simulated now (:func:`_picks_table`), with a
+    note where the stored ones are the spectral method's; return the writer of them
+    (:func:`_picks_writer`)."""
+    objectives = _pick_objectives(picked, cfg, result, params)
+    base.show_table(_picks_table(picked, *objectives), keys=3)
+    if cfg.simulation.method == "spectral":  # (stored: stationary; here: in time)
+        out.print(
+            f"note: the stored values are the spectral method's (stationary); simulate "
+            f"integrates {cfg.simulation.duration:g} s in time: they differ by the finite "
+            f"road's error (docs/guide/spectral.md)"
+        )
+    return _picks_writer(picked, objectives)
 
 
 def _pick_objectives(picked, cfg, result, params):
@@ -349,7 +356,7 @@ def _picks_table(picked, F, names, units) -> Table:
     import numpy as np
 
     table = base.new_table(f"{picked.source.name}: the picked designs' objectives")
-    for col in ("pick", "row", "objective", "stored", "simulated", "change"):
+    for col in ("pick", "design", "objective", "stored", "simulated", "change"):
         table.add_column(col, justify="left" if col in ("pick", "objective") else "right")
     for i, name in enumerate(picked.names):
         for j, (objective, unit) in enumerate(zip(names, units)):
@@ -363,7 +370,7 @@ def _picks_table(picked, F, names, units) -> Table:
             change = f"{relative:+.1e}" if np.isfinite(relative) else ""
             table.add_row(
                 name if j == 0 else "",
-                str(int(picked.rows[i])) if j == 0 else "",
+                picked.ids[i] if j == 0 else "",
                 f"{objective} [{unit}]",
                 "" if np.isnan(stored) else f"{stored:.6g}",
                 f"{F[i, j]:.6g}",

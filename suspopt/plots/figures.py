@@ -165,9 +165,13 @@ def transmissibilities(
 
 
 def _mark_optima(ax, x: np.ndarray, y: np.ndarray, s) -> None:
-    """The pool's k-ε optimum (a red star) and each case's own (open squares) at ``(x, y)``."""
+    """The pool's k-ε optimum (a red star, its id in the legend: :mod:`suspopt.design_ids`)
+    and each case's own (open squares) at ``(x, y)``."""
+    from ..design_ids import selection_ids
+
+    label = f"optimum (all): design {selection_ids(s)[s.sort.chosen]}"
     optimum = dict(marker="*", s=260, facecolor="none", edgecolor="red", linewidth=1.5)
-    ax.scatter(x[s.sort.chosen], y[s.sort.chosen], label="optimum (all)", zorder=3, **optimum)
+    ax.scatter(x[s.sort.chosen], y[s.sort.chosen], label=label, zorder=3, **optimum)
     own = dict(marker="s", s=110, facecolor="none", edgecolor="black", linewidth=1.0)
     for j, cs in enumerate(s.case_sorts.values()):
         label = "optimum of each case" if j == 0 else None
@@ -181,10 +185,12 @@ def plot_kesort(selection, path: str | Path) -> Path:
     Left: the first two objectives (the main ones of Ch. 6-7, Fig. 7.5a/7.6), one marker per
     case, coloured by the pool's k-ε level; the pool's optimum is a star, each case's own
     optimum an open square, the Pareto picks (edges and knee, Fig. 8.21) are labelled. Right:
-    the k-ε level of every design against the first objective (Fig. 6.7). With one objective
+    the k-ε level of every design against the first objective (Fig. 6.7). Designs are named
+    by their ids (:mod:`suspopt.design_ids`), as ``--pick`` takes them. With one objective
     only the right panel is drawn. A selection sorted as built (``kesort --as-built``) is
     drawn at the values it was sorted on (``F_as_built``), as its axes say.
     """
+    from ..design_ids import selection_ids
     from ..errors import require
     from ..selection import Selection
 
@@ -219,9 +225,10 @@ def plot_kesort(selection, path: str | Path) -> Path:
         at: dict[int, list[str]] = {}
         for key, i in s.picks.items():
             at.setdefault(i, []).append(key)
+        ids = selection_ids(s)
         for i, keys in at.items():
             front.annotate(
-                ", ".join(keys),
+                f"{', '.join(keys)} (design {ids[i]})",
                 (F[i, 0], F[i, 1]),
                 textcoords="offset points",
                 xytext=(6, 6),

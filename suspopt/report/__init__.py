@@ -21,6 +21,9 @@ browser and makes no network request. Per study:
 - hover and click on a design: its row, objectives with units, variables (those at a
   bound marked), constraint margins, in the panel beside the plot, and the ``suspopt export`` and ``simulate``
   commands that take it on (the file's path as given, quoted for a POSIX shell);
+- every design named by its id (``ids`` in the page's data, :mod:`suspopt.design_ids`: its
+  row in the front it came from), in the panel, the hover texts, the legends and the
+  commands, as ``--pick`` takes it;
 - the picks' (and ``with_signals`` rows') time histories and power spectral densities
   [unit²/Hz], simulated when the report is built (from each design's own config, in one
   batch per config), each history thinned to at most about :data:`MAX_SAMPLES` samples with
@@ -115,6 +118,7 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
         "F": _list(table.F),
         "X": _list(table.X),
         "picks": table.picks,
+        "ids": table.ids,  # (each row's design id: suspopt.design_ids, as --pick takes it)
         "source": shlex.quote(str(path)),  # (as given, for the commands that take a row on)
         "provenance": attrs,
         **extra,
@@ -281,7 +285,7 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
         by_config.setdefault(int(table.config_of[row]), []).append(row)
     results = []
     for group_rows in by_config.values():  # one batch per config (the pooled sets of kesort)
-        picked = read_picks(path, [str(r) for r in group_rows])
+        picked = read_picks(path, [table.ids[r] for r in group_rows])
         with np.errstate(all="ignore"):
             results.append((group_rows, simulate(picked.config, picked.params())))
         if picked.config.seat is not None:

@@ -69,11 +69,13 @@ SCRIPT = r"""
     }
   }
 
+  function designId(d, row) { return d.ids ? d.ids[row] : String(row); }  // (suspopt.design_ids)
   function showDesign(i, row) {
     const study = data.studies[i], d = study.data, box = document.getElementById("design-" + i);
     if (row === "config") return showBaseline(i, d, box);
     box.textContent = "";
-    el("h3", "row " + row, box);
+    const id = designId(d, row);
+    el("h3", "design " + id, box);
     const picks = Object.entries(d.picks).filter(([, r]) => r === row).map(([n]) => n);
     if (picks.length) el("div", "pick: " + picks.join(", "), box);
     const t = el("table", null, box);
@@ -95,9 +97,10 @@ SCRIPT = r"""
     const onward = el("div", null, box);  // (paths as given to suspopt report)
     onward.className = "onward";
     el("div", "take it on (from where the report was made):", onward);
-    el("code", "suspopt export " + d.source + " --pick " + row + " -o design_" + row + ".yaml", onward);
-    el("code", "suspopt simulate " + d.source + " --pick " + row + " -o design_" + row + ".h5 --plot design_" + row + ".png", onward);
-    el("code", "suspopt analyse builds " + d.source + " --pick " + row + " -o design_" + row + "_builds.h5", onward);
+    const file = "design_" + id.replace(/[^A-Za-z0-9_.-]/g, "_");
+    el("code", "suspopt export " + d.source + " --pick " + id + " -o " + file + ".yaml", onward);
+    el("code", "suspopt simulate " + d.source + " --pick " + id + " -o " + file + ".h5 --plot " + file + ".png", onward);
+    el("code", "suspopt analyse builds " + d.source + " --pick " + id + " -o " + file + "_builds.h5", onward);
     api.selected = { study: i, row: row };
     box.setAttribute("data-row", String(row));
   }
@@ -189,7 +192,7 @@ SCRIPT = r"""
       return;
     }
     el("div", "simulate them in one batch (from where the report was made):", box);
-    el("code", "suspopt simulate " + data.studies[i].data.source + " --pick " + rows.join(",") + " -o brushed.h5", box);
+    el("code", "suspopt simulate " + data.studies[i].data.source + " --pick " + rows.map(r => designId(data.studies[i].data, r)).join(",") + " -o brushed.h5", box);
   }
 
   function baselineTrace(d, x, y) {  // the config's own design: where the run started
@@ -204,7 +207,7 @@ SCRIPT = r"""
     const c = document.getElementById("c-" + i).value;
     const three = document.getElementById("d3-" + i);
     const rows = d.F.map((_, r) => r);
-    const hover = rows.map(r => "row " + r + "<br>" + d.objectives.map((n, j) => n + " " + fmt(d.F[r][j])).join("<br>"));
+    const hover = rows.map(r => "design " + designId(d, r) + "<br>" + d.objectives.map((n, j) => n + " " + fmt(d.F[r][j])).join("<br>"));
     const marker = Object.assign(colouring(study, c), { showscale: true, size: 7 });
     const traces = [], labels = [];
     const use3d = three && three.checked;
@@ -350,11 +353,11 @@ SCRIPT = r"""
   }
 
   function drawSignals(i) {
-    const s = data.studies[i].data.signals;
+    const d = data.studies[i].data, s = d.signals;
     const names = Object.keys(s.signals);
     if (!names.length) return Promise.resolve();
     const pick = document.getElementById("s-" + i).value;
-    const labels = s.rows.map(row => "row " + row);
+    const labels = s.rows.map(row => "design " + designId(d, row));
     const traces = charts.lines(s.time, s.signals[pick], labels, "");
     const spectra = charts.lines(s.psd_f, s.psd[pick], labels, "");
     const unit = s.units[pick], range = s.psd_range[pick], below = { orientation: "h", y: -0.2 };
@@ -371,11 +374,11 @@ SCRIPT = r"""
   }
 
   function drawTransmissibility(i) {
-    const t = data.studies[i].data.signals.transmissibility;
+    const d = data.studies[i].data, t = d.signals.transmissibility;
     if (!t) return Promise.resolve();
     const traces = [];
     for (const [dof, curves] of Object.entries(t.dofs)) {
-      traces.push(...charts.lines(t.f, curves, t.rows.map(row => "row " + row),
+      traces.push(...charts.lines(t.f, curves, t.rows.map(row => "design " + designId(d, row)),
         (dof === "head" ? "STHT (head)" : dof) + ", ", { line: { dash: dof === "head" ? "solid" : "dot" } }));
     }
     return Plotly.newPlot("tr-" + i, traces, { xaxis: { title: { text: "frequency [Hz]" }, type: "log" },
