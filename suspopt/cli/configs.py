@@ -12,6 +12,7 @@ import typer
 from ..errors import ConfigError
 from .base import (
     app,
+    check_suffix,
     claim_output,
     err,
     fail,
@@ -100,6 +101,7 @@ def init(
             text = template_text(kind)
         except ValueError as exc:
             fail(f"init: {exc}")
+        check_suffix(output, "yaml")
         claim_output(stack, output, force)
         try:
             with atomic_file(output) as stream:
@@ -156,6 +158,7 @@ def export(
             from ..picks import design_config, read_picks, split_picks
             from ..signature import signed_config
 
+            check_suffix(output, "yaml")
             claim_output(stack, output, force, inputs=[("the input", source)])
             names = split_picks(pick)
             if len(names) != 1:

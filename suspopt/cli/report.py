@@ -37,6 +37,7 @@ def report(
     from ..report import build_report
 
     rows = [r.strip() for item in with_signals for r in item.split(",") if r.strip()]
+    base.check_suffix(output, "html")
     with ExitStack() as stack:
         base.claim_output(stack, output, force, inputs=[("the input", s) for s in sources])
         try:
