@@ -150,10 +150,20 @@ def _differences(old: dict, new: dict) -> list[str]:
     """``key old, not new`` for each key whose value differs (in ``old``'s order)."""
     keys = list(old) + [k for k in new if k not in old]
     return [
-        f"{key} {old.get(key, 'unset')}, not {new.get(key, 'unset')}"
+        f"{key} {_said(old, key)}, not {_said(new, key)}"
         for key in keys
         if old.get(key) != new.get(key)
     ]
+
+
+def _said(values: dict, key: str) -> str:
+    """The value of ``key`` as a command line gives it (a list as its items), or unset."""
+    if key not in values:
+        return "unset"
+    value = values[key]
+    if isinstance(value, list):
+        return " ".join(str(v) for v in value)
+    return str(value)
 
 
 def _config_differences(stored: str, text: str, source) -> list[str]:
@@ -191,21 +201,23 @@ def refusal(path: Path, text: str | None, guard: Guard, source=None) -> str | No
         return None  # (not a result: check_target has judged whether it may be replaced)
     if stored_text is None and stored_request is None:
         return None
-    command = (stored_request or {}).get("command", guard.request["command"])
+    asked = guard.request.get("command")
+    command = (stored_request or {}).get("command", asked)
     holds = _HOLDS.get(command, "a result")
     changed = (
         _config_differences(stored_text, text, source)
         if stored_text is not None and text is not None
         else []
     )
-    if changed:
+    if command != asked:
+        why = f"another command (suspopt {command}, not {asked})"
+    elif changed:
         why = f"another config ({_described(changed)})"
     elif stored_request is not None and stored_request != guard.request:
-        names = {k: v for k, v in stored_request.items()}
-        why = f"another command's result ({_described(_differences(names, guard.request))})"
+        why = f"other options ({_described(_differences(stored_request, guard.request))})"
     else:
         return None
-    resume = " or --resume to continue it" if guard.request["command"] == "optimise" else ""
+    resume = " or --resume to continue it" if asked == "optimise" else ""
     return f"{path} holds {holds} of {why}; give --force to replace it{resume}"
 
 

@@ -213,10 +213,10 @@ class RunOptions:
             if execute:
                 stack.enter_context(self.executing())
             guard = Guard(dict(self.request), self.force, self.resume, plot)
-            check_suffix(output, "hdf5")
             claim_output(stack, output, self.force, inputs=inputs, guard=guard)
             others = [*inputs, ("-o", output)] if output is not None else inputs
             claim_output(stack, plot, self.force, "--plot", others)
+            check_suffix(output, "hdf5")  # (after the names' own checks: an empty name)
             if output is not None and plot is not None:
                 from .. import io
                 from ..replacing import together

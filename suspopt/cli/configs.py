@@ -101,8 +101,8 @@ def init(
             text = template_text(kind)
         except ValueError as exc:
             fail(f"init: {exc}")
-        check_suffix(output, "yaml")
         claim_output(stack, output, force)
+        check_suffix(output, "yaml")
         try:
             with atomic_file(output) as stream:
                 stream.write(signed_config(text).encode())
@@ -158,8 +158,8 @@ def export(
             from ..picks import design_config, read_picks, split_picks
             from ..signature import signed_config
 
-            check_suffix(output, "yaml")
             claim_output(stack, output, force, inputs=[("the input", source)])
+            check_suffix(output, "yaml")
             names = split_picks(pick)
             if len(names) != 1:
                 fail(f"--pick: -o writes one design; got {len(names)} ({', '.join(names)})")

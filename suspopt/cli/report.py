@@ -37,9 +37,9 @@ def report(
     from ..report import build_report
 
     rows = [r.strip() for item in with_signals for r in item.split(",") if r.strip()]
-    base.check_suffix(output, "html")
     with ExitStack() as stack:
         base.claim_output(stack, output, force, inputs=[("the input", s) for s in sources])
+        base.check_suffix(output, "html")
         try:
             path, size, notes = build_report(sources, output, rows, title)
         except ConfigError as exc:
