@@ -100,20 +100,27 @@ class Guard:
     stale: Path | None = None
 
 
-def request_of(command: str, params: dict, skip: set[str]) -> dict:
-    """The request of ``command`` given the parameters ``params`` (name -> value, as the
-    command took them), those in ``skip`` left out (outputs, how the run is executed, the
-    inputs' names), paths and lists as text: ``{"command": "analyse", "kind": "builds",
-    "--samples": 200}``. Parameters at None or an empty list are left out."""
+def request_of(command: str, parameters: list, given: dict, skip: set[str]) -> dict:
+    """The request of ``command`` (module docstring) given the values ``given`` of its
+    ``parameters`` (``inspect.Parameter``, their defaults typer's options): each option by
+    its longest flag (``{"command": "analyse", "kind": "builds", "--samples": 200}``), paths
+    and lists as text. Left out: the names in ``skip`` (outputs, how the run is executed),
+    the input files (arguments of paths: what they hold is in the result's config) and
+    options at None, False or an empty list."""
     request: dict = {"command": command}
-    for name, value in params.items():
-        if name in skip or value is None or value == [] or value is False:
+    for p in parameters:
+        value = given.get(p.name)
+        kind = type(p.default).__name__
+        decls = getattr(p.default, "param_decls", None) or ()
+        if p.name in skip or (kind == "ArgumentInfo" and "Path" in str(p.annotation)):
+            continue
+        if value is None or value == [] or value is False:
             continue
         if isinstance(value, (list, tuple)):
             value = [os.path.normpath(v) if isinstance(v, Path) else v for v in value]
         elif isinstance(value, Path):
             value = os.path.normpath(value)
-        request[name] = value
+        request[max(decls, key=len) if decls else p.name] = value
     return json.loads(json.dumps(request, default=str))
 
 
@@ -203,7 +210,7 @@ def refusal(path: Path, text: str | None, guard: Guard, source=None) -> str | No
         return None
     asked = guard.request.get("command")
     command = (stored_request or {}).get("command", asked)
-    holds = _HOLDS.get(command, "a result")
+    holds = _HOLDS.get(str(command), "a result")
     changed = (
         _config_differences(stored_text, text, source)
         if stored_text is not None and text is not None

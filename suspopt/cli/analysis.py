@@ -134,7 +134,8 @@ def analyse(
     """Run an analysis of configs or of a Pareto file and print its table.
 
     The kinds: models, roads, masses, controllers, tolerances, builds, transmissibility,
-    scenarios and cdf-sensitivity (see KIND below)."""
+    scenarios and cdf-sensitivity (see KIND below); suspopt analyse KIND --help shows a
+    kind's own options and an example."""
     from ..plots import check_path
 
     given = {

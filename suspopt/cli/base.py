@@ -239,8 +239,10 @@ _RUN_OPTIONS = (
 def run_options(command: Callable[..., None]) -> Callable[..., None]:
     """``command``, whose last parameter is the keyword-only ``run: RunOptions``, as a typer
     command that takes the :class:`RunOptions` after its own options and hands them over as
-    that one ``run``, with the command's request (:func:`_request`); a ConfigError that
-    leaves ``command`` is bad input (:func:`fail`)."""
+    that one ``run``, with the command's request (:func:`suspopt.replacing.request_of`); a
+    ConfigError that leaves ``command`` is bad input (:func:`fail`)."""
+    from ..replacing import request_of
+
     own = [p for p in inspect.signature(command).parameters.values() if p.name != "run"]
     shared = [
         inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=option(), annotation=kind)
@@ -251,7 +253,7 @@ def run_options(command: Callable[..., None]) -> Callable[..., None]:
     def wrapper(**kwargs: Any) -> None:
         run = RunOptions(
             **{p.name: kwargs.pop(p.name) for p in shared},
-            request=_request(command.__name__, own, kwargs),
+            request=request_of(command.__name__, own, kwargs, _NOT_REQUESTED),
             resume=bool(kwargs.get("resume", False)),
         )
         try:
@@ -267,22 +269,6 @@ def run_options(command: Callable[..., None]) -> Callable[..., None]:
 #: The parameters that do not change what a command writes: its outputs, how it is run, and
 #: ``--set`` (which the result's config records).
 _NOT_REQUESTED = {"output", "plot", "resume", "set_", "full"}
-
-
-def _request(name: str, parameters: list[inspect.Parameter], given: dict) -> dict:
-    """The request of the command ``name`` given ``given`` (:func:`suspopt.replacing.
-    request_of`), its options by their longest flag; the input files (arguments of paths:
-    what they hold is in the result's config) and :data:`_NOT_REQUESTED` left out."""
-    from ..replacing import request_of
-
-    labels, skip = {}, set(_NOT_REQUESTED)
-    for p in parameters:
-        decls = getattr(p.default, "param_decls", None) or ()
-        if isinstance(p.default, typer.models.ArgumentInfo) and "Path" in str(p.annotation):
-            skip.add(p.name)
-        labels[p.name] = max(decls, key=len) if decls else p.name
-    values = {labels[k]: v for k, v in given.items() if k not in skip}
-    return request_of(name, values, set())
 
 
 @contextmanager

@@ -5,8 +5,8 @@ command (see :mod:`suspopt.cli.analysis`)."""
 from __future__ import annotations
 
 import copy
+from typing import Any
 
-import click
 from typer.core import TyperCommand
 
 #: An example command line of each kind (from docs/guide/analyses.md).
@@ -69,13 +69,13 @@ class AnalyseCommand(TyperCommand):
     """The ``analyse`` command, whose ``--help`` after a kind shows that kind's help: its
     description and example (:func:`kind_help`), its usage and only the options it takes."""
 
-    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+    def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
         kind = _kind_asked(args)
         if kind is not None:  # (--help is eager: it is shown while these are parsed)
             ctx.meta[_KEY] = kind
         return super().parse_args(ctx, args)
 
-    def format_help(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+    def format_help(self, ctx: Any, formatter: Any) -> None:
         kind = ctx.meta.get(_KEY)
         if kind is None:
             return super().format_help(ctx, formatter)
@@ -87,6 +87,7 @@ class AnalyseCommand(TyperCommand):
         view.help = kind_help(kind).replace("[", "\\[")
         view.params = [p for p in self.params if p.name in taken and p.name != "kind"]
         sources = "SOURCE..." if spec.many else "SOURCE"
-        view.options_metavar = f"{kind} {sources} [OPTIONS]"
-        view.collect_usage_pieces = lambda ctx: [view.options_metavar]  # type: ignore[method-assign]
+        usage = f"{kind} {sources} [OPTIONS]"
+        view.options_metavar = usage
+        view.collect_usage_pieces = lambda ctx: [usage]  # type: ignore[method-assign]
         return TyperCommand.format_help(view, ctx, formatter)

@@ -13,10 +13,10 @@ The whole table is always in the command's output file; without one the line say
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Any
 
-if TYPE_CHECKING:
-    from rich.table import Table
+#: A table of :func:`suspopt.cli.base.new_table` (a rich ``Table`` with its ``cells``).
+Table = Any
 
 #: A table of more rows than this is cut to its first :data:`SUMMARY_ROWS`.
 LONG_TABLE = 25
@@ -48,7 +48,8 @@ def top_rows(table: Table) -> Table:
 def parts_that_fit(parts: list[Table]) -> list[Table]:
     """The first of ``parts`` whose lines (rows and frames) take at most
     :data:`SUMMARY_LINES`, the first always."""
-    kept, used = [], 0
+    kept: list[Table] = []
+    used = 0
     for part in parts:
         lines = len(part.cells) + _FRAME_LINES
         if kept and used + lines > SUMMARY_LINES:
