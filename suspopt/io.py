@@ -25,7 +25,9 @@ write leaves the target as it was.
 
 Root attributes of every HDF5 file: ``suspopt_version``, ``created`` (UTC ISO 8601),
 ``command``, ``config`` (the YAML text) and ``seed`` (the config's random seed, -1 when it
-draws nothing). Every dataset carries a ``units`` attribute.
+draws nothing); of a command's output (a :func:`claim` with a guard) also ``request`` and,
+with a figure, ``plot`` (:mod:`suspopt.replacing`, which says what such a file may be
+replaced by). Every dataset carries a ``units`` attribute.
 
 **Dimensions** (:func:`write_dataset`, the one writer of every dataset): each axis of a dataset
 is attached to an HDF5 dimension scale, the netCDF-4 way, so that xarray (engine

@@ -15,7 +15,9 @@ in one line naming the file and the first differences::
 A result of the same config and request is replaced without a word: it is the same result
 again (the runs are seeded), so running a command twice gives what running it once does.
 The old file is never touched when the command is refused: the check reads it before
-anything is written, and the new file is written aside and renamed over it.
+anything is written (the request when the output is claimed, before any work; the config
+before the run or at the first write, once it is known), and the new file is written aside
+and renamed over it.
 
 **Suffixes** (:func:`check_suffix`): an output's suffix must name what is written into it;
 ``-o out.csv`` for an HDF5 writer is refused (:data:`SUFFIXES`).

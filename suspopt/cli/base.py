@@ -206,7 +206,7 @@ class RunOptions:
         replace only a result of the same config and request (:mod:`suspopt.replacing`);
         ``plot`` is written with it as one (``hold``: both renamed at the block's end; else
         ``output`` lands as it is written, :func:`suspopt.replacing.together`)."""
-        from ..replacing import Guard
+        from ..replacing import Guard, refusal
 
         set_memory_limit(self.max_memory)
         with ExitStack() as stack:
@@ -217,6 +217,10 @@ class RunOptions:
             others = [*inputs, ("-o", output)] if output is not None else inputs
             claim_output(stack, plot, self.force, "--plot", others)
             check_suffix(output, "hdf5")  # (after the names' own checks: an empty name)
+            if output is not None and not (self.force or self.resume):
+                why = refusal(output, None, guard)  # (the request now; the config on writing)
+                if why is not None:
+                    fail(why)
             if output is not None and plot is not None:
                 from .. import io
                 from ..replacing import together
