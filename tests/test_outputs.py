@@ -14,6 +14,7 @@ import pytest
 from conftest import CONFIGS, tiny
 
 from suspopt._entry import main
+from suspopt.analyse import SUMMARIES
 
 pytestmark = pytest.mark.cli
 
@@ -181,6 +182,28 @@ def test_a_figure_lands_with_its_result_or_neither_does(tmp_path):
     assert [p.read_text() for p in (result, figure)] == ["new suspopt"] * 2
 
 
+def test_a_result_that_lands_as_it_goes_takes_its_old_figure_when_it_has_no_new_one(tmp_path):
+    """Not held (``optimise``'s checkpoints): the result lands when written; a run that ends
+    without its figure (interrupted) removes the old one, which is of the old result."""
+    from contextlib import ExitStack
+
+    from suspopt import io
+    from suspopt.replacing import together
+
+    result, figure = tmp_path / "r.txt", tmp_path / "f.txt"
+    for path in (result, figure):
+        path.write_text("old suspopt")
+    with pytest.raises(KeyboardInterrupt), ExitStack() as stack:
+        for path in (result, figure):
+            stack.enter_context(io.claim(path))
+        stack.enter_context(together([io._key(result), io._key(figure)], False, io.commit))
+        with io.atomic_file(result) as stream:
+            stream.write(b"new suspopt")
+        assert result.read_text() == "new suspopt"  # (landed at once)
+        raise KeyboardInterrupt
+    assert result.read_text() == "new suspopt" and not figure.exists()
+
+
 def test_a_long_table_shows_its_first_rows_and_counts_the_rest(capsys, tmp_path):
     from suspopt.cli import base, summary
 
@@ -245,6 +268,28 @@ def test_the_tolerance_table_is_summarised_and_full_prints_what_the_file_holds(
     assert len(summarised.splitlines()) < len(whole.splitlines())
 
 
+def _kind_help(capsys, monkeypatch, kind: str) -> str:
+    monkeypatch.setenv("COLUMNS", "200")
+    code, out, _ = cli(capsys, "analyse", kind, "--help")
+    assert code == 0
+    return " ".join(out.split())
+
+
+@pytest.mark.parametrize("kind", sorted(SUMMARIES))
+def test_each_analyse_kind_has_its_own_help_with_an_example(capsys, monkeypatch, kind):
+    from suspopt.analyse import analysis_kinds
+    from suspopt.cli.kinds import EXAMPLES
+
+    assert set(EXAMPLES) == set(SUMMARIES)
+    text = _kind_help(capsys, monkeypatch, kind)
+    assert f"Usage: suspopt analyse {kind} SOURCE" in text
+    assert SUMMARIES[kind].split(" (")[0] in text
+    assert f"Example: {EXAMPLES[kind]}" in text
+    flags = set(re.findall(r" (--[a-z-]+)", EXAMPLES[kind]))
+    taken = {"--" + o.rstrip("_").replace("_", "-") for o in analysis_kinds()[kind].options}
+    assert flags <= taken | {"--plot"}, flags - taken  # (the example takes the kind's own)
+
+
 @pytest.mark.parametrize(
     "kind, own, not_own",
     [
@@ -254,21 +299,7 @@ def test_the_tolerance_table_is_summarised_and_full_prints_what_the_file_holds(
         ("models", "--reference", "--pick"),
     ],
 )
-def test_each_analyse_kind_has_its_own_help_with_an_example(
-    capsys, monkeypatch, kind, own, not_own
-):
-    from suspopt.analyse import SUMMARIES, analysis_kinds
-    from suspopt.cli.kinds import EXAMPLES
-
-    assert set(EXAMPLES) == set(SUMMARIES)
-    monkeypatch.setenv("COLUMNS", "200")
-    code, out, _ = cli(capsys, "analyse", kind, "--help")
-    assert code == 0
-    text = " ".join(out.split())
-    assert f"Usage: suspopt analyse {kind} SOURCE" in text
-    assert SUMMARIES[kind].split(" (")[0] in text
-    assert EXAMPLES[kind] in text
+def test_a_kinds_help_lists_only_the_options_it_takes(capsys, monkeypatch, kind, own, not_own):
+    text = _kind_help(capsys, monkeypatch, kind)
     assert own in text and not_own not in text
-    flags = set(re.findall(r" (--[a-z-]+)", EXAMPLES[kind]))
-    taken = {"--" + o.rstrip("_").replace("_", "-") for o in analysis_kinds()[kind].options}
-    assert flags <= taken | {"--output", "--plot"} | {"-o"}, flags - taken
+    assert "--output" in text and "--full" in text and "--force" in text
