@@ -25,7 +25,9 @@ write leaves the target as it was.
 
 Root attributes of every HDF5 file: ``suspopt_version``, ``created`` (UTC ISO 8601),
 ``command``, ``config`` (the YAML text) and ``seed`` (the config's random seed, -1 when it
-draws nothing). Every dataset carries a ``units`` attribute.
+draws nothing); of a command's output (a :func:`claim` with a guard) also ``request`` and,
+with a figure, ``plot`` (:mod:`suspopt.replacing`, which says what such a file may be
+replaced by). Every dataset carries a ``units`` attribute.
 
 **Dimensions** (:func:`write_dataset`, the one writer of every dataset): each axis of a dataset
 is attached to an HDF5 dimension scale, the netCDF-4 way, so that xarray (engine
@@ -42,6 +44,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import json
 import os
 import stat
 import sys
@@ -58,6 +61,7 @@ from .config import Config, ConfigError
 from .files import Unreadable, link_kind, status
 from .h5read import open_dataset  # (suspopt.io.open_dataset, as docs/guide/results.md reads it)
 from .locks import take_lock, take_notes, this_command
+from .replacing import Guard, admit, deferred, remove_figure
 from .signature import CONFIG_SUFFIXES, signature_state
 
 __all__ = [
@@ -71,6 +75,8 @@ __all__ = [
     "is_output",
     "atomic_file",
     "atomic_h5",
+    "commit",
+    "check_replace",
     "config_inputs",
     "check_not_input",
     "write_dataset",
@@ -89,7 +95,7 @@ __all__ = [
 OUTPUT_MARKER = "suspopt"
 _TMP = ".suspopt-tmp"
 _HEAD = 4096
-#: Locks this process holds: resolved target -> [descriptor, depth, force].
+#: Locks this process holds: resolved target -> [descriptor, depth, force, guard].
 _held: dict[Path, list] = {}
 
 
@@ -213,6 +219,7 @@ def claim(
     option: str = "-o",
     inputs: Iterable[tuple[str, str | Path]] = (),
     command: str | None = None,
+    guard: Guard | None = None,
 ) -> Iterator[Path]:
     """Check ``path`` (:func:`check_target`), hold the writer's lock of it (module docstring)
     and clear the temporary files of dead writers; ConfigError when another process writes
@@ -223,7 +230,8 @@ def claim(
 
     What a killed run left (its lock and temporary files) is removed and said in a line for
     :func:`take_notes`. ``command``: what the lock file says this run is (default: this
-    process's command line, :func:`this_command`)."""
+    process's command line, :func:`this_command`). ``guard``: what the result written there
+    may replace (:func:`suspopt.replacing.refusal`, checked by :func:`atomic_h5`)."""
     check_not_input(path, inputs, option)
     path = check_target(path, force, option)
     key = _key(path)
@@ -235,7 +243,7 @@ def claim(
             _held[key][1] -= 1
         return
     lock, fd = take_lock(path, option, command, _TMP)
-    _held[key] = [fd, 1, force]
+    _held[key] = [fd, 1, force, guard]
     try:
         yield path
     finally:
@@ -296,20 +304,27 @@ def _atomic_file(path: Path, force: bool, inputs: Iterable[tuple[str, str | Path
                 yield stream
                 stream.flush()
                 os.fsync(stream.fileno())
-            check_target(path, force=True)  # nothing took its place meanwhile
-            os.replace(tmp, path)
+            if not deferred(_key(path), Path(tmp)):  # (else renamed with its group)
+                commit(Path(tmp), path)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
             raise
-        try:
-            folder = os.open(path.parent, os.O_RDONLY | os.O_DIRECTORY)
-        except OSError:
-            return
-        try:
-            with contextlib.suppress(OSError):  # a folder some file systems cannot sync
-                os.fsync(folder)
-        finally:
-            os.close(folder)
+
+
+def commit(tmp: Path, path: Path) -> None:
+    """Rename the written temporary file ``tmp`` over ``path`` (nothing having taken its
+    place meanwhile) and sync the folder."""
+    check_target(path, force=True)
+    os.replace(tmp, path)
+    try:
+        folder = os.open(path.parent, os.O_RDONLY | os.O_DIRECTORY)
+    except OSError:
+        return
+    try:
+        with contextlib.suppress(OSError):  # a folder some file systems cannot sync
+            os.fsync(folder)
+    finally:
+        os.close(folder)
 
 
 @contextmanager
@@ -327,10 +342,41 @@ def atomic_h5(
     where the command line refused."""
     import h5py
 
+    guard = _guarded(Path(path), cfg, force)
     with atomic_file(path, force, [*config_inputs(cfg), *inputs]) as stream:
         with h5py.File(stream, "w") as h5:
             h5.attrs.update(root_attrs(cfg, command))
+            if guard is not None:
+                h5.attrs["request"] = json.dumps(guard.request)
+                if guard.plot is not None:
+                    h5.attrs["plot"] = os.path.relpath(guard.plot, Path(path).parent)
             yield h5
+    if guard is not None and guard.stale is not None:  # (the figure of the result replaced)
+        remove_figure(guard.stale)
+        guard.stale = None
+
+
+def check_replace(path: str | Path, cfg: Config) -> None:
+    """ConfigError when the command that claimed ``path`` may not replace what it holds with
+    a result of ``cfg`` (:func:`suspopt.replacing.refusal`): said before a long run starts,
+    not at its first write."""
+    _guarded(Path(path), cfg, False)
+
+
+def _guarded(path: Path, cfg: Config, force: bool) -> Guard | None:
+    """The guard a command's claim of ``path`` holds, once it lets ``cfg``'s result replace
+    what ``path`` holds (:func:`suspopt.replacing.admit`; checked on the first write);
+    ConfigError saying why when it does not."""
+    try:
+        held = _held.get(_key(path))
+    except OSError:
+        return None
+    guard = held[3] if held is not None else None
+    if guard is not None:
+        if force:
+            guard.force = True
+        admit(path, cfg.text, guard, cfg.source)
+    return guard
 
 
 def root_attrs(cfg: Config, command: str | None = None) -> dict:

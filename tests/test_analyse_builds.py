@@ -362,7 +362,7 @@ def test_each_variable_is_built_to_its_own_tolerance(ps_front, tmp_path):
     cases += ((["--tolerance", "12", "--tolerance", "K_v=6"], [6, 12]),)
     for given, bands in cases:
         out = tmp_path / "builds.h5"
-        res = _invoke("analyse", "builds", own, "-o", out, "--samples", 40, *given)
+        res = _invoke("analyse", "builds", own, "-o", out, "--samples", 40, "--force", *given)
         assert res.exit_code == 0, res.output
         with h5py.File(out) as h5:
             assert h5["builds/tolerance"][()].tolist() == bands

@@ -878,8 +878,8 @@ def test_an_output_that_is_an_input_is_bad_input_and_the_input_stays(front, caps
 
 def test_a_road_profile_that_is_the_output_is_bad_input_and_stays(tmp_path, capsys):
     """A config's road profile was no input of the output check: ``simulate cfg.yaml -o
-    road.csv --force`` replaced the profile with HDF5. It is now refused at the key that
-    names it, and the profile stays as it was."""
+    road.csv --force`` replaced the profile with HDF5. It is now refused for its suffix and,
+    named as HDF5 (``road.h5``), at the key that names it; the profile stays as it was."""
     road = tmp_path / "road.csv"
     road.write_bytes(b"distance,height\n0,0\n10,0.01\n20,0\n30,0.02\n40,0\n")
     text = GOOD.split("road:")[0] + (
@@ -887,6 +887,11 @@ def test_a_road_profile_that_is_the_output_is_bad_input_and_stays(tmp_path, caps
     )
     config = write(tmp_path, text)
     message = one_error(capsys, "simulate", config, "-o", tmp_path / "." / "road.csv", "--force")
+    assert "road.csv: ends in .csv, but this writes HDF5" in message  # (its suffix first)
+    # a profile whose name has an HDF5 suffix (the reader takes any name)
+    road = road.rename(tmp_path / "road.h5")
+    config = write(tmp_path, text.replace("path: road.csv", "path: road.h5"))
+    message = one_error(capsys, "simulate", config, "-o", tmp_path / "." / "road.h5", "--force")
     assert message.startswith(f"error: {config}:18: road.path: road profile") and (
         "is an output of this command, which writing would replace it" in message
     )

@@ -9,6 +9,7 @@ import typer
 from ..errors import ConfigError
 from . import base
 from .base import app, out
+from .kinds import AnalyseCommand
 
 _ANALYSE_OPTIONS = {
     "reference": "--reference",
@@ -82,7 +83,7 @@ def _checked(kind: str, sources: list[Path], given: dict):
     return spec, options
 
 
-@app.command()
+@app.command(cls=AnalyseCommand)
 @base.run_options
 def analyse(
     kind: str = typer.Argument(..., help=_analysis_help(), autocompletion=_analysis_kinds),
@@ -126,13 +127,15 @@ def analyse(
     ),
     pick: list[str] | None = typer.Option(None, "--pick", help=_PICK_HELP),
     batch: list[str] | None = typer.Option(None, "--batch", help=_BATCH_HELP),
+    full: bool = base.full_option(),
     *,
     run: base.RunOptions,
 ) -> None:
     """Run an analysis of configs or of a Pareto file and print its table.
 
     The kinds: models, roads, masses, controllers, tolerances, builds, transmissibility,
-    scenarios and cdf-sensitivity (see KIND below)."""
+    scenarios and cdf-sensitivity (see KIND below); suspopt analyse KIND --help shows a
+    kind's own options and an example."""
     from ..plots import check_path
 
     given = {
@@ -161,18 +164,22 @@ def analyse(
             report = spec.run(sources if spec.many else sources[0], output, plot, **options)
         except (ConfigError, FileNotFoundError, ValueError) as exc:
             base.fail(str(exc))
-    _show(report, output, plot)
+    _show(report, output, plot, full)
 
 
-def _show(report, output: Path | None, plot: Path | None) -> None:
-    """An analysis's table and notes, and the files it wrote."""
+def _show(report, output: Path | None, plot: Path | None, full: bool = True) -> None:
+    """An analysis's table (a long one summarised unless ``full``) and notes, and the files
+    it wrote."""
     table = base.new_table(report.title)
     for col in report.columns:
         table.add_column(col)
     for row in report.rows:
         table.add_row(*row)
-    base.show_table(table, keys=2 if report.columns[:2] == ["metric", "unit"] else 1)
-    for note in report.notes:
+    keys = 2 if report.columns[:2] == ["metric", "unit"] else 1
+    base.show_table(table, keys, full, output)
+    from .summary import notes_that_fit
+
+    for note in report.notes if full else notes_that_fit(report.notes):
         out.print(note)
     for path in (output, plot):
         if path is not None:

@@ -10,7 +10,7 @@ import shlex
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -106,7 +106,10 @@ err = LazyConsole(stderr=True)
 #: Exit code of a run that finished but whose every design failed to simulate.
 EXIT_ALL_FAILED = 3
 
-FORCE_HELP = "replace an existing output that suspopt did not write"
+FORCE_HELP = (
+    "replace an existing output that suspopt did not write, or a result of another config "
+    "or other options"
+)
 MEMORY_HELP = (
     "most memory a run may take, e.g. 4G (default: what the machine has free); "
     "evaluations of many designs run in batches of at most half of it"
@@ -114,7 +117,8 @@ MEMORY_HELP = (
 
 
 def force_option():
-    """``--force``: replace an existing output that suspopt did not write."""
+    """``--force``: replace an existing output that suspopt did not write, or a result of
+    another config or request (:mod:`suspopt.replacing`)."""
     return typer.Option(False, "--force", help=FORCE_HELP)
 
 
@@ -178,6 +182,9 @@ class RunOptions:
     executor: str | None = None
     scheduler: str | None = None
     workers: int | None = None
+    #: What the command is asked for (:func:`suspopt.replacing.request_of`) and ``--resume``.
+    request: dict = field(default_factory=dict)
+    resume: bool = False
 
     def executing(self, progress=None, lost_hint: str = ""):
         """:func:`executing` with the command's ``--executor``, ``--scheduler``, ``--workers``."""
@@ -190,18 +197,36 @@ class RunOptions:
         plot: Path | None,
         execute: bool = True,
         inputs: Sequence[tuple[str, Path]] = (),
+        hold: bool = True,
     ) -> Iterator[None]:
         """``--max-memory`` applied; then, for the block, the executor options in force (unless
         ``execute`` is False: the command puts them in force itself) and ``output`` and
         ``plot`` claimed (:func:`claim_output`, ``--force``), neither of them one of the
-        command's ``inputs`` nor the other."""
+        command's ``inputs`` nor the other. ``output`` must end in an HDF5 suffix, and may
+        replace only a result of the same config and request (:mod:`suspopt.replacing`);
+        ``plot`` is written with it as one (``hold``: both renamed at the block's end; else
+        ``output`` lands as it is written, :func:`suspopt.replacing.together`)."""
+        from ..replacing import Guard, refusal
+
         set_memory_limit(self.max_memory)
         with ExitStack() as stack:
             if execute:
                 stack.enter_context(self.executing())
-            claim_output(stack, output, self.force, inputs=inputs)
+            guard = Guard(dict(self.request), self.force, self.resume, plot)
+            claim_output(stack, output, self.force, inputs=inputs, guard=guard)
             others = [*inputs, ("-o", output)] if output is not None else inputs
             claim_output(stack, plot, self.force, "--plot", others)
+            check_suffix(output, "hdf5")  # (after the names' own checks: an empty name)
+            if output is not None and not (self.force or self.resume):
+                why = refusal(output, None, guard)  # (the request now; the config on writing)
+                if why is not None:
+                    fail(why)
+            if output is not None and plot is not None:
+                from .. import io
+                from ..replacing import together
+
+                keys = [io._key(output), io._key(plot)]
+                stack.enter_context(together(keys, hold, io.commit))
             yield
 
 
@@ -218,7 +243,10 @@ _RUN_OPTIONS = (
 def run_options(command: Callable[..., None]) -> Callable[..., None]:
     """``command``, whose last parameter is the keyword-only ``run: RunOptions``, as a typer
     command that takes the :class:`RunOptions` after its own options and hands them over as
-    that one ``run``; a ConfigError that leaves ``command`` is bad input (:func:`fail`)."""
+    that one ``run``, with the command's request (:func:`suspopt.replacing.request_of`); a
+    ConfigError that leaves ``command`` is bad input (:func:`fail`)."""
+    from ..replacing import request_of
+
     own = [p for p in inspect.signature(command).parameters.values() if p.name != "run"]
     shared = [
         inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=option(), annotation=kind)
@@ -227,7 +255,11 @@ def run_options(command: Callable[..., None]) -> Callable[..., None]:
 
     @functools.wraps(command)
     def wrapper(**kwargs: Any) -> None:
-        run = RunOptions(**{p.name: kwargs.pop(p.name) for p in shared})
+        run = RunOptions(
+            **{p.name: kwargs.pop(p.name) for p in shared},
+            request=request_of(command.__name__, own, kwargs, _NOT_REQUESTED),
+            resume=bool(kwargs.get("resume", False)),
+        )
         try:
             command(**kwargs, run=run)
         except ConfigError as exc:  # bad input wherever it is found (a full disk on writing)
@@ -236,6 +268,11 @@ def run_options(command: Callable[..., None]) -> Callable[..., None]:
     wrapper.__signature__ = inspect.Signature(own + shared)  # type: ignore[attr-defined]
     wrapper.__annotations__ = {p.name: p.annotation for p in own + shared}
     return wrapper
+
+
+#: The parameters that do not change what a command writes: its outputs, how it is run, and
+#: ``--set`` (which the result's config records).
+_NOT_REQUESTED = {"output", "plot", "resume", "set_", "full"}
 
 
 @contextmanager
@@ -369,10 +406,40 @@ def against_baseline(names, values, baseline, feasible: bool) -> str:
     )
 
 
-def show_table(table: Table, keys: int = 1) -> None:
+def full_option():
+    """``--full``: print long tables whole (:func:`show_table`)."""
+    from .summary import LONG_TABLE, SUMMARY_LINES
+
+    return typer.Option(
+        False,
+        "--full",
+        help=f"print long tables whole (without it, a table of more than {LONG_TABLE} rows "
+        f"or {SUMMARY_LINES} lines shows its first rows and columns and counts the rest; "
+        "the whole table is in the output file)",
+    )
+
+
+def show_table(table: Table, keys: int = 1, full: bool = True, where: Path | None = None) -> None:
     """Print ``table``; when it is wider than the terminal (a CI log's 80 columns), as several
     tables of the columns that fit, each with the first ``keys`` columns again, so that no
-    number is cut or broken across lines."""
+    number is cut or broken across lines. Unless ``full``, a long table is summarised: its
+    first rows and parts and a line counting the rest, saying that ``--full`` prints them
+    and that the whole table is in ``where`` (:mod:`suspopt.cli.summary`)."""
+    from . import summary
+
+    shown = table if full else summary.top_rows(table)
+    parts = _parts(shown, keys)
+    kept = parts if full else summary.parts_that_fit(parts)
+    for part in kept:
+        out.print(part)
+    if not full:
+        line = summary.rest_line(table, shown, parts[len(kept) :], where, keys)
+        if line is not None:
+            out.print(line)
+
+
+def _parts(table: Table, keys: int) -> list[Table]:
+    """``table``, or the tables of the columns that fit the terminal (:func:`show_table`)."""
 
     def needs(j: int) -> int:  # column j's widest cell and the border and padding
         return (
@@ -382,8 +449,7 @@ def show_table(table: Table, keys: int = 1) -> None:
 
     width, count = out.width, len(table.columns)
     if 1 + sum(needs(j) for j in range(count)) <= width or count <= keys + 1:
-        out.print(table)
-        return
+        return [table]
     key, rest = list(range(keys)), list(range(keys, count))
     base = 1 + sum(needs(c) for c in key)
     groups, current, used = [], [], base
@@ -395,13 +461,15 @@ def show_table(table: Table, keys: int = 1) -> None:
         used += needs(column)
     groups.append(current)
     title = str(table.title or "")
+    parts = []
     for i, group in enumerate(groups, start=1):
         part = new_table(f"{title} ({i} of {len(groups)})" if title else None)
         for j in key + group:
             part.add_column(table.columns[j].header, justify=table.columns[j].justify)
         for row, kept in zip(table.cells, table.rows):  # (and where a section ends)
             part.add_row(*(row[j] for j in key + group), end_section=kept.end_section)
-        out.print(part)
+        parts.append(part)
+    return parts
 
 
 def plain_helps(typer_app: typer.Typer) -> None:
@@ -448,20 +516,35 @@ def claim_output(
     force: bool,
     option: str = "-o",
     inputs: Sequence[tuple[str, Path]] = (),
+    guard=None,
 ) -> None:
     """Check an output (not one of the command's ``inputs``: ``(option, path)`` pairs) and
-    hold its writer's lock for the rest of the command (:func:`suspopt.io.claim`); what a
-    killed run had left beside it is said at once (:func:`say_io_notes`)."""
+    hold its writer's lock for the rest of the command (:func:`suspopt.io.claim`, with
+    ``guard``: what it may replace); what a killed run had left beside it is said at once
+    (:func:`say_io_notes`)."""
     from ..io import claim
 
     if path is None:
         return
     try:
-        stack.enter_context(claim(path, force, option, inputs, command=command_line()))
+        stack.enter_context(claim(path, force, option, inputs, command=command_line(), guard=guard))
     except ConfigError as exc:
         fail(str(exc))
     finally:
         say_io_notes()
+
+
+def check_suffix(path: Path | None, kind: str, option: str = "-o") -> None:
+    """Bad input when the output ``path`` does not end in a suffix of ``kind``
+    (:func:`suspopt.replacing.check_suffix`: ``-o out.csv`` for an HDF5 writer)."""
+    from ..replacing import check_suffix as check
+
+    if path is None:
+        return
+    try:
+        check(path, kind, option)
+    except ConfigError as exc:
+        fail(str(exc))
 
 
 def say_io_notes() -> None:

@@ -12,6 +12,7 @@ import typer
 from ..errors import ConfigError
 from .base import (
     app,
+    check_suffix,
     claim_output,
     err,
     fail,
@@ -101,6 +102,7 @@ def init(
         except ValueError as exc:
             fail(f"init: {exc}")
         claim_output(stack, output, force)
+        check_suffix(output, "yaml")
         try:
             with atomic_file(output) as stream:
                 stream.write(signed_config(text).encode())
@@ -158,6 +160,7 @@ def export(
             from ..signature import signed_config
 
             claim_output(stack, output, force, inputs=[("the input", source)])
+            check_suffix(output, "yaml")
             names = split_picks(pick)
             if len(names) != 1:
                 fail(f"--pick: -o writes one design; got {len(names)} ({', '.join(names)})")

@@ -135,6 +135,11 @@ def optimise(
     far, objectives scaled by the first feasible generation's range (reference point 1.1):
     it never falls."""
     output = output if output is not None else Path(config.stem + ".h5")
+    if resume and plot is None:  # (the figure of the run it continues, rewritten)
+        from ..files import is_hdf5
+        from ..replacing import stored_plot
+
+        plot = stored_plot(output) if is_hdf5(output) else None
     if plot is not None:
         from ..plots import check_path
 
@@ -142,7 +147,8 @@ def optimise(
             check_path(plot)
         except ValueError as exc:
             base.fail(str(exc))
-    with run.outputs(output, plot, execute=False, inputs=[("the config", config)]):
+    inputs = [("the config", config)]
+    with run.outputs(output, plot, execute=False, inputs=inputs, hold=False):
         _optimise(config, output, resume, plot, run, set_)
 
 
@@ -209,13 +215,14 @@ def _optimise(
     sets: list[str],
 ) -> None:
     from ..checks import check_config
-    from ..io import WriteError
+    from ..io import WriteError, check_replace
     from ..optimise import optimise as run
     from ..params import apply_sets
 
     try:
         cfg = apply_sets(base.read_config(config), sets)
         check_config(cfg)
+        check_replace(output, cfg)  # (before the run, not at its first checkpoint)
     except ConfigError as exc:
         base.fail(str(exc))
     bar, report, chunk_done = _progress(cfg)

@@ -39,6 +39,7 @@ def report(
     rows = [r.strip() for item in with_signals for r in item.split(",") if r.strip()]
     with ExitStack() as stack:
         base.claim_output(stack, output, force, inputs=[("the input", s) for s in sources])
+        base.check_suffix(output, "html")
         try:
             path, size, notes = build_report(sources, output, rows, title)
         except ConfigError as exc:

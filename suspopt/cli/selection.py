@@ -295,6 +295,7 @@ def kesort(
     plot: Path | None = typer.Option(
         None, "--plot", help="figure of the k-ε levels over the front (.png or .svg)"
     ),
+    full: bool = base.full_option(),
     *,
     run: base.RunOptions,
 ) -> None:
@@ -306,13 +307,13 @@ def kesort(
     with run.outputs(output, plot, inputs=inputs):
         _kesort(
             pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output,
-            plot, (builds, min_feasible_builds, as_built),
+            plot, (builds, min_feasible_builds, as_built), full,
         )  # fmt: skip
 
 
 def _kesort(
     pareto, config, label, eps, P, P_range, P_step, normalise, keep_infeasible, output, plot,
-    by_builds,
+    by_builds, full=True,
 ) -> None:  # fmt: skip
     import importlib.util
 
@@ -351,7 +352,7 @@ def _kesort(
 
         plot_kesort(selection, plot)
     for table, keys in zip(_kesort_tables(selection), (2, 3)):
-        base.show_table(table, keys=keys)
+        base.show_table(table, keys, full, output)
     for label_, cs in selection.case_sorts.items():
         out.print(_threshold_line(cs.sort, label_))
     out.print(

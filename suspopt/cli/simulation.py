@@ -133,13 +133,14 @@ def simulate(
     plot: Path | None = base.plot_option(
         "the signals over time, their PSD and the ISO 2631 comfort levels"
     ),
+    full: bool = base.full_option(),
     *,
     run: base.RunOptions,
 ) -> None:
     """Simulate a config (or designs picked from a result file) and write signals to HDF5."""
     with run.outputs(output, plot, inputs=[("the input", source)]):
         try:
-            _simulate(source, output, pick, set_, sweep_, zipped, plot, scenario)
+            _simulate(source, output, pick, set_, sweep_, zipped, plot, scenario, full)
         except (ConfigError, ValueError) as exc:
             base.fail(str(exc))
 
@@ -242,7 +243,9 @@ def _picks_writer(picked, objectives):
     return extra
 
 
-def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=None) -> None:
+def _simulate(
+    source: Path, output, pick, sets, sweeps, zipped, plot, scenario=None, full=True
+) -> None:
     import numpy as np
 
     from ..checks import check_config, check_stability
@@ -295,12 +298,12 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
             f"(at t = {np.nanmin(result.diverged_at):.4g} s); their samples are NaN; "
             f"try a smaller simulation.dt"
         )
-    base.show_table(_summary_table(result, picked), keys=2)
+    base.show_table(_summary_table(result, picked), 2, full, output)
     if result.metrics:
-        base.show_table(_metrics_table(result, picked), keys=2)
+        base.show_table(_metrics_table(result, picked), 2, full, output)
     extra = None
     if picked is not None:
-        extra = _show_picks(picked, cfg, result, params)
+        extra = _show_picks(picked, cfg, result, params, full, output)
     if output is not None:
         started = time.perf_counter()
         write_simulation(
@@ -320,12 +323,12 @@ def _simulate(source: Path, output, pick, sets, sweeps, zipped, plot, scenario=N
         out.print(f"wrote {plot}")
 
 
-def _show_picks(picked, cfg, result, params):
+def _show_picks(picked, cfg, result, params, full, output):
     """Show the picks' objectives, stored and simulated now (:func:`_picks_table`), with a
     note where the stored ones are the spectral method's; return the writer of them
     (:func:`_picks_writer`)."""
     objectives = _pick_objectives(picked, cfg, result, params)
-    base.show_table(_picks_table(picked, *objectives), keys=3)
+    base.show_table(_picks_table(picked, *objectives), 3, full, output)
     if cfg.simulation.method == "spectral":  # (stored: stationary; here: in time)
         out.print(
             f"note: the stored values are the spectral method's (stationary); simulate "
