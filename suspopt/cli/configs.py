@@ -131,15 +131,27 @@ def export(
     csv: Path | None = typer.Option(
         None, "--csv", help="folder for the file's tables as CSV, units in the headers"
     ),
+    mat: Path | None = typer.Option(
+        None, "--mat", help="MATLAB file (.mat) of every group of the file, as structs"
+    ),
     force: bool = force_option(),
 ) -> None:
-    """Write a picked design as a standalone config, or a result file's tables as CSV.
+    """Write a picked design as a standalone config, or a result file's tables as CSV or MATLAB.
 
-    With -o design.yaml it writes the config of one pick; with --csv DIR, the tables."""
-    if (output is None) == (csv is None):
-        fail("export: give -o FILE.yaml (with --pick) or --csv DIR")
+    With -o design.yaml it writes the config of one pick; with --csv DIR, the tables; with
+    --mat FILE.mat, every group as a MATLAB struct (docs/guide/export-mat.md)."""
+    if [output, csv, mat].count(None) != 2:
+        fail("export: give -o FILE.yaml (with --pick), --csv DIR or --mat FILE.mat")
     with ExitStack() as stack:
         try:
+            if mat is not None:
+                from ..matfile import write_mat
+
+                if pick:
+                    fail("--mat writes every group of the file; --pick is for -o")
+                claim_output(stack, mat, force, "--mat", inputs=[("the input", source)])
+                out.print(f"wrote {write_mat(source, mat, force=force)}")
+                return
             if csv is not None:
                 from ..export import write_csv
 
