@@ -224,8 +224,10 @@ class _Writer:
                 )  # fmt: skip
                 if unit is not None:
                     units[field] = unit
-            else:  # (a link to nothing, a committed datatype)
-                raise ConfigError(f"{self.where}: {hdf5}: neither a group nor a dataset")
+            else:  # (a damaged object header, a link to nothing, a committed datatype)
+                raise ConfigError(
+                    f"{self.where}: {hdf5}: damaged or not a group or dataset, cannot be read"
+                )
         out["units"], out["meta"] = units, meta
         out["attributes"] = self.attributes(
             group, group.name, f"{matlab}.attributes" if matlab else "attributes"
@@ -280,9 +282,11 @@ def write_mat(h5_path: str | Path, mat_path: str | Path, force: bool = False) ->
     import scipy.io
 
     from .h5read import H5Reader
-    from .io import atomic_file, check_target
+    from .io import atomic_file, check_not_input, check_target
 
     h5_path, mat_path = Path(h5_path), Path(mat_path)
+    inputs = [("the input", h5_path)]
+    check_not_input(mat_path, inputs, "--mat")
     check_target(mat_path, force, "--mat")
     if mat_path.suffix.lower() != ".mat":
         raise ConfigError(f"--mat {mat_path}: a MATLAB file's name ends in .mat")
@@ -292,7 +296,7 @@ def write_mat(h5_path: str | Path, mat_path: str | Path, force: bool = False) ->
                 f"{h5_path}: not a file suspopt wrote (no root attribute 'suspopt_version')"
             )
         variables = _variables(reader)
-    with atomic_file(mat_path, force, [("the input", h5_path)]) as stream:
+    with atomic_file(mat_path, force, inputs) as stream:
         scipy.io.savemat(
             stream, variables, long_field_names=True, do_compression=True, oned_as="column"
         )

@@ -149,8 +149,11 @@ def export(
 
                 if pick:
                     fail("--mat writes every group of the file; --pick is for -o")
-                claim_output(stack, mat, force, "--mat", inputs=[("the input", source)])
-                out.print(f"wrote {write_mat(source, mat, force=force)}")
+                try:
+                    written = write_mat(source, mat, force=force)
+                finally:
+                    say_io_notes()  # (a killed run's leftovers beside the target)
+                out.print(f"wrote {written}")
                 return
             if csv is not None:
                 from ..export import write_csv
