@@ -144,26 +144,20 @@ def export(
         fail("export: give -o FILE.yaml (with --pick), --csv DIR or --mat FILE.mat")
     with ExitStack() as stack:
         try:
-            if mat is not None:
+            if csv is not None or mat is not None:
+                from ..export import write_csv
                 from ..matfile import write_mat
 
+                option, kind = ("--csv", "table") if csv is not None else ("--mat", "group")
                 if pick:
-                    fail("--mat writes every group of the file; --pick is for -o")
+                    fail(f"{option} writes every {kind} of the file; --pick is for -o")
                 try:
-                    written = write_mat(source, mat, force=force)
+                    if csv is not None:
+                        written = write_csv(source, csv, force=force)
+                    else:
+                        written = [write_mat(source, mat, force=force)]
                 finally:
-                    say_io_notes()  # (a killed run's leftovers beside the target)
-                out.print(f"wrote {written}")
-                return
-            if csv is not None:
-                from ..export import write_csv
-
-                if pick:
-                    fail("--csv writes every table of the file; --pick is for -o")
-                try:
-                    written = write_csv(source, csv, force=force)
-                finally:
-                    say_io_notes()  # (a killed run's leftovers beside a table)
+                    say_io_notes()  # (a killed run's leftovers beside an output)
                 for path in written:
                     out.print(f"wrote {path}")
                 return
