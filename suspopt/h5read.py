@@ -126,9 +126,11 @@ def dimension_scales(ds) -> list[tuple[str, object]]:
     out: list[tuple[str, object]] = []
     for axis in range(ds.ndim):
         scales = ds.dims[axis]
-        out.append(
-            (scales[0].name.rsplit("/", 1)[-1], scales[0]) if len(scales) else (f"dim{axis}", None)
-        )
+        scale = scales[0] if len(scales) else None
+        if scale is None or scale.name is None:  # (none, or one no path of the file reaches)
+            out.append((f"dim{axis}", None))
+        else:
+            out.append((scale.name.rsplit("/", 1)[-1], scale))
     return out
 
 

@@ -1019,6 +1019,7 @@ H5_RUNS = [
     ["simulate", "{path}", "--pick", "knee,0", "-o", "{out}"],
     ["export", "{path}", "--pick", "knee", "-o", "{out}.yaml"],
     ["export", "{path}", "--csv", "{out}.csv"],
+    ["export", "{path}", "--mat", "{out}.mat"],
 ]
 #: the bundled config of the tiny front, and its run length [s]
 FRONT = "ch8/pareto_ps_class_a"
@@ -1545,6 +1546,7 @@ OPTION_BASES = [
     ["optimise", "{path}/study.yaml", "-o", "{out}"],
     ["kesort", "{path}/front.h5", "-o", "{out}"],
     ["export", "{path}/choice.h5", "--pick", "chosen", "-o", "{out}.yaml"],
+    ["export", "{path}/builds.h5", "--mat", "{out}.mat"],
     ["report", "{path}/front.h5", "-o", "{out}.html"],
     ["analyse", "roads", "{path}/front.h5", "--road", "{path}/road.yaml", "-o", "{out}"],
     ["analyse", "masses", "{path}/front.h5", "-o", "{out}"],

@@ -134,24 +134,33 @@ def export(
     csv: Path | None = typer.Option(
         None, "--csv", help="folder for the file's tables as CSV, units in the headers"
     ),
+    mat: Path | None = typer.Option(
+        None, "--mat", help="MATLAB file (.mat) of every group of the file, as structs"
+    ),
     force: bool = force_option(),
 ) -> None:
-    """Write a picked design as a standalone config, or a result file's tables as CSV.
+    """Write a picked design as a standalone config, or a result file's tables as CSV or MATLAB.
 
-    With -o design.yaml it writes the config of one pick; with --csv DIR, the tables."""
-    if (output is None) == (csv is None):
-        fail("export: give -o FILE.yaml (with --pick) or --csv DIR")
+    With -o design.yaml it writes the config of one pick; with --csv DIR, the tables; with
+    --mat FILE.mat, every group as a MATLAB struct (docs/guide/export-mat.md)."""
+    if [output, csv, mat].count(None) != 2:
+        fail("export: give -o FILE.yaml (with --pick), --csv DIR or --mat FILE.mat")
     with ExitStack() as stack:
         try:
-            if csv is not None:
+            if csv is not None or mat is not None:
                 from ..export import write_csv
+                from ..matfile import write_mat
 
+                option, kind = ("--csv", "table") if csv is not None else ("--mat", "group")
                 if pick:
-                    fail("--csv writes every table of the file; --pick is for -o")
+                    fail(f"{option} writes every {kind} of the file; --pick is for -o")
                 try:
-                    written = write_csv(source, csv, force=force)
+                    if csv is not None:
+                        written = write_csv(source, csv, force=force)
+                    else:
+                        written = [write_mat(source, mat, force=force)]
                 finally:
-                    say_io_notes()  # (a killed run's leftovers beside a table)
+                    say_io_notes()  # (a killed run's leftovers beside an output)
                 for path in written:
                     out.print(f"wrote {path}")
                 return
