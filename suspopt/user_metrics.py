@@ -182,9 +182,19 @@ def _checked(name: str, where: str, function: Callable) -> Callable[[Any, Any, s
 
 
 def _entry_points() -> list:
+    """The installed entry points of :data:`GROUP` (not loaded); ValueError for one that
+    takes a built-in metric's name."""
     from importlib.metadata import entry_points
 
-    return list(entry_points(group=GROUP))
+    found = list(entry_points(group=GROUP))
+    for ep in found:
+        if ep.name in BUILT_IN:
+            raise ValueError(
+                f"entry point {ep.name} = {ep.value} ({GROUP}"
+                + (f", package {ep.dist.name}" if getattr(ep, "dist", None) else "")
+                + ") takes a built-in metric's name; rename it"
+            )
+    return found
 
 
 def _load(name: str) -> bool:
@@ -195,10 +205,6 @@ def _load(name: str) -> bool:
     if not found:
         return False
     ep = found[0]
-    if name in BUILT_IN:
-        raise ValueError(
-            f"entry point {name} = {ep.value} ({GROUP}) takes a built-in metric's name"
-        )
     try:
         loaded = ep.load()
     except Exception as exc:
