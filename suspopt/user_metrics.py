@@ -85,10 +85,38 @@ def metric(
     unit: str | Callable[[str], str] | None = None,
     description: str | None = None,
 ) -> Callable[[Callable], Callable]:
-    """Decorator: register the function as the user metric ``name`` (default the function's
-    name) with ``unit`` (a fixed unit, a function of the signal's unit, or None: the
-    signal's) and ``description`` (default the docstring's first line). Returns the function
-    unchanged (marked with its metric's name); see :func:`register`."""
+    """Register the decorated function as a metric that configs name like a built-in one.
+
+    The function takes a signal's samples ``x`` ``(P, T)`` (SI units, read-only) and the
+    output times ``t`` ``(T,)`` [s] and returns one value per design ``(P,)``, in SI units,
+    without a loop over the designs; a value that is not finite marks its design failed.
+    Registration must happen before a config that names the metric is loaded
+    (docs/guide/custom-metrics.md).
+
+    Parameters
+    ----------
+    name : str, optional
+        The metric's name in YAML (``metric: NAME``): letters, digits and ``_``, not a
+        built-in metric's. Default the function's name; registering a name again replaces
+        the user metric.
+    unit : str or callable, optional
+        The metric's SI unit: a fixed unit (``"m/s^3"``), a function of the signal's unit
+        (``lambda u: f"({u})/s"``), or None (default) for the signal's own unit.
+    description : str, optional
+        One line on what it measures (default the docstring's first line).
+
+    Returns
+    -------
+    callable
+        A decorator that registers the function and returns it unchanged.
+
+    Examples
+    --------
+    >>> import numpy as np, suspopt
+    >>> @suspopt.metric(name="peak_jerk", unit=lambda u: f"({u})/s")
+    ... def peak_jerk(x, t):
+    ...     return np.abs(np.diff(x, axis=-1)).max(axis=-1) / (t[1] - t[0])
+    """
 
     def decorate(function: Callable) -> Callable:
         register(function, name or function.__name__, unit=unit, description=description)
@@ -140,9 +168,10 @@ def register(
 
 def unregister(name: str) -> None:
     """Forget the user metric ``name`` (KeyError if there is none; a built-in stays)."""
-    if name not in _SOURCES:
+    if name in BUILT_IN or name not in METRICS:
         raise KeyError(f"no user metric {name!r}")
-    del METRICS[name], _SOURCES[name]
+    del METRICS[name]
+    _SOURCES.pop(name, None)
 
 
 def source(name: str | None) -> Source | None:
@@ -230,20 +259,28 @@ def check_metric(name: str) -> str:
     (loaded now), else a ValueError that suggests the closest of all of them."""
     if name in METRICS or _load(name):
         return name
-    return check_known("metric", name, [*METRICS, *(ep.name for ep in _entry_points())])
+    installed = (ep.name for ep in _entry_points())
+    return check_known("metric", name, dict.fromkeys([*METRICS, *installed]))
 
 
 def _restore(name: str, module: str, entry_point: bool) -> Source:
-    """A :class:`Source` unpickled: the metric registered in this process first."""
+    """A :class:`Source` unpickled: the metric registered in this process first. When the
+    module does not register it here (a ``__main__`` the worker does not run), the metric
+    is one whose evaluation is a ConfigError saying so, which the worker sends back."""
     if name not in METRICS:
         if entry_point:
             _load(name)
         else:
             importlib.import_module(module)
     if name not in METRICS:
-        raise ConfigError(
+        message = (
             f"metric {name!r} is registered by module {module!r}, which does not register it "
-            "in this worker: define user metrics in a module the workers import, or in an "
+            "in a worker: define user metrics in a module the workers import, or in an "
             f"entry point ({GROUP}); docs/guide/custom-metrics.md"
         )
+
+        def missing(spec, result, signal: str) -> np.ndarray:
+            raise ConfigError(message)
+
+        METRICS[name] = MetricDef("user", _same, message, missing, stream="keep")
     return _SOURCES.get(name, Source(name, module, entry_point))

@@ -328,3 +328,22 @@ def test_a_spec_carries_its_metric_to_a_process_that_has_not_imported_it(tmp_pat
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["(m)/s", "peak_jerk"]
+
+
+def test_a_metric_a_worker_cannot_register_is_one_line_from_the_worker(tmp_path):
+    """A spec unpickled where its metric's module does not register it (a worker that does
+    not run the script's ``__main__``) evaluates to a ConfigError saying so, not to a
+    KeyError deep in the streaming code."""
+
+    def jerk(x, t):
+        return peak_jerk(x, t)
+
+    jerk.__module__ = "__main__"  # (as if defined in a notebook)
+    user_metrics.register(jerk, "main_jerk")
+    cfg = suspopt.load_config(write(tmp_path, TINY))
+    cfg.metrics = [{"metric": "main_jerk", "signal": "body.heave_acc"}]
+    shipped = pickle.dumps(cfg)
+    user_metrics.unregister("main_jerk")
+    in_worker = pickle.loads(shipped)  # (pytest's __main__ registers no metric)
+    with pytest.raises(ConfigError, match="^metric 'main_jerk' is registered by module '__main__'"):
+        suspopt.simulate(in_worker)

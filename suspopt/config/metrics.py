@@ -17,7 +17,11 @@ class MetricSpec(Section):
     """One metric of one signal (or of a per-corner signal family), see suspopt.metrics.specs."""
 
     name: str | None = Field(None, description="name under /metrics (default metric.signal)")
-    metric: str = Field(description="one of: " + ", ".join(METRICS))
+    metric: str = Field(
+        description="one of: "
+        + ", ".join(METRICS)
+        + "; or a user metric (suspopt.metric, docs/guide/custom-metrics.md)"
+    )
     signal: str | None = Field(
         None,
         description="signal name (body.heave_acc) or per-corner "
