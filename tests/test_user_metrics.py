@@ -218,12 +218,18 @@ def test_a_decorated_metric_is_simulated_and_optimised_from_python(tmp_path):
 
     from suspopt.optimise import optimise
 
+    limit = {"name": "jerk_max", "metric": "py_jerk", "signal": "body.heave_acc", "max": 1e3}
+    cfg.constraints = [*cfg.constraints, limit]
     optimise(cfg, tmp_path / "front.h5")
     with h5py.File(tmp_path / "front.h5") as h5:
-        X, F = h5["pareto/X"][()], h5["pareto/F"]
+        X, F, G = h5["pareto/X"][()], h5["pareto/F"], h5["pareto/G"]
         j = list(F.attrs["names"]).index("jerk")
         assert F.attrs["units"][j] == "m/s^3"
         jerk = F[:, j]
+        g = list(G.attrs["names"]).index("jerk_max <= 1000")
+        assert G.attrs["units"][g] == "m/s^3"
+        margin = G[:, g]  # g = value - max
+    np.testing.assert_allclose(margin, jerk - 1e3)
     params = {v.path: X[:, i] for i, v in enumerate(cfg.design_variables)}
     again = suspopt.simulate(cfg, params=params)
     np.testing.assert_allclose(jerk, peak_jerk(again.signals["body.heave_acc"], again.time))
