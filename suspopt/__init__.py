@@ -36,6 +36,7 @@ _EXPORTS = {
     "KEpsilonSort": "kesort",
     "pareto_picks": "kesort",
     "reuse_memory": "memory",
+    "metric": "user_metrics",
 }
 
 __all__ = ["__version__", *_EXPORTS]
@@ -74,4 +75,5 @@ if TYPE_CHECKING:
     from .optimise import OptimisationResult, Problem
     from .simulate import Result, simulate
     from .templates import load_template
+    from .user_metrics import metric
     from .vehicle import build_vehicle, frequency_response, modal_analysis

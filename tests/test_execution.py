@@ -70,6 +70,49 @@ def test_nsga2_on_dask_and_on_processes_gives_the_local_pareto_set(tmp_path, clu
     _same(local, on_processes)
 
 
+#: A user's module of metrics (suspopt.user_metrics), registered when it is imported.
+USER_MODULE = """\
+import numpy as np
+import suspopt
+
+
+@suspopt.metric(name="dask_jerk", unit="m/s^3")
+def dask_jerk(x, t):
+    return np.abs(np.diff(x, axis=-1)).max(axis=-1) / (t[1] - t[0])
+"""
+
+
+def test_a_user_metric_reaches_the_dask_workers_from_its_module(tmp_path, cluster, monkeypatch):
+    """The workers have never imported the users' module: the spec they get carries it
+    (:class:`suspopt.user_metrics.Source`), they import it and give the local values."""
+    import sys
+
+    from suspopt import user_metrics
+
+    (tmp_path / "users_jerk.py").write_text(USER_MODULE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with distributed.Client(cluster) as client:  # (the workers see the module's folder)
+        client.run(lambda folder: sys.path.insert(0, folder), str(tmp_path))
+        assert not any(client.run(lambda: "users_jerk" in sys.modules).values())
+        import users_jerk  # noqa: F401
+
+        text = TINY.replace(
+            "metric: var, signal: tyre_deflection, reduce: mean",
+            "metric: dask_jerk, signal: body.heave_acc",
+        )
+        try:
+            local = _optimised(tmp_path, "local", text)
+            address = cluster.scheduler_address
+            _same(
+                local,
+                _optimised(tmp_path, "dask", text, executor="dask", scheduler=address, chunk=CHUNK),
+            )
+            assert all(client.run(lambda: "users_jerk" in sys.modules).values())
+        finally:
+            user_metrics.unregister("dask_jerk")
+            sys.modules.pop("users_jerk", None)
+
+
 METRICS = """\
 metrics:
   - {metric: var, signal: body.heave_acc}

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Field, field_validator
+from pydantic import Field, PrivateAttr, field_validator, model_validator
 
+from .. import user_metrics
 from ..specs import METRICS
-from .base import Duration, Section, bounds, check_known
+from .base import Duration, Section, bounds
 
 __all__ = ["MetricSpec"]
 
@@ -16,7 +17,11 @@ class MetricSpec(Section):
     """One metric of one signal (or of a per-corner signal family), see suspopt.metrics.specs."""
 
     name: str | None = Field(None, description="name under /metrics (default metric.signal)")
-    metric: str = Field(description="one of: " + ", ".join(METRICS))
+    metric: str = Field(
+        description="one of: "
+        + ", ".join(METRICS)
+        + "; or a user metric (suspopt.metric, docs/guide/custom-metrics.md)"
+    )
     signal: str | None = Field(
         None,
         description="signal name (body.heave_acc) or per-corner "
@@ -39,4 +44,13 @@ class MetricSpec(Section):
     @field_validator("metric")
     @classmethod
     def _known_metric(cls, metric: str | None) -> str | None:
-        return metric if metric is None else check_known("metric", metric, METRICS)
+        return metric if metric is None else user_metrics.check_metric(metric)
+
+    #: Where a user metric came from (:class:`suspopt.user_metrics.Source`; None for a
+    #: built-in): it goes with the spec to the workers, which register the metric from it.
+    _source: user_metrics.Source | None = PrivateAttr(None)
+
+    @model_validator(mode="after")
+    def _user_metric_source(self) -> MetricSpec:
+        self._source = user_metrics.source(self.metric)
+        return self
