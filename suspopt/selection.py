@@ -99,12 +99,22 @@ class ParetoSet:
     config_text: str
     picked: dict[str, int] | None = None
     source_rows: np.ndarray | None = None
+    obj_units: list[str] | None = None
     ids: tuple[str, ...] | None = None
 
     def config(self) -> Config:
         """The config the set was optimised with; errors point into the file
         (``PARETO.h5:config:LINE``), and relative paths resolve from the file's folder."""
         return load_config_text(self.config_text, self.path.with_name(self.path.name + ":config"))
+
+    def plot(self, picks: dict[str, int] | None = None):
+        """The front as ``suspopt optimise --plot`` draws it
+        (:func:`!suspopt.plots.pareto_set_figure`), with the file's ``/history`` where it
+        has one; ``picks`` (name -> row here) starred and named, default :meth:`marks`.
+        Returns a matplotlib Figure."""
+        from .plots import pareto_set_figure
+
+        return pareto_set_figure(self, self.marks() if picks is None else picks)
 
     def marks(self) -> dict[str, int]:
         """The designs a report names: the picks given (``--pick``; a row number names
@@ -255,12 +265,25 @@ def read_pareto(path: str | Path) -> ParetoSet:
                 f"{path}: attribute 'config' (the YAML text) is missing; give --config"
             )
         text = h5.text_attr("config")
-    (X, var_names, var_units), (F, obj_names, _), (G, constraint_names, _) = (
+    (X, var_names, var_units), (F, obj_names, obj_units), (G, constraint_names, _) = (
         data["X"],
         data["F"],
         data["G"],
     )
-    return ParetoSet(path, X, var_names, var_units, F, obj_names, G, constraint_names, text)
+    return ParetoSet(
+        path,
+        X,
+        var_names,
+        var_units,
+        F,
+        obj_names,
+        G,
+        constraint_names,
+        text,
+        None,
+        None,
+        obj_units,
+    )
 
 
 def evaluate_pareto(

@@ -1,4 +1,4 @@
-"""The code's shape (function and module sizes) and the integrator against independent
+"""The code's shape (function sizes; modules are cut by concept, with no cap) and the integrator against independent
 references: every bundled config runs; a linear quarter car agrees with ``scipy.signal.lsim``
 of the model's own linear matrices; RK4 converges at fourth order on a smooth road."""
 
@@ -15,16 +15,13 @@ import suspopt
 from suspopt.road import road_inputs
 
 MAX_FUNCTION_LINES = 80
-MAX_MODULE_LINES = 600
 
 
-def test_no_function_over_80_lines_and_no_module_over_600():
+def test_no_function_over_80_lines():
     too_long = []
     for path in sorted((ROOT / "suspopt").rglob("*.py")):
         text = path.read_text()
         where = path.relative_to(ROOT)
-        if len(text.splitlines()) > MAX_MODULE_LINES:
-            too_long.append(f"{where}: {len(text.splitlines())} lines")
         for node in ast.walk(ast.parse(text)):
             if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
                 lines = node.end_lineno - node.lineno + 1

@@ -62,6 +62,7 @@ from .runs import (
     design_labels,
     optimisation_figure,
     optimisation_result_figure,
+    pareto_set_figure,
     plot_optimisation,
     plot_simulation,
     result_figure,
@@ -107,6 +108,7 @@ __all__ = [
     "optimisation_figure",
     "plot_optimisation",
     "optimisation_result_figure",
+    "pareto_set_figure",
     "chosen_designs",
     "design_labels",
 ]

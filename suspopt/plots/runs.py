@@ -390,6 +390,36 @@ def optimisation_figure(
     return fig
 
 
+def _check_picks(picks: Mapping[str, int] | None, N: int) -> None:
+    """ValueError unless every pick of ``picks`` (name -> row) is a row of a front of ``N``."""
+    for name, row in (picks or {}).items():
+        if isinstance(row, bool) or not isinstance(row, (int, np.integer)) or not 0 <= row < N:
+            raise ValueError(f"picks: {name!r}: {row!r} is not a row of the front (0 to {N - 1})")
+
+
+def pareto_set_figure(pareto, picks: Mapping[str, int] | None = None):
+    """The figure of :func:`optimisation_figure` for a :class:`suspopt.selection.ParetoSet`
+    read from a file (:meth:`suspopt.selection.ParetoSet.plot`), unsaved: its front, with
+    the file's ``/history`` (hypervolume and feasible share per generation) where it holds
+    one, else empty history panels; ``picks`` (name -> row of the set) starred and named."""
+    from ..h5read import H5Reader
+
+    F = np.atleast_2d(pareto.F)
+    N, m = F.shape
+    _check_picks(picks, N)
+    keys = ("generation", "hypervolume", "feasible")
+    history: dict = {key: np.empty(0) for key in keys} | {"best": np.empty((0, m))}
+    with H5Reader(pareto.path) as h5:
+        if all(h5._node(f"history/{key}") is not None for key in keys):
+            found = {key: h5.array(f"history/{key}", ndim=1) for key in keys}
+            if len({len(v) for v in found.values()}) == 1:
+                history.update(found)
+    units = pareto.obj_units if pareto.obj_units is not None else [""] * m
+    G = pareto.G if pareto.G is not None else np.zeros((N, 0))
+    title = f"{Path(pareto.path).name}: {N} design{'s' if N != 1 else ''} of the set"
+    return optimisation_figure(F, G, pareto.obj_names, units, history, title, None, picks)
+
+
 def plot_optimisation(result, path: str | Path) -> Path:
     """Draw :func:`optimisation_result_figure` of a
     :class:`suspopt.optimise.OptimisationResult` to ``path`` (.png or .svg; ``suspopt
@@ -408,10 +438,7 @@ def optimisation_result_figure(result, picks: Mapping[str, int] | None = None):
     from ..optimise.run import OptimisationResult
 
     require(result, OptimisationResult, "result", "from suspopt.optimise.optimise(cfg, path)")
-    N = len(np.atleast_2d(result.F))
-    for name, row in (picks or {}).items():
-        if isinstance(row, bool) or not isinstance(row, (int, np.integer)) or not 0 <= row < N:
-            raise ValueError(f"picks: {name!r}: {row!r} is not a row of the front (0 to {N - 1})")
+    _check_picks(picks, len(np.atleast_2d(result.F)))
     history = result.history
     generations = len(np.atleast_1d(history["generation"]))
     evaluations = int(history["evaluations"][-1]) if generations else 0
