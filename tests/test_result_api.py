@@ -181,10 +181,7 @@ def test_optimisation_plot_draws_the_front_and_marks_the_picks(front):
     assert isinstance(fig, Figure)
     ax = fig.axes[0]
     assert ax.get_xlabel() == "f1 [(m/s^2)^2]" and ax.get_ylabel() == "f3 [m^2]"
-    feasible = (front.G <= 0).all(axis=1)
-    kinds = [feasible] + ([~feasible] if (~feasible).any() else [])
-    for points, rows in zip(ax.collections, kinds):  # feasible filled, then infeasible
-        np.testing.assert_array_equal(points.get_offsets(), front.F[rows][:, :2])
+    _draws_the_front(ax, front)
     stars = {name: t.xy for t in ax.texts for name in t.get_text().split(", ")}
     assert set(stars) == set(picks)
     for name, row in picks.items():
@@ -202,10 +199,7 @@ def test_a_pareto_set_read_from_its_file_plots_its_front_history_and_marks(front
     fig = pareto.plot()
     ax = fig.axes[0]
     assert ax.get_xlabel() == "f1 [(m/s^2)^2]" and ax.get_ylabel() == "f3 [m^2]"
-    feasible = (front.G <= 0).all(axis=1)
-    kinds = [feasible] + ([~feasible] if (~feasible).any() else [])
-    for points, rows in zip(ax.collections, kinds):  # feasible filled, then infeasible
-        np.testing.assert_array_equal(points.get_offsets(), front.F[rows][:, :2])
+    _draws_the_front(ax, front)
     stars = {name for t in ax.texts for name in t.get_text().split(", ")}
     assert stars == set(pareto.marks())
     hv = fig.axes[1].lines[0].get_ydata()  # the file's hypervolume per generation
