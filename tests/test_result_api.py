@@ -206,3 +206,11 @@ def test_a_pareto_set_read_from_its_file_plots_its_front_history_and_marks(front
     np.testing.assert_array_equal(hv, front.history["hypervolume"])
     with pytest.raises(ValueError, match="picks: 'knee': 99 is not a row"):
         pareto.plot({"knee": 99})
+
+
+def _draws_the_front(ax, front) -> None:
+    """``ax`` shows ``front``'s first two objectives: feasible designs, then infeasible."""
+    feasible = (front.G <= 0).all(axis=1)
+    kinds = [feasible] + ([~feasible] if (~feasible).any() else [])
+    for points, rows in zip(ax.collections, kinds):  # feasible filled, then infeasible
+        np.testing.assert_array_equal(points.get_offsets(), front.F[rows][:, :2])
