@@ -157,7 +157,7 @@ def export(
                 try:
                     if csv is not None:
                         written = write_csv(source, csv, force=force)
-                    else:
+                    elif mat is not None:
                         written = [write_mat(source, mat, force=force)]
                 finally:
                     say_io_notes()  # (a killed run's leftovers beside an output)
@@ -168,6 +168,7 @@ def export(
             from ..picks import design_config, read_picks, split_picks
             from ..signature import signed_config
 
+            assert output is not None  # (one of the three is given: checked above)
             claim_output(stack, output, force, inputs=[("the input", source)])
             check_suffix(output, "yaml")
             names = split_picks(pick)
