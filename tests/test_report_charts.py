@@ -160,7 +160,9 @@ def _groups(curves) -> list[list[int]]:
 def test_the_transmissibility_legend_has_one_entry_per_distinct_curve(page, shown):
     """Curves the same to 1e-12 are one line and one legend entry, naming every design
     that shares it (here the seat is not designed: every pick's is the same)."""
-    tr = _payload(page)["studies"][1]["data"]["signals"]["transmissibility"]
+    data = _payload(page)["studies"][1]["data"]
+    tr = data["signals"]["transmissibility"]
+    ids = data.get("ids") or [str(r) for r in range(data["rows"])]
     names, entries = shown.execute_script(
         "const div = document.getElementById('tr-1');"
         " return [div.data.map(t => t.name), div.querySelectorAll('.legend .traces').length]"
@@ -169,7 +171,7 @@ def test_the_transmissibility_legend_has_one_entry_per_distinct_curve(page, show
     for dof, curves in tr["dofs"].items():
         prefix = "STHT (head)" if dof == "head" else dof
         for g in _groups(curves):
-            expected.append(prefix + ", " + ", ".join(f"row {tr['rows'][k]}" for k in g))
+            expected.append(prefix + ", " + ", ".join(f"design {ids[tr['rows'][k]]}" for k in g))
     assert names == expected and entries == len(expected)
     assert len(expected) == 2 < sum(len(c) for c in tr["dofs"].values())
 
@@ -178,14 +180,16 @@ def test_the_time_histories_merge_only_identical_curves(page, shown):
     """The time histories of the picks: one line per distinct history over the whole run,
     thinned with the highest and lowest values kept; the spectrum record_psd's of the whole
     history."""
-    signals = _payload(page)["studies"][1]["data"]["signals"]
+    data = _payload(page)["studies"][1]["data"]
+    signals = data["signals"]
+    ids = data.get("ids") or [str(r) for r in range(data["rows"])]
     _select_signal(shown, "seat.acc")
     names, x_range = shown.execute_script(
         "const div = document.getElementById('signal-1');"
         " return [div.data.map(t => t.name), div._fullLayout.xaxis.range]"
     )
     groups = _groups(signals["signals"]["seat.acc"])
-    assert names == [", ".join(f"row {signals['rows'][k]}" for k in g) for g in groups]
+    assert names == [", ".join(f"design {ids[signals['rows'][k]]}" for k in g) for g in groups]
     assert x_range[0] <= signals["time"][0] and x_range[1] >= signals["time"][-1]
     import suspopt
     from suspopt.picks import read_picks

@@ -17,7 +17,7 @@ browser and makes no network request. Per study:
   variable's axis spanning its search range (:func:`_search_bounds`);
   brushing ranges along its axes selects the designs inside all of them in the front,
   counts them and shows the ``suspopt simulate`` of them (up to 100). It is drawn when it comes on screen, at most three at a time (a browser
-  keeps about 16 WebGL contexts per page and each takes three: :data:`.page.SCRIPT`);
+  keeps about 16 WebGL contexts per page and each takes three: ``assets/page.js``);
 - hover and click on a design: its row, objectives with units, variables (those at a
   bound marked), constraint margins, in the panel beside the plot, and the ``suspopt export`` and ``simulate``
   commands that take it on (the file's path as given, quoted for a POSIX shell);
