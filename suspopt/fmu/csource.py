@@ -140,7 +140,7 @@ def _header(d: Description, bound: Bound, guid: str, offsets: dict) -> str:
         "su_dq_row su_dq_col su_dq_react su_du_row su_du_col su_law_code su_law_row su_no_pull "
         "su_weighted su_tyre_rows su_damper_rows su_laws su_below su_rate_row su_rate_col "
         "su_split_steps su_split_first su_split_kick su_start_kicks su_out_kind su_out_i "
-        "su_out_j su_in_slot su_tunable su_range_start su_range_count su_range_bind "
+        "su_out_j su_in_slot su_rate_input su_tunable su_range_start su_range_count su_range_bind "
         "su_range_zero su_range_alpha su_bind_par su_bind_deg"
     ).split()
     lines.append("extern const int " + ", ".join(f"{x}[]" for x in ints) + ";")
@@ -218,6 +218,7 @@ def _model_c(d: Description, bound: Bound, flat: np.ndarray) -> str:
         "su_start_kicks": s.get("start_kicks", ()), "su_out_kind": s["out_kind"],
         "su_out_i": s["out_i"], "su_out_j": s["out_j"],
         "su_in_slot": [slot for _, _, _, slot in d.info["inputs"]],
+        "su_rate_input": s["rate_inputs"],
         "su_tunable": [int(p.tunable) for p in bound.parameters],
         "su_range_start": starts, "su_range_count": counts, "su_range_bind": binds,
         "su_range_zero": zeros, "su_range_alpha": alphas, "su_bind_par": pars,

@@ -255,6 +255,8 @@ static const double *su_road_half(Inst *m, long j, double t)
     int i;
     (void)j;
     for (i = 0; i < 2 * NC; i++) m->uz[i] = m->u_set[i] + m->du_set[i] * (t - m->t_set);
+    for (i = 0; i < NC; i++) /* no rate input (the tyre does not damp): the height's slope */
+        if (!su_rate_input[i]) m->uz[NC + i] = m->du_set[i];
     return m->uz;
 #endif
 }
@@ -292,6 +294,7 @@ static const double *su_road_at(Inst *m, double t)
     double a, b;
     const double *va, *vb;
     int e;
+    if (t >= SU_ROAD_END) return &m->E[E_ROAD_TABLE + 2 * SU_STEPS * 2 * NC];
     if (j < 0) j = 0;
     if (j >= 2 * SU_STEPS) j = 2 * SU_STEPS - 1;
     a = j * hdt;
@@ -914,11 +917,7 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
 fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time)
 {
     Inst *m = (Inst *)c;
-#if SU_EMBEDDED
-    if (time > SU_ROAD_END * (1.0 + 1e-12) + 1e-12)
-        return su_fail(m, "%s", "the road built into this FMU ends at the config's duration");
-#endif
-    m->time = time;
+    m->time = time; /* (past the embedded road's end, its last value holds: su_road_at) */
     m->valid = 0;
     return fmi2OK;
 }
