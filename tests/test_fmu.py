@@ -81,8 +81,9 @@ def study(tmp_path_factory):
             text = text.replace(old, new)
         config.write_text(text)
         for road in ("embedded", "input"):
-            code, lines, said = invoke("export", config, "--fmu", d / f"{kind}_{road}.fmu",
-                                       "--road", road)  # fmt: skip
+            code, lines, said = invoke(
+                "export", config, "--fmu", d / f"{kind}_{road}.fmu", "--road", road
+            )
             assert code == 0, lines
             assert "compiled for linux64" in said
         assert invoke("simulate", config, "-o", d / f"{kind}.h5")[0] == 0
@@ -90,13 +91,22 @@ def study(tmp_path_factory):
     ke = d / "ke.yaml"
     assert invoke("init", "kesort", "-o", ke)[0] == 0
     budget = ["--set", "optimiser.population=8", "--set", "optimiser.generations=2"]
-    code, lines, _ = invoke("optimise", ke, "-o", d / "front.h5", *budget,
-                            "--set", "simulation.duration=1.0")  # fmt: skip
+    code, lines, _ = invoke(
+        "optimise", ke, "-o", d / "front.h5", *budget, "--set", "simulation.duration=1.0"
+    )
     assert code == 0, lines
     code, lines, _ = invoke("kesort", d / "front.h5", "-o", d / "ke.h5", "--keep-infeasible")
     assert code == 0, lines
-    code, lines, _ = invoke("export", d / "ke.h5", "--pick", "chosen", "--fmu",
-                            d / "kesort_embedded.fmu", "--road", "embedded")  # fmt: skip
+    code, lines, _ = invoke(
+        "export",
+        d / "ke.h5",
+        "--pick",
+        "chosen",
+        "--fmu",
+        d / "kesort_embedded.fmu",
+        "--road",
+        "embedded",
+    )
     assert code == 0, lines
     assert invoke("export", d / "ke.h5", "--pick", "chosen", "-o", d / "chosen.yaml")[0] == 0
     assert invoke("simulate", d / "chosen.yaml", "-o", d / "kesort.h5")[0] == 0
@@ -115,8 +125,14 @@ def signals_of(path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
 @pytest.mark.parametrize("kind", [*CASES, "kesort"])
 def test_fmpy_validates_every_fmu(study, kind, road):
     if kind == "kesort" and road == "input":
-        code, lines, _ = invoke("export", study["folder"] / "ke.h5", "--pick", "chosen",
-                                "--fmu", study["folder"] / "kesort_input.fmu")  # fmt: skip
+        code, lines, _ = invoke(
+            "export",
+            study["folder"] / "ke.h5",
+            "--pick",
+            "chosen",
+            "--fmu",
+            study["folder"] / "kesort_input.fmu",
+        )
         assert code == 0, lines
     path = study["folder"] / f"{kind}_{road}.fmu"
     assert validate_fmu(str(path)) == []
@@ -151,8 +167,12 @@ def cosim_with_inputs(path, time, inputs: dict, step: float) -> dict[str, np.nda
     md = read_model_description(str(path))
     refs = {v.name: v.valueReference for v in md.modelVariables}
     outputs = [v.name for v in md.modelVariables if v.causality == "output"]
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(path)), instanceName="road",
-                    modelIdentifier=md.coSimulation.modelIdentifier)  # fmt: skip
+    fmu = FMU2Slave(
+        guid=md.guid,
+        unzipDirectory=extract(str(path)),
+        instanceName="road",
+        modelIdentifier=md.coSimulation.modelIdentifier,
+    )
     fmu.instantiate()
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
@@ -194,8 +214,13 @@ def input_run(path, signals, t) -> tuple[float, str]:
 #: The largest error allowed with the road from inputs, relative to each signal's peak: the
 #: straight lines between samples at the communication step (the config's dt); the seat's
 #: wheel hop on its class A road at 33 m/s has the most of the road's curvature in it.
-INPUT_TOLERANCE = {"quarter": 1e-3, "half_pitch": 1e-3, "full": 1e-3, "seat": 3e-3,
-                   "semi_active": 3e-3}  # fmt: skip
+INPUT_TOLERANCE = {
+    "quarter": 1e-3,
+    "half_pitch": 1e-3,
+    "full": 1e-3,
+    "seat": 3e-3,
+    "semi_active": 3e-3,
+}
 
 
 @pytest.mark.slow
@@ -203,8 +228,10 @@ INPUT_TOLERANCE = {"quarter": 1e-3, "half_pitch": 1e-3, "full": 1e-3, "seat": 3e
 def test_cosimulation_fed_simulates_road_agrees(study, kind):
     t, signals = signals_of(study["folder"] / f"{kind}.h5")
     error, name = input_run(study["folder"] / f"{kind}_input.fmu", signals, t)
-    print(f"{kind}: co-simulation, road from inputs every {t[1]:g} s: max error {error:.2g} "
-          f"of the peak ({name})")  # fmt: skip
+    print(
+        f"{kind}: co-simulation, road from inputs every {t[1]:g} s: max error {error:.2g} "
+        f"of the peak ({name})"
+    )
     assert error <= INPUT_TOLERANCE[kind], (error, name)
 
 
@@ -227,9 +254,12 @@ def test_the_input_roads_error_falls_with_the_step(study, tmp_path):
 @pytest.mark.parametrize("kind", ["quarter", "half_pitch", "seat"])
 def test_model_exchange_under_cvode_agrees(study, kind):
     t, signals = signals_of(study["folder"] / f"{kind}.h5")
-    result = simulate_fmu(str(study["folder"] / f"{kind}_embedded.fmu"),
-                          fmi_type="ModelExchange", output_interval=t[1],
-                          relative_tolerance=1e-8)  # fmt: skip
+    result = simulate_fmu(
+        str(study["folder"] / f"{kind}_embedded.fmu"),
+        fmi_type="ModelExchange",
+        output_interval=t[1],
+        relative_tolerance=1e-8,
+    )
     last = np.r_[result["time"][1:] != result["time"][:-1], True]  # (after each event)
 
     def at_samples(name):
@@ -313,8 +343,11 @@ def test_every_law_translates_and_an_untranslatable_rule_is_refused(monkeypatch)
 
 @pytest.mark.slow
 def test_a_student_t_threshold_is_refused_in_one_line_and_nothing_written(study, tmp_path):
-    text = study["semi_active"].read_text().replace("distribution: empirical",
-                                                    "distribution: student_t")  # fmt: skip
+    text = (
+        study["semi_active"]
+        .read_text()
+        .replace("distribution: empirical", "distribution: student_t")
+    )
     config = tmp_path / "t.yaml"
     config.write_text(text)
     code, lines, _ = invoke("export", config, "--fmu", tmp_path / "t.fmu")
@@ -366,8 +399,14 @@ def test_without_a_compiler_the_fmu_is_source_only_and_says_so(study, tmp_path, 
 
 @pytest.mark.slow
 def test_several_picks_write_one_fmu_each(study, tmp_path):
-    code, lines, said = invoke("export", study["folder"] / "ke.h5", "--pick", "chosen,knee",
-                               "--fmu", tmp_path / "design.fmu")  # fmt: skip
+    code, lines, said = invoke(
+        "export",
+        study["folder"] / "ke.h5",
+        "--pick",
+        "chosen,knee",
+        "--fmu",
+        tmp_path / "design.fmu",
+    )
     assert code == 0, lines
     for pick in ("chosen", "knee"):
         path = tmp_path / f"design-{pick}.fmu"

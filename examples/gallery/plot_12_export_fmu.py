@@ -33,8 +33,10 @@ cfg = suspopt.load_template("quarter")
 cfg.simulation.duration = 2.0  # [s]
 folder = Path(tempfile.mkdtemp())
 done = export_fmu(cfg, folder / "quarter.fmu", road="embedded")
-print(f"{done.path.name}: {done.binary or 'source-only'}, {done.outputs} outputs, "
-      f"{done.tunable} tunable parameters")  # fmt: skip
+print(
+    f"{done.path.name}: {done.binary or 'source-only'}, {done.outputs} outputs, "
+    f"{done.tunable} tunable parameters"
+)
 assert validate_fmu(str(done.path)) == []  # FMPy finds nothing wrong with it
 
 # %%
@@ -56,8 +58,13 @@ for ax, name in zip(axes, ("body.heave_acc", "tyre_deflection.F1")):
     reference = result.signals[name][0]
     ax.plot(result.time, reference, color="0.6", lw=3, label="suspopt simulate")
     ax.plot(cosim["time"], cosim[name], "C0", lw=1, label="FMU, co-simulation (RK4)")
-    ax.plot(exchange["time"][last], exchange[name][last], "C3--", lw=1,
-            label="FMU, model exchange (CVode)")  # fmt: skip
+    ax.plot(
+        exchange["time"][last],
+        exchange[name][last],
+        "C3--",
+        lw=1,
+        label="FMU, model exchange (CVode)",
+    )
     ax.set_ylabel(f"{name} [{result.signal_unit(name)}]")
     error = np.abs(cosim[name] - reference).max() / np.abs(reference).max()
     ax.set_title(f"{name}: co-simulation within {error:.1e} of suspopt's peak", fontsize=9)

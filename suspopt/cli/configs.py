@@ -157,15 +157,9 @@ def export(
     config's own design) as an FMU compiled for this platform when a C compiler is found
     (docs/guide/export-fmu.md); with --csv DIR, the tables; with --mat FILE.mat, every group as
     a MATLAB struct (docs/guide/export-mat.md)."""
-    if [output, csv, mat, fmu].count(None) != 3:
-        fail(
-            "export: give -o FILE.yaml (with --pick), --fmu FILE.fmu, --csv DIR or --mat FILE.mat"
-        )
-    if fmu is None and road != "input":
-        fail("--road is for --fmu")
-    if fmu is not None:
-        _export_fmu(source, pick, fmu, road, force)
-        return
+    target = _one_output(output, csv, mat, fmu, road)
+    if target is not None:
+        return _export_fmu(source, pick, target, road, force)
     with ExitStack() as stack:
         try:
             if csv is not None or mat is not None:
@@ -202,6 +196,16 @@ def export(
         except ConfigError as exc:
             fail(str(exc))
     out.print(f"wrote {output} (design {picked.ids[0]} of {source}, --pick {names[0]})")
+
+
+def _one_output(output, csv, mat, fmu, road: str) -> Path | None:
+    """Bad input unless ``export`` was given one output (and ``--road`` only with
+    ``--fmu``); the FMU's path, or None for another output."""
+    if [output, csv, mat, fmu].count(None) != 3:
+        fail("export: give -o FILE.yaml (with --pick), --fmu FILE.fmu, --csv DIR or --mat FILE.mat")
+    if fmu is None and road != "input":
+        fail("--road is for --fmu")
+    return fmu
 
 
 def _export_fmu(source: Path, pick: list[str], fmu: Path, road: str, force: bool) -> None:

@@ -122,8 +122,9 @@ def _map_entries(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 def _network(d: Description, network, model, cfg: Config) -> None:
     """The elements, their maps and laws (module docstring)."""
-    dq_row, dq_col, dq_val, dq_react, du_row, du_col, du_val = ([] for _ in range(7))
-    k, c, law_code, law_row, law_par, groups, no_pull = [], [], [], [], [], [], []
+    lists: list[list[Any]] = [[] for _ in range(14)]
+    dq_row, dq_col, dq_val, dq_react, du_row, du_col, du_val = lists[:7]
+    k, c, law_code, law_row, law_par, groups, no_pull = lists[7:]
     start = 0
     for g in network.groups:
         dof_map = g.dof_map[0] if g.dof_map.ndim == 3 else g.dof_map
@@ -148,14 +149,14 @@ def _network(d: Description, network, model, cfg: Config) -> None:
         start += g.size
     d.structure.update(
         R=start,
-        dq_row=np.array(dq_row, int),
-        dq_col=np.array(dq_col, int),
-        dq_react=np.array(dq_react, int),
-        du_row=np.array(du_row, int),
-        du_col=np.array(du_col, int),
-        law_code=np.array(law_code, int),
-        law_row=np.array(law_row, int),
-        no_pull=np.array(no_pull, int),
+        dq_row=np.array(dq_row, dtype=np.int64),
+        dq_col=np.array(dq_col, dtype=np.int64),
+        dq_react=np.array(dq_react, dtype=np.int64),
+        du_row=np.array(du_row, dtype=np.int64),
+        du_col=np.array(du_col, dtype=np.int64),
+        law_code=np.array(law_code, dtype=np.int64),
+        law_row=np.array(law_row, dtype=np.int64),
+        no_pull=np.array(no_pull, dtype=np.int64),
         groups=tuple(groups),
     )
     d.put("mass", network.mass[:, 0, 0])
@@ -163,7 +164,7 @@ def _network(d: Description, network, model, cfg: Config) -> None:
     d.put("du", du_val)
     d.put("k", k)
     d.put("c", c)
-    d.put("law", np.array(law_par, float).reshape(-1))
+    d.put("law", np.asarray(law_par, dtype=np.float64).reshape(-1))
 
 
 def _law_rows(g, start: int, codes: list, rows: list, params: list) -> None:
@@ -208,11 +209,11 @@ def _statics(d: Description, model, cfg: Config) -> None:
 def _inputs(d: Description, model, road: str) -> None:
     """The FMU's inputs in ``input`` mode: each wheel's road height, and its rate where the
     tyre damps (the rate enters only through c_T)."""
-    c = d.entries["c"]
+    damping = d.entries["c"]
     start = next(s for n, s, _ in d.structure["groups"] if n == "tyre")
-    damped = [int(c[start + i] != 0.0) for i in range(len(model.corners))]
+    damped = [int(damping[start + i] != 0.0) for i in range(len(model.corners))]
     d.structure["rate_inputs"] = np.array(damped if road == "input" else [0] * len(damped), int)
-    nu, inputs = len(model.corners), []
+    nu, inputs = len(model.corners), []  # (name, unit, description, slot of [z; zdot])
     if road == "input":
         for c, corner in enumerate(model.corners):
             inputs.append((f"input.road.{corner}", "m", f"road height under the wheel {corner}", c))
@@ -239,9 +240,10 @@ def _controller(d: Description, controller, network, cfg: Config) -> None:
     suspension = next((s, m) for n, s, m in d.structure["groups"] if n == "suspension")
     spec = cfg.control.threshold if cfg.control is not None else None
     adaptive = spec is not None and spec.mode == "adaptive"
-    if adaptive and spec.distribution not in ("empirical", "normal"):
+    distribution = spec.distribution if spec is not None else "empirical"
+    if adaptive and distribution not in ("empirical", "normal"):
         raise ConfigError(
-            f"control.threshold.distribution {spec.distribution}: an adaptive threshold "
+            f"control.threshold.distribution {distribution}: an adaptive threshold "
             "fitted by the Student-t distribution cannot be exported to an FMU (its fit is "
             "not in the C code); use empirical or normal"
         )
@@ -257,7 +259,7 @@ def _controller(d: Description, controller, network, cfg: Config) -> None:
         every=int(controller.sample_every),
         lagged=int(controller.lag_decay is not None),
         adaptive=int(adaptive),
-        distribution=0 if not adaptive or spec.distribution == "empirical" else 1,
+        distribution=0 if not adaptive or distribution == "empirical" else 1,
     )
     d.put("rates", vals)
     d.put("c_min", rules.c_min[0])
@@ -284,7 +286,8 @@ def _adaptive(d: Description, cfg: Config, rules) -> None:
     fit and the refit factor, and for the normal fit ``Φ⁻¹(level)``."""
     from scipy.special import ndtri
 
-    spec = cfg.control.threshold
+    spec = cfg.control.threshold if cfg.control is not None else None
+    assert spec is not None and spec.c_max_share is not None  # (an adaptive threshold)
     share = float(spec.c_max_share)
     level = np.where(np.asarray(rules.below, bool), share, 1.0 - share)
     d.put("level", level)
@@ -322,9 +325,9 @@ def _embedded_road(d: Description, cfg: Config, model, network) -> None:
         lefts.append(left)
         first.append(first[-1] + hk.size)
     d.structure.update(
-        split_steps=np.array(steps, int),
-        split_first=np.array(first, int),
-        split_kick=np.array(kicks, int),
+        split_steps=np.array(steps, dtype=np.int64),
+        split_first=np.array(first, dtype=np.int64),
+        split_kick=np.array(kicks, dtype=np.int64),
         start_kicks=np.array(plan.at_start, int),
         edges=int(times.size),
     )

@@ -27,11 +27,23 @@ __all__ = ["model_description", "base_units"]
 _BASE = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 #: Named units as exponents of the base units (and a factor, 1 for SI).
 _NAMED = {
-    "kg": {"kg": 1}, "m": {"m": 1}, "s": {"s": 1}, "A": {"A": 1}, "K": {"K": 1},
-    "mol": {"mol": 1}, "cd": {"cd": 1}, "rad": {"rad": 1}, "N": {"kg": 1, "m": 1, "s": -2},
-    "J": {"kg": 1, "m": 2, "s": -2}, "W": {"kg": 1, "m": 2, "s": -3},
-    "Pa": {"kg": 1, "m": -1, "s": -2}, "Hz": {"s": -1}, "1": {}, "-": {}, "cycles": {},
-}  # fmt: skip
+    "kg": {"kg": 1},
+    "m": {"m": 1},
+    "s": {"s": 1},
+    "A": {"A": 1},
+    "K": {"K": 1},
+    "mol": {"mol": 1},
+    "cd": {"cd": 1},
+    "rad": {"rad": 1},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "J": {"kg": 1, "m": 2, "s": -2},
+    "W": {"kg": 1, "m": 2, "s": -3},
+    "Pa": {"kg": 1, "m": -1, "s": -2},
+    "Hz": {"s": -1},
+    "1": {},
+    "-": {},
+    "cycles": {},
+}
 _TOKEN = re.compile(r"\s*([A-Za-z]+|\d+(?:\.\d+)?|[()^*/-])")
 #: Outputs that change only at the controller's samples or the lag's steps.
 _DISCRETE_HEADS = ("damping", "damper_state", "control_condition", "control_threshold")
@@ -97,8 +109,7 @@ def _unit_definitions(units: set[str]) -> str:
     lines = ["  <UnitDefinitions>"]
     for unit in sorted(units):
         exps = base_units(unit)
-        whole = exps is not None and all(float(v).is_integer() for v in exps.values())
-        if whole:
+        if exps is not None and all(float(v).is_integer() for v in exps.values()):
             attrs = "".join(f' {k}="{int(v)}"' for k, v in exps.items() if v and k in _BASE)
             lines.append(f"    <Unit name={quoteattr(unit)}><BaseUnit{attrs}/></Unit>")
         else:
@@ -108,7 +119,7 @@ def _unit_definitions(units: set[str]) -> str:
 
 
 def _variable(name, vr, description, causality, variability, real, initial=None) -> str:
-    attrs = f"name={quoteattr(name)} valueReference=\"{vr}\""
+    attrs = f'name={quoteattr(name)} valueReference="{vr}"'
     if description:
         attrs += f" description={quoteattr(description)}"
     attrs += f' causality="{causality}" variability="{variability}"'
@@ -131,7 +142,9 @@ def _real(unit: str | None = None, start: float | None = None, derivative: int |
 def _variables(d: Description, bound: Bound) -> tuple[list[str], dict[str, list[int]], set]:
     """The ScalarVariables and the 1-based indices of the outputs, states' derivatives and
     initial unknowns; the units used."""
-    rows, units, index = [], set(), {"outputs": [], "derivatives": [], "initial": []}
+    rows: list[str] = []
+    units: set[str] = set()
+    index: dict[str, list[int]] = {"outputs": [], "derivatives": [], "initial": []}
 
     def unit_of(u):
         if u and base_units(u) is not None:
@@ -142,20 +155,39 @@ def _variables(d: Description, bound: Bound) -> tuple[list[str], dict[str, list[
     for p in bound.parameters:
         if p.tunable:
             real = _real(unit_of(p.unit), p.value)
-            rows.append(_variable(fmi_name(p.path), len(rows), p.description, "parameter",
-                                  "tunable", real, "exact"))  # fmt: skip
+            rows.append(
+                _variable(
+                    fmi_name(p.path),
+                    len(rows),
+                    p.description,
+                    "parameter",
+                    "tunable",
+                    real,
+                    "exact",
+                )
+            )
         else:
             text = f"{p.description} (a constant of this FMU: {p.reason})".lstrip()
             real = _real(unit_of(p.unit), p.value)
-            rows.append(_variable(fmi_name(p.path), len(rows), text, "local", "constant",
-                                  real, "exact"))  # fmt: skip
+            rows.append(
+                _variable(fmi_name(p.path), len(rows), text, "local", "constant", real, "exact")
+            )
     for name, unit, text, _ in d.info["inputs"]:
-        rows.append(_variable(name, len(rows), text, "input", "continuous",
-                              _real(unit_of(unit), 0.0)))  # fmt: skip
+        rows.append(
+            _variable(name, len(rows), text, "input", "continuous", _real(unit_of(unit), 0.0))
+        )
     for fmi, signal, unit, text in d.info["outputs"]:
         discrete = signal.split(".")[0] in _DISCRETE_HEADS
-        rows.append(_variable(fmi, len(rows), f"{text} ({signal})", "output",
-                              "discrete" if discrete else "continuous", _real(unit_of(unit))))  # fmt: skip
+        rows.append(
+            _variable(
+                fmi,
+                len(rows),
+                f"{text} ({signal})",
+                "output",
+                "discrete" if discrete else "continuous",
+                _real(unit_of(unit)),
+            )
+        )
         index["outputs"].append(len(rows))
     _states(d, rows, index, unit_of)
     return rows, index, units
@@ -167,19 +199,43 @@ def _states(d: Description, rows: list[str], index: dict, unit_of) -> None:
     unit = [("rad" if dof in ("body.roll", "body.pitch") else "m") for dof in dofs]
     first_x = len(rows) + 1
     for dof, u in zip(dofs, unit):
-        rows.append(_variable(fmi_name(f"x.{dof}"), len(rows), f"{dof} from static equilibrium",
-                              "local", "continuous", _real(unit_of(u), 0.0), "exact"))  # fmt: skip
+        rows.append(
+            _variable(
+                fmi_name(f"x.{dof}"),
+                len(rows),
+                f"{dof} from static equilibrium",
+                "local",
+                "continuous",
+                _real(unit_of(u), 0.0),
+                "exact",
+            )
+        )
     first_v = len(rows) + 1
     for i, (dof, u) in enumerate(zip(dofs, unit)):
-        rows.append(_variable(fmi_name(f"v.{dof}"), len(rows), f"{dof} rate",
-                              "local", "continuous",
-                              _real(unit_of(u + "/s"), 0.0, first_x + i), "exact"))  # fmt: skip
+        rows.append(
+            _variable(
+                fmi_name(f"v.{dof}"),
+                len(rows),
+                f"{dof} rate",
+                "local",
+                "continuous",
+                _real(unit_of(u + "/s"), 0.0, first_x + i),
+                "exact",
+            )
+        )
         index["derivatives"].append(len(rows))
     for i, (dof, u) in enumerate(zip(dofs, unit)):
-        rows.append(_variable(f"der({fmi_name(f'v.{dof}')})", len(rows),
-                              f"{dof} acceleration (the equations of motion)", "local",
-                              "continuous", _real(unit_of(u + "/s^2"), None, first_v + i),
-                              "calculated"))  # fmt: skip
+        rows.append(
+            _variable(
+                f"der({fmi_name(f'v.{dof}')})",
+                len(rows),
+                f"{dof} acceleration (the equations of motion)",
+                "local",
+                "continuous",
+                _real(unit_of(u + "/s^2"), None, first_v + i),
+                "calculated",
+            )
+        )
         index["derivatives"].append(len(rows))
         index["initial"].append(len(rows))
 

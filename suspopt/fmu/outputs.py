@@ -48,10 +48,21 @@ _WHAT = {"": "displacement", "vel": "velocity", "acc": "acceleration"}
 def quantity_layout(n: int, nu: int, R: int) -> dict[str, int]:
     """Where each quantity starts in the runtime's vector ``Q`` (module docstring)."""
     sizes = [
-        ("q", n), ("v", n), ("a", n), ("u", nu), ("ud", nu), ("d", R), ("dv", R),
-        ("f_elastic", R), ("f_viscous", R), ("f_total", R), ("c_now", R), ("static", R),
-        ("base", 3), ("mech", 1),
-    ]  # fmt: skip
+        ("q", n),
+        ("v", n),
+        ("a", n),
+        ("u", nu),
+        ("ud", nu),
+        ("d", R),
+        ("dv", R),
+        ("f_elastic", R),
+        ("f_viscous", R),
+        ("f_total", R),
+        ("c_now", R),
+        ("static", R),
+        ("base", 3),
+        ("mech", 1),
+    ]
     layout, at = {}, 0
     for name, size in sizes:
         layout[name] = at

@@ -185,7 +185,10 @@ def _classify(cfg: Config, road: str, d0: Description, e0, p: Parameter):
         return None
     moved, degree, why = _degrees(e0, probes, steps, zero)
     if why is not None:
-        p.tunable, p.reason = False, f"the model depends on it in a way the FMU cannot recompute ({why})"
+        p.tunable, p.reason = (
+            False,
+            f"the model depends on it in a way the FMU cannot recompute ({why})",
+        )
         return None
     alpha = probes[0][moved] / values[0] if zero else None
     return Binding(moved, degree, alpha)
