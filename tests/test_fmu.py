@@ -251,6 +251,22 @@ def test_the_input_roads_error_falls_with_the_step(study, tmp_path):
 
 
 @pytest.mark.slow
+def test_a_damping_tyre_takes_the_road_rate_as_an_input_too(study, tmp_path):
+    text = study["quarter"].read_text().replace("damping: 0 ", "damping: 49 ")  # (Part 2b)
+    config = tmp_path / "damped.yaml"
+    config.write_text(text)
+    assert invoke("export", config, "--fmu", tmp_path / "damped.fmu")[0] == 0
+    md = read_model_description(str(tmp_path / "damped.fmu"))
+    rate = next(v for v in md.modelVariables if v.name == "input.road_vel.F1")
+    assert rate.causality == "input" and rate.unit == "m/s"
+    result = suspopt.simulate(suspopt.load_config(config))
+    signals = {n: result.signals[n][0] for n in result.signals}
+    error, name = input_run(tmp_path / "damped.fmu", signals, result.time)
+    print(f"quarter, c_T = 49 N s/m, road and its rate from inputs: max error {error:.2g} ({name})")
+    assert error <= 1e-3, (error, name)
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["quarter", "half_pitch", "seat"])
 def test_model_exchange_under_cvode_agrees(study, kind):
     t, signals = signals_of(study["folder"] / f"{kind}.h5")
@@ -321,6 +337,8 @@ def test_the_model_description_records_provenance_units_and_the_pick(study):
     var = {v.name: v for v in md.modelVariables}
     assert var["head.acc"].unit == "m/s^2" and var["head.acc"].causality == "output"
     assert var["vehicle.corners.F1.damper.c"].variability == "tunable"
+    knl = var["vehicle.corners.F1.spring.cubic"]  # (the design variable K_nlF1 of the pick)
+    assert knl.variability == "tunable" and knl.description.startswith("design variable K_nlF1")
     prepared = prepare(load_config_text(config.decode()))
     every = signal_names(prepared.model, {}, prepared.attachments)
     assert {n for n, v in var.items() if v.causality == "output"} == set(every)

@@ -104,18 +104,23 @@ def _description(cfg: Config, path: str) -> str:
 
 
 def model_parameters(cfg: Config, road: str) -> list[Parameter]:
-    """The model's numeric config fields (module docstring): integers (a seed, a count of
-    waves) are settings, not parameters, and are left out."""
+    """The model's numeric config fields (module docstring), a design variable's described
+    as one: integers (a seed, a count of waves) are settings, not parameters, and are left
+    out."""
     from ..params import field_unit, numeric_paths
 
     ints: set[str] = set()
     _int_paths(cfg.model_dump(), "", ints)
     sections = _SECTIONS + (("road.",) if road == "embedded" else ())
+    labels = {v.path: v.label for v in cfg.design_variables}
     found = []
     for path, value in numeric_paths(cfg).items():
         if not path.startswith(sections) or path.startswith(_SKIP) or path in ints:
             continue
-        found.append(Parameter(path, value, field_unit(cfg, path), _description(cfg, path)))
+        text = _description(cfg, path)
+        if path in labels:
+            text = f"design variable {labels[path]}: {text}"
+        found.append(Parameter(path, value, field_unit(cfg, path), text))
     return found
 
 
