@@ -19,6 +19,7 @@ from fmpy.validation import validate_fmu
 from typer.testing import CliRunner
 
 import suspopt
+import suspopt.fmu
 from suspopt.cli import app
 from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
@@ -306,6 +307,34 @@ def test_tuned_parameters_agree_with_simulate_of_the_changed_config(study, kind,
     error, name = worst({n: result.signals[n][0] for n in result.signals}, lambda n: tuned[n])
     moved = max(peak_error(before.signals[n][0], result.signals[n][0]) for n in result.signals)
     assert moved > 1e-2  # (the change matters)
+    assert error <= 1e-9, (error, name)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "law",
+    [
+        "sh_l\n        linear_weight: 0.5",
+        "add",
+        "sh_add_1\n        crossover_frequency: 39.0",
+        "sh_add_2\n        crossover_frequency: 39.0",
+        "groundhook",
+        "hybrid\n        skyhook_weight: 0.7",
+    ],
+    ids=lambda law: law.split()[0],
+)
+def test_every_control_law_with_a_lag_repeats_simulate(study, tmp_path, law):
+    text = study["semi_active"].read_text()
+    text = text.replace("law: sh_2 ", f"law: {law} ").replace(
+        "actuator_lag: 0.0 ", "actuator_lag: 0.005 "
+    )
+    config = tmp_path / "law.yaml"
+    config.write_text(text)
+    cfg = suspopt.load_config(config)
+    done = suspopt.fmu.export_fmu(cfg, tmp_path / "law.fmu", road="embedded")
+    result = suspopt.simulate(cfg)
+    got = simulate_fmu(str(done.path), output_interval=result.time[1])
+    error, name = worst({n: result.signals[n][0] for n in result.signals}, lambda n: got[n])
     assert error <= 1e-9, (error, name)
 
 
