@@ -14,6 +14,7 @@ import zipfile
 
 import numpy as np
 import pytest
+from conftest import CONFIGS
 from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 from typer.testing import CliRunner
@@ -336,6 +337,33 @@ def test_every_control_law_with_a_lag_repeats_simulate(study, tmp_path, law):
     got = simulate_fmu(str(done.path), output_interval=result.time[1])
     error, name = worst({n: result.signals[n][0] for n in result.signals}, lambda n: got[n])
     assert error <= 1e-9, (error, name)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name, form",
+    [
+        ("nss1", "exact"),
+        ("nss2", "exact"),
+        ("nss3", "exact"),
+        ("nss4", "exact"),
+        ("nss2", "taylor"),
+    ],
+)
+def test_the_negative_stiffness_seats_repeat_simulate(tmp_path, name, form):
+    text = (CONFIGS / "ch8" / f"{name}_class_b_passenger.yaml").read_text()
+    text = re.sub(r"(?m)^(\s+form:) exact", rf"\1 {form}", text)
+    text = re.sub(r"duration: [0-9.e]+", "duration: 1.0", text)
+    config = tmp_path / f"{name}.yaml"
+    config.write_text(text)
+    cfg = suspopt.load_config(config)
+    assert cfg.seat.kind == name and cfg.seat.form == form
+    done = suspopt.fmu.export_fmu(cfg, tmp_path / f"{name}.fmu", road="embedded")
+    assert validate_fmu(str(done.path)) == []
+    result = suspopt.simulate(cfg)
+    got = simulate_fmu(str(done.path), output_interval=result.time[1])
+    error, signal = worst({n: result.signals[n][0] for n in result.signals}, lambda n: got[n])
+    assert error <= 1e-9, (error, signal)
 
 
 @pytest.mark.slow

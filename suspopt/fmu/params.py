@@ -160,7 +160,8 @@ def _probe(cfg: Config, road: str, changes: dict[str, float], d0: Description):
 
 def _degrees(e0: np.ndarray, probes: list[np.ndarray], steps, zero: bool):
     """The moved entries and their degrees, or a reason the dependence is not a power."""
-    moved = np.flatnonzero(np.any([p != e0 for p in probes], axis=0))
+    same = [(p == e0) | (np.isnan(p) & np.isnan(e0)) for p in probes]  # (NaN: no limit)
+    moved = np.flatnonzero(~np.all(same, axis=0))
     if not moved.size:
         return moved, np.zeros(0, int), None
     if zero:
@@ -273,7 +274,7 @@ def _verified(cfg: Config, road: str, d0: Description, e0, bound: Bound) -> bool
         for i in tunable:
             _demote(bound, i, "changing it with the others changes the model's structure")
         return False
-    wrong = ~np.isclose(predicted(e0, bound, values), actual, rtol=1e-9, atol=0)
+    wrong = ~np.isclose(predicted(e0, bound, values), actual, rtol=1e-9, atol=0, equal_nan=True)
     if not wrong.any():
         return True
     for i in list(bound.bindings):
