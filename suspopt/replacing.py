@@ -60,8 +60,15 @@ SUFFIXES = {
     "html": (".html", ".htm"),
     "yaml": (".yaml", ".yml"),
     "figure": (".png", ".svg"),
+    "fmu": (".fmu",),
 }
-_FORMAT_NAMES = {"hdf5": "HDF5", "html": "HTML", "yaml": "YAML", "figure": "a figure"}
+_FORMAT_NAMES = {
+    "hdf5": "HDF5",
+    "html": "HTML",
+    "yaml": "YAML",
+    "figure": "a figure",
+    "fmu": "an FMU (FMI 2.0)",
+}
 #: What a result of each command holds, for :func:`refusal`'s line.
 _HOLDS = {
     "optimise": "a front",

@@ -1020,6 +1020,7 @@ H5_RUNS = [
     ["export", "{path}", "--pick", "knee", "-o", "{out}.yaml"],
     ["export", "{path}", "--csv", "{out}.csv"],
     ["export", "{path}", "--mat", "{out}.mat"],
+    ["export", "{path}", "--pick", "knee", "--fmu", "{out}.fmu"],
 ]
 #: the bundled config of the tiny front, and its run length [s]
 FRONT = "ch8/pareto_ps_class_a"
@@ -1547,6 +1548,7 @@ OPTION_BASES = [
     ["kesort", "{path}/front.h5", "-o", "{out}"],
     ["export", "{path}/choice.h5", "--pick", "chosen", "-o", "{out}.yaml"],
     ["export", "{path}/builds.h5", "--mat", "{out}.mat"],
+    ["export", "{path}/choice.h5", "--pick", "chosen", "--fmu", "{out}.fmu"],
     ["report", "{path}/front.h5", "-o", "{out}.html"],
     ["analyse", "roads", "{path}/front.h5", "--road", "{path}/road.yaml", "-o", "{out}"],
     ["analyse", "masses", "{path}/front.h5", "-o", "{out}"],

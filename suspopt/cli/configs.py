@@ -137,14 +137,29 @@ def export(
     mat: Path | None = typer.Option(
         None, "--mat", help="MATLAB file (.mat) of every group of the file, as structs"
     ),
+    fmu: Path | None = typer.Option(
+        None,
+        "--fmu",
+        help="FMU (FMI 2.0, model exchange and co-simulation) of the pick, or of a config's "
+        "own design; several picks: one FMU each, <stem>-<pick>.fmu",
+    ),
+    road: str = typer.Option(
+        "input",
+        "--road",
+        help="with --fmu: input (the road under each wheel from the FMU's inputs) or "
+        "embedded (the config's road built in: the FMU alone reproduces simulate)",
+    ),
     force: bool = force_option(),
 ) -> None:
-    """Write a picked design as a standalone config, or a result file's tables as CSV or MATLAB.
+    """Write a picked design as a standalone config or an FMU, or a file's tables as CSV or MATLAB.
 
-    With -o design.yaml it writes the config of one pick; with --csv DIR, the tables; with
-    --mat FILE.mat, every group as a MATLAB struct (docs/guide/export-mat.md)."""
-    if [output, csv, mat].count(None) != 2:
-        fail("export: give -o FILE.yaml (with --pick), --csv DIR or --mat FILE.mat")
+    With -o design.yaml it writes the config of one pick; with --fmu design.fmu, the pick (or a
+    config's own design) as an FMU compiled for this platform when a C compiler is found
+    (docs/guide/export-fmu.md); with --csv DIR, the tables; with --mat FILE.mat, every group as
+    a MATLAB struct (docs/guide/export-mat.md)."""
+    target = _one_output(output, csv, mat, fmu, road)
+    if target is not None:
+        return _export_fmu(source, pick, target, road, force)
     with ExitStack() as stack:
         try:
             if csv is not None or mat is not None:
@@ -181,3 +196,58 @@ def export(
         except ConfigError as exc:
             fail(str(exc))
     out.print(f"wrote {output} (design {picked.ids[0]} of {source}, --pick {names[0]})")
+
+
+def _one_output(output, csv, mat, fmu, road: str) -> Path | None:
+    """Bad input unless ``export`` was given one output (and ``--road`` only with
+    ``--fmu``); the FMU's path, or None for another output."""
+    if [output, csv, mat, fmu].count(None) != 3:
+        fail("export: give -o FILE.yaml (with --pick), --fmu FILE.fmu, --csv DIR or --mat FILE.mat")
+    if fmu is None and road != "input":
+        fail("--road is for --fmu")
+    return fmu
+
+
+def _export_fmu(source: Path, pick: list[str], fmu: Path, road: str, force: bool) -> None:
+    """``export SOURCE --fmu FILE.fmu``: the picks of a result file, or a config's own design
+    (:mod:`suspopt.fmu`); every target claimed and checked before any is written."""
+    from ..fmu.export import check_pick_targets, export_fmu, export_picks
+    from ..fmu.model import ROAD_MODES
+    from ..picks import split_picks
+    from ..signature import CONFIG_SUFFIXES
+
+    if road not in ROAD_MODES:
+        fail(f"--road {road}: use {' or '.join(ROAD_MODES)}")
+    is_config = source.suffix.lower() in CONFIG_SUFFIXES
+    with ExitStack() as stack:
+        try:
+            if is_config and pick:
+                fail(
+                    f"--pick: {source} is a config: it has one design, its own; pick from a "
+                    "result file of optimise, kesort or analyse"
+                )
+            names = [] if is_config else split_picks(pick)
+            targets = check_pick_targets(fmu, names)
+            for target in targets:
+                claim_output(stack, target, force, "--fmu", inputs=[("the input", source)])
+                check_suffix(target, "fmu", "--fmu")
+            if is_config:
+                from ..config import load_config
+
+                written = [export_fmu(load_config(source), fmu, road, source=str(source))]
+            else:
+                written = export_picks(source, names, fmu, road, force=force)
+        except ConfigError as exc:
+            fail(str(exc))
+    for done in written:
+        built = (
+            f"compiled for {done.binary.split('/')[1]} with {done.note}"
+            if done.binary
+            else f"source-only ({done.note}; sources/ compiles with any C99 compiler)"
+        )
+        out.print(
+            f"wrote {done.path} (FMI 2.0 model exchange and co-simulation, road {road}; "
+            f"{built}; {done.inputs} inputs, {done.outputs} outputs, {done.tunable} tunable "
+            f"parameters, {done.constants} constants)",
+            soft_wrap=True,
+        )
