@@ -128,28 +128,31 @@ def _is_model(annotation: Any) -> bool:
     return isinstance(annotation, type) and issubclass(annotation, BaseModel)
 
 
-def _member(union: Any, part: Any) -> tuple[bool, Any]:
-    """``(True, member)`` when ``part`` labels a member of ``union`` (a discriminated
-    union's tag, a model's name, or pydantic's label of a plain type such as ``list[str]``;
-    the member is None when only the label is known), else ``(False, None)``."""
+def _member(union: Any, part: Any) -> tuple[str, Any]:
+    """What ``part`` is in a location at ``union``: ``("tag", member)`` for a discriminated
+    union's tag (``bump_step``, ``semi_active``), ``("label", member)`` for pydantic's label
+    of a member of a union told apart by trying each (a model's name, or ``list[str]``; the
+    member None when only the label is known), ``("", None)`` for neither."""
     if not isinstance(part, str):
-        return False, None
+        return "", None
     for raw in get_args(union):
         tags = [m.tag for m in getattr(raw, "__metadata__", ()) if hasattr(m, "tag")]
         member = _unwrap(raw)
         if part in tags:
-            return True, member
+            return "tag", member
         if _is_model(member):
             kind = member.model_fields.get("kind")
-            if part == member.__name__ or (kind and part in get_args(_unwrap(kind.annotation))):
-                return True, member
+            if kind and part in get_args(_unwrap(kind.annotation)):
+                return "tag", member
+            if part == member.__name__:
+                return "label", member
         elif get_origin(member) is not None and part.startswith(
             getattr(get_origin(member), "__name__", "").lower()
         ):
-            return True, member
+            return "label", member
     if "[" in part or part in ("str", "int", "float", "bool", "none"):
-        return True, None
-    return False, None
+        return "label", None
+    return "", None
 
 
 def _place(root: type, loc: tuple) -> _Place:
@@ -162,9 +165,10 @@ def _place(root: type, loc: tuple) -> _Place:
             continue
         annotation = _unwrap(annotation)
         if _is_union(annotation):
-            labelled, member = _member(annotation, part)
-            if labelled:
-                place.member_at = i if place.member_at is None else place.member_at
+            what, member = _member(annotation, part)
+            if what:
+                if what == "label" and place.member_at is None:
+                    place.member_at = i
                 annotation = member
                 continue
         origin = get_origin(annotation)
@@ -349,8 +353,8 @@ def _section_at(root: type, loc: tuple) -> Any:
             continue
         annotation = _unwrap(annotation)
         if _is_union(annotation):
-            labelled, member = _member(annotation, part)
-            if labelled:
+            what, member = _member(annotation, part)
+            if what:
                 annotation = member
                 continue
         origin = get_origin(annotation)

@@ -89,7 +89,7 @@ def number(value: float) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, int):
-        if abs(value) < 10**20:
+        if abs(value) < 10**30:
             return str(value)
         return f"a whole number of {int(value.bit_length() * math.log10(2)) + 1} digits or so"
     if math.isnan(value):
@@ -134,10 +134,13 @@ class Plausible:
     error_below: float | None = None
     error_above: float | None = None
     when: Callable[[dict], bool] | None = None
+    signed: bool = False
 
     def hint(self, value: float) -> str | None:
         """``looks like tonnes (1.2 t = 1200 kg)?`` for the first slip that takes ``value``
         into the plausible range, or None."""
+        if not (self.signed or value > 0) or self.low <= abs(value) <= self.high:
+            return None
         for slip in self.slips:
             si = value * slip.factor
             if self.low <= abs(si) <= self.high:
@@ -151,7 +154,7 @@ class Plausible:
         """``(severity, message)`` of a value outside the plausible range (module
         docstring), or None."""
         size = abs(value)
-        if self.low <= size <= self.high:
+        if self.low <= size <= self.high or not (self.signed or value > 0):
             return None
         below = size < self.low
         hint = self.hint(value)
@@ -216,7 +219,9 @@ PLAUSIBLE: tuple[Plausible, ...] = (
         (MM,),
         error_above=10.0,
     ),
-    Plausible((("road", "height"),), "bump height", "m", 1e-3, 0.5, (MM,), error_above=2.0),
+    Plausible(
+        (("road", "height"),), "bump height", "m", 1e-3, 0.5, (MM,), error_above=2.0, signed=True
+    ),
     Plausible((("road", "length"),), "bump length", "m", 0.05, 200.0, (MM,)),
     Plausible((("road", "speed"),), "speed", "m/s", 0.1, 70.0, (KMH,)),
     Plausible(
@@ -227,6 +232,7 @@ PLAUSIBLE: tuple[Plausible, ...] = (
         0.5,
         (MM,),
         when=_is_travel_limit,
+        signed=True,
     ),
     Plausible(
         tuple(("seat", key) for key in (*_SEAT_LENGTHS, "roller_radius")),
@@ -270,7 +276,7 @@ def slip_hint(loc: tuple, value: Any, data: Any = None) -> str | None:
     """The unit-slip hint of ``value`` at the key path ``loc`` (of the config's ``data``,
     for an entry that holds only in some sections), or None."""
     entry = entry_of(loc)
-    if entry is None or not _number(value) or entry.low <= abs(value) <= entry.high:
+    if entry is None or not _number(value):
         return None
     if entry.when is not None and not (data is not None and _holds(entry, data, loc)):
         return None
