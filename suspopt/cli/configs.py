@@ -31,7 +31,6 @@ def validate(
     max_errors: int = typer.Option(
         20,
         "--max-errors",
-        min=0,
         metavar="N",
         help="list at most N errors of each config (0: all of them)",
     ),
@@ -48,6 +47,8 @@ def validate(
 
     The exit code is 2 if any config is not valid."""
     set_memory_limit(max_memory)
+    if max_errors < 0:
+        fail(f"--max-errors {max_errors}: give how many errors to list, or 0 for all of them")
     problems = 0
     for config in configs:
         try:

@@ -155,6 +155,16 @@ def _member(union: Any, part: Any) -> tuple[str, Any]:
     return "", None
 
 
+def _holding(union: Any, key: Any) -> Any:
+    """The first model of ``union`` that has the field ``key`` (a key path without the
+    union's tag: ``road.height``), else ``union``."""
+    for raw in get_args(union):
+        member = _unwrap(raw)
+        if _is_model(member) and key in member.model_fields:
+            return member
+    return union
+
+
 def _place(root: type, loc: tuple) -> _Place:
     """Walk the pydantic location ``loc`` through the models from ``root`` (the Config)."""
     place = _Place(())
@@ -171,6 +181,7 @@ def _place(root: type, loc: tuple) -> _Place:
                     place.member_at = i
                 annotation = member
                 continue
+            annotation = _holding(annotation, part)
         origin = get_origin(annotation)
         if _is_model(annotation):
             place.model, place.field = annotation, annotation.model_fields.get(part)
@@ -192,6 +203,20 @@ def _unit(field: Any) -> str:
         if re.fullmatch(r"[A-Za-z0-9/^ ()*.%-]{1,12}", found) and found not in ("-", "1"):
             return found
     return ""
+
+
+def _tags(field: Any) -> list[str]:
+    """The ``kind`` of each member of the discriminated union of ``field`` (a road's, a
+    seat's), in their order."""
+    union = _unwrap(getattr(field, "annotation", None))
+    tags: list[str] = []
+    for raw in get_args(union) if _is_union(union) else ():
+        member = _unwrap(raw)
+        kind = member.model_fields.get("kind") if _is_model(member) else None
+        tags += (
+            [t for t in get_args(_unwrap(kind.annotation)) if isinstance(t, str)] if kind else []
+        )
+    return tags
 
 
 def _what(loc: tuple) -> str:
@@ -296,10 +321,11 @@ def _message(err: dict, place: _Place, allowed: list[str]) -> str:
     if kind == "literal_error":
         return _unknown(_what(place.loc), err.get("input"), _choices(ctx.get("expected", "")))
     if kind in ("union_tag_invalid", "union_tag_not_found"):
-        options = _choices(ctx.get("expected_tags", ""))
+        options = _tags(place.field) or _choices(ctx.get("expected_tags", ""))
         if kind == "union_tag_not_found":
             return f"required key is missing; one of {', '.join(map(str, options))}"
-        return _unknown(_what(place.loc), ctx.get("tag"), options)
+        given = err["input"].get("kind") if isinstance(err.get("input"), dict) else ctx.get("tag")
+        return _unknown(_what(place.loc), given, options)
     if kind == "damper_kind":
         given = err["input"].get("kind") if isinstance(err.get("input"), dict) else None
         options = ["passive", "semi_active"]
@@ -314,6 +340,8 @@ def _message(err: dict, place: _Place, allowed: list[str]) -> str:
         pattern = ctx.get("pattern", "")
         return f"must be {PATTERNS.get(pattern, f'text of the form {pattern}')}{_got(err)}"
     expected = _expected(kind, err)
+    if kind.startswith("int") and isinstance(err.get("input"), float):  # (2.0, 2.5, 1e5)
+        return f"expected a whole number, written without a point (got {err['input']!r})"
     if expected and _quoted_number(err):
         return f"expected {expected} (got the text {shown(err['input'])}: write numbers without quotes)"
     if expected:

@@ -168,18 +168,21 @@ class Plausible:
             return "error", message + (f"; {hint}" if hint else "")
         if hint is None:
             return None
+        either = " either way" if self.signed else ""
         return "warning", (
-            f"{said} is {'below' if below else 'above'} a road vehicle's {self.what} "
-            f"({number(self.low)} to {number(self.high)} {self.unit}); {hint}"
+            f"{said} is {'less' if below else 'more'}{' in size' if self.signed else ''} than "
+            f"a road vehicle's {self.what} ({number(self.low)} to {number(self.high)} "
+            f"{self.unit}{either}); {hint}"
         )
 
 
 def _is_travel_limit(constraint: dict) -> bool:
     """Whether a constraint's mapping limits a suspension travel in metres."""
-    signal = constraint.get("signal")
+    signal, metric = constraint.get("signal"), constraint.get("metric")
     return (
         isinstance(signal, str)
-        and constraint.get("metric") in SAME_UNIT_METRICS
+        and isinstance(metric, str)
+        and metric in SAME_UNIT_METRICS
         and (signal == "travel" or signal.startswith("travel.") or signal == "seat.travel")
     )
 
