@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import ast
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from types import NoneType, UnionType
 from typing import Annotated, Any, Union, get_args, get_origin
@@ -61,7 +62,7 @@ def suggest_words(name: object, known: list[str]) -> list[str]:
     close = suggest(name, known)
     if close or not isinstance(name, str):
         return close
-    words = {}
+    words: dict[str, list[str]] = {}
     for option in known:
         parts = re.split(r"[_.]", str(option))
         for n in range(1, len(parts)):
@@ -397,7 +398,7 @@ def _section_at(root: type, loc: tuple) -> Any:
     return annotation if _is_model(annotation) else None
 
 
-def plain_errors(errors: list[dict], root: type) -> list[tuple[tuple, str]]:
+def plain_errors(errors: Sequence[Any], root: type) -> list[tuple[tuple, str]]:
     """``[(key path, message), ...]`` of pydantic's ``errors`` of validating ``root`` (the
     Config), in their order, each key path once per distinct problem (module docstring)."""
     out: list[tuple[tuple, str]] = []

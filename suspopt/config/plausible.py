@@ -335,11 +335,13 @@ def _set_values(data: dict) -> Iterator[tuple[tuple, tuple, Any]]:
                     yield loc, tuple(path.split(".")), value
 
 
-def check_plausible(data: Any, skip: set[tuple] = frozenset()) -> list[tuple[tuple, str, str]]:
+def check_plausible(
+    data: Any, skip: set[tuple] | frozenset[tuple] = frozenset()
+) -> list[tuple[tuple, str, str]]:
     """``[(key path, severity, message), ...]`` of the values of a config's ``data`` (as
     read from YAML) outside their plausible range (module docstring), leaving out the key
     paths in ``skip`` (those the schema refused already)."""
-    out = []
+    out: list[tuple[tuple, str, str]] = []
     if not isinstance(data, dict):
         return out
     for entry in PLAUSIBLE:
@@ -351,10 +353,10 @@ def check_plausible(data: Any, skip: set[tuple] = frozenset()) -> list[tuple[tup
                 if judged is not None:
                     out.append((loc, *judged))
     for loc, path, value in _set_values(data):
-        entry = entry_of(path)
-        if loc in skip or entry is None or entry.when is not None or not _number(value):
+        found = entry_of(path)
+        if loc in skip or found is None or found.when is not None or not _number(value):
             continue
-        judged = entry.judge(value)
+        judged = found.judge(value)
         if judged is not None:
             out.append((loc, *judged))
     return out
