@@ -6,8 +6,8 @@ key they came from; a key absent from the file at the line of the nearest key ab
 is there, or with no line when none is (``case.yaml: road: required key is missing``).
 
 One load reports every problem it finds (``ConfigError.problems``): all of pydantic's errors,
-said in the user's terms (:mod:`suspopt.config.messages`), and the values the table of
-:mod:`suspopt.config.plausible` finds absurd for a road vehicle; its warnings (a value that
+said in the user's terms (``suspopt.config.messages``), and the values the table of
+``suspopt.config.plausible`` finds absurd for a road vehicle; its warnings (a value that
 looks like a unit slip) are ``cfg.warnings``, or ``exc.warnings`` with the errors.
 """
 
@@ -111,7 +111,7 @@ class Config(Section):
 
     def problems(self) -> Problems:
         """A collector of problems found after validation, located like load errors (each
-        at its key's line); :meth:`Problems.raise_if_any` raises them as one ConfigError."""
+        at its key's line); ``raise_if_any()`` raises them as one ConfigError."""
         name = str(self._source) if self._source is not None else "<config>"
         lines = self._lines
         return Problems(name, lambda loc: _line_of(loc, lines) if lines else None, self._hint)
@@ -122,7 +122,7 @@ class Config(Section):
 
     @property
     def warnings(self) -> tuple[Problem, ...]:
-        """What loading found plausible only as a unit slip (:mod:`suspopt.config.plausible`):
+        """What loading found plausible only as a unit slip (``suspopt.config.plausible``):
         problems of severity ``warning``, which reject nothing; ``suspopt validate`` prints
         them."""
         return self._warnings
