@@ -386,8 +386,9 @@ def _mutate(data: dict, mutation) -> None:
         parent[key] = parent[key] * factor
 
 
+@pytest.mark.slow
 @settings(
-    max_examples=60,
+    max_examples=150,
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
