@@ -187,7 +187,7 @@ def _is_travel_limit(constraint: dict) -> bool:
     )
 
 
-_SEAT_LENGTHS = ("wall_distance", "spring_free_length", "bar_length", "cam_radius")
+_SEAT_LENGTHS = ("wall_distance", "spring_free_length", "bar_length", "cam_radius", "roller_radius")
 
 #: The table (module docstring).
 PLAUSIBLE: tuple[Plausible, ...] = (
@@ -238,7 +238,7 @@ PLAUSIBLE: tuple[Plausible, ...] = (
         signed=True,
     ),
     Plausible(
-        tuple(("seat", key) for key in (*_SEAT_LENGTHS, "roller_radius")),
+        tuple(("seat", key) for key in _SEAT_LENGTHS),
         "seat mechanism length",
         "m",
         5e-3,
