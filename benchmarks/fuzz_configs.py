@@ -73,7 +73,7 @@ def tally(cases, results) -> dict:
                 c["exit 0"] += 1
             elif run["exit"] == 2:
                 c["exit 2"] += 1
-                if run["stderr_lines"] != 1:
+                if run["stderr_lines"] != 1 and run["command"] != "validate":
                     c["multi-line (or empty) messages"] += 1
             else:
                 c["other exits"] += 1

@@ -9,7 +9,9 @@ command that simulates, so that what ``validate`` accepts no other command rejec
 - :func:`stability_limit` and :func:`check_stability`: ``dt`` within classical RK4's
   stability limit for every mode of the linearised model (vehicle, seat and passenger).
 
-Each raises :class:`~suspopt.config.ConfigError` naming the key, its line and the limit.
+Each raises :class:`~suspopt.config.ConfigError` naming the key, its line and the limit; one
+that checks several things independent of each other (:func:`check_steps`,
+:func:`check_config`) reports every problem it finds in it (``ConfigError.problems``).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import numpy as np
 
 from .config import Config, ConfigError
 from .config.road import BumpHalfSine, BumpStep, Iso8608Road
+from .errors import FAILED, Problems
 from .network import Network
 
 __all__ = [
@@ -48,12 +51,14 @@ def _whole(ratio: float) -> bool:
     return abs(ratio - round(ratio)) <= _WHOLE * max(1.0, ratio)
 
 
-def _resolved(cfg: Config, span: float, steps: int, what: str, tail: str = "") -> None:
-    """ConfigError on ``simulation.dt`` unless ``span`` [s] (``what``, formatted with it) spans
+def _resolved(
+    cfg: Config, found: Problems, span: float, steps: int, what: str, tail: str = ""
+) -> None:
+    """A problem on ``simulation.dt`` unless ``span`` [s] (``what``, formatted with it) spans
     at least ``steps`` steps."""
     dt = cfg.simulation.dt
     if span < steps * dt * (1 - _WHOLE):
-        raise cfg.error(
+        found.add(
             ("simulation", "dt"),
             f"{dt:g} s steps over {what.format(span)} must span at least {steps} steps; "
             f"use dt <= {span / steps:.3g} s{tail}",
@@ -62,13 +67,14 @@ def _resolved(cfg: Config, span: float, steps: int, what: str, tail: str = "") -
 
 def check_steps(cfg: Config) -> None:
     """The time grid, the road's features against ``dt`` and the metrics' sample rate (module
-    docstring)."""
+    docstring); ConfigError with every problem of them."""
     from .metrics.iso2631 import MIN_SAMPLE_RATE
     from .specs import METRICS
 
     sim, road = cfg.simulation, cfg.road
+    found = cfg.problems()
     if not _whole(sim.duration / sim.dt):
-        raise cfg.error(
+        found.add(
             ("simulation", "duration"),
             f"{sim.duration:g} s is not a whole number "
             f"of steps dt = {sim.dt:g} s ({sim.duration / sim.dt:.6g} steps); "
@@ -76,18 +82,18 @@ def check_steps(cfg: Config) -> None:
         )
     if isinstance(road, (BumpStep, BumpHalfSine)):
         if road.start >= sim.duration:
-            raise cfg.error(
+            found.add(
                 ("road", "start"),
                 f"the bump starts at {road.start:g} s, after "
                 f"the run ends (simulation.duration = {sim.duration:g} s)",
             )
         crossing = road.length / road.speed
         what = "the bump: a wheel crosses it in {:.4g} s (road.length/road.speed), which"
-        _resolved(cfg, crossing, MIN_STEPS_PER_BUMP, what)
+        _resolved(cfg, found, crossing, MIN_STEPS_PER_BUMP, what)
     if isinstance(road, Iso8608Road):
         period = 1.0 / (road.n_max * road.speed)
         what = "the road's shortest wave: 1/(n_max V) = {:.4g} s"
-        _resolved(cfg, period, MIN_STEPS_PER_WAVE, what, " or a lower road.n_max")
+        _resolved(cfg, found, period, MIN_STEPS_PER_WAVE, what, " or a lower road.n_max")
     rate = sim.output_rate
     specs = [(("metrics", i), spec) for i, spec in enumerate(cfg.metrics)]
     if cfg.objectives is not None:
@@ -103,12 +109,13 @@ def check_steps(cfg: Config) -> None:
             and METRICS[spec.metric].kind == "iso2631"
             and rate < MIN_SAMPLE_RATE
         ):
-            raise cfg.error(
+            found.add(
                 loc + ("metric",),
                 f"{spec.metric} needs signals sampled at "
                 f"{MIN_SAMPLE_RATE:g} Hz or more; simulation.output_dt gives "
                 f"{rate:.4g} Hz",
             )
+    found.raise_if_any()
 
 
 def full_network(model, attachments) -> Network:
@@ -265,40 +272,70 @@ def bound_corners(cfg: Config) -> dict[str, np.ndarray]:
 def check_config(cfg: Config, optimisation: bool = True) -> None:
     """Everything about ``cfg`` that a run would reject, without running it: what
     :func:`suspopt.simulate.prepare` checks, RK4's stability limit for the configured design,
-    the memory ``suspopt simulate`` needs to write every output signal and, with ``optimisation`` and an optimisation section, the problem
+    the memory ``suspopt simulate`` needs to write every output signal and, with
+    ``optimisation`` and an optimisation section, the problem
     (:meth:`suspopt.Problem.from_config`), the stability limit at the corners of the design
     variables' bounds and the optimiser with its options. ``suspopt validate`` runs all of
-    it; the commands that simulate run what they use."""
-    from .params import ParamView
-    from .seat import build_attachments
-    from .simulate import check_memory, prepare, signal_names
-    from .vehicle import build_vehicle
+    it; the commands that simulate run what they use.
 
-    pv, model, controller, attachments = prepare(cfg)
-    check_stability(cfg, pv, model, attachments)
+    The checks that do not depend on each other all run, and the ConfigError holds the
+    problems of every one of them. A check that needs an earlier part to be sound is skipped
+    when that part failed, so that one mistake is said once, where it is: the stability
+    limit, the memory, the signals the metrics read and the optimisation's checks need the
+    model built (the vehicle, its controller and seat), and the optimisation's checks the
+    signals known too (its objectives read them); the stability at the bounds' corners, the
+    scenarios and the optimiser need the optimisation's problem built. The time
+    grid's checks (:func:`check_steps`) need only the loaded config. A config that does not
+    load (a value of the wrong type, out of range or absurd for a road vehicle) gets none of
+    these checks: its load errors are all reported instead."""
+    from .simulate import assemble, check_memory, check_signals, signal_names
+
+    found = cfg.problems()
+    found.attempt(check_steps, cfg)
+    prepared = found.attempt(assemble, cfg)
+    if prepared is FAILED:
+        found.raise_if_any()
+    signals = found.attempt(check_signals, cfg, prepared) is not FAILED
+    pv, model, controller, attachments = prepared
+    found.attempt(check_stability, cfg, pv, model, attachments)
     written = (
         cfg.output.signals
         if cfg.output.signals != "all"
         else signal_names(model, getattr(controller, "units", {}), attachments)
     )
-    check_memory(cfg, model, attachments, 1, signals=len(written) + len(cfg.metrics))
-    if not optimisation or not (cfg.design_variables or cfg.objectives or cfg.optimiser):
-        return
+    found.attempt(check_memory, cfg, model, attachments, 1, signals=len(written) + len(cfg.metrics))
+    if signals and optimisation and (cfg.design_variables or cfg.objectives or cfg.optimiser):
+        found.attempt(_check_optimisation, cfg)
+    found.raise_if_any()
+
+
+def _check_optimisation(cfg: Config) -> None:
+    """:func:`check_config`'s checks of the optimisation: its problem, then, each on its
+    own, the stability limit at the corners of the bounds, the scenarios and the
+    optimiser."""
     from .optimise import Problem, build_optimiser
+    from .params import ParamView
+    from .seat import build_attachments
+    from .vehicle import build_vehicle
 
     problem = Problem.from_config(cfg)
-    pv = ParamView(cfg, bound_corners(cfg))
-    check_stability(
-        cfg,
-        pv,
-        build_vehicle(cfg, pv),
-        build_attachments(cfg, pv),
-        what=" at a corner of the design variables' bounds",
-    )
+    found = cfg.problems()
+    pv = found.attempt(ParamView, cfg, bound_corners(cfg))
+    if pv is not FAILED:
+        found.attempt(
+            lambda: check_stability(
+                cfg,
+                pv,
+                build_vehicle(cfg, pv),
+                build_attachments(cfg, pv),
+                what=" at a corner of the design variables' bounds",
+            )
+        )
     if problem.scenarios is not None:
-        check_scenarios(cfg, problem)
+        found.attempt(check_scenarios, cfg, problem)
     if cfg.optimiser is not None:
-        build_optimiser(cfg, problem)
+        found.attempt(build_optimiser, cfg, problem)
+    found.raise_if_any()
 
 
 def check_scenarios(cfg: Config, problem) -> None:
@@ -335,5 +372,6 @@ def check_scenarios(cfg: Config, problem) -> None:
                     what=" at a corner of the design variables' bounds",
                 )
             except ConfigError as exc:
-                message = str(exc).split(": ", 1)[-1]
+                first = exc.problems[0]
+                message = f"{first.key}: {first.message}" if first.key else str(first)
                 raise cfg.error(scenario.loc, f"in scenario {scenario.name}: {message}") from None

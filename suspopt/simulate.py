@@ -10,7 +10,6 @@ and returns a :class:`~suspopt.result.Result` with the config's metrics;
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Mapping, Sequence
 from typing import Any, NamedTuple
 
@@ -21,6 +20,7 @@ from .checks import check_steps, full_network
 from .config import Config
 from .config.loader import require_config
 from .control.controller import build_controller
+from .errors import suggest
 from .integrator import DIVERGENCE_LIMIT, Controller, Edges, Held, Run, Trajectory, integrate
 from .network import Assembled
 from .params import ParamView
@@ -33,6 +33,9 @@ from .vehicle import VehicleModel, build_vehicle
 __all__ = [
     "simulate",
     "prepare",
+    "build_run",
+    "assemble",
+    "check_signals",
     "run_memory",
     "check_memory",
     "signal_names",
@@ -59,28 +62,54 @@ def prepare(cfg: Config, params: Mapping[str, Any] | None = None) -> Prepared:
     """Designs, model, controller and attachments of a run, after the checks that need no
     integration (so that bad input fails before any): the time grid and the road against
     ``dt`` (:func:`suspopt.checks.check_steps`), and the metric specs and ``output.signals``
-    against the signals the run will have."""
-    check_steps(require_config(cfg))
-    pv = ParamView(cfg, params)
+    against the signals the run will have (:func:`build_run`). The ConfigError holds the
+    problems of both."""
+    found = require_config(cfg).problems()
+    found.attempt(check_steps, cfg)
+    prepared = found.attempt(build_run, cfg, params)
+    found.raise_if_any()
+    return prepared
+
+
+def build_run(cfg: Config, params: Mapping[str, Any] | None = None) -> Prepared:
+    """:func:`prepare` without the time grid's checks: the designs, the model, its controller
+    and attachments (:func:`assemble`), and every metric spec and ``output.signals`` entry
+    checked against the signals the run will have (:func:`check_signals`)."""
+    prepared = assemble(cfg, params)
+    check_signals(cfg, prepared)
+    return prepared
+
+
+def assemble(cfg: Config, params: Mapping[str, Any] | None = None) -> Prepared:
+    """The designs, the model, its controller and attachments of a run, unchecked."""
+    pv = ParamView(require_config(cfg), params)
     model = build_vehicle(cfg, pv)
     controller: Controller | None = build_controller(cfg, pv, model)
     attachments: list[Attachment] = build_attachments(cfg, pv)
+    return Prepared(pv, model, controller, attachments)
+
+
+def check_signals(cfg: Config, prepared: Prepared) -> None:
+    """Every metric spec and ``output.signals`` entry of ``cfg`` against the signals of the
+    run ``prepared`` (ConfigError with the problems of all of them)."""
+    _, model, controller, attachments = prepared
     available = signal_names(model, getattr(controller, "units", {}), attachments)
+    found = cfg.problems()
     for i, spec in enumerate(cfg.metrics):
         try:
             spec_signals(spec, available, model.corners)
         except ValueError as exc:
-            raise cfg.error(("metrics", i, "signal"), str(exc)) from None
+            found.add(("metrics", i, "signal"), str(exc))
     if cfg.output.signals != "all":
         for i, name in enumerate(cfg.output.signals):
             if name not in available:
-                close = difflib.get_close_matches(name, available, n=3)
-                raise cfg.error(
+                close = suggest(name, available)
+                found.add(
                     ("output", "signals", i),
                     f"unknown signal {name!r}"
                     + (f"; did you mean {', '.join(close)}?" if close else ""),
                 )
-    return Prepared(pv, model, controller, attachments)
+    found.raise_if_any()
 
 
 def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:

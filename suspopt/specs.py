@@ -13,13 +13,13 @@ constraints.
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from .errors import suggest
 from .metrics import energy, iso2631, springs, stats, transient
 
 __all__ = ["METRICS", "MetricDef", "evaluate_spec", "spec_signals", "metric_unit"]
@@ -241,7 +241,7 @@ def spec_signals(spec, available: list[str], corners: tuple[str, ...]) -> list[s
     if not names or missing:
         bad = missing[0] if missing else family
         families = sorted({n.rsplit(".", 1)[0] for n in available} | set(available))
-        close = difflib.get_close_matches(bad, families + available, n=3)
+        close = suggest(bad, families + available)
         raise ValueError(
             f"unknown signal {bad!r}" + (f"; did you mean {', '.join(close)}?" if close else "")
         )

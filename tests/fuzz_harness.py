@@ -6,7 +6,8 @@ inputs, runs the commands and judges what they did.
 
 The contract every case is held to (docs/guide/errors.md): exit 0, or exit 2 with exactly one
 line on stderr that names the input file (and, for a Pareto file, the dataset at fault) and no
-``Traceback``; never another exit code; never longer than :data:`LIMIT` seconds per command;
+``Traceback`` (``validate``: a line per problem, each naming the file, then their count:
+:func:`report_problems`); never another exit code; never longer than :data:`LIMIT` seconds per command;
 and a config that ``validate`` accepts must ``simulate -o OUT.h5`` (exit 0, the file written).
 
 **How cases run.** The commands run in-process through ``typer.testing.CliRunner`` inside
@@ -1699,6 +1700,39 @@ def stderr_lines(text: str) -> list[str]:
     return [line for line in text.splitlines() if line.strip() and not PROGRESS.match(line)]
 
 
+#: ``validate``'s last line for a config it refused: ``3 errors in FILE``, ``1 error and 1
+#: warning in FILE``, ``25 errors in FILE (5 not shown: --max-errors 0 lists all)``
+COUNT_LINE = re.compile(
+    r"^(?P<errors>\d+) errors? (?:and (?P<warnings>\d+) warnings? )?in (?P<file>.+?)"
+    r"(?: \((?P<hidden>\d+) not shown: --max-errors 0 lists all\))?$"
+)
+
+
+def report_problems(lines: list[str], name: str) -> list[str]:
+    """What is wrong with ``validate``'s stderr ``lines`` for a config ``name`` it refused
+    (empty when nothing is): one line per problem, ``error: ...`` or ``warning: ...``, each
+    naming the file, then :data:`COUNT_LINE` naming it, whose counts are those lines'."""
+    if len(lines) < 2:
+        return [f"{len(lines)} lines: no problem and count"]
+    *listed, last = lines
+    found = [
+        f"not a problem line: {line[:200]}"
+        for line in listed
+        if not line.startswith(("error: ", "warning: "))
+    ]
+    found += [f"does not name the file: {line[:200]}" for line in listed if name not in line]
+    count = COUNT_LINE.match(last)
+    if count is None or name not in count["file"]:
+        return found + [f"not a count naming the file: {last[:200]}"]
+    errors = sum(line.startswith("error: ") for line in listed)
+    warnings = sum(line.startswith("warning: ") for line in listed)
+    if errors == 0 or int(count["errors"]) != errors + int(count["hidden"] or 0):
+        found.append(f"{errors} error lines, counted as {last[:200]}")
+    if int(count["warnings"] or 0) != warnings:
+        found.append(f"{warnings} warning lines, counted as {last[:200]}")
+    return found
+
+
 def names_dataset(line: str, dataset: str) -> bool:
     """Whether an error line names ``dataset``: ``/pareto/F`` itself, or ``/pareto`` with
     the letter ``F`` (``/pareto: X, F and G have 8, 0 and 8 rows``)."""
@@ -1753,7 +1787,10 @@ def problems(case: Case, result: dict) -> list[dict]:
             add("traceback in the output")
         if run.get("changed"):  # (an option case: a refused command changed its inputs)
             add("refused, but changed the inputs", stderr="; ".join(run["changed"])[:300])
-        if code == 2:
+        if code == 2 and cmd == "validate" and case.family == "config":
+            for breach in report_problems(stderr_lines(run["stderr"]), case.name):
+                add("validate's report: " + breach, stderr=run["stderr"][:600])
+        elif code == 2:
             if run["stderr_lines"] != 1:
                 add(
                     f"exit 2 with {run['stderr_lines']} lines on stderr", stderr=run["stderr"][:600]

@@ -52,10 +52,14 @@ def assert_calm(out: str, err: str) -> None:
 
 
 def one_error(capsys, *args) -> str:
-    """The single stderr line of a command that must exit 2 (no warning before it)."""
+    """The single stderr line of a command that must exit 2 (no warning before it;
+    ``validate``'s count of its errors after it: ``1 error in FILE``)."""
     code, out, err = cli(capsys, *args)
     assert code == 2, (out, err)
     lines = err.strip().splitlines()
+    if args[0] == "validate":
+        assert len(lines) == 2 and lines[1].startswith("1 error in "), err
+        lines = lines[:1]
     assert len(lines) == 1 and lines[0].startswith("error: "), err
     return lines[0]
 

@@ -128,9 +128,10 @@ def test_simulate_writes_the_design_md_layout(tmp_path):
         assert h5["modal/frequency"].attrs["units"] == "Hz"
 
 
-def test_validate_takes_several_configs_and_gives_each_its_line(tmp_path):
-    """Each config gets one line in the order given, valid (stdout) or its first problem
-    (stderr); a bad one does not stop the rest, and the exit code is 2 if any is bad."""
+def test_validate_takes_several_configs_and_gives_each_its_lines(tmp_path):
+    """Each config gets its lines in the order given, valid (stdout) or every problem and
+    their count (stderr); a bad one does not stop the rest, and the exit code is 2 if any
+    is bad."""
     from typer.testing import CliRunner
 
     from suspopt.cli import app
@@ -141,9 +142,14 @@ def test_validate_takes_several_configs_and_gives_each_its_line(tmp_path):
     res = CliRunner().invoke(app, ["validate", str(good), str(bad), str(missing), str(good)])
     assert res.exit_code == 2, res.output
     assert res.stdout.splitlines() == [f"{good}: valid (half_pitch, road bump_half_sine)"] * 2
-    errors = res.stderr.splitlines()
-    assert len(errors) == 2 and errors[0].startswith(f"error: {bad}:9: vehicle.corners.F1.")
-    assert errors[1] == f"error: {missing}: no such config file"
+    assert res.stderr.splitlines() == [
+        f"error: {bad}:8: vehicle.corners.F1.unsprung_mass: required key is missing",
+        f"error: {bad}:9: vehicle.corners.F1.unsprung_mas: unknown key; did you mean "
+        "unsprung_mass?",
+        f"2 errors in {bad}",
+        f"error: {missing}: no such config file",
+        f"1 error in {missing}",
+    ]
     res = CliRunner().invoke(app, ["validate", str(good), str(good)])
     assert res.exit_code == 0 and res.stderr == ""
 
@@ -162,3 +168,4 @@ def test_every_bundled_config_validates():
     for cfg in configs:
         res = runner.invoke(app, ["validate", str(cfg)])
         assert res.exit_code == 0, f"{cfg}: {res.output}"
+        assert res.stderr == "", f"{cfg}: {res.stderr}"  # (not even a warning)

@@ -609,7 +609,7 @@ BAD = {
     ),
     "unknown_law": (
         QC_TEXT.replace("law: sh_2", "law: skyhook"),
-        "vehicle.corners.F1.damper.law: Input should be",
+        "vehicle.corners.F1.damper.law: unknown law 'skyhook'; expected one of sh_2,",
         15,
     ),
     "misspelt_key": (
@@ -624,7 +624,7 @@ BAD = {
     ),
     "share_out_of_range": (
         QC_TEXT.replace("c_max_share: 0.27", "c_max_share: 27"),
-        "control.threshold.c_max_share: Input should be less than 1",
+        "control.threshold.c_max_share: must be less than 1 (got 27)",
         26,
     ),
     "adaptive_without_share": (
@@ -641,15 +641,19 @@ BAD = {
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
-def test_bad_control_input_exits_2_with_one_line(tmp_path, case):
+def test_bad_control_input_exits_2_at_its_line(tmp_path, case):
+    """``validate`` gives the problem at its line (a misspelt key also makes the key it
+    should have been missing: two errors), then their count."""
     text, needle, line = BAD[case]
     path = tmp_path / "case.yaml"
     path.write_text(text)
     proc = run("validate", path)
     assert proc.returncode == 2, proc.stdout + proc.stderr
-    message = proc.stderr.strip()
-    assert len(message.splitlines()) == 1 and "Traceback" not in message
-    assert needle in message and f"case.yaml:{line}:" in message, message
+    *errors, count = proc.stderr.strip().splitlines()
+    assert "Traceback" not in proc.stderr and all(e.startswith("error: ") for e in errors)
+    assert count == f"{len(errors)} error{'s' * (len(errors) > 1)} in {path}"
+    assert len(errors) == (2 if case == "misspelt_key" else 1), errors
+    assert any(needle in e and f"case.yaml:{line}:" in e for e in errors), errors
 
 
 def test_bad_sample_time_exits_2_from_the_shell(tmp_path):

@@ -259,7 +259,7 @@ def test_a_sweep_of_3_by_4_values_is_one_batch_of_12_named_designs(tmp_path, cap
         (("--set", "vehicle.body.mass=heavy"), "'heavy' is not a number"),
         (
             ("--set", "vehicle.body.mass=-3"),
-            "vehicle.body.mass: Input should be greater than or equal to 0.001",
+            "vehicle.body.mass: must be at least 0.001 kg (got -3)",
         ),
         (
             ("--sweep", "road.speed=1:2:3"),

@@ -213,7 +213,7 @@ def test_load_mass_follows_the_rule_of_analyse_masses():
             "2402 scenarios, more than 256",  # (the nominal and 7^4; the count stopped at 7^3)
         ),
         ("  nominal: false\n", "no scenario"),
-        ("  cases: [{name: a/b}]\n", "String should match pattern"),
+        ("  cases: [{name: a/b}]\n", "must be a name without '/' that does not start with"),
     ],
 )
 def test_bad_scenarios_name_their_key(extra, message):

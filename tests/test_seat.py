@@ -425,8 +425,7 @@ def test_infeasible_geometry_is_reported_never_raised():
     [
         (
             "seat: {kind: nss5, mass: 95, damping: 1000}",
-            "seat: Input tag 'nss5' found using 'kind' does not match any of the expected tags: 'ps', "
-            "'nss1', 'nss2', 'nss3', 'nss4'",
+            "seat.kind: unknown seat kind 'nss5'; expected one of ps, nss1, nss2, nss3, nss4",
         ),
         (
             "seat: {kind: nss2, mass: 95, damping: 1000, stiffness_ratio: 0.4, "
@@ -464,7 +463,7 @@ def test_bad_seat_input_names_the_key_and_line(text, needle):
     assert f"<config>:{base.count(chr(10)) + 1}:" in message
 
 
-def test_bad_seat_config_exits_2_with_one_line(tmp_path):
+def test_bad_seat_config_exits_2_with_its_line_and_count(tmp_path):
     text = (
         (CONFIGS / "ch8" / "nss3_class_a.yaml")
         .read_text()
@@ -479,8 +478,9 @@ def test_bad_seat_config_exits_2_with_one_line(tmp_path):
         timeout=120,
     )
     assert proc.returncode == 2
-    assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
-    assert "seat: NSS3 has no static deflection" in proc.stderr and "case.yaml:" in proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 2 and lines[1] == f"1 error in {path}" and "Traceback" not in proc.stderr
+    assert "seat: NSS3 has no static deflection" in lines[0] and "case.yaml:" in lines[0]
 
 
 def test_seat_signals_have_units_and_are_written(tmp_path):

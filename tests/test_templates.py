@@ -73,6 +73,7 @@ def test_template_says_what_every_value_is_and_where_it_comes_from(name):
 def test_template_validates_runs_and_is_physically_sensible(name, tmp_path):
     cfg = load_config_text(template_text(name))
     check_config(cfg)  # what suspopt validate checks
+    assert cfg.warnings == ()  # (no value that looks like a slip of units)
     if name in ("quarter", "half_roll", "half_pitch", "full"):
         assert cfg.vehicle.preset == name
     assert cfg.simulation.duration <= 20.0  # cheap in CI; comments say how long

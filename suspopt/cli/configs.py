@@ -28,39 +28,80 @@ from .base import (
 @app.command()
 def validate(
     configs: list[Path] = typer.Argument(..., help="YAML config files", metavar="CONFIG"),
+    max_errors: int = typer.Option(
+        20,
+        "--max-errors",
+        metavar="N",
+        help="list at most N errors of each config (0: all of them)",
+    ),
     max_memory: str | None = max_memory_option(),
 ) -> None:
-    """Check configs and report each one's first problem, with its line.
+    """Check configs and list every problem of each, with its line.
 
-    What it reports is what any command would reject about a config. Each config gets one
-    line, valid or its error; the exit code is 2 if any is not valid."""
+    What it reports is what any command would reject about a config. A valid config gets
+    one line on stdout; one with errors a line per error on stderr (error: FILE:LINE:
+    KEY: message, in the order of the file), then their count.
+
+    A value that looks like a slip of units (1.2 for a body of 1200 kg) is an error where
+    it is absurd for a road vehicle, else a warning, which rejects nothing.
+
+    The exit code is 2 if any config is not valid."""
     set_memory_limit(max_memory)
+    if max_errors < 0:
+        fail(f"--max-errors {max_errors}: give how many errors to list, or 0 for all of them")
     problems = 0
     for config in configs:
         try:
-            _validate_one(config)
+            valid, warnings = _validate_one(config)
         except ConfigError as exc:
             problems += 1
-            err.print("error: " + " ".join(str(exc).split()), soft_wrap=True)
+            _report(config, exc.problems, exc.warnings, max_errors)
+        else:
+            _report(config, (), warnings, max_errors)
+            out.print(valid)
     if problems:
         raise typer.Exit(code=2)
 
 
-def _validate_one(config: Path) -> None:
-    """Check one config (ConfigError for its first problem) and print that it is valid."""
+def _validate_one(config: Path) -> tuple[str, tuple]:
+    """Check one config (ConfigError with its problems); the line that says it is valid and
+    its warnings."""
     from ..checks import check_config
     from ..config import load_config
 
     started = time.perf_counter()
     cfg = load_config(config)
     verbose_info(f"{config}: read and typed in {time.perf_counter() - started:.3g} s")
-    check_config(cfg)
+    try:
+        check_config(cfg)
+    except ConfigError as exc:
+        raise ConfigError(problems=exc.problems, warnings=cfg.warnings) from None
     verbose_info(
         f"checked the run (steps, road, RK4 stability, memory"
         f"{', the optimisation' if cfg.design_variables else ''}) in "
         f"{time.perf_counter() - started:.3g} s"
     )
-    out.print(f"{config}: valid ({cfg.vehicle.preset}, road {cfg.road.kind})")
+    return f"{config}: valid ({cfg.vehicle.preset}, road {cfg.road.kind})", cfg.warnings
+
+
+def _report(config: Path, errors, warnings, max_errors: int) -> None:
+    """The lines of one config's ``errors`` (at most ``max_errors``, 0 for all) and
+    ``warnings`` on stderr, in the order of the file, then the count of its errors."""
+    shown = list(errors) if max_errors == 0 else list(errors)[:max_errors]
+    lines = sorted(
+        [("error", p) for p in shown] + [("warning", p) for p in warnings],
+        key=lambda item: item[1].line or 0,
+    )
+    for severity, problem in lines:
+        err.print(f"{severity}: " + " ".join(str(problem).split()), soft_wrap=True)
+    if not errors:
+        return
+    count = f"{len(errors)} error{'s' if len(errors) != 1 else ''}"
+    if warnings:
+        count += f" and {len(warnings)} warning{'s' if len(warnings) != 1 else ''}"
+    hidden = len(errors) - len(shown)
+    more = f" ({hidden} not shown: --max-errors 0 lists all)" if hidden else ""
+    err.print(f"{count} in {config}{more}", soft_wrap=True)
 
 
 @app.command()

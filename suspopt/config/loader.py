@@ -4,24 +4,32 @@ Every error names the YAML key path and its line: ``case.yaml:12: vehicle.body.m
 Values built into the config by merging (``corner_defaults``) are reported at the line of the
 key they came from; a key absent from the file at the line of the nearest key above it that
 is there, or with no line when none is (``case.yaml: road: required key is missing``).
+
+One load reports every problem it finds (``ConfigError.problems``): all of pydantic's errors,
+said in the user's terms (``suspopt.config.messages``), and the values the table of
+``suspopt.config.plausible`` finds absurd for a road vehicle; its warnings (a value that
+looks like a unit slip) are ``cfg.warnings``, or ``exc.warnings`` with the errors.
 """
 
 from __future__ import annotations
 
-import difflib
 import os
+import shlex
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
-from typing import Any, get_args, get_origin
+from typing import Any
 
 import yaml
 from pydantic import Field, PrivateAttr, ValidationError
 
-from ..errors import ConfigError, require, type_name
+from ..errors import ConfigError, Problem, Problems, require, type_name
 from .base import Section
 from .control import Control
+from .messages import plain_errors
 from .metrics import MetricSpec
 from .optimise import Constraint, DesignVariable, Objectives, Optimiser
+from .plausible import check_plausible
 from .road import RoadConfig
 from .scenarios import Scenarios
 from .seat import SeatConfig
@@ -98,12 +106,26 @@ class Config(Section):
     _text: str = PrivateAttr("")
     _lines: dict = PrivateAttr(default_factory=dict)
     _loaded: dict | None = PrivateAttr(None)  # the values as loaded from _text
+    _warnings: tuple = PrivateAttr(())  # Problems of severity warning found on loading
+    _hint: str | None = PrivateAttr(None)  # how to see every problem (ConfigError.hint)
+
+    def problems(self) -> Problems:
+        """A collector of problems found after validation, located like load errors (each
+        at its key's line); ``raise_if_any()`` raises them as one ConfigError."""
+        name = str(self._source) if self._source is not None else "<config>"
+        lines = self._lines
+        return Problems(name, lambda loc: _line_of(loc, lines) if lines else None, self._hint)
 
     def error(self, loc: tuple, message: str) -> ConfigError:
         """A ConfigError for a problem found after validation, located like a load error."""
-        name = str(self._source) if self._source is not None else "<config>"
-        line = _line_of(loc, self._lines) if self._lines else None
-        return ConfigError(f"{_at(name, line)}: {_dotted(loc)}: {message}")
+        return ConfigError(problems=[self.problems().problem(loc, message)], hint=self._hint)
+
+    @property
+    def warnings(self) -> tuple[Problem, ...]:
+        """What loading found plausible only as a unit slip (``suspopt.config.plausible``):
+        problems of severity ``warning``, which reject nothing; ``suspopt validate`` prints
+        them."""
+        return self._warnings
 
     @property
     def source(self) -> Path | None:
@@ -150,13 +172,6 @@ def line_of(node: yaml.Node | None, keys: tuple) -> int | None:
     return _line_of(tuple(keys), _line_map(node)) if node is not None else None
 
 
-def _at(name: str, line: int | None) -> str:
-    """``file:line`` of a message, or the file alone when the key and every key above it are
-    absent from the file (a section left out: ``case.yaml: road: required key is missing``,
-    where ``case.yaml:?:`` was written before)."""
-    return f"{name}:{line}" if line else name
-
-
 def _line_of(loc: tuple, lines: dict) -> int | None:
     """Line of a pydantic error location: the key itself, else where a merged value came
     from (``corner_defaults``), else the nearest enclosing key."""
@@ -171,104 +186,6 @@ def _line_of(loc: tuple, lines: dict) -> int | None:
         if loc[:n] in lines:
             return lines[loc[:n]]
     return None
-
-
-_DAMPER_TAGS = ("passive", "semi_active")
-
-
-def _clean_loc(loc: tuple) -> tuple:
-    """Drop pydantic's union-tag entries (e.g. the ``bump_step`` in road.bump_step.height, the
-    ``semi_active`` in vehicle.corners.F1.damper.semi_active.c_max)."""
-    out = []
-    for i, part in enumerate(loc):
-        if (
-            i == 1
-            and isinstance(part, str)
-            and (loc[0] == "seat" or loc[0] == "road" and len(loc) > 2)
-        ):
-            continue
-        if i >= 1 and loc[i - 1] == "damper" and part in _DAMPER_TAGS:
-            continue
-        out.append(part)
-    return tuple(out)
-
-
-def _dotted(loc: tuple) -> str:
-    """``("metrics", 0, "signal")`` -> ``metrics[0].signal``."""
-    return "".join(
-        f"[{p}]" if isinstance(p, int) else (f".{p}" if i else str(p)) for i, p in enumerate(loc)
-    )
-
-
-def _format(err: dict, lines: dict, data: Any) -> tuple[str, int | None]:
-    loc = _clean_loc(tuple(err["loc"]))
-    dotted = _dotted(loc) or "(top level)"
-    msg = err["msg"]
-    custom = msg.startswith("Value error, ")
-    if custom:
-        msg = msg[len("Value error, ") :]
-    if err["type"] == "extra_forbidden":
-        allowed = _allowed_keys(tuple(err["loc"])[:-1])
-        close = difflib.get_close_matches(str(loc[-1]), allowed, n=3)
-        msg = "unknown key" + (
-            f"; did you mean {', '.join(close)}?"
-            if close
-            else f"; allowed: {', '.join(allowed)}"
-            if allowed
-            else ""
-        )
-    elif err["type"] == "missing":
-        msg = "required key is missing"
-    elif not custom and "input" in err and not isinstance(err["input"], (dict, list)):
-        got = repr(err["input"])
-        msg = f"{msg} (got {got if len(got) <= 40 else got[:37] + '...'})"
-    return f"{dotted}: {msg}", _line_of(loc, lines)
-
-
-def _section_type(annotation: Any) -> Any:
-    """The pydantic model inside an annotation (``X | None``, ``dict[str, X]``, unions)."""
-    if hasattr(annotation, "model_fields"):
-        return annotation
-    for arg in get_args(annotation):
-        found = _section_type(arg)
-        if found is not None:
-            return found
-    return None
-
-
-def _union_member(annotation: Any, tag: Any) -> Any:
-    """The section of a discriminated union whose ``kind`` is ``tag`` (None if there is none)."""
-    for arg in get_args(annotation):
-        kind = getattr(arg, "model_fields", {}).get("kind")
-        if kind is not None and tag in get_args(kind.annotation):
-            return arg
-        found = None if hasattr(arg, "model_fields") else _union_member(arg, tag)
-        if found is not None:
-            return found
-    return None
-
-
-def _allowed_keys(loc: tuple) -> list[str]:
-    """Field names of the section at ``loc``, a pydantic error location with its union tags
-    (for 'did you mean' hints)."""
-    model: Any = Config
-    annotation: Any = None
-    for part in loc:
-        fields = getattr(model, "model_fields", {})
-        if part in fields:
-            annotation = fields[part].annotation
-            model = _section_type(annotation)
-            if get_origin(annotation) is dict:
-                model = ("dict", model)
-        elif isinstance(part, int):  # an item of a list of sections
-            continue
-        elif isinstance(model, tuple):  # a key of a dict of sections
-            model = model[1]
-        elif _union_member(annotation, part) is not None:  # a union's tag: its member
-            model = _union_member(annotation, part)
-        else:
-            return []
-    return sorted(getattr(model, "model_fields", {}))
 
 
 def _sections(text: str, name: str):
@@ -290,33 +207,41 @@ def load_config_text(text: str, source: Path | None = None) -> Config:
 
     The YAML is read by :func:`suspopt.config.yamlio.parse_yaml`: safe tags, the YAML 1.2
     core schema, bounded depth and size, no duplicate keys. ``source`` (a str or Path) names
-    the file in messages, and relative paths inside the config are read from its folder."""
+    the file in messages, and relative paths inside the config are read from its folder.
+    The ConfigError holds every problem of the config's values (module docstring)."""
+    return _load_text(text, source)
+
+
+def _load_text(text: str, source: Path | None, hint: str | None = None) -> Config:
+    """:func:`load_config_text`; ``hint`` says how to see every problem (``ConfigError``)."""
     if not isinstance(text, str):
         raise TypeError(f"text must be the YAML as a str; got {type_name(text)}")
     source = Path(source) if source is not None else None
     name = str(source) if source is not None else "<config>"
     data, node = _sections(text, name)
     lines = _line_map(node) if node is not None else {}
+    found = Problems(name, lambda loc: _line_of(loc, lines), hint)
+    refused: set[tuple] = set()
+    cfg = None
     try:
         base_dir = source.parent if source is not None else Path.cwd()
         cfg = Config.model_validate(data, context={"base_dir": base_dir})
     except ValidationError as exc:
-        # an unknown key usually explains a 'missing' one (a typo): report it first
-        first = min(
-            exc.errors(),
-            key=lambda e: (
-                e["type"] != "extra_forbidden",
-                _line_of(_clean_loc(tuple(e["loc"])), lines) or 0,
-            ),
-        )
-        msg, line = _format(first, lines, data)
-        more = len(exc.errors()) - 1
-        tail = f" (+{more} more error{'s' if more > 1 else ''})" if more else ""
-        raise ConfigError(f"{_at(name, line)}: {msg}{tail}") from None
+        for loc, message in plain_errors(exc.errors(include_url=False), Config):
+            found.add(loc, message)
+            refused.add(loc)
+    for loc, severity, message in check_plausible(data, refused):
+        found.add(loc, message, severity)
+    if found or cfg is None:
+        # an unknown key usually explains a 'missing' one (a typo): the first said
+        found.errors.sort(key=lambda p: (not p.message.startswith("unknown key"), p.line or 0))
+        raise found.error()
     cfg._source = source
     cfg._text = text
     cfg._lines = lines
     cfg._loaded = cfg.model_dump(mode="json")
+    cfg._warnings = tuple(found.warnings)
+    cfg._hint = hint
     return cfg
 
 
@@ -350,7 +275,7 @@ def load_config(path: str | Path) -> Config:
         raise ConfigError(f"{path}: no such config file") from None
     except YamlError as exc:
         raise ConfigError(f"{path}{f':{exc.line}' if exc.line else ''}: {exc}") from None
-    return load_config_text(text, path)
+    return _load_text(text, path, f"run suspopt validate {shlex.quote(str(path))}")
 
 
 def require_config(cfg: object, argument: str = "cfg") -> Config:
@@ -388,7 +313,8 @@ def edit_config(
     try:
         return load_config_text(edited, source)
     except ConfigError as exc:
-        raise ConfigError(f"{exc} (with {what})") from None
+        problems = [replace(p, message=f"{p.message} (with {what})") for p in exc.problems]
+        raise ConfigError(problems=problems) from None
 
 
 def config_schema() -> dict:
