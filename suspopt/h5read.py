@@ -487,7 +487,7 @@ def open_dataset(path: str | Path, group: str | None = None):
     named dimensions with their coordinates, those held by the groups above included (``time``
     and ``design`` for ``/signals``), each variable's attributes (``units``, ``names``), and the
     root's attributes (``suspopt_version``, ``created``, ``command``, ``config``, ``seed``, ...)
-    under the group's own, which win where both have one. :func:`suspopt.layout.as_dataset`
+    under the group's own, which win where both have one. ``suspopt.layout.as_dataset``
     gives the same Dataset from a result in memory (``Result.to_xarray()``).
     ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
     pandas DataFrame. A file that is missing, not HDF5 or damaged is a ConfigError naming it
