@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 __all__ = [
+    "require_like",
     "ConfigError",
     "Problem",
     "Problems",
@@ -174,6 +175,15 @@ def require(value, kind: type, argument: str, how: str):
     the loaded file belongs) is not an AttributeError from deep inside."""
     if not isinstance(value, kind):
         raise TypeError(f"{argument} must be a {kind.__name__} ({how}); got {type_name(value)}")
+    return value
+
+
+def require_like(value, kind: str, attributes: Iterable[str], argument: str, how: str):
+    """``value`` when it has every one of ``attributes``, else :func:`require`'s TypeError
+    naming ``kind``: for the code of a layer below ``kind``'s (the figures of
+    :mod:`suspopt.plots`), which knows it by what it holds, not by importing its class."""
+    if not all(hasattr(value, name) for name in attributes):
+        raise TypeError(f"{argument} must be a {kind} ({how}); got {type_name(value)}")
     return value
 
 

@@ -44,8 +44,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .config import ConfigError
+from ._version import __version__
+from .errors import ConfigError
 from .files import Unreadable, status
 
 __all__ = ["write_csv"]

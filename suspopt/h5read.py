@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .config import ConfigError
 from .config.yamlio import MAX_CONFIG_BYTES
+from .errors import ConfigError
 from .files import kind_of
 
 __all__ = [

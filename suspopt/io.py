@@ -56,13 +56,20 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from ._version import __version__
 from .config import Config, ConfigError
 from .files import Unreadable, link_kind, status
 from .h5read import open_dataset  # (suspopt.io.open_dataset, as docs/guide/results.md reads it)
 from .locks import take_lock, take_notes, this_command
-from .replacing import Guard, admit, deferred, remove_figure
-from .signature import CONFIG_SUFFIXES, signature_state
+from .replacing import (
+    OUTPUT_MARKER,
+    Guard,
+    _not_ours,
+    admit,
+    deferred,
+    is_suspopt_output,
+    remove_figure,
+)
 
 __all__ = [
     "OUTPUT_MARKER",
@@ -92,9 +99,7 @@ __all__ = [
 
 #: Written into every non-HDF5 file suspopt makes (figure metadata, a comment), so that it
 #: can tell its own outputs from other files.
-OUTPUT_MARKER = "suspopt"
 _TMP = ".suspopt-tmp"
-_HEAD = 4096
 #: Locks this process holds: resolved target -> [descriptor, depth, force, guard].
 _held: dict[Path, list] = {}
 
@@ -102,37 +107,6 @@ _held: dict[Path, list] = {}
 def _seed_of(cfg: Config) -> int:
     seed = getattr(cfg.road, "seed", None)
     return -1 if seed is None else int(seed)
-
-
-def is_suspopt_output(path: Path) -> bool:
-    """Whether the regular file ``path`` was written by suspopt (module docstring). A config
-    (a file ending in a config signature, or any ``.yaml``/``.yml`` file) is suspopt's only
-    while its signature matches its lines: once edited it is the user's, and ``init`` or
-    ``export`` run again replace it only with ``--force``."""
-    return _not_ours(path) is None
-
-
-def _not_ours(path: Path) -> str | None:
-    """Why suspopt may not replace the regular file ``path`` without ``--force``, or None
-    (:func:`is_suspopt_output`)."""
-    foreign = "exists and was not written by suspopt"
-    with open(path, "rb") as stream:
-        head = stream.read(_HEAD)
-        size = os.fstat(stream.fileno()).st_size
-    if head.startswith(b"\x89HDF\r\n\x1a\n"):
-        from .h5read import H5Reader
-
-        try:  # (a damaged file, one that crashes or hangs the HDF5 library included, is
-            with H5Reader(path) as reader:  # not known to be suspopt's)
-                return None if reader.has_attr("suspopt_version") else foreign
-        except ConfigError:
-            return foreign
-    signed = signature_state(path, size)
-    if signed is False:
-        return "was edited since suspopt wrote it"
-    if signed is None and path.suffix.lower() in CONFIG_SUFFIXES:
-        return foreign
-    return None if signed or OUTPUT_MARKER.encode() in head else foreign
 
 
 def check_target(path: str | Path, force: bool = False, option: str = "-o") -> Path:

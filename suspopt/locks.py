@@ -34,7 +34,7 @@ import sys
 from datetime import UTC, datetime
 from pathlib import Path
 
-from .config import ConfigError
+from .errors import ConfigError
 from .files import link_kind
 
 __all__ = [

@@ -57,8 +57,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .config import ConfigError
+from ._version import __version__
+from .errors import ConfigError
 
 __all__ = ["write_mat", "read_mat", "matlab_name", "MAX_NAME", "MAX_VARIABLE_BYTES"]
 

@@ -195,7 +195,7 @@ def check(need: float, what: str, advice: str, cfg=None, key: tuple = ()) -> Non
     """ConfigError when ``need`` bytes exceed the limit (:func:`limit`): the message gives
     the estimate, the limit and ``advice``, located at ``key`` of ``cfg`` (its file and
     line: ``Config.error``) when a config is given."""
-    from .config import ConfigError
+    from .errors import ConfigError
 
     cap, source = limit()
     if need > cap:

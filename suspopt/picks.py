@@ -285,7 +285,7 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
     """Design ``i`` of ``picked`` written into its config: the values in place, a road file
     made absolute (the config leaves the file's folder), and a comment block saying where
     it came from. Returns the config and its YAML text."""
-    from . import __version__
+    from ._version import __version__
 
     require(picked, Picked, "picked", "from read_picks(path, picks)")
     if isinstance(i, bool) or not isinstance(i, (int, np.integer)):

@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import ConfigError
+from .signature import CONFIG_SUFFIXES, signature_state
 
 __all__ = [
     "SUFFIXES",
@@ -48,6 +49,8 @@ __all__ = [
     "admit",
     "check_suffix",
     "remove_figure",
+    "is_suspopt_output",
+    "OUTPUT_MARKER",
     "refusal",
     "request_of",
     "stored_plot",
@@ -259,9 +262,45 @@ def admit(path: Path, text: str, guard: Guard, source=None) -> None:
     guard.checked = True
 
 
+#: The text by which suspopt knows a file other than HDF5 as its own (in its first
+#: :data:`_HEAD` bytes: a figure's metadata, a CSV's first line).
+OUTPUT_MARKER = "suspopt"
+_HEAD = 4096
+
+
+def is_suspopt_output(path: Path) -> bool:
+    """Whether the regular file ``path`` was written by suspopt (:mod:`suspopt.io`'s docstring). A config
+    (a file ending in a config signature, or any ``.yaml``/``.yml`` file) is suspopt's only
+    while its signature matches its lines: once edited it is the user's, and ``init`` or
+    ``export`` run again replace it only with ``--force``."""
+    return _not_ours(path) is None
+
+
+def _not_ours(path: Path) -> str | None:
+    """Why suspopt may not replace the regular file ``path`` without ``--force``, or None
+    (:func:`is_suspopt_output`)."""
+    foreign = "exists and was not written by suspopt"
+    with open(path, "rb") as stream:
+        head = stream.read(_HEAD)
+        size = os.fstat(stream.fileno()).st_size
+    if head.startswith(b"\x89HDF\r\n\x1a\n"):
+        from .h5read import H5Reader
+
+        try:  # (a damaged file, one that crashes or hangs the HDF5 library included, is
+            with H5Reader(path) as reader:  # not known to be suspopt's)
+                return None if reader.has_attr("suspopt_version") else foreign
+        except ConfigError:
+            return foreign
+    signed = signature_state(path, size)
+    if signed is False:
+        return "was edited since suspopt wrote it"
+    if signed is None and path.suffix.lower() in CONFIG_SUFFIXES:
+        return foreign
+    return None if signed or OUTPUT_MARKER.encode() in head else foreign
+
+
 def remove_figure(path: Path) -> None:
     """Remove the figure ``path`` if it is a regular file that suspopt wrote."""
-    from .io import is_suspopt_output
 
     if path.is_file() and not path.is_symlink():
         with contextlib.suppress(OSError):

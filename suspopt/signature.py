@@ -12,7 +12,7 @@ import hashlib
 import re
 from pathlib import Path
 
-from . import __version__
+from ._version import __version__
 from .config.yamlio import MAX_CONFIG_BYTES
 
 __all__ = ["CONFIG_SUFFIXES", "signed_config", "signature_state"]

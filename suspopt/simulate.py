@@ -19,7 +19,7 @@ from . import memory
 from .checks import check_steps, full_network
 from .config import Config
 from .config.loader import require_config
-from .control.controller import build_controller
+from .controller import build_controller
 from .errors import suggest
 from .integrator import DIVERGENCE_LIMIT, Controller, Edges, Held, Run, Trajectory, integrate
 from .network import Assembled

@@ -167,7 +167,8 @@ def test_a_design_gives_the_same_bits_in_any_batch(name, lift_off):
 def _compiled_signatures() -> set[tuple[str, object]]:
     """(function, signature) of every specialisation the kernel's compiled functions hold in
     this process."""
-    from suspopt.integrator import _accumulate, _kernel, _reductions
+    from suspopt.integrator import _accumulate, _kernel
+    from suspopt.metrics import _loops as _reductions
 
     return {
         (f"{module.__name__}.{name}", sig)
@@ -242,6 +243,8 @@ def test_auto_without_numba_runs_numpy_and_says_so_once(monkeypatch):
 
     monkeypatch.setattr(integrator, "compiled_available", lambda: False)
     monkeypatch.setattr(integrator, "_fallback_told", [])
+    # (none of the command's listeners that an earlier in-process command left registered)
+    monkeypatch.setattr(_notices, "_listeners", [])
     told = []
 
     def listener(kind, **data):
@@ -368,7 +371,7 @@ def test_an_adaptive_threshold_refits_between_the_kernels_samples(
     0.66 s), which the controller takes from the history of the kernel's conditions: the
     records and the states agree with the numpy engine (1e-9, 1e-12), and the controller is
     asked at the refits only."""
-    from suspopt.control.controller import SemiActiveController
+    from suspopt.controller import SemiActiveController
 
     data = _two_laws("sh_add_2_cdf.yaml", 1.5, laws, 1000)
     data["control"]["actuator_lag"] = lag

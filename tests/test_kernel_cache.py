@@ -16,8 +16,10 @@ import pytest
 
 numba = pytest.importorskip("numba")
 
-from suspopt import _notices  # noqa: E402
-from suspopt.integrator import _numba_cache  # noqa: E402
+from suspopt import (
+    _notices,  # noqa: E402
+    _numba_cache,  # noqa: E402
+)
 
 SOURCE = "import numba\n\n@numba.njit(cache=True)\ndef add(x):\n    return x + 1\n"
 

@@ -1,4 +1,4 @@
-"""The compiled loops of the reductions (:mod:`suspopt.integrator._reductions`) against the
+"""The compiled loops of the reductions (:mod:`suspopt.metrics._loops`) against the
 numpy arithmetic they replace, bit for bit, on hostile signals:
 
 - the pairwise sum against ``np.sum`` for every length a block may have;
@@ -16,12 +16,12 @@ import pytest
 from conftest import CONFIGS
 
 import suspopt
-import suspopt.integrator as integrator
+import suspopt.metrics.compiled as metric_loops
 from suspopt import streaming
 from suspopt.metrics.iso2631 import weighting_filter
 
 pytest.importorskip("numba")
-from suspopt.integrator import _reductions  # noqa: E402  (needs numba)
+from suspopt.metrics import _loops as _reductions  # noqa: E402  (needs numba)
 
 WEIGHTINGS = ("Wk", "Wd", "Wf", "Wc", "We", "Wj")
 #: numpy's warnings on the hostile values (NaN, infinities), which both sides propagate
@@ -40,7 +40,7 @@ def _hostile(rng, shape) -> np.ndarray:
 @pytest.fixture
 def numpy_only(monkeypatch):
     """The callers' numpy arithmetic: no compiled loops."""
-    monkeypatch.setattr(integrator, "compiled_reductions", lambda: None)
+    monkeypatch.setattr(metric_loops, "compiled_reductions", lambda: None)
 
 
 def _same(a, b) -> bool:
@@ -97,7 +97,7 @@ def test_the_streamed_block_sums_are_numpys(T, monkeypatch):
     rng = np.random.default_rng(T)
     x = _hostile(rng, (13, T))
     compiled = streaming._block_moments(x), streaming._power_sums(x)
-    monkeypatch.setattr(integrator, "compiled_reductions", lambda: None)
+    monkeypatch.setattr(metric_loops, "compiled_reductions", lambda: None)
     with np.errstate(invalid="ignore", over="ignore"):
         reference = streaming._block_moments(x), streaming._power_sums(x)
     assert [m for m, _, _ in compiled[0]] == [m for m, _, _ in reference[0]]
@@ -120,7 +120,7 @@ def test_an_optimisations_values_are_the_same_bits_without_the_compiled_loops(na
     monkeypatch.setattr(streaming, "WINDOW_BYTES", 1)  # windows of one block: 5, the last short
     X = np.random.default_rng(5).random((6, len(cfg.design_variables)))
     compiled = _evaluated(cfg, X)
-    monkeypatch.setattr(integrator, "compiled_reductions", lambda: None)
+    monkeypatch.setattr(metric_loops, "compiled_reductions", lambda: None)
     reference = _evaluated(cfg, X)
     assert all(_same(a, b) for a, b in zip(compiled, reference))
 

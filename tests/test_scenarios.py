@@ -232,7 +232,7 @@ def test_a_constraint_cannot_combine_by_std():
 
 
 def test_validate_checks_stability_in_each_scenario(tmp_path):
-    from suspopt.checks import check_config
+    from suspopt.validation import check_config
 
     cfg = load_config_text(
         BASE
@@ -444,7 +444,7 @@ def test_bumps_of_other_heights_are_columns_of_one_batch(engine, kind, monkeypat
 
 def test_a_scenario_road_too_large_for_memory_is_bad_input(monkeypatch):
     from suspopt import memory
-    from suspopt.checks import check_config
+    from suspopt.validation import check_config
 
     memory.set_limit(200 << 20)
     try:

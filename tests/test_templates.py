@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import suspopt
-from suspopt.checks import check_config
 from suspopt.config.loader import load_config_text
 from suspopt.optimise import optimise
 from suspopt.templates import template_description, template_names, template_text
+from suspopt.validation import check_config
 
 NAMES = template_names()
 

@@ -72,14 +72,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import ConfigError
 from ..config.optimise import batches as config_batches
 from ..design_ids import front_ids, id_marks
+from ..errors import ConfigError
 from ..io import atomic_h5, write_dataset
 from ..params import MAX_SWEEP_DESIGNS
 from ..picks import read_front
 from ..selection import DesignSet, ParetoSet, evaluate_pareto
-from . import KINDS, Kind, Report, relative_change
 from .builds_file import feasible_builds
 from .cells import (
     NOT_COMPUTED,
@@ -91,6 +90,7 @@ from .cells import (
     stored_reference,
 )
 from .pseudo import is_comfort, table_designs, write_stored_front
+from .registry import KINDS, Kind, Report, relative_change
 from .tolerances import (
     Tolerances,
     bands,

@@ -17,7 +17,7 @@ from typing import TypeVar
 
 import numpy as np
 
-from ..config import ConfigError
+from ..errors import ConfigError
 
 __all__ = ["feasible_builds", "as_built_objectives"]
 

@@ -32,8 +32,8 @@ from ..io import atomic_h5, write_dataset
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..result import Result
 from ..simulate import simulate
-from . import KINDS, Kind, Report, relative_change
 from .cells import NOT_COMPUTED, NOT_COMPUTED_NOTE, percent
+from .registry import KINDS, Kind, Report, relative_change
 
 __all__ = ["SHARES", "METRIC_UNITS", "c_max_share", "semi_active_metrics", "run"]
 

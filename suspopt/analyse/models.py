@@ -57,8 +57,8 @@ from ..metrics.spectral import PSD_SEGMENT, record_psd
 from ..simulate import Result, simulate
 from ..specs import METRICS, evaluate_spec
 from ..vehicle import modal_analysis
-from . import KINDS, Kind, Report, relative_change
 from .cells import NOT_COMPUTED_NOTE, percent
+from .registry import KINDS, Kind, Report, relative_change
 
 __all__ = [
     "ModelResponse",

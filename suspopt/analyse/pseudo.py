@@ -74,7 +74,8 @@ from ..picks import read_front
 from ..plots.runs import evenly_spaced
 from ..seat import build_seat, passenger_mass_change
 from ..selection import DesignSet, ParetoSet, evaluate_pareto
-from . import KINDS, Kind, Report, cells, relative_change
+from . import cells
+from .registry import KINDS, Kind, Report, relative_change
 
 __all__ = [
     "Variant",

@@ -24,12 +24,12 @@ from pathlib import Path
 import numpy as np
 
 from .. import plots
-from ..config import ConfigError
+from ..errors import ConfigError
 from ..h5read import H5Reader
 from ..io import atomic_h5, text_array, write_dataset
 from ..kesort import pareto_picks
 from ..selection import read_pareto
-from . import KINDS, Kind, Report
+from .registry import KINDS, Kind, Report
 
 __all__ = ["run", "read_scenarios"]
 

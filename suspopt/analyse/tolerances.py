@@ -31,14 +31,14 @@ from typing import Any
 
 import numpy as np
 
-from ..config import ConfigError
 from ..design_ids import front_ids
+from ..errors import ConfigError
 from ..files import listed
 from ..params import field_range
 from ..selection import ParetoSet
-from . import KINDS, Kind, Report
 from .cells import NOT_COMPUTED, percent
 from .pseudo import PseudoFronts, Variant, run_variants
+from .registry import KINDS, Kind, Report
 
 __all__ = [
     "TOLERANCE",

@@ -74,8 +74,8 @@ from ..seat import (
 )
 from ..selection import ParetoSet
 from ..simulate import simulate
-from . import KINDS, Kind, Report
 from .pseudo import config_with, read_sections
+from .registry import KINDS, Kind, Report
 
 __all__ = [
     "SeatTransmissibility",

@@ -66,8 +66,8 @@ def validate(
 def _validate_one(config: Path) -> tuple[str, tuple]:
     """Check one config (ConfigError with its problems); the line that says it is valid and
     its warnings."""
-    from ..checks import check_config
     from ..config import load_config
+    from ..validation import check_config
 
     started = time.perf_counter()
     cfg = load_config(config)

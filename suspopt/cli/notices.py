@@ -19,7 +19,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
-from .base import err, out
+from .console import err, out
 
 __all__ = ["Notices", "notices", "duration"]
 

@@ -214,10 +214,10 @@ def _optimise(
     options: base.RunOptions,
     sets: list[str],
 ) -> None:
-    from ..checks import check_config
     from ..io import WriteError, check_replace
     from ..optimise import optimise as run
     from ..params import apply_sets
+    from ..validation import check_config
 
     try:
         cfg = apply_sets(base.read_config(config), sets)

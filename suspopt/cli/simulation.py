@@ -248,10 +248,11 @@ def _simulate(
 ) -> None:
     import numpy as np
 
-    from ..checks import check_config, check_stability
+    from ..checks import check_stability
     from ..io import write_simulation
     from ..simulate import check_memory, prepare, signal_names
     from ..simulate import simulate as run
+    from ..validation import check_config
 
     if plot is not None:
         from ..plots import check_path

@@ -33,7 +33,7 @@ _FRAME_LINES = 5
 def top_rows(table: Table) -> Table:
     """``table``, or when it has more than :data:`LONG_TABLE` rows a copy of its first
     :data:`SUMMARY_ROWS` (with its columns, title and section ends)."""
-    from .base import new_table
+    from .console import new_table
 
     if len(table.cells) <= LONG_TABLE:
         return table

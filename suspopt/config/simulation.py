@@ -17,7 +17,7 @@ def _installed(choice: str) -> str:
     when what it needs is missing: numba for the ``compiled`` engine, dask.distributed for
     the ``dask`` executor (looked for here, not when suspopt starts)."""
     if choice == "compiled":
-        from ..integrator import INSTALL_FAST, compiled_available
+        from .._numba_cache import INSTALL_FAST, compiled_available
 
         if not compiled_available():
             raise ValueError(f"the compiled engine needs numba: {INSTALL_FAST}")

@@ -1,9 +1,9 @@
-"""Semi-active dampers: the control laws (:mod:`.laws`, Sec 2.1.6), the digital controller
-(:mod:`.controller`, Sec 4.2) and the fits of the CDF threshold (:mod:`.stats`, Ch. 4) and the
-summary an adaptive threshold refits from (:mod:`.summary`).
+"""Semi-active dampers: the control laws (:mod:`.laws`, Sec 2.1.6), the fits of the CDF
+threshold (:mod:`.stats`, Ch. 4) and the summary an adaptive threshold refits from
+(:mod:`.summary`).
 
-The laws and the fits sit below the config (:mod:`suspopt.config.vehicle` reads the laws);
-the controller, built from a config, is imported when first used."""
+They sit below the config (:mod:`suspopt.config.vehicle` reads the laws); the digital
+controller built from a config (Sec 4.2) is :mod:`suspopt.controller`, above it."""
 
 from .laws import LAWS, PARAMETERS, Law, Motion, Parameter, law_condition, stiff_coefficient
 from .stats import distribution_quantile, fit_student_t, t_quantile, threshold_for_share
@@ -22,14 +22,4 @@ __all__ = [
     "threshold_for_share",
     "t_quantile",
     "StudentTSummary",
-    "SemiActiveController",
-    "build_controller",
 ]
-
-
-def __getattr__(name: str):
-    if name in ("SemiActiveController", "build_controller"):
-        from . import controller
-
-        return getattr(controller, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -53,7 +53,7 @@ take the ratio ``ż_s / ṠT`` (or ``X / ṠT²``) as 0.
 
 **Adding a law** is adding one :class:`Law` to :data:`LAWS` (with any new :class:`Parameter`
 in :data:`PARAMETERS`): the config (``vehicle...damper.law`` and its parameter fields,
-:mod:`suspopt.config.vehicle`) and the controller (:mod:`suspopt.control.controller`) read
+:mod:`suspopt.config.vehicle`) and the controller (:mod:`suspopt.controller`) read
 them from here. The compiled engine takes the samples of the laws it lists
 (:data:`suspopt.integrator._kernel.CONTROL_LAWS`, with these same rules) and hands any other
 law's back to the controller at each sample. This module imports nothing of the config.

@@ -12,8 +12,8 @@ from importlib import resources
 
 import numpy as np
 
+from .description import Description
 from .laws import c_name
-from .model import Description
 from .outputs import quantity_layout
 from .params import Bound, flat_entries
 

@@ -18,7 +18,7 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from .. import __version__
+from .._version import __version__
 from ..config import Config, ConfigError
 from .build import compile_binary
 from .csource import COMPILED, sources

@@ -16,8 +16,8 @@ import ast
 import inspect
 import textwrap
 
-from ..config import ConfigError
 from ..control.laws import LAWS, PARAMETERS
+from ..errors import ConfigError
 
 __all__ = ["law_functions", "c_name"]
 

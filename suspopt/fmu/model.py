@@ -24,7 +24,6 @@ config field is found by :mod:`suspopt.fmu.params`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -34,43 +33,13 @@ from ..integrator import EdgePlan, Edges
 from ..integrator.compiled import LAWS as ELEMENT_LAWS
 from ..road import road_edges, road_inputs
 from ..simulate import prepare
+from .description import Description
+from .outputs import add_outputs
 
 __all__ = ["Description", "describe", "ROAD_MODES"]
 
 #: ``--road``: the road from the FMU's inputs, or built into it.
 ROAD_MODES = ("input", "embedded")
-#: Record kinds of the controller's signals (:meth:`SemiActiveController.published`).
-RECORDS = ("damper_state", "control_condition", "control_threshold")
-
-
-@dataclass
-class Description:
-    """The C-ready description of one design (module docstring). ``info`` holds what the
-    model description and the outputs need and the probes do not compare (names, units)."""
-
-    structure: dict[str, Any] = field(default_factory=dict)
-    entries: dict[str, np.ndarray] = field(default_factory=dict)
-    info: dict[str, Any] = field(default_factory=dict)
-
-    def put(self, name: str, values) -> None:
-        self.entries[name] = np.atleast_1d(np.asarray(values, dtype=float)).ravel().copy()
-
-    def same_structure(self, other: Description) -> bool:
-        """Whether ``other`` has this structure and entries of the same sizes."""
-        if self.structure.keys() != other.structure.keys():
-            return False
-        for key, value in self.structure.items():
-            if not _equal(value, other.structure[key]):
-                return False
-        return {k: v.size for k, v in self.entries.items()} == {
-            k: v.size for k, v in other.entries.items()
-        }
-
-
-def _equal(a, b) -> bool:
-    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-        return np.array_equal(np.asarray(a), np.asarray(b))
-    return a == b
 
 
 def describe(cfg: Config, road: str = "input") -> Description:
@@ -108,8 +77,6 @@ def describe(cfg: Config, road: str = "input") -> Description:
     _inputs(d, model, road)
     if road == "embedded":
         _embedded_road(d, cfg, model, network)
-    from .outputs import add_outputs
-
     add_outputs(d, prepared, network)
     return d
 

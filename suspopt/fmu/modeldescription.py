@@ -18,7 +18,7 @@ import re
 from datetime import UTC, datetime
 from xml.sax.saxutils import quoteattr
 
-from .model import Description
+from .description import Description
 from .outputs import fmi_name
 from .params import Bound
 

@@ -17,9 +17,9 @@ import re
 
 import numpy as np
 
-from ..config import ConfigError
+from ..errors import ConfigError
 from ..result import signal_table
-from .model import RECORDS, Description
+from .description import RECORDS, Description
 
 __all__ = ["add_outputs", "quantity_layout", "fmi_name"]
 

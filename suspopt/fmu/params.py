@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config import Config, ConfigError
-from .model import Description, describe
+from .description import Description
+from .model import describe
 
 __all__ = ["Parameter", "Binding", "bind_parameters", "flat_entries"]
 

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .._numba_cache import INSTALL_FAST, compiled_available
 from .rk4 import (
     DIVERGENCE_LIMIT,
     Controller,
@@ -50,7 +51,6 @@ __all__ += [
     "DIVERGENCE_LIMIT",
     "ENGINES",
     "compiled_available",
-    "compiled_reductions",
     "compiled_runs",
     "auto_engine",
     "AUTO_STEPS",
@@ -61,19 +61,6 @@ __all__ += [
 WINDOW_MULTIPLE = 32
 #: The values of ``simulation.engine``.
 ENGINES = ("numpy", "compiled", "auto")
-
-#: How to install the compiled engine.
-INSTALL_FAST = "pip install numba (a dependency of suspopt; this platform may lack its wheels)"
-
-
-@functools.cache
-def compiled_available() -> bool:
-    """Whether numba can be imported (the compiled engine's one dependency); looked up once
-    per process, not at every simulation."""
-    import importlib.util
-
-    return importlib.util.find_spec("numba") is not None
-
 
 #: ``auto``'s rule for a simulation that is not an evaluation (:func:`auto_engine`): the
 #: compiled engine from this many integration steps of one design, fewer as the designs grow
@@ -131,17 +118,6 @@ def auto_engine(steps: int, designs: int, evaluation: bool) -> str:
     if evaluation or steps * (1 + designs / AUTO_DESIGNS) >= AUTO_STEPS:
         return "compiled"
     return "numpy"
-
-
-def compiled_reductions() -> Any:
-    """The compiled loops of the reductions and the weighting filter (``._reductions``: the
-    numpy arithmetic, the same bits) when numba is installed, else None; the callers then
-    run their numpy arithmetic."""
-    if not compiled_available():
-        return None
-    from . import _reductions
-
-    return _reductions
 
 
 def integrate(run: Run, engine: str = "numpy") -> Trajectory:

@@ -24,7 +24,7 @@ structure and machine on its first use. What runs is the text generated in this 
 compiled under that file's name, never the file read back. Where the cache cannot be
 written, :func:`steps` returns None and the kernel walks the network. A source file there
 that is damaged (not UTF-8) is written anew, and numba reads a damaged copy of its own as a
-missing one (:mod:`._numba_cache`).
+missing one (:mod:`suspopt._numba_cache`).
 """
 
 from __future__ import annotations
@@ -174,8 +174,8 @@ def source(idx: np.ndarray, lay: np.ndarray) -> str:
 
 def cache_dir() -> Path:
     """Where the generated modules (and numba's compiled copies) are kept: ``fused`` in
-    suspopt's cache folder (:func:`._numba_cache.cache_root`)."""
-    from ._numba_cache import cache_root
+    suspopt's cache folder (:func:`suspopt._numba_cache.cache_root`)."""
+    from .._numba_cache import cache_root
 
     return cache_root() / "fused"
 
@@ -219,7 +219,7 @@ def load(text: str, names: tuple[str, ...]) -> tuple | None:
     module = types.ModuleType(f"suspopt_fused_{digest}")
     module.__file__ = str(path)
     sys.modules[module.__name__] = module  # (numba's cache finds the module by its name)
-    from . import _numba_cache
+    from .. import _numba_cache
 
     _numba_cache.prepare()  # (numba's damaged copy of the module: compiled again)
     what = "the kernel's reductions" if "accumulate" in names else "the fused step"

@@ -33,11 +33,11 @@ import numpy as np
 from numba import types
 from numba.extending import intrinsic
 
+from .. import _numba_cache
 from ..control.laws import LAWS
-from . import _numba_cache
 from ._accumulate import accumulate, no_accumulate, no_first, no_regular
 
-_numba_cache.prepare()  # (cached for the machine, damaged files compiled again: ._numba_cache)
+_numba_cache.prepare()  # (cached for the machine, damaged files compiled again: suspopt._numba_cache)
 _jit = numba.njit(cache=True, nogil=True)
 #: A helper compiled into its one caller (no call, no reference counts).
 _inline = numba.njit(cache=True, nogil=True, inline="always")
@@ -461,7 +461,7 @@ def _stiff(code, c_min, c_max, st, zs, x, lw, cf, sw):
 
 @_jit
 def _control(step, W, F, pb, idx, lay, road, lr, cp, ci, records):
-    """The controller's sample at ``step`` (:class:`suspopt.control.controller.
+    """The controller's sample at ``step`` (:class:`suspopt.controller.
     SemiActiveController`'s arithmetic): the rates ``[ṠT; ż_s; ż_u]`` of the velocities (and
     ``z̈_s`` of the accelerations with the coefficients in force), each corner's condition,
     threshold and command, the command into the damper's coefficient (or its share of the

@@ -69,7 +69,7 @@ class Accumulators:
         buffer's rows being the whole network's rows ``wanted`` (sorted), in order."""
         from ..metrics.iso2631 import SUM_BLOCK
         from ._accumulate import PER_PAIR, PER_SIGNAL
-        from .compiled import padded
+        from .lanes import padded
 
         P = blocks * B
         S = len(self.signals)

@@ -60,6 +60,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from ..network import Assembled
+from .lanes import padded
 from .reach import reached, reached_road, renumbered
 from .rk4 import (
     _CHECK_EVERY,
@@ -101,14 +102,6 @@ def unsupported(asm: Assembled, controller: Controller | None) -> str | None:
         if g.extra is not None and (g.extra_law is None or g.extra_law[0] not in LAWS):
             return f"the non-linear part of {g.name!r} has no compiled law"
     return None
-
-
-def padded(a: np.ndarray, P: int) -> np.ndarray:
-    """``a (..., 1 | P0)`` over ``P >= P0`` designs, the last one repeated: a new, writable,
-    contiguous array (a read-only view, as ``broadcast_to`` gives for one design, is another
-    numba type: the kernel compiled again for it, a minute on a fresh machine)."""
-    extra = np.repeat(a[..., -1:], P - a.shape[-1], axis=-1)
-    return np.concatenate([a, extra], axis=-1)
 
 
 def _entries(matrix: np.ndarray, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -466,7 +459,7 @@ def _no_control(blocks: int, B: int) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 
 def _sample_rules(controller):
-    """The controller's :class:`~suspopt.control.controller.SampleRules` when the kernel can
+    """The controller's :class:`~suspopt.controller.SampleRules` when the kernel can
     take its samples (laws of :data:`._kernel.CONTROL_LAWS`; an adaptive threshold's refits
     are the controller's own samples), else None (every sample in numpy, between compiled
     stretches)."""

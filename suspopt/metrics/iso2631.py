@@ -6,7 +6,7 @@ return a scalar or ``(P,)``. ``weighting`` is one of ``"Wk", "Wd", "Wf", "Wc", "
 
 Method of weighting: the analogue response ``H(j2πf)`` of ISO 2631-1 Annex A (parameters in
 ``docs/iso-facts.md#filter-structure-annex-a``) is realised as a recursive digital filter at the
-record's sample rate (:mod:`suspopt.weighting`: the analogue poles mapped exactly,
+record's sample rate (:mod:`suspopt.metrics.filters`: the analogue poles mapped exactly,
 a numerator fitted so that the complex response is within 0.1 % of ``H`` from 0 Hz to a quarter
 of the sample rate for fs >= 500 Hz, 0.05 % from 1 kHz; the errors at other rates are tabulated
 in ``docs/iso-facts.md``). The filter starts at rest, so the output is the response of the causal
@@ -16,13 +16,24 @@ pieces, for the streamed reductions), with no transform of the whole record.
 
 from __future__ import annotations
 
-import difflib
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
+from .annex_a import (
+    MAX_SAMPLE_RATE,
+    MIN_SAMPLE_RATE,
+    WEIGHTINGS,
+    WeightingParameters,
+    canonical_name,
+    check_rate,
+    parameters,
+    weighting_response,
+)
+
 __all__ = [
+    "MIN_SAMPLE_RATE",
+    "MAX_SAMPLE_RATE",
     "WEIGHTINGS",
     "WeightingParameters",
     "MTVV_RATIO_LIMIT",
@@ -42,12 +53,7 @@ __all__ = [
     "comfort_reaction",
 ]
 
-_Q_BAND = 1.0 / math.sqrt(2.0)
-MIN_SAMPLE_RATE = 100.0
-#: Highest sample rate a weighting is designed for [Hz]: a config's shortest output step
-#: (0.1 µs); above it the poles crowd z = 1 past what the filter's coefficients resolve.
-MAX_SAMPLE_RATE = 1.0e7
-_UNWEIGHTED = "none"
+_INF = math.inf
 
 MTVV_RATIO_LIMIT = 1.5
 """ISO 2631-1 6.3.3 (thesis Eq 2.84): above MTVV/a_w = 1.5 the basic method underestimates."""
@@ -55,40 +61,6 @@ MTVV_RATIO_LIMIT = 1.5
 VDV_RATIO_LIMIT = 1.75
 """ISO 2631-1 6.3.3 (thesis Eq 2.85): above VDV/(a_w T^¼) = 1.75 the basic method falls short."""
 
-
-@dataclass(frozen=True)
-class WeightingParameters:
-    """Corner frequencies (Hz) and quality factors of one ISO 2631-1 Annex A weighting.
-
-    ``math.inf`` for ``f3`` drops the numerator of the acceleration-velocity transition, for
-    ``f4`` the whole transition, for ``f5``/``f6`` the upward step (the table in
-    docs/iso-facts.md#filter-structure-annex-a); the Q of
-    an absent stage is unused and set to 1.
-    """
-
-    f1: float
-    f2: float
-    f3: float
-    f4: float
-    q4: float
-    f5: float
-    q5: float
-    f6: float
-    q6: float
-
-
-_INF = math.inf
-WEIGHTINGS: dict[str, WeightingParameters] = {
-    "Wk": WeightingParameters(0.4, 100.0, 12.5, 12.5, 0.63, 2.37, 0.91, 3.35, 0.91),
-    "Wd": WeightingParameters(0.4, 100.0, 2.0, 2.0, 0.63, _INF, 1.0, _INF, 1.0),
-    "Wf": WeightingParameters(0.08, 0.63, _INF, 0.25, 0.86, 0.0625, 0.80, 0.10, 0.80),
-    "Wc": WeightingParameters(0.4, 100.0, 8.0, 8.0, 0.63, _INF, 1.0, _INF, 1.0),
-    "We": WeightingParameters(0.4, 100.0, 1.0, 1.0, 0.63, _INF, 1.0, _INF, 1.0),
-    "Wj": WeightingParameters(0.4, 100.0, _INF, _INF, 1.0, 3.75, 0.91, 5.32, 0.91),
-}
-"""ISO 2631-1:1997 Annex A parameters of the six weightings
-(docs/iso-facts.md#filter-structure-annex-a)."""
-_BY_LOWER_NAME = {name.lower(): name for name in WEIGHTINGS}
 
 COMFORT_REACTIONS: tuple[tuple[float, float, str], ...] = (
     (0.0, 0.315, "not uncomfortable"),
@@ -110,98 +82,32 @@ _ZONE_LABELS = np.array(
 )
 
 
-def _parameters(weighting: str | None) -> WeightingParameters | None:
-    """Look a weighting up by name; ``None`` means unweighted. Unknown names suggest matches."""
-    if weighting is None or weighting.lower() == _UNWEIGHTED:
-        return None
-    if weighting.lower() in _BY_LOWER_NAME:
-        return WEIGHTINGS[_BY_LOWER_NAME[weighting.lower()]]
-    close = difflib.get_close_matches(weighting, [*WEIGHTINGS, _UNWEIGHTED], n=3)
-    hint = f" Did you mean {', '.join(close)}?" if close else ""
-    raise ValueError(
-        f"unknown ISO 2631-1 weighting {weighting!r}; choose one of "
-        f"{', '.join(WEIGHTINGS)} or 'none'.{hint}"
-    )
-
-
-def _second_order(s: np.ndarray, f: float, q: float) -> np.ndarray:
-    """``1 + s/(Qω) + s²/ω²`` with ``ω = 2πf``; 1 where ``f`` is infinite."""
-    if math.isinf(f):
-        return np.ones_like(s)
-    w = 2.0 * math.pi * f
-    return 1.0 + s / (q * w) + (s / w) ** 2
-
-
-def _response(f: np.ndarray | float, params: WeightingParameters) -> np.ndarray:
-    """Analogue Annex A product at frequencies ``f`` (Hz); see :func:`weighting_response`."""
-    s = 2j * math.pi * np.asarray(f, dtype=float)
-    high_pass = (s / (2.0 * math.pi * params.f1)) ** 2 / _second_order(s, params.f1, _Q_BAND)
-    low_pass = 1.0 / _second_order(s, params.f2, _Q_BAND)
-    numerator = np.ones_like(s) if math.isinf(params.f3) else 1.0 + s / (2.0 * math.pi * params.f3)
-    transition = numerator / _second_order(s, params.f4, params.q4)
-    step = _second_order(s, params.f5, params.q5) / _second_order(s, params.f6, params.q6)
-    if not math.isinf(params.f5):
-        step = step * (params.f5 / params.f6) ** 2
-    return high_pass * low_pass * transition * step
-
-
-def weighting_response(f: np.ndarray | float, weighting: str | None) -> np.ndarray:
-    """Complex analogue response ``H(j2πf)`` of an ISO 2631-1 weighting (dimensionless).
-
-    ISO 2631-1:1997 Annex A, the product of (``s = j2πf``, ``ω_i = 2πf_i``, Q1 = Q2 = 1/√2):
-
-    - band-limiting high-pass ``s²/(s² + ω1 s/Q1 + ω1²)`` and low-pass
-      ``ω2²/(s² + ω2 s/Q2 + ω2²)``,
-    - acceleration-velocity transition ``(1 + s/ω3)/(1 + s/(Q4ω4) + s²/ω4²)``,
-    - upward step ``(1 + s/(Q5ω5) + s²/ω5²)/(1 + s/(Q6ω6) + s²/ω6²)·(ω5/ω6)²``.
-
-    This is one factor ``WP`` or ``WA`` of the thesis's Eq 2.79. ``f`` in Hz, any shape; the
-    unweighted response is 1.
-    """
-    params = _parameters(weighting)
-    if params is None:
-        return np.ones_like(np.asarray(f, dtype=float), dtype=complex)
-    return _response(f, params)
-
-
 def _check(a: np.ndarray, fs: float) -> tuple[np.ndarray, float]:
     a = np.asarray(a, dtype=float)
     if a.ndim == 0 or a.shape[-1] == 0:
         raise ValueError("acceleration must have a non-empty time axis (last axis)")
-    return a, _check_rate(fs)
-
-
-def _check_rate(fs: float) -> float:
-    if not fs >= MIN_SAMPLE_RATE:
-        raise ValueError(
-            f"sampling rate fs = {fs} Hz is below the supported {MIN_SAMPLE_RATE:g} Hz"
-        )
-    if not fs <= MAX_SAMPLE_RATE * (1.0 + 1e-9):  # (a rate from a sample grid's rounding)
-        raise ValueError(
-            f"sampling rate fs = {fs} Hz is above the supported {MAX_SAMPLE_RATE:g} Hz"
-        )
-    return float(fs)
+    return a, check_rate(fs)
 
 
 def weighting_filter(weighting: str | None, fs: float):
-    """The recursive filter (:class:`suspopt.weighting.WeightingFilter`) that realises the ISO
+    """The recursive filter (:class:`suspopt.metrics.filters.WeightingFilter`) that realises the ISO
     2631-1 weighting ``weighting`` at the sample rate ``fs`` [Hz] (at least 100 Hz), or None
     for the unweighted signal. :func:`weight` is its output from rest; a signal that arrives
     in pieces (the streamed reductions of :mod:`suspopt.streaming`) is filtered piece by piece
     with its state, to the same bits."""
-    fs = _check_rate(fs)
-    if _parameters(weighting) is None:
+    fs = check_rate(fs)
+    if parameters(weighting) is None:
         return None
-    from ..weighting import design
+    from .filters import design
 
-    return design(_BY_LOWER_NAME[str(weighting).lower()], fs)
+    return design(canonical_name(weighting), fs)
 
 
 def weight(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
     """Frequency-weighted acceleration ``a_w(t)`` in m/s², same shape as ``a`` (Eq 2.79).
 
     ``a`` in m/s² sampled at ``fs`` Hz (>= 100 Hz), time on the last axis. The weighting runs as
-    the recursive filter of :func:`suspopt.weighting.design` (see the module
+    the recursive filter of :func:`suspopt.metrics.filters.design` (see the module
     docstring), which keeps the weighting's phase: the output is the causal filter's response
     from rest. Deviation from the thesis: Eq 2.79 writes the weighting on the spectrum of the
     whole record; this is its causal time-domain equivalent, matched to the analogue response

@@ -33,7 +33,7 @@ from ..config import Config, ConfigError
 from ..config.loader import require_config
 from ..config.optimise import DesignVariable, Objective, batches
 from ..config.scenarios import CONSTRAINT_DEFAULT, OBJECTIVE_DEFAULT
-from ..control.controller import build_controller
+from ..controller import build_controller
 from ..params import ParamView, field_unit, numeric_paths, one_per_run
 from ..seat import CONSTRAINT_UNITS, build_attachments, seat_constraints, seat_static_deflection
 from ..simulate import signal_table

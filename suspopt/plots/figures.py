@@ -191,10 +191,15 @@ def plot_kesort(selection, path: str | Path) -> Path:
     drawn at the values it was sorted on (``F_as_built``), as its axes say.
     """
     from ..design_ids import selection_ids
-    from ..errors import require
-    from ..selection import Selection
+    from ..errors import require_like
 
-    s = require(selection, Selection, "selection", "from suspopt.selection.select(sets)")
+    s = require_like(
+        selection,
+        "Selection",
+        ("F_sorted", "sort", "units", "names"),
+        "selection",
+        "from suspopt.selection.select(sets)",
+    )
     path = check_path(path)
     F, levels, units = s.F_sorted, s.sort.k_eps, s.units
     built = "" if s.as_built is None else f", as built (p{s.as_built:g})"

@@ -279,10 +279,9 @@ def result_figure(
     and ``suspopt simulate --plot`` (:func:`plot_simulation`) draw it."""
     import difflib
 
-    from ..errors import require
-    from ..result import Result
+    from ..errors import require_like
 
-    require(result, Result, "result", "from suspopt.simulate(cfg)")
+    require_like(result, "Result", ("signals", "time", "P"), "result", "from suspopt.simulate(cfg)")
     names = listed(signals) if signals is not None else default_signals(result)  # (one name: str)
     for name in names:
         if name not in result.signals:
@@ -434,10 +433,15 @@ def optimisation_result_figure(result, picks: Mapping[str, int] | None = None):
     generation; ``picks`` (name -> row of the front, e.g. :func:`suspopt.pareto_picks`)
     starred and named on the front. :meth:`suspopt.optimise.OptimisationResult.plot` and
     ``suspopt optimise --plot`` (:func:`plot_optimisation`) draw it."""
-    from ..errors import require
-    from ..optimise.run import OptimisationResult
+    from ..errors import require_like
 
-    require(result, OptimisationResult, "result", "from suspopt.optimise.optimise(cfg, path)")
+    require_like(
+        result,
+        "OptimisationResult",
+        ("F", "G", "history", "weights"),
+        "result",
+        "from suspopt.optimise.optimise(cfg, path)",
+    )
     _check_picks(picks, len(np.atleast_2d(result.F)))
     history = result.history
     generations = len(np.atleast_1d(history["generation"]))

@@ -117,7 +117,7 @@ def save(fig, path: str | Path, dpi: int = 120) -> Path:
     """Write ``fig`` to ``path`` (format from the suffix) atomically
     (:func:`suspopt.io.atomic_file`: a failed write never leaves a broken figure), marked as
     suspopt's in its metadata."""
-    from .. import __version__
+    from .._version import __version__
     from ..io import OUTPUT_MARKER, atomic_file
 
     path = check_path(path)

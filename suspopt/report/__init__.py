@@ -56,7 +56,7 @@ from typing import Any
 
 import numpy as np
 
-from ..config import ConfigError
+from ..errors import ConfigError
 from ..files import listed
 
 __all__ = ["build_report", "collect", "Study", "MAX_SAMPLES", "MAX_BYTES"]

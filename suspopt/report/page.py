@@ -15,7 +15,7 @@ import html
 import json
 from typing import Any
 
-from ..config import ConfigError
+from ..errors import ConfigError
 from .charts import settings
 
 __all__ = ["render", "asset"]
@@ -101,7 +101,7 @@ BRUSH_COMMAND_ROWS = 100
 
 def render(studies, title: str) -> str:
     """The whole page of ``studies`` (:class:`suspopt.report.Study`)."""
-    from .. import __version__
+    from .._version import __version__
 
     payload = {
         "studies": [{"label": s.label, "kind": s.kind, "data": s.data} for s in studies],

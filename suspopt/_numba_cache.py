@@ -9,8 +9,8 @@ written anew. It wraps the two methods of ``numba.core.caching.IndexDataCacheFil
 the index and the data, once per process, and only where numba has them; nothing else of
 numba's changes. It holds for every cached numba function of the process, suspopt's or not
 (a damaged file is then compiled again where numba would have raised). The modules that compile with ``cache=True`` call it before their first
-function (``._kernel``, ``._accumulate``, ``._reductions``, and ``._fused`` before a
-generated module).
+function (``suspopt.integrator._kernel``, ``._accumulate``, ``suspopt.metrics._loops``, and
+``suspopt.integrator._fused`` before a generated module).
 
 **Where the cache lives** (:func:`prepare`): numba keys its cache on the folder of the
 source file, so every install of suspopt (each virtual environment, a wheel, a checkout)
@@ -18,7 +18,7 @@ compiled the kernel again, a minute or more each time. :class:`MachineCacheLocat
 the compiled functions of suspopt's own modules in ``cache_root() / "numba"``
 (``$SUSPOPT_CACHE_DIR/numba``, else ``$XDG_CACHE_HOME/suspopt/numba`` or
 ``~/.cache/suspopt/numba``), in a folder named by a digest of the sources numba compiles
-(``suspopt/integrator`` and ``suspopt/control``) and the version: every install of the same
+(``suspopt/integrator``, ``suspopt/control`` and ``suspopt/metrics``) and the version: every install of the same
 code on a machine shares one compile, and a change to any of those files (numba's own cache
 does not see a change in a file that a cached function calls into) compiles anew. numba
 still checks each file's own content and the machine's CPU before it uses an entry. Where
@@ -45,9 +45,30 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from .. import _notices
+from . import _notices
 
-__all__ = ["heal", "prepare", "cache_root", "kernel_cache", "compiling"]
+__all__ = [
+    "heal",
+    "prepare",
+    "cache_root",
+    "kernel_cache",
+    "compiling",
+    "compiled_available",
+    "INSTALL_FAST",
+]
+
+#: What to install for the compiled engine and the compiled loops of the metrics.
+INSTALL_FAST = "pip install numba (a dependency of suspopt; this platform may lack its wheels)"
+
+
+@functools.cache
+def compiled_available() -> bool:
+    """Whether numba can be imported (the compiled engine's and the compiled metric loops'
+    one dependency), without importing it; looked up once per process."""
+    import importlib.util
+
+    return importlib.util.find_spec("numba") is not None
+
 
 #: What unpickling a damaged file raises (the bytes decide which).
 _DAMAGED = (
@@ -102,14 +123,14 @@ def cache_root() -> Path:
 
 
 #: The package folders whose modules numba compiles (their digest names the cache folder).
-_COMPILED_PACKAGES = ("integrator", "control")
-_PACKAGE = Path(__file__).resolve().parents[1]
+_COMPILED_PACKAGES = ("integrator", "control", "metrics")
+_PACKAGE = Path(__file__).resolve().parent
 
 
 @functools.cache
 def _digest() -> str:
     """A digest of suspopt's version and the sources numba compiles, read once a process."""
-    from .. import __version__
+    from ._version import __version__
 
     h = hashlib.sha256(__version__.encode())
     for folder in _COMPILED_PACKAGES:

@@ -24,13 +24,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..config import Config, ConfigError
-from ..config.control import Control
-from ..params import ParamView
-from ..vehicle import VehicleModel
-from .laws import LAWS, PARAMETERS, Motion
-from .stats import distribution_quantile, t_quantile
-from .summary import StudentTSummary
+from .config import Config, ConfigError
+from .config.control import Control
+from .control.laws import LAWS, PARAMETERS, Motion
+from .control.stats import distribution_quantile, t_quantile
+from .control.summary import StudentTSummary
+from .params import ParamView
+from .vehicle import VehicleModel
 
 __all__ = ["SemiActiveController", "SampleRules", "build_controller"]
 

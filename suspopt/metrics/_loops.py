@@ -1,10 +1,10 @@
 """Compiled loops of the streamed reductions and of the weighting filter (imported only when
-numba is installed, through :func:`suspopt.integrator.compiled_reductions`).
+numba is installed, through :func:`suspopt.metrics.compiled.compiled_reductions`).
 
 Each function is the numpy arithmetic it replaces, operation for operation, so that both give
 the same bits (``tests/test_reductions.py`` checks it against numpy on hostile signals):
 
-- :func:`weight_rows`: :meth:`suspopt.weighting.WeightingFilter.apply` — the FIR correction
+- :func:`weight_rows`: :meth:`suspopt.metrics.filters.WeightingFilter.apply` — the FIR correction
   as the sum of shifted copies in its fixed order, then each second-order section in scipy's
   transposed direct form II (``sosfilt``'s difference equations, sample by sample);
 - :func:`block_moments`: the block statistics of :class:`suspopt.streaming._Moments` — each
@@ -27,9 +27,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from . import _numba_cache
+from .. import _numba_cache
 
-_numba_cache.prepare()  # (cached for the machine, damaged files compiled again: ._numba_cache)
+_numba_cache.prepare()  # (cached for the machine, damaged files compiled again: suspopt._numba_cache)
 _jit = numba.njit(cache=True, nogil=True)
 
 

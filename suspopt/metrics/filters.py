@@ -89,8 +89,8 @@ class WeightingFilter:
         the filter's state after it; ``state`` continues a signal cut into pieces (default: at
         rest). Pieces give the bits of the whole signal filtered at once. With numba
         installed the same arithmetic runs compiled, one pass per row
-        (:func:`suspopt.integrator.compiled_reductions`), to the same bits."""
-        from .integrator import compiled_reductions
+        (:func:`suspopt.metrics.compiled.compiled_reductions`), to the same bits."""
+        from .compiled import compiled_reductions
 
         a = np.asarray(a, dtype=float)
         if state is None:
@@ -195,7 +195,7 @@ def _sections(params, fs: float) -> np.ndarray:
 def _grids(name: str, fs: float, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Frequencies [Hz] of the fitted band (log and linear spacing from a thousandth of the
     high-pass corner) and of the rest to fs/2."""
-    from .metrics.iso2631 import WEIGHTINGS
+    from .annex_a import WEIGHTINGS
 
     top = BAND * fs
     low = 1e-3 * WEIGHTINGS[name].f1
@@ -217,7 +217,7 @@ class _Grid:
 
 
 def _grid(name: str, fs: float, sections: np.ndarray, n: int) -> _Grid:
-    from .metrics.iso2631 import weighting_response
+    from .annex_a import weighting_response
 
     inside, outside = _grids(name, fs, n)
     zi_in, zi_out = np.exp(-2j * math.pi * inside / fs), np.exp(-2j * math.pi * outside / fs)
@@ -277,7 +277,7 @@ def design(weighting: str, fs: float) -> WeightingFilter:
     """The recursive filter of the ISO 2631-1 weighting ``weighting`` (a name of
     :data:`~suspopt.metrics.iso2631.WEIGHTINGS`) at the sample rate ``fs`` [Hz]; see the
     module docstring for the method. Cached per process."""
-    from .metrics.iso2631 import WEIGHTINGS
+    from .annex_a import WEIGHTINGS
 
     params = WEIGHTINGS[weighting]
     sections = _sections(params, fs)

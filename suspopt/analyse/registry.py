@@ -1,0 +1,72 @@
+"""What every analysis kind shares: its :class:`Kind` entry in :data:`KINDS` (filled by the
+module that implements it), the :class:`Report` it returns, the help's :data:`SUMMARIES` and
+:func:`relative_change`. Re-exported by :mod:`suspopt.analyse`."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
+
+__all__ = ["Report", "Kind", "KINDS", "SUMMARIES", "relative_change"]
+
+
+@dataclass
+class Report:
+    """A table of results: ``columns`` headers, ``rows`` of formatted cells, and notes."""
+
+    title: str
+    columns: list[str]
+    rows: list[list[str]]
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Kind:
+    """An analysis kind: ``run(source | sources, output, plot, **options)``.
+
+    ``many``: ``run`` takes a list of sources (else exactly one path); ``options``: the names
+    of the keyword options ``run`` accepts besides ``output`` and ``plot``.
+    """
+
+    run: Callable[..., Report]
+    many: bool = False
+    options: tuple[str, ...] = ()
+
+
+def relative_change(value, reference) -> np.ndarray:
+    """``100 (value - reference) / reference`` [%] (the percentages of Tables 3.3-3.21,
+    4.2-4.3, 8.12-8.13; their signs are each table's), NaN where it cannot be computed: the
+    reference is 0 or NaN (a failed design's), the value NaN, or the change beyond the
+    floating-point range (a stored value of 1e-308 or 1e308: a damaged file). Computed
+    without a floating-point warning; a table shows NaN as ``n/a``
+    (:func:`suspopt.analyse.cells.percent`)."""
+    import numpy as np
+
+    with np.errstate(all="ignore"):
+        change = (np.asarray(value, dtype=float) - reference) / reference * 100.0
+    return np.where(np.isfinite(change), change, np.nan)
+
+
+#: kind name -> Kind
+KINDS: dict[str, Kind] = {}
+#: What each kind does, for ``suspopt analyse --help`` (which must not import the kinds'
+#: modules to say so; a test checks that it lists every kind of :data:`KINDS`).
+SUMMARIES = {
+    "models": "configs side by side, as Ch. 3 does (transient or random-road metrics, modes)",
+    "roads": "a Pareto file's designs on other roads (Sec 8.4.2, Table 8.12)",
+    "masses": "a Pareto file's designs with another passenger mass (Sec 8.4.3, Table 8.13)",
+    "controllers": "a Pareto file's designs with another controller (Fig. 7.4b)",
+    "transmissibility": "seat-to-head and seat transmissibility of a config or of a front's "
+    "edges and knee (Eq 2.86, Fig. 8.26)",
+    "scenarios": "a robust front's picks under each of its scenarios (no simulation)",
+    "tolerances": "a Pareto file's designs with each design variable off by ±t % in turn "
+    "(as built: manufacturing tolerances)",
+    "builds": "a Pareto file's designs built many times with every design variable off "
+    "at once within ±t % (Monte Carlo of manufacturing tolerances)",
+    "cdf-sensitivity": "the C_max share of an adaptive CDF threshold swept from 20 to 70 % "
+    "(Figs. 4.7, 4.10)",
+}
