@@ -73,7 +73,7 @@ def read_pseudo(path: Path) -> dict:
 
 def dominated_share(A: np.ndarray, B: np.ndarray) -> float:
     """Share of the rows of ``A`` that some row of ``B`` dominates (all <=, one <; minimised)."""
-    return float(np.mean([np.any(np.all(B <= a, axis=1) & np.any(B < a, axis=1)) for a in A]))
+    return float(np.mean([np.any(np.all(a >= B, axis=1) & np.any(a > B, axis=1)) for a in A]))
 
 
 def stiff_share(path: Path) -> np.ndarray:

@@ -20,7 +20,8 @@ from ._version import __version__
 #: Public name -> the module that defines it.
 _EXPORTS = {
     "Config": "config",
-    "ConfigError": "config",
+    "InputError": "errors",
+    "ConfigError": "errors",
     "config_schema": "config",
     "load_config": "config",
     "load_template": "templates",
@@ -68,7 +69,8 @@ __getattr__, __dir__ = lazy_names(__name__, globals(), _EXPORTS, __all__)
 
 
 if TYPE_CHECKING:
-    from .config import Config, ConfigError, config_schema, load_config
+    from .config import Config, config_schema, load_config
+    from .errors import ConfigError, InputError
     from .kesort import KEpsilonSort, kesort, pareto_picks
     from .memory import reuse_memory
     from .optimise import OptimisationResult, Problem

@@ -18,6 +18,7 @@ from typing import Any
 
 __all__ = [
     "require_like",
+    "InputError",
     "ConfigError",
     "Problem",
     "Problems",
@@ -49,8 +50,13 @@ class Problem:
         return f"{at}: {self.key}: {self.message}" if self.key else f"{at}: {self.message}"
 
 
-class ConfigError(ValueError):
-    """Bad input: ``str(exc)`` is one line naming the file, line and key path (or the file
+class InputError(ValueError):
+    """Bad input, whatever it is: a config, an argument, a file given to read (a missing,
+    foreign or damaged result file included) or an output that cannot be written. The
+    command line makes it exit code 2 with its one line. ``ConfigError`` is the same class
+    (its name before it covered more than configs).
+
+    ``str(exc)`` is one line naming the file, line and key path (or the file
     and the dataset) of its first problem, followed by ``(+K more: HINT)`` when it holds
     ``K`` more (``HINT`` says how to see them, e.g. ``run suspopt validate case.yaml``).
 
@@ -80,8 +86,12 @@ class ConfigError(ValueError):
         return (_rebuild, (str(self), self.problems, self.warnings, self.hint))
 
 
-def _rebuild(message, problems, warnings, hint) -> ConfigError:
-    return ConfigError(message, problems, warnings, hint)
+#: The name :class:`InputError` had while it stood for a config's errors only; the same class.
+ConfigError = InputError
+
+
+def _rebuild(message, problems, warnings, hint) -> InputError:
+    return InputError(message, problems, warnings, hint)
 
 
 class Problems:

@@ -72,8 +72,28 @@ RESERVED = ("units", "attributes", "meta")
 NAMES_MAP = "names_map"
 #: MATLAB's keywords (``iskeyword``): not valid names.
 KEYWORDS = frozenset(
-    "break case catch classdef continue else elseif end for function global if otherwise "
-    "parfor persistent return spmd switch try while".split()
+    [
+        "break",
+        "case",
+        "catch",
+        "classdef",
+        "continue",
+        "else",
+        "elseif",
+        "end",
+        "for",
+        "function",
+        "global",
+        "if",
+        "otherwise",
+        "parfor",
+        "persistent",
+        "return",
+        "spmd",
+        "switch",
+        "try",
+        "while",
+    ]
 )
 #: Attributes of the HDF5 dimension-scale API itself (``meta.<name>.dims`` says what they do).
 H5DS = frozenset({"CLASS", "NAME", "REFERENCE_LIST", "DIMENSION_LIST"})

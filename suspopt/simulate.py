@@ -112,7 +112,9 @@ def check_signals(cfg: Config, prepared: Prepared) -> None:
     found.raise_if_any()
 
 
-def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:
+def simulate(
+    cfg: Config, params: Mapping[str, Any] | None = None, prepared: Prepared | None = None
+) -> Result:
     """Simulate ``cfg`` for one design, or for P designs given as dotted-path arrays.
 
     ``params`` maps dotted config paths (e.g. ``"vehicle.corners.F1.damper.c"``) to arrays of
@@ -126,6 +128,10 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:
     params : mapping of str to array_like, optional
         Design parameters by dotted config path, each ``(P,)`` in the field's SI unit (the
         unit the schema gives that key: N/m, N s/m, kg, m, ...); all of one length P.
+    prepared : Prepared, optional
+        The run already built and checked from ``cfg`` and ``params`` (:func:`prepare`, or
+        :func:`suspopt.validation.check_config` for the config's own design), so that a
+        caller that checked it first does not build the model again.
 
     Returns
     -------
@@ -133,7 +139,8 @@ def simulate(cfg: Config, params: Mapping[str, Any] | None = None) -> Result:
         Signals ``(P, T)`` with their SI units (``Result.signal_unit``), the metrics ``(P,)``
         and the time ``(T,)`` [s].
     """
-    prepared = prepare(cfg, params)
+    if prepared is None:
+        prepared = prepare(cfg, params)
     pv, model, _, attachments = prepared
     check_memory(cfg, model, attachments, pv.P, signals=len(cfg.metrics))
     result = _run(with_engine(cfg, pv.P), prepared)

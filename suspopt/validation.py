@@ -33,7 +33,7 @@ def bound_corners(cfg: Config) -> dict[str, np.ndarray]:
     return {v.path: np.where(upper[:, j], v.upper, v.lower) for j, v in enumerate(variables)}
 
 
-def check_config(cfg: Config, optimisation: bool = True) -> None:
+def check_config(cfg: Config, optimisation: bool = True):
     """Everything about ``cfg`` that a run would reject, without running it: what
     :func:`suspopt.simulate.prepare` checks, RK4's stability limit for the configured design,
     the memory ``suspopt simulate`` needs to write every output signal and, with
@@ -51,7 +51,11 @@ def check_config(cfg: Config, optimisation: bool = True) -> None:
     scenarios and the optimiser need the optimisation's problem built. The time
     grid's checks (:func:`check_steps`) need only the loaded config. A config that does not
     load (a value of the wrong type, out of range or absurd for a road vehicle) gets none of
-    these checks: its load errors are all reported instead."""
+    these checks: its load errors are all reported instead.
+
+    Returns the run of the config's own design it built and checked
+    (:class:`suspopt.simulate.Prepared`), which :func:`suspopt.simulate.simulate` takes as
+    ``prepared`` so that a command builds the model once."""
     from .simulate import assemble, check_memory, check_signals, signal_names
 
     found = cfg.problems()
@@ -71,6 +75,7 @@ def check_config(cfg: Config, optimisation: bool = True) -> None:
     if signals and optimisation and (cfg.design_variables or cfg.objectives or cfg.optimiser):
         found.attempt(_check_optimisation, cfg)
     found.raise_if_any()
+    return prepared
 
 
 def _check_optimisation(cfg: Config) -> None:

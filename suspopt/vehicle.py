@@ -181,13 +181,14 @@ def _wheelbase_offsets(cfg: Config, pv: ParamView, corners: tuple[str, ...]) -> 
     rear = np.array([cn[0] == "R" for cn in corners])
     wheelbase = (veh.body.a_front or 0.0) + (veh.body.a_rear or 0.0)
     offsets = np.where(rear, wheelbase, 0.0) if cfg.road.wheelbase_delay else np.zeros(len(corners))
-    if pv.varies("vehicle.body.a_front") or pv.varies("vehicle.body.a_rear"):
-        if any(cn[0] == "R" for cn in corners):
-            raise ConfigError(
-                "params: vehicle.body.a_front/a_rear cannot be design parameters "
-                "of a model with a rear axle: the road's wheelbase delay is one "
-                "per run"
-            )
+    if (pv.varies("vehicle.body.a_front") or pv.varies("vehicle.body.a_rear")) and any(
+        cn[0] == "R" for cn in corners
+    ):
+        raise ConfigError(
+            "params: vehicle.body.a_front/a_rear cannot be design parameters "
+            "of a model with a rear axle: the road's wheelbase delay is one "
+            "per run"
+        )
     return offsets
 
 

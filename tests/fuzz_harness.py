@@ -34,6 +34,7 @@ cases keeps the first ones as they were.
 from __future__ import annotations
 
 import base64
+import contextlib
 import copy
 import functools
 import json
@@ -1889,7 +1890,7 @@ class Worker:
     def start(self) -> None:
         work = self.folder / f"w{self.index}-{self.starts}"
         work.mkdir(parents=True, exist_ok=True)
-        self.log = open(work / "stderr.log", "wb")
+        self.log = open(work / "stderr.log", "wb")  # noqa: SIM115  (closed with the worker)
         self.proc = subprocess.Popen(
             [
                 sys.executable,
@@ -2225,10 +2226,8 @@ def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: boo
                 "fatal": "harness error in the worker",
                 "detail": "".join(traceback.format_exception(exc))[-1500:],
             }
-        try:
+        with contextlib.suppress(OSError):
             _clear(work)
-        except OSError:
-            pass
         proto.write(json.dumps(answer) + "\n")
 
 

@@ -301,9 +301,8 @@ def test_the_library_settings_are_checked_as_the_command_lines(settings, needle)
     """``execution.use`` took any settings: 10**6 workers, 0 workers, workers "2" (a
     TypeError from a comparison), a chunk of 0; they are the command line's checks now,
     in the library's words, and nothing is put in force."""
-    with pytest.raises(ValueError, match=re.escape(needle)):
-        with execution.use(**settings):
-            pass
+    with pytest.raises(ValueError, match=re.escape(needle)), execution.use(**settings):
+        pass
     assert execution.settings()["executor"] == "local"
 
 

@@ -135,7 +135,7 @@ def test_auto_P_is_the_smallest_that_leaves_one_best_solution():
     # C alone rises (to 1 - 0.5/eps): the smallest grid P with one best is 0.51.
     F = np.array([[0.0, 1.0], [1.0, 0.0], [0.5, 0.5]])
     result = kesort(F, P="auto", P_range=(0.01, 1.0), P_step=0.01)
-    assert result.P == pytest.approx(0.51) and result.P_auto
+    assert pytest.approx(0.51) == result.P and result.P_auto
     assert result.chosen == 2 and result.unique
     tied = kesort(F, P=0.5)
     assert not tied.unique and list(tied.ties) == [0, 1, 2] and tied.chosen == 0
@@ -145,7 +145,7 @@ def test_ties_are_reported_when_no_P_separates_them():
     F = np.array([[1.0, 2.0], [1.0, 2.0], [2.0, 1.5]])  # two identical designs
     result = kesort(F)
     assert not result.unique and list(result.ties) == [0, 1]
-    assert result.P == pytest.approx(1.0)  # the grid ran out
+    assert pytest.approx(1.0) == result.P  # the grid ran out
 
 
 def _sorted_at_every_P(F, tie_tol=1e-9, step=0.01):

@@ -150,8 +150,8 @@ def test_nsga2_approaches_the_zdt1_front():
 
 
 def test_same_seed_same_run_and_no_global_random_state():
-    np.random.seed(123)
-    before = np.random.get_state()[1].copy()
+    np.random.seed(123)  # noqa: NPY002  (the global state the run must not touch)
+    before = np.random.get_state()[1].copy()  # noqa: NPY002
     runs = [
         minimize(
             TwoObjectives(),
@@ -163,7 +163,7 @@ def test_same_seed_same_run_and_no_global_random_state():
     np.testing.assert_array_equal(runs[0].X, runs[1].X)
     np.testing.assert_array_equal(runs[0].F, runs[1].F)
     assert not np.array_equal(runs[0].F, runs[2].F)
-    np.testing.assert_array_equal(np.random.get_state()[1], before)  # global RNG untouched
+    np.testing.assert_array_equal(np.random.get_state()[1], before)  # noqa: NPY002
 
 
 def test_weighted_sum_with_one_unit_weight_is_the_single_objective():

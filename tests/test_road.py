@@ -39,7 +39,7 @@ def iso(**changes) -> RoadConfig:
 
 def window(delay: float) -> np.ndarray:
     """Times (of T) a wheel delayed by ``delay`` spends on the bump."""
-    return (T >= START + delay) & (T < START + delay + LENGTH / SPEED)
+    return (START + delay <= T) & (START + delay + LENGTH / SPEED > T)
 
 
 # --- bumps -----------------------------------------------------------------------------------

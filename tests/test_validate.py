@@ -263,7 +263,7 @@ def test_bounds_and_scenarios_are_judged_as_the_values_they_set():
 def test_the_travel_limit_metrics_are_those_in_the_signals_unit():
     from suspopt.specs import METRICS
 
-    assert SAME_UNIT_METRICS == {name for name, m in METRICS.items() if m.unit("m") == "m"}
+    assert {name for name, m in METRICS.items() if m.unit("m") == "m"} == SAME_UNIT_METRICS
 
 
 def test_every_entry_of_the_table_is_consistent():

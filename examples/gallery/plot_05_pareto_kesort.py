@@ -68,7 +68,7 @@ ax_k.set_title("Each design's k-ε level: the choice holds the highest")
 
 def dominated(F, i):
     """Whether some row of F is no worse than row i in every objective and better in one."""
-    return bool(np.any(np.all(F <= F[i], axis=1) & np.any(F < F[i], axis=1)))
+    return bool(np.any(np.all(F[i] >= F, axis=1) & np.any(F[i] > F, axis=1)))
 
 
 assert not any(dominated(F, i) for i in range(len(F)))

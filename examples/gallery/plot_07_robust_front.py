@@ -85,4 +85,4 @@ K_v = robust_front.X[:, robust_front.var_names.index("K_v")]
 heaviest = max(s.load_mass for s in robust.scenarios.product[1])
 X_ST = robust_front.F[:, robust_front.obj_names.index("X_ST")]
 assert np.allclose(X_ST * K_v, heaviest * robust.vehicle.gravity, rtol=1e-9)
-assert np.all(X_ST <= limit)
+assert np.all(limit >= X_ST)

@@ -320,7 +320,7 @@ def draw_builds(
     X = np.empty_like(wanted)
     for j, limits in enumerate(variable_limits(pareto)):  # (per variable: its field's range)
         X[..., j] = inside(wanted[..., j], limits)
-    return X, (X != wanted).sum(axis=(0, 1))
+    return X, (wanted != X).sum(axis=(0, 1))
 
 
 def builds(

@@ -261,8 +261,9 @@ def _simulate(
     cfg, params, picked = _inputs(source, pick, sets, sweeps, zipped)
     if scenario is not None:
         cfg, params, picked = _under_scenario(cfg, params, picked, scenario)
-    check_config(cfg, optimisation=False)
-    pv, model, controller, attachments = prepare(cfg, params)
+    checked = check_config(cfg, optimisation=False)  # (the config's own design, built)
+    prepared = prepare(cfg, params) if params else checked
+    pv, model, controller, attachments = prepared
     written = (
         cfg.output.signals
         if cfg.output.signals != "all"
@@ -291,7 +292,7 @@ def _simulate(
             f"{describe(shared + pv.P * per_design)} of memory"
         )
     started = time.perf_counter()
-    result = run(cfg, params)
+    result = run(cfg, params, prepared=prepared)
     base.verbose_info(f"simulated in {time.perf_counter() - started:.3g} s")
     if result.diverged.any():
         err.print(

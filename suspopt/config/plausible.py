@@ -266,9 +266,13 @@ def _number(value: Any) -> bool:
 
 def _at(data: Any, loc: tuple) -> Any:
     for key in loc:
-        if isinstance(data, dict) and key in data:
-            data = data[key]
-        elif isinstance(data, list) and isinstance(key, int) and 0 <= key < len(data):
+        if (
+            isinstance(data, dict)
+            and key in data
+            or isinstance(data, list)
+            and isinstance(key, int)
+            and 0 <= key < len(data)
+        ):
             data = data[key]
         else:
             return None

@@ -113,14 +113,13 @@ def export_fmu(
     description = draft.replace('guid="{GUID}"', f'guid="{guid}"')
     files["model.h"] = files["model.h"].replace(b'"{GUID}"', f'"{guid}"'.encode())
     binary, note = compile_binary(files, COMPILED, identifier)
-    with atomic_file(path, force) as stream:
-        with zipfile.ZipFile(stream, "w") as fmu:
-            fmu.writestr("modelDescription.xml", description, zipfile.ZIP_STORED)
-            for name, data in files.items():
-                fmu.writestr(f"sources/{name}", data, zipfile.ZIP_DEFLATED)
-            if binary is not None:
-                fmu.writestr(binary[0], binary[1], zipfile.ZIP_DEFLATED)
-            fmu.writestr("resources/config.yaml", cfg.text, zipfile.ZIP_DEFLATED)
+    with atomic_file(path, force) as stream, zipfile.ZipFile(stream, "w") as fmu:
+        fmu.writestr("modelDescription.xml", description, zipfile.ZIP_STORED)
+        for name, data in files.items():
+            fmu.writestr(f"sources/{name}", data, zipfile.ZIP_DEFLATED)
+        if binary is not None:
+            fmu.writestr(binary[0], binary[1], zipfile.ZIP_DEFLATED)
+        fmu.writestr("resources/config.yaml", cfg.text, zipfile.ZIP_DEFLATED)
     tunable = sum(p.tunable for p in bound.parameters)
     return Exported(
         path=path,

@@ -182,7 +182,7 @@ def power_sums(aw, block, squares, fourth, peak):
                 sq[i] = s
                 quad[i] = s * s
                 size = abs(v)
-                if not size <= top:  # (a NaN stays)
+                if not size <= top:  # noqa: SIM102  (a NaN stays: np.max's order of tests)
                     if not np.isnan(top):
                         top = size
             squares[r, b] = _pairwise(sq, 0, m)

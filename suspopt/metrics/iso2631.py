@@ -96,7 +96,7 @@ def weighting_filter(weighting: str | None, fs: float):
     in pieces (the streamed reductions of :mod:`suspopt.streaming`) is filtered piece by piece
     with its state, to the same bits."""
     fs = check_rate(fs)
-    if parameters(weighting) is None:
+    if weighting is None or parameters(weighting) is None:
         return None
     from .filters import design
 

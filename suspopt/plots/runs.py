@@ -216,7 +216,7 @@ def default_signals(result) -> list[str]:
 def evenly_spaced(P: int, most: int) -> list[int]:
     """At most ``most`` of the design indices 0 to P - 1, evenly spaced by index, the first
     and the last included (all of them when there are no more than ``most``)."""
-    if P <= most or most < 2:
+    if most >= P or most < 2:
         return list(range(min(P, most)))
     return sorted({int(round(x)) for x in np.linspace(0, P - 1, most)})
 
