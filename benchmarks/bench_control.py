@@ -45,7 +45,7 @@ PROBLEMS = {
 }
 #: (designs, rounds, output_dt [s]; None keeps every step as the configs do)
 SIZES = ((1, 15, None), (100, 10, None), (1000, 6, None), (1000, 6, 0.004))
-_simulate_module = importlib.import_module("suspopt.simulate")
+_simulate_module = importlib.import_module("suspopt.simulation")
 _build_controller = _simulate_module.build_controller
 
 

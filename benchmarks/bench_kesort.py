@@ -22,7 +22,7 @@ import tracemalloc
 import numpy as np
 
 import suspopt
-from suspopt.kesort import k_eps_levels
+from suspopt.kepsilon import k_eps_levels
 
 
 def measure(call):

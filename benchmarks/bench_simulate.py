@@ -209,7 +209,7 @@ def flops_per_design_step(cfg) -> int:
     four stages; 12 per state row for the stage states and the update."""
     from suspopt.integrator.compiled import _packed
     from suspopt.network import Assembled
-    from suspopt.simulate import full_network, prepare
+    from suspopt.simulation import full_network, prepare
 
     pv, model, _, attachments = prepare(cfg)
     asm = Assembled(full_network(model, attachments), pv.P)

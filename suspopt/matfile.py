@@ -72,28 +72,8 @@ RESERVED = ("units", "attributes", "meta")
 NAMES_MAP = "names_map"
 #: MATLAB's keywords (``iskeyword``): not valid names.
 KEYWORDS = frozenset(
-    [
-        "break",
-        "case",
-        "catch",
-        "classdef",
-        "continue",
-        "else",
-        "elseif",
-        "end",
-        "for",
-        "function",
-        "global",
-        "if",
-        "otherwise",
-        "parfor",
-        "persistent",
-        "return",
-        "spmd",
-        "switch",
-        "try",
-        "while",
-    ]
+    "break case catch classdef continue else elseif end for function global if otherwise "
+    "parfor persistent return spmd switch try while".split()
 )
 #: Attributes of the HDF5 dimension-scale API itself (``meta.<name>.dims`` says what they do).
 H5DS = frozenset({"CLASS", "NAME", "REFERENCE_LIST", "DIMENSION_LIST"})

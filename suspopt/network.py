@@ -18,7 +18,7 @@ The vehicle (:mod:`suspopt.vehicle`: suspension springs and dampers, tyres, anti
 the seat with its passenger (:mod:`suspopt.seat`: links, mechanism) are networks; a seat is
 mounted by :meth:`Network.attach`, which replaces the seat's floor input by the body's motion
 at the seat's point and, for a two-way (coupled) seat, puts the floor reaction on the body.
-The simulator integrates the assembled network (:mod:`suspopt.simulate`), and the linear
+The simulator integrates the assembled network (:mod:`suspopt.simulation`), and the linear
 analyses (modes, frequency responses, transmissibility) take its matrices from
 :meth:`Network.linear_model`: one description of the physics serves both.
 

@@ -11,7 +11,7 @@ A *design table* is the table of designs a result file holds, with their variabl
 - ``suspopt analyse transmissibility`` of a front: ``/designs`` (its edges and knee).
 
 A *pick* names one row of it: ``knee``, ``best_<objective>`` (the edges of the front,
-:func:`suspopt.kesort.pareto_picks`, or the ones the file stored), ``chosen`` (the k-ε
+:func:`suspopt.kepsilon.pareto_picks`, or the ones the file stored), ``chosen`` (the k-ε
 optimum of a kesort file) or a design's id (:mod:`suspopt.design_ids`: its row in the front
 it came from, ``NAME:ROW`` in a kesort file of several fronts), which names the same design
 in every file that holds it. :func:`read_picks` resolves picks into
@@ -145,7 +145,7 @@ def read_table(path: str | Path) -> DesignTable:
     ConfigError naming the file and the dataset for anything else."""
     from .design_ids import table_ids
     from .h5read import H5Reader
-    from .kesort import pareto_picks
+    from .kepsilon import pareto_picks
 
     path = Path(path)
     with H5Reader(path) as h5:

@@ -93,7 +93,7 @@ def road_inputs(
     limit (the road just before it; ``left`` changes nothing elsewhere). The step bump's
     derivative is a Dirac ``±h δ(t - t_edge)`` at its edges and 0 between them: ``zdot`` is
     that regular part, 0 everywhere, and the simulator integrates the Dirac exactly as an
-    impulse at the edge (:func:`suspopt.simulate.simulate`).
+    impulse at the edge (:func:`suspopt.simulation.simulate`).
 
     For an ``iso8608`` road without ``n_waves`` the number of harmonics follows from the span of
     road positions the wheels cover, ``V (max t - min t) + (max d - min d)``

@@ -11,9 +11,9 @@
    objective code; otherwise the file's ``F`` and ``G`` are used as they are.
 3. :func:`!select` pools the sets (Fig. 7.6), keeps the case each design came from, drops the
    designs whose simulation failed (and, unless asked, the infeasible ones), sorts the pool
-   and each case alone by k-ε optimality (:func:`!suspopt.kesort.kesort`; Fig. 7.5: the
+   and each case alone by k-ε optimality (:func:`!suspopt.kepsilon.kesort`; Fig. 7.5: the
    optimum of each case, Fig. 7.6: the optimum among all; each sort normalises over its own
-   designs, Eq 7.11-7.12) and takes the Pareto-theory picks (:func:`~suspopt.kesort.pareto_picks`).
+   designs, Eq 7.11-7.12) and takes the Pareto-theory picks (:func:`~suspopt.kepsilon.pareto_picks`).
 4. :func:`write_selection` writes ``/kesort`` atomically (:func:`suspopt.io.atomic_h5`).
 
 A *case* is a label: the sets of several files carry one label to form one case (Ch. 6 Part A
@@ -59,7 +59,7 @@ from .design_ids import picked_note, selection_ids
 from .errors import require
 from .files import listed
 from .io import atomic_h5, write_attrs, write_dataset
-from .kesort import KEpsilonSort, kesort, pareto_picks
+from .kepsilon import KEpsilonSort, kesort, pareto_picks
 from .optimise.problem import PENALTY, Problem
 
 __all__ = [
@@ -118,7 +118,7 @@ class ParetoSet:
 
     def marks(self) -> dict[str, int]:
         """The designs a report names: the picks given (``--pick``; a row number names
-        none), or the edges and knee of the front (:func:`suspopt.kesort.pareto_picks`)."""
+        none), or the edges and knee of the front (:func:`suspopt.kepsilon.pareto_picks`)."""
         if self.picked is not None:
             return dict(self.picked)
         return pareto_picks(self.F, self.obj_names)
@@ -458,7 +458,7 @@ def select(
     P_step: float = 0.01,
 ) -> Selection:
     """Pool ``sets`` and sort them by k-ε optimality (see the module docstring); ``eps``,
-    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`!suspopt.kesort.kesort`.
+    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`!suspopt.kepsilon.kesort`.
     ConfigError when the sets have different objectives or no design is left to sort."""
     sets = [
         require(s, DesignSet, f"sets[{i}]", "from load_design_sets(paths)")

@@ -98,7 +98,7 @@ def check(cfg: Config, specs: Sequence[tuple[Any, tuple]]) -> None:
     a non-linear model or road (naming the key that makes it so) or a metric of
     ``specs`` (``(spec, its location in the config)``) without a stationary closed form."""
     from .checks import full_network
-    from .simulate import prepare
+    from .simulation import prepare
 
     for spec, loc in specs:
         if spec.metric is not None and spec.metric not in METRICS:
@@ -145,7 +145,7 @@ class _Linear:
 
     def subset(self, keep: np.ndarray) -> _Linear:
         """The same for the designs ``keep`` (a mask over the batch) alone."""
-        from .simulate import prepare
+        from .simulation import prepare
 
         pv, model, _, attachments = prepare(
             self.cfg, {k: v[keep] for k, v in self.pv.params.items()}
@@ -339,7 +339,7 @@ def reduce(
     """The metric specs of ``requests`` (``(spec, its signal names)``) of the designs
     ``params``, stationary, by the frequency integral (module docstring): a
     :class:`suspopt.streaming.Reduced` (engine ``spectral``)."""
-    from .simulate import prepare
+    from .simulation import prepare
     from .streaming import Reduced
 
     pv, model, controller, attachments = prepare(cfg, params)

@@ -287,8 +287,8 @@ class Reduced:
 def window_width(cfg: Config, model, attachments, P: int, signals: int) -> int:
     """Output samples of one window of a run of P designs computing ``signals`` signals: as
     many whole :data:`BLOCK` s as :data:`WINDOW_BYTES` holds by
-    :func:`suspopt.simulate.run_memory`'s estimate, at least one block."""
-    from .simulate import run_memory
+    :func:`suspopt.simulation.run_memory`'s estimate, at least one block."""
+    from .simulation import run_memory
 
     per_sample = run_memory(cfg, model, attachments, 1, signals, window=1)[1]
     blocks = int(WINDOW_BYTES // (max(P, 1) * per_sample)) // BLOCK
@@ -367,7 +367,7 @@ def _probe_result(cfg: Config, setup, states, accelerations, z=None, zd=None):
     zd (n_u, T)`` at those samples (zero when None), for :func:`recorded_rows` and
     :func:`suspopt.affine.affine_signals`."""
     from .integrator import Trajectory
-    from .simulate import _result
+    from .simulation import _result
 
     pv, model, attachments, run, road = setup
     T, step = states.shape[-1], 2 * cfg.simulation.output_every
@@ -563,7 +563,7 @@ def reduce(
     config's road (robust design, one batch for several roads on one time grid). A run with
     a controller is one window (its hold keeps records over the run)."""
     from . import integrator
-    from .simulate import _result, _setup, check_memory, prepare, with_engine
+    from .simulation import _result, _setup, check_memory, prepare, with_engine
 
     pv, model, controller, attachments = prepare(cfg, params)
     cfg = with_engine(cfg, pv.P, evaluation=True)

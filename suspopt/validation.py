@@ -35,7 +35,7 @@ def bound_corners(cfg: Config) -> dict[str, np.ndarray]:
 
 def check_config(cfg: Config, optimisation: bool = True):
     """Everything about ``cfg`` that a run would reject, without running it: what
-    :func:`suspopt.simulate.prepare` checks, RK4's stability limit for the configured design,
+    :func:`suspopt.simulation.prepare` checks, RK4's stability limit for the configured design,
     the memory ``suspopt simulate`` needs to write every output signal and, with
     ``optimisation`` and an optimisation section, the problem
     (:meth:`suspopt.Problem.from_config`), the stability limit at the corners of the design
@@ -54,9 +54,9 @@ def check_config(cfg: Config, optimisation: bool = True):
     these checks: its load errors are all reported instead.
 
     Returns the run of the config's own design it built and checked
-    (:class:`suspopt.simulate.Prepared`), which :func:`suspopt.simulate.simulate` takes as
+    (:class:`suspopt.simulation.Prepared`), which :func:`suspopt.simulation.simulate` takes as
     ``prepared`` so that a command builds the model once."""
-    from .simulate import assemble, check_memory, check_signals, signal_names
+    from .simulation import assemble, check_memory, check_signals, signal_names
 
     found = cfg.problems()
     found.attempt(check_steps, cfg)
@@ -116,7 +116,7 @@ def check_scenarios(cfg: Config, problem) -> None:
     from .optimise.scenarios import Group
     from .params import ParamView
     from .seat import build_attachments
-    from .simulate import check_memory, prepare
+    from .simulation import check_memory, prepare
     from .vehicle import build_vehicle
 
     corners = bound_corners(cfg)

@@ -2156,7 +2156,7 @@ def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: boo
     import suspopt.analyse
     import suspopt.optimise  # noqa: F401 - imported before the clock starts
     import suspopt.selection  # noqa: F401
-    import suspopt.simulate  # noqa: F401
+    import suspopt.simulation  # noqa: F401
     from suspopt.cli import app
 
     suspopt.analyse.analysis_kinds()

@@ -13,7 +13,7 @@ from suspopt import streaming
 from suspopt.affine import affine_signals
 from suspopt.config import load_config
 from suspopt.config.metrics import MetricSpec
-from suspopt.simulate import prepare, simulate
+from suspopt.simulation import prepare, simulate
 from suspopt.specs import spec_signals
 
 pytest.importorskip("numba")

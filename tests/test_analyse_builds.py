@@ -672,7 +672,7 @@ def test_kesort_as_built_of_pooled_fronts_takes_each_sets_own_builds(ps_front, p
     """Pooled fronts sorted as built: each set's values are the percentiles of its own
     builds file, and each case's sort ranks them too (its levels are those of the case's
     designs sorted alone on the same values)."""
-    from suspopt.kesort import kesort
+    from suspopt.kepsilon import kesort
 
     front, _ = ps_front
     twin, out = tmp_path / "twin.h5", tmp_path / "ke.h5"

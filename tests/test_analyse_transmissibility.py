@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 import suspopt
 from suspopt.cli import app
-from suspopt.kesort import pareto_picks
+from suspopt.kepsilon import pareto_picks
 from suspopt.seat import build_seat
 
 PASSENGER = CONFIGS / "ch8" / "ps_class_a_passenger.yaml"

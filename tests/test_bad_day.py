@@ -283,7 +283,7 @@ def test_the_largest_road_a_profile_may_hold_diverges_without_a_numpy_warning(tm
     warned = [line for line in err.splitlines() if line.startswith("warning:")]
     assert len(warned) == 1 and "diverged" in warned[0], err
     from suspopt import load_config
-    from suspopt.simulate import simulate
+    from suspopt.simulation import simulate
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)

@@ -19,7 +19,7 @@ from conftest import CONFIGS, make_config
 import suspopt
 from suspopt.control import LAWS, PARAMETERS
 from suspopt.errors import ConfigError
-from suspopt.simulate import prepare, simulate
+from suspopt.simulation import prepare, simulate
 
 numba = pytest.importorskip("numba")
 
@@ -88,7 +88,7 @@ def test_compiled_and_numpy_engines_agree_on_every_chapter_config(name):
     if compiled_run.engine == "numpy":  # not covered: there is a reason
         from suspopt.integrator import compiled
         from suspopt.network import Assembled
-        from suspopt.simulate import full_network, prepare
+        from suspopt.simulation import full_network, prepare
 
         pv, model, controller, attachments = prepare(cfg, params)
         asm = Assembled(full_network(model, attachments), pv.P)
@@ -213,9 +213,9 @@ def test_a_diverging_design_stops_at_the_same_instant_on_both_engines():
 
 
 def test_the_compiled_engine_without_numba_is_bad_input(monkeypatch, tmp_path):
-    import suspopt.integrator as integrator
+    from suspopt import _numba_cache
 
-    monkeypatch.setattr(integrator, "compiled_available", lambda: False)
+    monkeypatch.setattr(_numba_cache, "compiled_available", lambda: False)
     text = (
         (CONFIGS / "quickstart.yaml")
         .read_text()
@@ -271,7 +271,7 @@ def test_the_rule_of_auto():
     """``auto``: compiled for evaluations and optimisation configs, else from
     ``AUTO_STEPS`` steps, fewer for a batch (docs/guide/engines.md#the-rule-of-auto)."""
     from suspopt.integrator import AUTO_DESIGNS, AUTO_STEPS, auto_engine
-    from suspopt.simulate import with_engine
+    from suspopt.simulation import with_engine
 
     assert auto_engine(10, 1, evaluation=True) == "compiled"
     assert auto_engine(AUTO_STEPS - 100, 1, evaluation=False) == "numpy"
@@ -507,7 +507,7 @@ def test_the_fused_modules_cache_is_rewritten_when_changed_and_skipped_when_unwr
     pv, model, controller, attachments = prepare(cfg, _designs(cfg, 2))
     from suspopt.integrator.compiled import _packed
     from suspopt.network import Assembled
-    from suspopt.simulate import full_network
+    from suspopt.simulation import full_network
 
     _, idx, lay = _packed(Assembled(full_network(model, attachments), pv.P), 1e-3, _fused.LANES)
     monkeypatch.setenv("SUSPOPT_CACHE_DIR", str(tmp_path))

@@ -191,7 +191,7 @@ def test_sets_sweeps_and_names_given_as_one_string_are_one_item(kesort_file):
 def test_a_sweep_of_3_by_4_values_is_one_batch_of_12_named_designs(tmp_path, capsys, monkeypatch):
     import importlib
 
-    simulate_module = importlib.import_module("suspopt.simulate")
+    simulate_module = importlib.import_module("suspopt.simulation")
 
     batches = []
     real = simulate_module._run

@@ -25,7 +25,7 @@ from suspopt.cli import app
 from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
 from suspopt.io import read_simulation_signals
-from suspopt.simulate import prepare, signal_names
+from suspopt.simulation import prepare, signal_names
 
 pytestmark = pytest.mark.cli
 

@@ -305,7 +305,7 @@ def test_the_stability_limit_is_rk4s():
     """The limit is where RK4 stops being stable: just below it a stiff design stays
     bounded, just above it it diverges (a quarter car with a very stiff tyre)."""
     from suspopt.checks import check_stability
-    from suspopt.simulate import prepare
+    from suspopt.simulation import prepare
 
     cfg = load_config_text((CONFIGS / "ch3/part1a_qc_bump.yaml").read_text())
     cfg.vehicle.corners["F1"].tyre.stiffness = 1.0e9

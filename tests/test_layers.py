@@ -56,7 +56,7 @@ def test_simulate_builds_its_model_once(tmp_path, monkeypatch):
 
     from suspopt.cli import app
 
-    simulation = importlib.import_module("suspopt.simulate")
+    simulation = importlib.import_module("suspopt.simulation")
 
     built = []
     build = simulation.build_vehicle

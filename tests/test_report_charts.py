@@ -111,7 +111,7 @@ def test_the_spectrum_has_the_plot_estimators_resolution_and_shows_the_body_mode
     drawn points; the value axis spans at most
     PSD_DECADES decades below the highest value, and every drawn point of the highest."""
     from suspopt.picks import read_picks
-    from suspopt.simulate import prepare
+    from suspopt.simulation import prepare
     from suspopt.vehicle import modal_analysis
 
     _select_signal(shown, "body.heave_acc")

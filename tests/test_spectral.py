@@ -27,7 +27,7 @@ from suspopt.config.metrics import MetricSpec
 from suspopt.integrator import compiled_available
 from suspopt.metrics.iso2631 import weighting_response
 from suspopt.road import iso8608_harmonics
-from suspopt.simulate import prepare
+from suspopt.simulation import prepare
 
 CASES = {
     "qc": ("ch3/part1a_qc_class_b.yaml", "identical", ["body.heave_acc", "travel.F1", "tyre_force.F1"]),

@@ -28,7 +28,7 @@ from suspopt.config import load_config
 from suspopt.config.metrics import MetricSpec
 from suspopt.integrator import compiled_available
 from suspopt.metrics.iso2631 import SUM_BLOCK
-from suspopt.simulate import _result, _setup, prepare, simulate
+from suspopt.simulation import _result, _setup, prepare, simulate
 from suspopt.specs import METRICS, spec_signals
 
 ENGINES = ["numpy"] + (["compiled"] if compiled_available() else [])

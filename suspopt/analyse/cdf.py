@@ -31,7 +31,7 @@ from ..errors import require
 from ..io import atomic_h5, write_dataset
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..result import Result
-from ..simulate import simulate
+from ..simulation import simulate
 from .cells import NOT_COMPUTED, NOT_COMPUTED_NOTE, percent
 from .registry import KINDS, Kind, Report, relative_change
 

@@ -54,7 +54,7 @@ from ..config.metrics import MetricSpec
 from ..files import listed
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..metrics.spectral import PSD_SEGMENT, record_psd
-from ..simulate import Result, simulate
+from ..simulation import Result, simulate
 from ..specs import METRICS, evaluate_spec
 from ..vehicle import modal_analysis
 from .cells import NOT_COMPUTED_NOTE, percent

@@ -131,7 +131,7 @@ class PseudoFronts:
 
     @property
     def picks(self) -> dict[str, int]:
-        """The edges and knee of the stored front (:func:`suspopt.kesort.pareto_picks`,
+        """The edges and knee of the stored front (:func:`suspopt.kepsilon.pareto_picks`,
         Fig. 8.21; Tables 8.12-8.13 report the edges), or the picks given (``--pick``)."""
         return self.pareto.marks()
 
@@ -520,7 +520,7 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
         rows.append(row)
     shown = p.picked_note() or [
         f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}, with "
-        f"the edges and knee of the front (suspopt.kesort.pareto_picks, Fig. 8.21)"
+        f"the edges and knee of the front (suspopt.kepsilon.pareto_picks, Fig. 8.21)"
     ]
     notes = [
         f"{shown[0]}; change = (f - f_stored)/f_stored (Tables 8.12-8.13)",

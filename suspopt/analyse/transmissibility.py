@@ -16,7 +16,7 @@ floor's acceleration as input, as in Fig. 8.26 (``T = z̈_head / z̈_s``). The s
 transmissibility of Fig. 2.18b is the ``seat`` entry.
 
 For a Pareto file (``suspopt optimise`` output, Sec 8.4.4, Fig. 8.26), the same for the
-Pareto-theory picks of its front (:func:`suspopt.kesort.pareto_picks`, Fig. 8.21): the edges
+Pareto-theory picks of its front (:func:`suspopt.kepsilon.pareto_picks`, Fig. 8.21): the edges
 ``best_<objective>`` (the thesis's Edge 1 and Edge 2: in Ch. 8 ``best_X_ST`` and
 ``best_RC_se``) and the ``knee`` (its Mid), simulated in one batch; with ``pick``
 (``--pick``), the designs it names, of any result file (:func:`suspopt.picks.read_front`:
@@ -73,7 +73,7 @@ from ..seat import (
     seat_constraints,
 )
 from ..selection import ParetoSet
-from ..simulate import simulate
+from ..simulation import simulate
 from .pseudo import config_with, read_sections
 from .registry import KINDS, Kind, Report
 
@@ -193,7 +193,7 @@ def seat_transmissibility(
 
 
 def front_designs(pareto: ParetoSet) -> FrontDesigns:
-    """The edges and the knee of ``pareto``'s front (:func:`suspopt.kesort.pareto_picks`),
+    """The edges and the knee of ``pareto``'s front (:func:`suspopt.kepsilon.pareto_picks`),
     each design once, in the order of the picks; of designs picked from a file
     (:func:`suspopt.picks.read_front`), every one, by the names it was picked by (``design
     ID`` for an id)."""
@@ -439,7 +439,7 @@ def _run_front(
         f"Wk r.m.s. {name}.acc [m/s^2]",
     ]
     shown = pareto.picked_note() or [
-        "picks of the front (suspopt.kesort.pareto_picks, Fig. 8.21): the edges "
+        "picks of the front (suspopt.kepsilon.pareto_picks, Fig. 8.21): the edges "
         "best_<objective> and the knee"
     ]
     notes = [

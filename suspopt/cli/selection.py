@@ -317,7 +317,7 @@ def _kesort(
 ) -> None:  # fmt: skip
     import importlib.util
 
-    from ..kesort import check_options
+    from ..kepsilon import check_options
     from ..selection import load_design_sets, select, write_selection
 
     if plot is not None:

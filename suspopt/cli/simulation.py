@@ -250,8 +250,8 @@ def _simulate(
 
     from ..checks import check_stability
     from ..io import write_simulation
-    from ..simulate import check_memory, prepare, signal_names
-    from ..simulate import simulate as run
+    from ..simulation import check_memory, prepare, signal_names
+    from ..simulation import simulate as run
     from ..validation import check_config
 
     if plot is not None:
@@ -281,7 +281,7 @@ def _simulate(
         )
     if base.VERBOSE[0]:
         from ..memory import describe
-        from ..simulate import run_memory
+        from ..simulation import run_memory
 
         shared, per_design = run_memory(
             cfg, model, attachments, pv.P, len(written) + len(cfg.metrics)

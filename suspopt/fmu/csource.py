@@ -172,40 +172,13 @@ def _header(d: Description, bound: Bound, guid: str, offsets: dict) -> str:
         if name != "size":
             lines.append(f"#define Q_{name.upper()} {at}")
     lines += ["", "extern const double su_e0[], su_par0[], su_alpha[];"]
-    ints = [
-        "su_dq_row",
-        "su_dq_col",
-        "su_dq_react",
-        "su_du_row",
-        "su_du_col",
-        "su_law_code",
-        "su_law_row",
-        "su_no_pull",
-        "su_weighted",
-        "su_tyre_rows",
-        "su_damper_rows",
-        "su_laws",
-        "su_below",
-        "su_rate_row",
-        "su_rate_col",
-        "su_split_steps",
-        "su_split_first",
-        "su_split_kick",
-        "su_start_kicks",
-        "su_out_kind",
-        "su_out_i",
-        "su_out_j",
-        "su_in_slot",
-        "su_rate_input",
-        "su_tunable",
-        "su_range_start",
-        "su_range_count",
-        "su_range_bind",
-        "su_range_zero",
-        "su_range_alpha",
-        "su_bind_par",
-        "su_bind_deg",
-    ]
+    ints = (
+        "su_dq_row su_dq_col su_dq_react su_du_row su_du_col su_law_code su_law_row su_no_pull "
+        "su_weighted su_tyre_rows su_damper_rows su_laws su_below su_rate_row su_rate_col "
+        "su_split_steps su_split_first su_split_kick su_start_kicks su_out_kind su_out_i "
+        "su_out_j su_in_slot su_rate_input su_tunable su_range_start su_range_count su_range_bind "
+        "su_range_zero su_range_alpha su_bind_par su_bind_deg"
+    ).split()
     lines.append("extern const int " + ", ".join(f"{x}[]" for x in ints) + ";")
     lines.append("extern const char *const su_par_name[];")
     lines.append("double su_where(double c, double a, double b);")

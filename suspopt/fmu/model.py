@@ -1,7 +1,7 @@
 """A design's element network as the FMU's C code takes it: :func:`describe`.
 
 The description is the network the simulator integrates (:func:`suspopt.checks.full_network`
-of :func:`suspopt.simulate.prepare`'s model and attachments), unpacked into
+of :func:`suspopt.simulation.prepare`'s model and attachments), unpacked into
 
 - ``structure``: every integer and flag - counts, the rows and columns of the non-zero
   entries of the deformation map ``D_q`` (with whether the DOF feels the element's force, the
@@ -32,7 +32,7 @@ from ..config import Config, ConfigError
 from ..integrator import EdgePlan, Edges
 from ..integrator.compiled import LAWS as ELEMENT_LAWS
 from ..road import road_edges, road_inputs
-from ..simulate import prepare
+from ..simulation import prepare
 from .description import Description
 from .outputs import add_outputs
 

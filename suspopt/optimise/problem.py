@@ -36,7 +36,7 @@ from ..config.scenarios import CONSTRAINT_DEFAULT, OBJECTIVE_DEFAULT
 from ..controller import build_controller
 from ..params import ParamView, field_unit, numeric_paths, one_per_run
 from ..seat import CONSTRAINT_UNITS, build_attachments, seat_constraints, seat_static_deflection
-from ..simulate import signal_table
+from ..simulation import signal_table
 from ..specs import evaluate_spec, metric_unit, spec_signals
 from ..vehicle import build_vehicle
 from .scenarios import ScenarioSet, aggregate
@@ -246,13 +246,13 @@ class Problem(_PymooProblem):
 
     def batch_width(self) -> int:
         """Designs simulated in one batch: as many as fit in :data:`!BATCH_BYTES` (or half of
-        ``--max-memory`` when that is smaller) by :func:`!suspopt.simulate.run_memory`, at
+        ``--max-memory`` when that is smaller) by :func:`!suspopt.simulation.run_memory`, at
         least one, at most :data:`!MAX_BATCH` (so that the time per design does not grow with
         the population). It depends on the config (and an explicit memory limit) only, never
         on the memory free at the moment, so that a run repeats bit for bit."""
         if self._width is None:
             from .. import memory
-            from ..simulate import prepare, run_memory
+            from ..simulation import prepare, run_memory
             from ..specs import METRICS
 
             terms = [t for t in self._all_terms() if t.spec.metric]

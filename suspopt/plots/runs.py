@@ -257,7 +257,7 @@ def plot_simulation(
     designs: Sequence[int] | None = None,
     design_names: Sequence[str] | None = None,
 ) -> Path:
-    """Draw :func:`result_figure` of a :class:`suspopt.simulate.Result` to ``path`` (.png or
+    """Draw :func:`result_figure` of a :class:`suspopt.simulation.Result` to ``path`` (.png or
     .svg; ``suspopt simulate --plot``)."""
     path = check_path(path)
     return save(result_figure(result, signals, designs, design_names), path)
@@ -269,7 +269,7 @@ def result_figure(
     designs: Sequence[int] | None = None,
     design_names: Sequence[str] | None = None,
 ):
-    """The figure of a :class:`suspopt.simulate.Result` (:func:`simulation_figure`),
+    """The figure of a :class:`suspopt.simulation.Result` (:func:`simulation_figure`),
     unsaved: ``signals`` (default :func:`default_signals`) of the ``designs`` (indices;
     default every design, or :data:`MAX_DESIGNS` of them evenly spaced by index when there
     are more, which the title says). ``design_names`` (one per design of the result, e.g. the

@@ -274,7 +274,7 @@ def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, 
     from ..picks import read_picks
     from ..plots.runs import default_signals
     from ..plots.style import PSD_BAND, spectrum_limits
-    from ..simulate import simulate
+    from ..simulation import simulate
     from ..specs import METRICS
 
     out: dict[str, Any] = {
