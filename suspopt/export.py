@@ -41,6 +41,7 @@ import stat
 from contextlib import ExitStack, contextmanager, suppress
 from io import TextIOWrapper
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -131,7 +132,8 @@ def _plan(h5) -> list[tuple[str, str, list, list]]:
     tables = []
     for group in groups:
         parts = [_safe(p) for p in group.name.split("/") if p]
-        wide, long = [], {}
+        wide: list[tuple] = []
+        long: dict[tuple, tuple[Any, list]] = {}
         for name, ds in group.items():
             if not isinstance(ds, h5py.Dataset) or ds.is_scale or ds.dtype.kind not in "biufSO":
                 continue
@@ -144,9 +146,7 @@ def _plan(h5) -> list[tuple[str, str, list, list]]:
             if _names(ds, dims) is not None:
                 wide.append((".".join(parts + [_safe(name)]), group.name, [ds], dims))
             else:
-                key = tuple(
-                    (d, s.name if s is not None else None, n) for (d, s), n in zip(dims, ds.shape)
-                )
+                key = tuple((d, getattr(s, "name", None), n) for (d, s), n in zip(dims, ds.shape))
                 long.setdefault(key, (dims, []))[1].append(ds)
         for dims, members in long.values():
             label = [] if len(long) == 1 else ["-".join(_safe(d) for d, _ in dims) or "scalars"]

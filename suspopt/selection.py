@@ -292,7 +292,8 @@ def evaluate_pareto(
     """The designs of ``pareto`` with their main and supplementary objectives under ``cfg``
     (default: the file's own config), in one batch; see the module docstring."""
     own = cfg is None
-    cfg = pareto.config() if own else cfg
+    if cfg is None:
+        cfg = pareto.config()
     problem = Problem.from_config(cfg)
     where = cfg.source if cfg.source is not None else "the config"
     if sorted(pareto.var_names) != sorted(problem.var_names):

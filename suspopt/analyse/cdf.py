@@ -147,10 +147,11 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
         plots.check_path(plot)
     cfg = load_config(source)
     _check(cfg)
+    assert cfg.control is not None and cfg.control.threshold is not None  # (_check)
     spec = cfg.control.threshold
     base_learn = 2.0 * cfg.simulation.duration + spec.learn_time
     path = "control.threshold."
-    learn = np.concatenate(([base_learn], np.full(SHARES.size, spec.learn_time)))
+    learn = np.concatenate((np.array([base_learn]), np.full(SHARES.size, spec.learn_time)))
     shares = np.concatenate(([SHARES[0]], SHARES))
     result = simulate(cfg, params={path + "c_max_share": shares, path + "learn_time": learn})
     values = semi_active_metrics(result, share_after=spec.learn_time)
@@ -158,7 +159,7 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
     reduction = {k: 0.0 - relative_change(values[k][1:], base[k]) for k in METRIC_UNITS}
     corners = result.model.corners
     active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]
-    laws = sorted({cfg.vehicle.corners[c].damper.law for c in active})
+    laws = sorted({getattr(cfg.vehicle.corners[c].damper, "law", "") for c in active})
     threshold = np.stack([result.signals[f"control_threshold.{c}"][1:, -1] for c in active], axis=1)
     unit = result.signal_unit(f"control_threshold.{active[0]}")
     title = (

@@ -160,7 +160,7 @@ def _specs(configs: Sequence[Config], all_roll: bool) -> list[MetricSpec]:
             for s in signals
             for m in (_TRANSIENT_ACC if s.endswith("_acc") else _TRANSIENT)
         ]
-    return [MetricSpec(**d) for d in _RIDE + (_RIDE_ROLL if all_roll else ())]
+    return [MetricSpec.model_validate(d) for d in _RIDE + (_RIDE_ROLL if all_roll else ())]
 
 
 def _response(
@@ -229,10 +229,10 @@ def compare_models(
 ) -> ModelComparison:
     """Simulate every config of ``sources`` and compare them with ``reference`` (one of
     them; default the first), as the module docstring says."""
-    sources = [Path(s) for s in listed(sources)]
-    if len(sources) < 2:
+    paths = [Path(s) for s in listed(sources)]
+    if len(paths) < 2:
         raise ConfigError("analyse models compares at least two configs")
-    resolved = [s.resolve() for s in sources]
+    resolved = [s.resolve() for s in paths]
     if len(set(resolved)) != len(resolved):
         raise ConfigError("analyse models: a config is given twice")
     ref = 0
@@ -240,20 +240,21 @@ def compare_models(
         if Path(reference).resolve() not in resolved:
             raise ConfigError(f"--reference {reference}: not one of the configs compared")
         ref = resolved.index(Path(reference).resolve())
-    configs = [load_config(s) for s in sources]
+    configs = [load_config(s) for s in paths]
     results = [simulate(cfg) for cfg in configs]
     all_roll = all("body.roll" in r.signals for r in results)
     specs = _specs(configs, all_roll)
     models = [
         _response(label, s, cfg, r, specs)
-        for label, s, cfg, r in zip(_labels(sources), sources, configs, results)
+        for label, s, cfg, r in zip(_labels(paths), paths, configs, results)
     ]
-    order, units = {}, {}
+    order: dict[str, tuple[int, int]] = {}
+    units: dict[str, str] = {}
     for model in models:
         for name in model.metrics:
             order.setdefault(name, model.order[name])
             units.setdefault(name, model.units[name])
-    names = sorted(order, key=order.get)
+    names = sorted(order, key=lambda name: order[name])
     comparison = ModelComparison(
         models=models, reference=ref, metric_names=names, metric_units=units
     )

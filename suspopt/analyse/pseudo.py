@@ -461,7 +461,8 @@ def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts, command: str | N
 def is_comfort(cfg: Config) -> list[bool]:
     """Which main objectives are ISO 2631-1 weighted r.m.s. accelerations (their comfort
     levels are drawn)."""
-    return [spec.metric == "rms_weighted" for spec in cfg.objectives.main]
+    objectives = cfg.objectives
+    return [spec.metric == "rms_weighted" for spec in objectives.main] if objectives else []
 
 
 def plot_pseudo_fronts(

@@ -333,7 +333,7 @@ def show_table(table: Table, keys: int = 1, full: bool = True, where: Path | Non
             out.print(line)
 
 
-def _parts(table: Table, keys: int) -> list[Table]:
+def _parts(table: Any, keys: int) -> list[Any]:  # (tables of new_table: with their cells)
     """``table``, or the tables of the columns that fit the terminal (:func:`show_table`)."""
 
     def needs(j: int) -> int:  # column j's widest cell and the border and padding
@@ -347,7 +347,9 @@ def _parts(table: Table, keys: int) -> list[Table]:
         return [table]
     key, rest = list(range(keys)), list(range(keys, count))
     base = 1 + sum(needs(c) for c in key)
-    groups, current, used = [], [], base
+    groups: list[list[int]] = []
+    current: list[int] = []
+    used = base
     for column in rest:
         if current and used + needs(column) > width:
             groups.append(current)

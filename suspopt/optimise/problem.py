@@ -31,7 +31,7 @@ from pymoo.core.problem import Problem as _PymooProblem
 from .. import execution, streaming
 from ..config import Config, ConfigError
 from ..config.loader import require_config
-from ..config.optimise import DesignVariable, Objective, batches
+from ..config.optimise import DesignVariable, batches
 from ..config.scenarios import CONSTRAINT_DEFAULT, OBJECTIVE_DEFAULT
 from ..controller import build_controller
 from ..params import ParamView, field_unit, numeric_paths, one_per_run
@@ -61,9 +61,11 @@ _REMEMBERED = 100_000
 
 @dataclass(frozen=True)
 class _Term:
-    """A compiled objective or constraint spec: its value names and units, one per column."""
+    """A compiled objective or constraint spec: its value names and units, one per column.
+    ``spec`` is the config's :class:`~suspopt.config.optimise.Objective`, or its
+    :class:`~suspopt.config.optimise.Constraint` (``min``, ``max``, ...) for a constraint."""
 
-    spec: Objective
+    spec: Any
     names: tuple[str, ...]
     units: tuple[str, ...]
     keys: tuple[str, ...] = ()  # seat.geometry: the seat_constraints keys, in order
@@ -542,7 +544,7 @@ def _at_variable(cfg: Config, message: str) -> ConfigError:
 
 def _compile(
     cfg: Config,
-    spec: Objective,
+    spec: Any,  # (an Objective, or a Constraint when not ``objective``)
     loc: tuple,
     available: list[str],
     unit_of,

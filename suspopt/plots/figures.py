@@ -174,8 +174,8 @@ def _mark_optima(ax, x: np.ndarray, y: np.ndarray, s) -> None:
     ax.scatter(x[s.sort.chosen], y[s.sort.chosen], label=label, zorder=3, **optimum)
     own = dict(marker="s", s=110, facecolor="none", edgecolor="black", linewidth=1.0)
     for j, cs in enumerate(s.case_sorts.values()):
-        label = "optimum of each case" if j == 0 else None
-        ax.scatter(x[cs.chosen], y[cs.chosen], zorder=3, label=label, **own)
+        case_label = "optimum of each case" if j == 0 else None
+        ax.scatter(x[cs.chosen], y[cs.chosen], zorder=3, label=case_label, **own)
 
 
 def plot_kesort(selection, path: str | Path) -> Path:
@@ -207,7 +207,7 @@ def plot_kesort(selection, path: str | Path) -> Path:
     markers = "os^Dv<>phX*"
     two = F.shape[1] > 1
     fig, axes = new_figure(2 if two else 1, panel_size=(6.0, 5.0))
-    front, level_ax = (axes[0], axes[1]) if two else (None, axes[0])
+    front, level_ax = (axes[0], axes[1]) if two else (axes[0], axes[0])  # (front: if two)
     lo, hi = float(levels.min()), float(levels.max())
     for c, label in enumerate(s.cases):
         rows = s.case == label
@@ -223,9 +223,9 @@ def plot_kesort(selection, path: str | Path) -> Path:
                 **style,
             )
         level_ax.scatter(F[rows, 0], levels[rows], **style)
-    for ax, y in ((front, F[:, 1] if two else None), (level_ax, levels)):
-        if ax is not None:
-            _mark_optima(ax, F[:, 0], y, s)
+    if two:
+        _mark_optima(front, F[:, 0], F[:, 1], s)
+    _mark_optima(level_ax, F[:, 0], levels, s)
     if two:
         at: dict[int, list[str]] = {}
         for key, i in s.picks.items():
