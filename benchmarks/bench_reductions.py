@@ -1,7 +1,7 @@
 """The streamed reductions' compiled loops against their numpy arithmetic, in the same run.
 
 For windows of P designs x T samples (white noise, seed 2026): the ISO 2631 Wk filter at
-1 kHz (:meth:`suspopt.metrics.filters.WeightingFilter.apply`), the moments' block statistics and
+1 kHz (:meth:`suspopt.weighting.WeightingFilter.apply`), the moments' block statistics and
 the weighted power sums of :mod:`suspopt.streaming`, each timed with the compiled loops
 (:func:`suspopt.integrator.compiled_reductions`) and with the numpy code beside them, best of
 5, and whether the two gave the same bits. Needs numba. Run:

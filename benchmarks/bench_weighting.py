@@ -1,4 +1,4 @@
-"""The ISO 2631-1 weightings as recursive filters (``suspopt.metrics.filters``): accuracy and cost.
+"""The ISO 2631-1 weightings as recursive filters (``suspopt.weighting``): accuracy and cost.
 
 Table 1: for each weighting and sample rate, the FIR correction's degree, the largest relative
 error of the complex response from 0 Hz to fs/4 against the analogue Annex A product, the
@@ -20,8 +20,8 @@ import numpy as np
 from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
 
 import suspopt
-from suspopt.metrics.filters import design
 from suspopt.metrics.iso2631 import WEIGHTINGS, weight, weighting_response
+from suspopt.weighting import design
 
 RATES = (100.0, 200.0, 500.0, 1000.0, 2000.0, 4000.0)
 

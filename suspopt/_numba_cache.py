@@ -9,7 +9,7 @@ written anew. It wraps the two methods of ``numba.core.caching.IndexDataCacheFil
 the index and the data, once per process, and only where numba has them; nothing else of
 numba's changes. It holds for every cached numba function of the process, suspopt's or not
 (a damaged file is then compiled again where numba would have raised). The modules that compile with ``cache=True`` call it before their first
-function (``suspopt.integrator._kernel``, ``._accumulate``, ``suspopt.metrics._loops``, and
+function (``suspopt.integrator._kernel``, ``._accumulate``, ``suspopt.loops._compiled``, and
 ``suspopt.integrator._fused`` before a generated module).
 
 **Where the cache lives** (:func:`prepare`): numba keys its cache on the folder of the
@@ -18,7 +18,7 @@ compiled the kernel again, a minute or more each time. :class:`MachineCacheLocat
 the compiled functions of suspopt's own modules in ``cache_root() / "numba"``
 (``$SUSPOPT_CACHE_DIR/numba``, else ``$XDG_CACHE_HOME/suspopt/numba`` or
 ``~/.cache/suspopt/numba``), in a folder named by a digest of the sources numba compiles
-(``suspopt/integrator``, ``suspopt/control`` and ``suspopt/metrics``) and the version: every install of the same
+(``suspopt/integrator``, ``suspopt/control`` and ``suspopt/loops``) and the version: every install of the same
 code on a machine shares one compile, and a change to any of those files (numba's own cache
 does not see a change in a file that a cached function calls into) compiles anew. numba
 still checks each file's own content and the machine's CPU before it uses an entry. Where
@@ -123,7 +123,7 @@ def cache_root() -> Path:
 
 
 #: The package folders whose modules numba compiles (their digest names the cache folder).
-_COMPILED_PACKAGES = ("integrator", "control", "metrics")
+_COMPILED_PACKAGES = ("integrator", "control", "loops")
 _PACKAGE = Path(__file__).resolve().parent
 
 

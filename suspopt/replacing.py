@@ -41,7 +41,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import ConfigError
-from .signature import CONFIG_SUFFIXES, signature_state
 
 __all__ = [
     "SUFFIXES",
@@ -279,6 +278,8 @@ def is_suspopt_output(path: Path) -> bool:
 def _not_ours(path: Path) -> str | None:
     """Why suspopt may not replace the regular file ``path`` without ``--force``, or None
     (:func:`is_suspopt_output`)."""
+    from .signature import CONFIG_SUFFIXES, signature_state  # (not at start-up)
+
     foreign = "exists and was not written by suspopt"
     with open(path, "rb") as stream:
         head = stream.read(_HEAD)

@@ -46,7 +46,7 @@ on its batch, block, window or thread. The MTVV, the ``keep`` metrics and signal
 not affine are reduced from the windows as below.
 
 With numba installed, the block moments, the weighting filter and the weighted sums run as
-compiled loops over each window (:func:`suspopt.metrics.compiled.compiled_reductions`): the same
+compiled loops over each window (:func:`suspopt.loops.compiled_reductions`): the same
 arithmetic in the same order, so the same bits as the numpy code beside them
 (``tests/test_reductions.py``), one pass over each row instead of several whole-array
 passes and their temporaries.
@@ -116,7 +116,7 @@ def _block_moments(x: np.ndarray) -> list[tuple[int, np.ndarray, np.ndarray]]:
     samples of ``x (P, T)`` (the last one shorter), in time order: numpy's mean and squared
     deviations of each block, or the compiled loops' (the same bits) when numba is
     installed."""
-    from .metrics.compiled import compiled_reductions
+    from .loops import compiled_reductions
 
     P, T = x.shape
     loops = compiled_reductions()
@@ -235,7 +235,7 @@ def _power_sums(aw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`~suspopt.metrics.iso2631.block_sums` of ``aw²`` and of ``aw⁴`` (P, blocks) and
     the largest ``|aw|`` (P,) of ``aw (P, T)``: numpy's, or the compiled loops' (the same
     bits, one pass) when numba is installed."""
-    from .metrics.compiled import compiled_reductions
+    from .loops import compiled_reductions
     from .metrics.iso2631 import SUM_BLOCK, block_sums
 
     loops = compiled_reductions()

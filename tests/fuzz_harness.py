@@ -2257,7 +2257,7 @@ def _compile_the_kernel() -> None:
     cfg.road.start, cfg.simulation.duration = 0.01, 0.1
     problem = suspopt.Problem.from_config(cfg)
     problem.evaluate(((problem.xl + problem.xu) / 2)[None], return_values_of=["F", "G"])
-    # the streamed reductions' loops (suspopt.metrics._loops), as an evaluation calls them
+    # the streamed reductions' loops (suspopt.loops._compiled), as an evaluation calls them
     from suspopt import streaming
     from suspopt.metrics.iso2631 import weighting_filter
 

@@ -168,7 +168,7 @@ def _compiled_signatures() -> set[tuple[str, object]]:
     """(function, signature) of every specialisation the kernel's compiled functions hold in
     this process."""
     from suspopt.integrator import _accumulate, _kernel
-    from suspopt.metrics import _loops as _reductions
+    from suspopt.loops import _compiled as _reductions
 
     return {
         (f"{module.__name__}.{name}", sig)

@@ -1,4 +1,4 @@
-"""The compiled loops of the reductions (:mod:`suspopt.metrics._loops`) against the
+"""The compiled loops of the reductions (:mod:`suspopt.loops._compiled`) against the
 numpy arithmetic they replace, bit for bit, on hostile signals:
 
 - the pairwise sum against ``np.sum`` for every length a block may have;
@@ -16,12 +16,12 @@ import pytest
 from conftest import CONFIGS
 
 import suspopt
-import suspopt.metrics.compiled as metric_loops
+import suspopt.loops as metric_loops
 from suspopt import streaming
 from suspopt.metrics.iso2631 import weighting_filter
 
 pytest.importorskip("numba")
-from suspopt.metrics import _loops as _reductions  # noqa: E402  (needs numba)
+from suspopt.loops import _compiled as _reductions  # noqa: E402  (needs numba)
 
 WEIGHTINGS = ("Wk", "Wd", "Wf", "Wc", "We", "Wj")
 #: numpy's warnings on the hostile values (NaN, infinities), which both sides propagate

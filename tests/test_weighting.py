@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from suspopt.metrics.filters import TARGET, design
 from suspopt.metrics.iso2631 import WEIGHTINGS, weight, weighting_response
+from suspopt.weighting import TARGET, design
 
 
 def _digital_response(flt, f: np.ndarray) -> np.ndarray:

@@ -8,7 +8,7 @@ The frequency weightings of ISO 2631-1:1997 Annex A that ride comfort is measure
 of a recumbent person). Each is a product of second-order stages
 (``suspopt.metrics.iso2631.weighting_response``). The time-domain metrics do not use
 that analogue response directly: they filter the signal with a recursive digital filter
-designed at the signal's sample rate (``suspopt.metrics.filters``). Drawn: the analogue
+designed at the signal's sample rate (``suspopt.weighting``). Drawn: the analogue
 curves, and the gain the digital filter gives steady sines at 1 kHz.
 """
 
@@ -61,7 +61,7 @@ ax.legend(ncol=3)
 # -----------------------------------------------------
 # The filters are held to a complex response within 0.1 % of the analogue one up to a
 # quarter of the sample rate, here 250 Hz (their design aims at half of it,
-# ``suspopt.metrics.filters.TARGET``), and the start has decayed to 1e-4 of its size, so every
+# ``suspopt.weighting.TARGET``), and the start has decayed to 1e-4 of its size, so every
 # tone's complex gain must be within 0.1 % of ``H(j 2 pi f)``. Where a weighting is below
 # -60 dB (1e-3: Wf above 2 Hz) a relative error means nothing, and the check asks for an
 # absolute one of 1e-6.

@@ -10,7 +10,7 @@ road's inputs at that instant), then
   (``j`` the sample's count) computed once per sample;
 - the largest and smallest value (a NaN stays, as ``np.max`` keeps it);
 - for each (signal, weighting) pair, the weighting's filter (the arithmetic of
-  :func:`suspopt.metrics._loops.weight_rows`: the FIR correction, then each section in transposed
+  :func:`suspopt.loops._compiled.weight_rows`: the FIR correction, then each section in transposed
   direct form II), the sums of ``a_w²`` and ``a_w⁴`` over each block of ``SUM_BLOCK`` samples
   added to their totals at the block's end, and the largest ``|a_w|``.
 

@@ -6,7 +6,7 @@ return a scalar or ``(P,)``. ``weighting`` is one of ``"Wk", "Wd", "Wf", "Wc", "
 
 Method of weighting: the analogue response ``H(j2πf)`` of ISO 2631-1 Annex A (parameters in
 ``docs/iso-facts.md#filter-structure-annex-a``) is realised as a recursive digital filter at the
-record's sample rate (:mod:`suspopt.metrics.filters`: the analogue poles mapped exactly,
+record's sample rate (:mod:`suspopt.weighting`: the analogue poles mapped exactly,
 a numerator fitted so that the complex response is within 0.1 % of ``H`` from 0 Hz to a quarter
 of the sample rate for fs >= 500 Hz, 0.05 % from 1 kHz; the errors at other rates are tabulated
 in ``docs/iso-facts.md``). The filter starts at rest, so the output is the response of the causal
@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from .annex_a import (
+from ..weighting import (
     MAX_SAMPLE_RATE,
     MIN_SAMPLE_RATE,
     WEIGHTINGS,
@@ -90,7 +90,7 @@ def _check(a: np.ndarray, fs: float) -> tuple[np.ndarray, float]:
 
 
 def weighting_filter(weighting: str | None, fs: float):
-    """The recursive filter (:class:`suspopt.metrics.filters.WeightingFilter`) that realises the ISO
+    """The recursive filter (:class:`suspopt.weighting.WeightingFilter`) that realises the ISO
     2631-1 weighting ``weighting`` at the sample rate ``fs`` [Hz] (at least 100 Hz), or None
     for the unweighted signal. :func:`weight` is its output from rest; a signal that arrives
     in pieces (the streamed reductions of :mod:`suspopt.streaming`) is filtered piece by piece
@@ -98,7 +98,7 @@ def weighting_filter(weighting: str | None, fs: float):
     fs = check_rate(fs)
     if weighting is None or parameters(weighting) is None:
         return None
-    from .filters import design
+    from ..weighting import design
 
     return design(canonical_name(weighting), fs)
 
@@ -107,7 +107,7 @@ def weight(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
     """Frequency-weighted acceleration ``a_w(t)`` in m/s², same shape as ``a`` (Eq 2.79).
 
     ``a`` in m/s² sampled at ``fs`` Hz (>= 100 Hz), time on the last axis. The weighting runs as
-    the recursive filter of :func:`suspopt.metrics.filters.design` (see the module
+    the recursive filter of :func:`suspopt.weighting.design` (see the module
     docstring), which keeps the weighting's phase: the output is the causal filter's response
     from rest. Deviation from the thesis: Eq 2.79 writes the weighting on the spectrum of the
     whole record; this is its causal time-domain equivalent, matched to the analogue response

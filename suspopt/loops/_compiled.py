@@ -1,10 +1,10 @@
 """Compiled loops of the streamed reductions and of the weighting filter (imported only when
-numba is installed, through :func:`suspopt.metrics.compiled.compiled_reductions`).
+numba is installed, through :func:`suspopt.loops.compiled_reductions`).
 
 Each function is the numpy arithmetic it replaces, operation for operation, so that both give
 the same bits (``tests/test_reductions.py`` checks it against numpy on hostile signals):
 
-- :func:`weight_rows`: :meth:`suspopt.metrics.filters.WeightingFilter.apply` — the FIR correction
+- :func:`weight_rows`: :meth:`suspopt.weighting.WeightingFilter.apply` — the FIR correction
   as the sum of shifted copies in its fixed order, then each second-order section in scipy's
   transposed direct form II (``sosfilt``'s difference equations, sample by sample);
 - :func:`block_moments`: the block statistics of :class:`suspopt.streaming._Moments` — each
