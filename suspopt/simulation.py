@@ -129,9 +129,10 @@ def simulate(
         Design parameters by dotted config path, each ``(P,)`` in the field's SI unit (the
         unit the schema gives that key: N/m, N s/m, kg, m, ...); all of one length P.
     prepared : Prepared, optional
-        The run already built and checked from ``cfg`` and ``params`` (:func:`prepare`, or
-        :func:`suspopt.validation.check_config` for the config's own design), so that a
-        caller that checked it first does not build the model again.
+        The run already built and checked from ``cfg`` and ``params``
+        (``suspopt.simulation.prepare``, or ``suspopt.validation.check_config`` for the
+        config's own design), so that a caller that checked it first does not build the
+        model again.
 
     Returns
     -------

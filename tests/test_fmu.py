@@ -110,6 +110,10 @@ def study(tmp_path_factory):
         "embedded",
     )
     assert code == 0, lines
+    code, lines, _ = invoke(
+        "export", d / "ke.h5", "--pick", "chosen", "--fmu", d / "kesort_input.fmu"
+    )
+    assert code == 0, lines
     assert invoke("export", d / "ke.h5", "--pick", "chosen", "-o", d / "chosen.yaml")[0] == 0
     assert invoke("simulate", d / "chosen.yaml", "-o", d / "kesort.h5")[0] == 0
     out["kesort"] = d / "chosen.yaml"
@@ -126,16 +130,6 @@ def signals_of(path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
 @pytest.mark.parametrize("road", ["embedded", "input"])
 @pytest.mark.parametrize("kind", [*CASES, "kesort"])
 def test_fmpy_validates_every_fmu(study, kind, road):
-    if kind == "kesort" and road == "input":
-        code, lines, _ = invoke(
-            "export",
-            study["folder"] / "ke.h5",
-            "--pick",
-            "chosen",
-            "--fmu",
-            study["folder"] / "kesort_input.fmu",
-        )
-        assert code == 0, lines
     path = study["folder"] / f"{kind}_{road}.fmu"
     assert validate_fmu(str(path)) == []
     md = read_model_description(str(path))
@@ -158,11 +152,17 @@ def test_cosimulation_with_the_embedded_road_repeats_simulate(study, kind):
     assert error <= 1e-9, (error, name)
 
 
-def cosim_with_inputs(path, time, inputs: dict, step: float) -> dict[str, np.ndarray]:
+def cosim_with_inputs(
+    path, time, inputs: dict, step: float, order: int = 2
+) -> dict[str, np.ndarray]:
     """FMPy's FMU2Slave driven by hand: the inputs {name: values at ``time``} set at each
-    communication point with their first derivatives (the slopes to the next sample; FMPy's
-    ``simulate_fmu(set_input_derivatives=True)`` sets them only for nine inputs), the
-    outputs read after each step: {name: (T,)}."""
+    communication point with their derivatives up to ``order`` (FMPy's
+    ``simulate_fmu(set_input_derivatives=True)`` sets first ones only, and for nine inputs
+    only), the outputs read after each step: {name: (T,)}. Over each step the FMU follows
+    the inputs' Taylor polynomial: with ``order`` 1 the straight line to the next sample;
+    with 2 the parabola through it whose curvature is the smaller of the second differences
+    at the step's two ends, or none where they differ in sign (minmod: a bump's edge, a kink,
+    bends no step beside it), as a master that holds the input's table can set them."""
     from fmpy import extract
     from fmpy.fmi2 import FMU2Slave
 
@@ -179,12 +179,22 @@ def cosim_with_inputs(path, time, inputs: dict, step: float) -> dict[str, np.nda
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
     in_refs, table = [refs[n] for n in inputs], np.array(list(inputs.values()))
-    slopes = np.diff(table, axis=1) / np.diff(time)
+    h = np.diff(time)
+    slopes = np.diff(table, axis=1) / h
+    curvature = np.zeros_like(slopes)
+    if order == 2 and table.shape[1] > 2:
+        second = np.diff(slopes, axis=1) / h[1:]  # (at the inner samples)
+        at_samples = np.concatenate([second[:, :1], second, second[:, -1:]], axis=1)
+        left, right = at_samples[:, :-1], at_samples[:, 1:]  # (minmod: a kink's is not spread)
+        curvature = np.where(left * right > 0, np.sign(left) * np.minimum(abs(left), abs(right)), 0)
+        slopes = slopes - 0.5 * curvature * h  # (the parabola still meets the next sample)
 
     def put(j: int) -> None:
         fmu.setReal(in_refs, list(table[:, j]))
         if j < slopes.shape[1]:
             fmu.setRealInputDerivatives(in_refs, [1] * len(in_refs), list(slopes[:, j]))
+            if order == 2:
+                fmu.setRealInputDerivatives(in_refs, [2] * len(in_refs), list(curvature[:, j]))
 
     put(0)
     fmu.exitInitializationMode()
@@ -200,41 +210,41 @@ def cosim_with_inputs(path, time, inputs: dict, step: float) -> dict[str, np.nda
     return {n: values[:, i] for i, n in enumerate(outputs)}
 
 
-def input_run(path, signals, t) -> tuple[float, str]:
+def input_run(path, signals, t, order: int = 2) -> tuple[float, str]:
     """The worst output of the FMU at ``path`` fed ``signals``' road (``road.*``, and
     ``road_vel.*`` where it has that input); ``road_vel.*`` without an input of its own is the
     height's slope, left out."""
     names = {v.name for v in read_model_description(str(path)).modelVariables}
     inputs = {f"input.{n}": v for n, v in signals.items() if f"input.{n}" in names}
-    got = cosim_with_inputs(path, t, inputs, t[1] - t[0])
+    got = cosim_with_inputs(path, t, inputs, t[1] - t[0], order)
     compared = {
         n: v for n, v in signals.items() if not n.startswith("road_vel.") or f"input.{n}" in names
     }
     return worst(compared, lambda n: got[n])
 
 
-#: The largest error allowed with the road from inputs, relative to each signal's peak: the
-#: straight lines between samples at the communication step (the config's dt); the seat's
-#: wheel hop on its class A road at 33 m/s has the most of the road's curvature in it.
-INPUT_TOLERANCE = {
-    "quarter": 1e-3,
-    "half_pitch": 1e-3,
-    "full": 1e-3,
-    "seat": 3e-3,
-    "semi_active": 3e-3,
-}
+#: The largest error allowed with the road from inputs, relative to each signal's peak, at
+#: the config's dt (issue 56). The inputs' parabolas between samples
+#: (:func:`cosim_with_inputs`) miss the road most where a half-sine bump's edge, a kink,
+#: falls between two samples (the half cars: 4.5-4.9e-4) and on the seat's class A road at
+#: 33 m/s (4.2e-4); the straight lines alone miss the latter by 1.9e-3.
+INPUT_TOLERANCE = 1e-3
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("kind", list(CASES))
-def test_cosimulation_fed_simulates_road_agrees(study, kind):
+@pytest.mark.parametrize("order", [2, 1])
+@pytest.mark.parametrize("kind", [*CASES, "kesort"])
+def test_cosimulation_fed_simulates_road_agrees(study, kind, order):
+    """The road fed as inputs with its first and second derivatives within 1e-3 of each
+    signal's peak; with the first only (straight lines), within 3e-3 (said for masters that
+    set no second derivative)."""
     t, signals = signals_of(study["folder"] / f"{kind}.h5")
-    error, name = input_run(study["folder"] / f"{kind}_input.fmu", signals, t)
+    error, name = input_run(study["folder"] / f"{kind}_input.fmu", signals, t, order)
     print(
-        f"{kind}: co-simulation, road from inputs every {t[1]:g} s: max error {error:.2g} "
-        f"of the peak ({name})"
+        f"{kind}: co-simulation, road from inputs every {t[1]:g} s with derivatives to order "
+        f"{order}: max error {error:.2g} of the peak ({name})"
     )
-    assert error <= INPUT_TOLERANCE[kind], (error, name)
+    assert error <= (INPUT_TOLERANCE if order == 2 else 3 * INPUT_TOLERANCE), (error, name)
 
 
 @pytest.mark.slow
@@ -249,7 +259,7 @@ def test_the_input_roads_error_falls_with_the_step(study, tmp_path):
         signals = {n: result.signals[n][0] for n in result.signals}
         errors.append(input_run(tmp_path / f"q{dt}.fmu", signals, result.time)[0])
     print(f"quarter, road from inputs: {errors[0]:.2g} at dt = 1 ms, {errors[1]:.2g} at 0.5 ms")
-    assert errors[1] < 0.35 * errors[0]  # second order: a quarter of it
+    assert errors[1] < 0.15 * errors[0]  # (fourth order: a sixteenth of it)
 
 
 @pytest.mark.slow
@@ -269,7 +279,7 @@ def test_a_damping_tyre_takes_the_road_rate_as_an_input_too(study, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("kind", ["quarter", "half_pitch", "seat"])
+@pytest.mark.parametrize("kind", [*CASES, "kesort"])
 def test_model_exchange_under_cvode_agrees(study, kind):
     t, signals = signals_of(study["folder"] / f"{kind}.h5")
     result = simulate_fmu(

@@ -47,7 +47,7 @@ typedef struct {
     double a[SU_N1], raw[SU_N1];
     double d[SU_R1], dv[SU_R1], fel[SU_R1], fvis[SU_R1], ftot[SU_R1];
     double Q[SU_NQ1], out[SU_NOUT1];
-    double u_set[2 * NC + 1], du_set[2 * NC + 1], t_set, uz[2 * NC + 1];
+    double u_set[2 * NC + 1], du_set[2 * NC + 1], d2u_set[2 * NC + 1], t_set, uz[2 * NC + 1];
     /* the controller */
     double cmd[NC + 1], cond[NC + 1], thr[NC + 1], stiff[NC + 1], pulled[NC + 1];
     double *history; long hist_n, hist_cap; double next_fit, next_due;
@@ -254,9 +254,13 @@ static const double *su_road_half(Inst *m, long j, double t)
 #else
     int i;
     (void)j;
-    for (i = 0; i < 2 * NC; i++) m->uz[i] = m->u_set[i] + m->du_set[i] * (t - m->t_set);
+    double tau = t - m->t_set;
+    /* the inputs' Taylor polynomial from their last values and the derivatives the master
+       gave (first and second order; none: held) */
+    for (i = 0; i < 2 * NC; i++)
+        m->uz[i] = m->u_set[i] + tau * (m->du_set[i] + 0.5 * tau * m->d2u_set[i]);
     for (i = 0; i < NC; i++) /* no rate input (the tyre does not damp): the height's slope */
-        if (!su_rate_input[i]) m->uz[NC + i] = m->du_set[i];
+        if (!su_rate_input[i]) m->uz[NC + i] = m->du_set[i] + tau * m->d2u_set[i];
     return m->uz;
 #endif
 }
@@ -666,6 +670,7 @@ static void su_reset(Inst *m)
     memset(m->y, 0, sizeof m->y);
     memset(m->u_set, 0, sizeof m->u_set);
     memset(m->du_set, 0, sizeof m->du_set);
+    memset(m->d2u_set, 0, sizeof m->d2u_set);
     m->t_set = 0.0;
     m->time = 0.0;
     m->k = 0;
@@ -806,6 +811,7 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
             int j = (int)(v - VR_IN);
             m->u_set[su_in_slot[j]] = value[i];
             m->du_set[su_in_slot[j]] = 0.0;
+            m->d2u_set[su_in_slot[j]] = 0.0;
             m->t_set = m->time;
         } else return su_fail(m, "%s", "fmi2SetReal: only parameters and inputs can be set");
     }
@@ -970,9 +976,11 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     Inst *m = (Inst *)c;
     size_t i;
     for (i = 0; i < nvr; i++) {
-        if (vr[i] < VR_IN || vr[i] >= VR_OUT || order[i] != 1)
-            return su_fail(m, "%s", "fmi2SetRealInputDerivatives: first derivatives of inputs only");
-        m->du_set[su_in_slot[vr[i] - VR_IN]] = value[i];
+        if (vr[i] < VR_IN || vr[i] >= VR_OUT || order[i] < 1 || order[i] > 2)
+            return su_fail(m, "%s", "fmi2SetRealInputDerivatives: first and second derivatives "
+                                    "of inputs only");
+        if (order[i] == 1) m->du_set[su_in_slot[vr[i] - VR_IN]] = value[i];
+        else m->d2u_set[su_in_slot[vr[i] - VR_IN]] = value[i];
     }
     m->valid = 0;
     return fmi2OK;
