@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 from conftest import CONFIGS, write
-from fuzz_harness import report_problems
+from fuzz_harness import report_problems, walk
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -347,22 +347,9 @@ _MUTATION = st.tuples(
 )
 
 
-def _paths(node, prefix=()):
-    items = (
-        node.items()
-        if isinstance(node, dict)
-        else enumerate(node)
-        if isinstance(node, list)
-        else ()
-    )
-    for key, value in items:
-        yield prefix + (key,)
-        yield from _paths(value, prefix + (key,))
-
-
 def _mutate(data: dict, mutation) -> None:
     op, which, value, word, factor = mutation
-    paths = list(_paths(data))
+    paths = [path for path, _ in walk(data)]
     if not paths:
         return
     path = paths[which % len(paths)]
