@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -96,7 +97,7 @@ def check_steps(cfg: Config) -> None:
         what = "the road's shortest wave: 1/(n_max V) = {:.4g} s"
         _resolved(cfg, found, period, MIN_STEPS_PER_WAVE, what, " or a lower road.n_max")
     rate = sim.output_rate
-    specs = [(("metrics", i), spec) for i, spec in enumerate(cfg.metrics)]
+    specs: list[tuple[tuple, Any]] = [(("metrics", i), spec) for i, spec in enumerate(cfg.metrics)]
     if cfg.objectives is not None:
         specs += [(("objectives", "main", i), s) for i, s in enumerate(cfg.objectives.main)]
         specs += [
@@ -222,7 +223,7 @@ def check_stability(
     from .network import parameter_rows
 
     network = full_network(model, attachments)
-    cases = [None]
+    cases: list[dict[str, np.ndarray] | None] = [None]  # (None: the dampers as built)
     corners = cfg.vehicle.corners
     if any(corners[c].damper.kind == "semi_active" for c in model.corners):
         stiff = np.stack(

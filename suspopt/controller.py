@@ -20,7 +20,7 @@ a refit costs the same however long the history.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -155,7 +155,8 @@ class SemiActiveController:
         self._lagged = bool(np.any(actuator_lag > 0))
         self._threshold = threshold
         self._adaptive = c_max_share is not None
-        if self._adaptive:
+        if c_max_share is not None:  # (adaptive: learn_time and refit_factor given with it)
+            assert learn_time is not None and refit_factor is not None
             share = c_max_share[:, None, None]
             self._level = np.where(below[None, None, :], share, 1.0 - share)[:, 0, :]
             self._period = refit_factor * learn_time
@@ -302,9 +303,8 @@ class SemiActiveController:
                 else (idx[:, None] * corners + np.arange(corners)).ravel()
             )
             fit = self._t_summary.fit(history.reshape(n, -1), columns)
-            threshold = t_quantile(
-                tuple(a.reshape(idx.size, corners) for a in fit), self._level[idx]
-            )
+            first, second, third = (a.reshape(idx.size, corners) for a in fit)
+            threshold = t_quantile((first, second, third), self._level[idx])
         else:
             if idx.size < due.size:
                 history = history[:, idx]
@@ -379,7 +379,7 @@ def _threshold(cfg: Config, pv: ParamView, control: Control, laws: list, n_corne
     """The fixed CDF threshold ``(P, 1, N)`` (zero when there is none or it adapts) and the
     adaptive threshold's settings by keyword (empty unless ``mode: adaptive``)."""
     threshold = np.zeros((pv.P, 1, n_corners))
-    settings = {}
+    settings: dict[str, Any] = {}
     spec = control.threshold
     if spec is not None and spec.mode == "fixed":
         units = {LAWS[law].unit for law in laws if law is not None}
@@ -435,7 +435,9 @@ def build_controller(
             parameter.low_open,
         )
 
-    laws, c_min, c_max = [], [], []
+    laws: list[str | None] = []
+    c_min: list[np.ndarray] = []
+    c_max: list[np.ndarray] = []
     parameters: dict[str, list[np.ndarray]] = {name: [] for name in PARAMETERS}
     for name, damper in zip(model.corners, dampers):
         if damper.kind == "passive":

@@ -57,7 +57,7 @@ def numeric_paths(cfg: Config) -> dict[str, float]:
 
 
 @functools.cache
-def _limits(model: type, name: str) -> tuple[float, bool, float, bool]:
+def _limits(model: Any, name: str) -> tuple[float, bool, float, bool]:
     """``(low, low_closed, high, high_closed)`` of a float field of a config section, read
     from its annotation's constraints (the ranges of :mod:`suspopt.config.base`)."""
     low, low_closed, high, high_closed = -np.inf, True, np.inf, True
@@ -67,14 +67,19 @@ def _limits(model: type, name: str) -> tuple[float, bool, float, bool]:
         for inner in getattr(arg, "__metadata__", ()):
             metadata += getattr(inner, "metadata", [])
     for item in metadata:
+        bound: Any  # (a number: the ranges of suspopt.config.base)
         if isinstance(item, annotated_types.Ge):
-            low, low_closed = float(item.ge), True
+            bound = item.ge
+            low, low_closed = float(bound), True
         elif isinstance(item, annotated_types.Gt):
-            low, low_closed = float(item.gt), False
+            bound = item.gt
+            low, low_closed = float(bound), False
         elif isinstance(item, annotated_types.Le):
-            high, high_closed = float(item.le), True
+            bound = item.le
+            high, high_closed = float(bound), True
         elif isinstance(item, annotated_types.Lt):
-            high, high_closed = float(item.lt), False
+            bound = item.lt
+            high, high_closed = float(bound), False
     return low, low_closed, high, high_closed
 
 
@@ -91,7 +96,8 @@ def field_range(cfg: Config, path: str) -> tuple[float, bool, float, bool]:
     """The range a numeric config field accepts, ``(low, low_closed, high, high_closed)``
     (infinite where it has no bound)."""
     node, name = _section(cfg, path)
-    return _limits(type(node), name)
+    section: Any = type(node)  # (a pydantic model class: hashable, as the cache needs)
+    return _limits(section, name)
 
 
 _UNIT = re.compile(r"\[([^\],]+)\]")

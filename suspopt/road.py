@@ -304,7 +304,10 @@ def _psd_integral(
 
 def _nominal_level(road: Iso8608Road) -> float:
     """G_d(n0) [m^3] the config asks for: ``level``, else the class's geometric mean."""
-    return road.level if road.level is not None else ISO8608_CLASS_LEVELS[road.road_class]
+    if road.level is not None:
+        return road.level
+    assert road.road_class is not None  # (the config gives a class or a level)
+    return ISO8608_CLASS_LEVELS[road.road_class]
 
 
 def _n_waves(road: Iso8608Road, length_m: float) -> int:

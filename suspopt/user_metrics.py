@@ -220,7 +220,7 @@ def _entry_points() -> list:
         if ep.name in BUILT_IN:
             raise ValueError(
                 f"entry point {ep.name} = {ep.value} ({GROUP}"
-                + (f", package {ep.dist.name}" if getattr(ep, "dist", None) else "")
+                + (f", package {ep.dist.name}" if ep.dist is not None else "")
                 + ") takes a built-in metric's name; rename it"
             )
     return found

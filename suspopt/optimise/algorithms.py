@@ -72,7 +72,7 @@ class Solutions:
     @property
     def feasible(self) -> np.ndarray:
         """(N,) True where every constraint holds (``G <= 0``)."""
-        return (self.G <= 0).all(axis=1)
+        return np.asarray((self.G <= 0).all(axis=1))
 
 
 class Optimiser(ABC):

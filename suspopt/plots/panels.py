@@ -163,9 +163,9 @@ def draw_front(
         else:
             style.update(color="C0")
         ax.scatter(x, y, **style)
-    for name, (x, y) in (marks or {}).items():
-        ax.scatter([x], [y], marker="*", s=120, color="k", zorder=5)
-        ax.annotate(name, (x, y), textcoords="offset points", xytext=(5, 5), fontsize=8)
+    for name, (x_mark, y_mark) in (marks or {}).items():
+        ax.scatter([x_mark], [y_mark], marker="*", s=120, color="k", zorder=5)
+        ax.annotate(name, (x_mark, y_mark), textcoords="offset points", xytext=(5, 5), fontsize=8)
     if comfort:
         draw_comfort_levels(ax, "x")
     ax.set_xlabel(x_label)

@@ -337,7 +337,7 @@ def optimisation_figure(
     G = np.asarray(G, dtype=float).reshape(len(F), -1)
     m = F.shape[1]
     failed = (F >= FAILED_VALUE).any(axis=1)
-    feasible = (G <= 0).all(axis=1) & ~failed
+    feasible = np.asarray((G <= 0).all(axis=1) & ~failed)
     generation = np.asarray(history["generation"], dtype=float)
     share = np.asarray(history["feasible"], dtype=float)
     single = m == 1 or weights is not None
