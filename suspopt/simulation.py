@@ -85,7 +85,7 @@ def assemble(cfg: Config, params: Mapping[str, Any] | None = None) -> Prepared:
     pv = ParamView(require_config(cfg), params)
     model = build_vehicle(cfg, pv)
     controller: Controller | None = build_controller(cfg, pv, model)
-    attachments: list[Attachment] = build_attachments(cfg, pv)
+    attachments: list[Attachment] = list(build_attachments(cfg, pv))
     return Prepared(pv, model, controller, attachments)
 
 

@@ -217,7 +217,12 @@ METRICS: dict[str, MetricDef] = {
         family="tyre_force",
     ),
 }
-_REDUCE = {"mean": np.mean, "max": np.max, "min": np.min, "sum": np.sum}
+_REDUCE: dict[str, Callable[..., np.ndarray]] = {
+    "mean": np.mean,
+    "max": np.max,
+    "min": np.min,
+    "sum": np.sum,
+}
 
 
 def spec_signals(spec, available: list[str], corners: tuple[str, ...]) -> list[str]:

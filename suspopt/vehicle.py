@@ -341,7 +341,7 @@ def vehicle_network(
             "tyre", wheels, -np.eye(N), parameter_rows(tyre_stiffness), parameter_rows(tyre_damping)
         )
     )
-    if bar_map is not None:
+    if bar_map is not None and bar_stiffness is not None:
         groups.append(
             Elements(
                 "anti_roll_bar",

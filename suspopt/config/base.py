@@ -36,7 +36,7 @@ def bounds(low: float | None, high: float, *, closed: bool = True) -> Any:
     """The field constraint of a finite float in ``[low, high]`` (``(low, high]`` with
     ``closed=False``), for ``Annotated[float, bounds(...)]``: the range is checked on load and
     stated in the JSON schema."""
-    bound = {} if low is None else {"ge" if closed else "gt": low}
+    bound: dict[str, Any] = {} if low is None else {"ge" if closed else "gt": low}
     return Field(le=high, allow_inf_nan=False, **bound)
 
 

@@ -156,10 +156,10 @@ def batches(variables: Sequence[DesignVariable]) -> dict[str, list[int]]:
 class Objective(MetricSpec):
     """A metric spec (metric of a signal) or a design ``quantity``; one value per design."""
 
-    metric: str | None = Field(
+    metric: str | None = Field(  # type: ignore[assignment]  # (optional: or a quantity)
         None, description="metric of a signal (see metrics:); or give quantity"
     )
-    quantity: Literal[tuple(QUANTITIES)] | None = Field(
+    quantity: Literal[tuple(QUANTITIES)] | None = Field(  # type: ignore[valid-type]
         None,
         description="design quantity computed without simulating: "
         + "; ".join(f"{k}: {v}" for k, v in QUANTITIES.items()),
@@ -260,7 +260,7 @@ class Balance(Section):
     magnitude above the others for ``factor: 10`` (Case 5).
     """
 
-    samples: _count(1_000_000) = Field(100, description="random designs simulated to balance")
+    samples: _count(1_000_000) = Field(100, description="random designs simulated to balance")  # type: ignore[valid-type]
     dominant: str | None = Field(
         None, description="name of the objective that dominates (Case 5: f1)"
     )
@@ -291,7 +291,7 @@ class WeightedSum(Section):
 class Hybrid(Section):
     """GA, then SLSQP from the GA's best inside a box around it (Sec 5.1.1, S3-S4)."""
 
-    ga_generations: _count(1_000_000) = Field(
+    ga_generations: _count(1_000_000) = Field(  # type: ignore[valid-type]
         10, description="generations of the GA before the gradient takes over (Sec 5.1.1: 10)"
     )
     shrink: float = Field(
@@ -325,22 +325,22 @@ class Optimiser(Section):
         description="seed of the run's random generator (required: runs are "
         "reproducible bit for bit)"
     )
-    population: _count(1_000_000) | None = Field(
+    population: _count(1_000_000) | None = Field(  # type: ignore[valid-type]
         None, description="population size (S1/S3: 200, S2/S4: 1000); not for gradient"
     )
-    generations: _count(1_000_000) | None = Field(
+    generations: _count(1_000_000) | None = Field(  # type: ignore[valid-type]
         None,
         description="most generations (gradient: SLSQP iterations; hybrid: GA "
         "generations plus SLSQP iterations)",
     )
-    max_evaluations: _count(10**10) | None = Field(None, description="most designs simulated")
+    max_evaluations: _count(10**10) | None = Field(None, description="most designs simulated")  # type: ignore[valid-type]
     tolerance: Annotated[float, bounds(0.0, 1.0, closed=False)] = Field(
         1.0e-6,
         description="stop when the best objective improves less than this over "
         "stall_generations (GA; Ch. 5: 1e-6), or SLSQP's ftol on the objective scaled by its "
         "value at the start",
     )
-    stall_generations: _count(100_000) = Field(
+    stall_generations: _count(100_000) = Field(  # type: ignore[valid-type]
         30, description="window of the tolerance test of population algorithms"
     )
     weighted_sum: WeightedSum | None = Field(

@@ -151,7 +151,7 @@ class _SemiActiveFields(Section):
     kind: Literal["semi_active"] = Field(description="damper type")
     c_min: Damping = Field(description="soft damping coefficient C_min [N s/m]")
     c_max: Damping = Field(description="stiff damping coefficient C_max [N s/m], at least c_min")
-    law: Literal[DAMPER_LAWS] = Field(description="control law: " + " | ".join(DAMPER_LAWS))
+    law: Literal[DAMPER_LAWS] = Field(description="control law: " + " | ".join(DAMPER_LAWS))  # type: ignore[valid-type]
 
     soft_field: ClassVar[str] = "c_min"
 
@@ -171,7 +171,7 @@ class _SemiActiveFields(Section):
         return self
 
 
-def _parameter_field(parameter) -> tuple:
+def _parameter_field(parameter) -> tuple[Any, Any]:
     """The config field of a law parameter: optional, in its range, described."""
     laws = " and ".join(LAW_PARAMETERS[parameter.name])
     bound = {"gt" if parameter.low_open else "ge": parameter.low}
@@ -187,7 +187,7 @@ def _parameter_field(parameter) -> tuple:
     )
 
 
-SemiActiveDamper = create_model(
+SemiActiveDamper = create_model(  # type: ignore[call-overload]  # (fields from the laws)
     "SemiActiveDamper",
     __base__=_SemiActiveFields,
     __module__=__name__,
@@ -272,7 +272,7 @@ class Vehicle(Section):
     """A rigid body on corners; the four thesis models are presets
     (docs/architecture.md#conventions)."""
 
-    preset: Literal[tuple(PRESETS)] = Field(
+    preset: Literal[tuple(PRESETS)] = Field(  # type: ignore[valid-type]
         description=" | ".join(f"{p.name} ({p.label})" for p in PRESETS.values())
     )
     body: Body

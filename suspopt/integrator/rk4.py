@@ -89,8 +89,12 @@ class Controller(Protocol):
 
     units: dict[str, str]
     samples: int
-    sample_every: int
-    lag_decay: np.ndarray | None
+
+    @property
+    def sample_every(self) -> int: ...
+
+    @property
+    def lag_decay(self) -> np.ndarray | None: ...
 
     def start(self, P: int) -> np.ndarray: ...
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -76,7 +77,7 @@ def _link_law(stiffness, offset, length) -> Callable[[np.ndarray], np.ndarray]:
     def law(w, out=None):
         return np.multiply(a + b / np.sqrt(square - w * w), w, out=out)
 
-    law.compiled = ("link", (a, b, square))  # type: ignore[attr-defined]  (compiled.LAWS)
+    law.compiled = ("link", (a, b, square))  # type: ignore[attr-defined]  # (compiled.LAWS)
     return law
 
 
@@ -88,7 +89,7 @@ def carrella_law(stiffness, wall_distance, spring_free_length):
     def law(u, out=None):
         return np.multiply(b / np.sqrt(u * u + square) + a, u, out=out)
 
-    law.compiled = ("carrella", (a, b, square))  # type: ignore[attr-defined]  (compiled.LAWS)
+    law.compiled = ("carrella", (a, b, square))  # type: ignore[attr-defined]  # (compiled.LAWS)
     return law
 
 
@@ -240,12 +241,12 @@ class Mechanism:
     """
 
     node: int
-    law: Callable[..., Callable[[np.ndarray], np.ndarray]]
+    law: Callable[..., Callable[..., np.ndarray]]  # (scale, width) -> law(w, out=None)
     rest: np.ndarray | None
     series: tuple[np.ndarray, np.ndarray, np.ndarray] | None
     limit: np.ndarray | None
-    exact: Callable[[np.ndarray], np.ndarray] = field(init=False, repr=False)
-    _preload: np.ndarray | None = field(init=False, repr=False)
+    exact: Callable[..., np.ndarray] = field(init=False, repr=False)
+    _preload: Any = field(init=False, repr=False)  # (an array where rest is given)
 
     def __post_init__(self):
         self.exact = self.law(1.0)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -158,6 +159,8 @@ def _negative_stiffness(kind: str):
     ``K_v = m g / X_ST`` and ``K_h = α K_v`` (Sec 8.2.2)."""
 
     def build(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form: str):
+        geometry: tuple[np.ndarray, ...]
+        limit: np.ndarray | None
         if kind == "nss1":
             a_o, gamma = get("wall_distance"), get("gamma")
             geometry, limit = (a_o, a_o / gamma), None
@@ -173,8 +176,9 @@ def _negative_stiffness(kind: str):
                 get("cam_offset"),
                 get("precompression"),
             )
-            limit = mechanisms.nss3_contact_limit(*geometry)
-            x_st = mechanisms.nss3_static_deflection(*geometry[:3])
+            cam, roller, offset, precompression = geometry
+            limit = mechanisms.nss3_contact_limit(cam, roller, offset, precompression)
+            x_st = mechanisms.nss3_static_deflection(cam, roller, offset)
         k_v = mechanisms.vertical_stiffness(load, x_st, g)
         k_h = get("stiffness_ratio") * k_v
         params = tuple(p[:, None] for p in (k_h,) + geometry)
@@ -232,7 +236,8 @@ def _kdamper(get: Callable[[str], np.ndarray], load: np.ndarray, g: float, form:
 
 #: Exact force law (the parameters of the ``*_force`` function after the travel, giving the
 #: function of the travel) and Taylor coefficients of NSS1-NSS3.
-_FORMS = {
+#: Each NSS kind's exact law and its Taylor series: (parameters...) -> law, -> (k1, k2, k3).
+_FORMS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     "nss1": (mechanisms.carrella_law, mechanisms.nss1_taylor),
     "nss2": (mechanisms.nss2_law, mechanisms.nss2_taylor),
     "nss3": (mechanisms.nss3_law, mechanisms.nss3_taylor),
