@@ -488,7 +488,7 @@ class Assembled:
 
     def evaluator(
         self, width: int | None = None
-    ) -> Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray], None]:
+    ) -> Callable[..., None]:  # (y2, offset or None, coef, inverse_mass, acc2, acc)
         """A function ``(y2, offset, coef, inverse_mass, acc2, acc) -> None`` that writes
         ``q''`` of ``width`` design columns (default P) into ``acc``.
 

@@ -50,7 +50,7 @@ class Signal:
     """An entry of the signal table: its SI ``unit`` and ``compute(result) -> (P, T)``."""
 
     unit: str
-    compute: Callable[[Result], np.ndarray]
+    compute: Callable[..., np.ndarray]  # (result) -> (P, T)
 
 
 _DOF_UNITS = {"heave": "m", "roll": "rad", "pitch": "rad"}

@@ -1095,10 +1095,13 @@ def test_ctrl_c_at_any_moment_exits_130_without_a_traceback(tmp_path, delay, sig
     interpreter's own start-up is Python's.) SIGTERM (a batch system's time limit) the same
     way, with its own code: before, Python's default ended the process at once, leaving the
     output's temporary file and lock behind."""
+    # (long enough to be running 1.5 s after numpy is loaded: 3 million steps, which the
+    # compiled engine takes seconds over, where 300,000 had finished in time)
     long = write(
         tmp_path,
         edited(
-            "simulation: {duration: 3.0, dt: 1.0e-3}", "simulation: {duration: 300.0, dt: 1.0e-3}"
+            "simulation: {duration: 3.0, dt: 1.0e-3}",
+            "simulation: {duration: 3000.0, dt: 1.0e-3, output_dt: 5.0e-3}",
         ),
     )
     # the command starts with Ctrl-C at its default, as a shell's foreground job does,

@@ -12,6 +12,8 @@ same however long the run (its quantiles agree with the exact full-history fit's
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .laws import LAWS
@@ -163,10 +165,10 @@ def _ascent_step(
     gradient pointing out is held. Returns the step and where it is Newton's."""
     out = ((df >= NU_RANGE[1]) & (grad[2] > 0)) | ((df <= NU_RANGE[0]) & (grad[2] < 0))
     free = ~out
-    grad = (grad[0], grad[1], np.where(out, 0.0, grad[2]))
+    held = (grad[0], grad[1], np.where(out, 0.0, grad[2]))  # (ν's held where it is at a bound)
     h11, h21, h31, h22, h32, h33 = hess
     newton, concave = _solve_symmetric(
-        (-h11, -h21, -h31 * free, -h22, -h32 * free, np.where(out, 1.0, -h33)), grad
+        (-h11, -h21, -h31 * free, -h22, -h32 * free, np.where(out, 1.0, -h33)), held
     )
     if concave.all():
         step = newton
@@ -183,7 +185,7 @@ def _ascent_step(
                 -total * free * 2.0 * nu / (nu1 * nu3),
                 np.where(out, 1.0, total * nu * nu * info_nu),
             ),
-            grad,
+            held,
         )
         step = np.where(concave, newton, fisher)
     step /= np.maximum(1.0, _largest(step))
@@ -228,7 +230,8 @@ def fit_t(
         x, weights = x[:, work], None if weights is None else weights[:, work]
     total = np.full(x.shape[1], float(x.shape[0])) if weights is None else np.sum(weights, axis=0)
     params = tuple(a.reshape(-1)[work] for a in (loc, scale, df))
-    loglik = step = None  # at params, and the step from there
+    loglik: Any = None  # at params
+    step: Any = None  # the step from there
 
     def finish(which: np.ndarray, values: tuple) -> None:
         for whole, value in zip((loc, scale, df), values):
@@ -236,7 +239,7 @@ def fit_t(
 
     with np.errstate(divide="ignore", invalid="ignore"):
         for _ in range(_T_MAX_EVALUATIONS):
-            trial = params if step is None else _moved(*params, step)
+            trial = params if step is None else _moved(params[0], params[1], params[2], step)
             new_loglik, grad, hess, trigamma = _t_derivatives(x, weights, total, *trial)
             better = None  # the trial point is accepted if not lower
             if step is not None:
@@ -257,7 +260,7 @@ def fit_t(
             if going.all():
                 continue
             if converged.any():
-                finish(converged, _moved(*params, step))
+                finish(converged, _moved(params[0], params[1], params[2], step))
             finish(~going & ~converged, params)
             if not going.any():
                 return loc, scale, df

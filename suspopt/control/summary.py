@@ -229,6 +229,9 @@ class StudentTSummary:
         values, weights = self._points(columns)
         which = self._select(columns)
         start = tuple(a[which] for a in self._fit)
-        fit = fit_t(values, weights, *start, np.ones(columns.size, dtype=bool), _SUMMARY_TOLERANCE)
+        loc, scale, df = start
+        fit = fit_t(
+            values, weights, loc, scale, df, np.ones(columns.size, dtype=bool), _SUMMARY_TOLERANCE
+        )
         for stored, new in zip(self._fit, fit):
             stored[which] = new

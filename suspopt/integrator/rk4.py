@@ -40,7 +40,7 @@ A design whose state becomes non-finite or exceeds :data:`DIVERGENCE_LIMIT` gets
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from typing import NamedTuple, Protocol
 
@@ -154,15 +154,17 @@ class HeldRecords(Mapping):
     the ``Controller`` protocol) from the values kept at each sample when one is first read."""
 
     def __init__(
-        self, names: Sequence[str], publish: Callable[[], dict[str, np.ndarray]], index: np.ndarray
+        self, names: Iterable[str], publish: Callable[[], dict[str, np.ndarray]], index: np.ndarray
     ):
-        self._names, self._publish, self._index = tuple(names), publish, index
+        self._names, self._index = tuple(names), index
+        self._publish: Callable[[], dict[str, np.ndarray]] | None = publish
         self._held: dict[str, Held] | None = None
 
     def __getitem__(self, name: str) -> Held:
         if name not in self._names:
             raise KeyError(name)
         if self._held is None:
+            assert self._publish is not None  # (published once, then dropped)
             self._held = {n: Held(v, self._index) for n, v in self._publish().items()}
             self._publish = None
         return self._held[name]
@@ -259,7 +261,7 @@ class _ControllerHold:
         self.decay = (
             None if decay is None else widen(decay.transpose(2, 0, 1), self.damping.shape[1])
         )
-        self.lagged = None
+        self.lagged: np.ndarray | None = None
         if self.decay is not None:
             self.rise, self.pulled = 1.0 - self.decay, np.empty_like(self.damping)
             self.lagged = np.empty((self.damping.shape[0], P, n_out))
@@ -300,8 +302,10 @@ class _ControllerHold:
         """The damping (held, or the lagged record) and the records of the whole run."""
         held_at = np.searchsorted(self.changes, np.arange(n_out), side="right") - 1
         held_damping, held_records = self.held_damping, self.held_records
-        damping = (
-            self.lagged if self.decay is not None else Held(lambda: _stacked(held_damping), held_at)
+        damping: Held | np.ndarray = (
+            self.lagged
+            if self.lagged is not None
+            else Held(lambda: _stacked(held_damping), held_at)
         )
 
         def publish() -> dict[str, np.ndarray]:
@@ -515,6 +519,7 @@ def _controller_hold(
         return rk4.acc[:n_vehicle, :P, 0].copy()
 
     vehicle = _VehicleState(rk4.y[n : n + n_vehicle, :P, 0], vehicle_acceleration)
+    assert asm.damper_rows is not None  # (a controller: the network has semi-active rows)
     hold = _ControllerHold(controller, rk4.coef, asm.damper_rows, P, n_out, dt, vehicle)
     return hold
 
@@ -559,7 +564,7 @@ def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajector
     n, P = asm.n, asm.P
     n_out, width = run.window(width)
     columns = max(P, 2)  # (a single design as two identical columns)
-    active, roads = offsets.any(axis=(1, 2, 3)), offsets.shape[2]
+    active, roads = np.asarray(offsets.any(axis=(1, 2, 3))), offsets.shape[2]
     if offsets.size // roads * columns <= _WIDE_OFFSETS:  # small batches: no broadcasting
         offsets = widen(offsets, columns) if roads == 1 else offsets.repeat(P // roads, axis=2)
     # the inputs' part of each half-step, None where it is zero (a bump's road before and after)
@@ -588,7 +593,7 @@ def windows(run: Run, width: int | None = None) -> Iterator[tuple[int, Trajector
                     recorder.keep(k // every - j0)
                     if hold is not None:
                         hold.kept(k // every)
-                if k in split:
+                if splitter is not None and k in split:
                     splitter.step(k)
                 else:
                     rk4.rest(2 * k)

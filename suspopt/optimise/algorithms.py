@@ -349,7 +349,7 @@ class Hybrid(Optimiser):
         self.gradient.setup(self.problem, self._rng)
 
     @property
-    def n_gen(self) -> int:
+    def n_gen(self) -> int:  # type: ignore[override]  # (counted by its two stages)
         return self.ga.n_gen + (0 if self._in_ga else self.gradient.n_gen)
 
     @property
