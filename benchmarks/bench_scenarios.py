@@ -24,7 +24,7 @@ import numpy as np
 
 from suspopt.config.loader import edit_config, load_config_text, set_path
 from suspopt.integrator import compiled_available
-from suspopt.optimise import Problem
+from suspopt.optimisation import Problem
 
 CONFIG = Path(__file__).resolve().parents[1] / "configs" / "robust" / "hc2_bumps.yaml"
 MASSES = """    - {name: heavy_h40mm, set: {road.height: 0.04, vehicle.body.mass: 2500}}

@@ -177,7 +177,7 @@ def objectives_only(sizes, engines, rng) -> None:
     two calls, peak memory of a third."""
     import tracemalloc
 
-    from suspopt.optimise.problem import MAX_BATCH
+    from suspopt.optimisation.problem import MAX_BATCH
 
     base = suspopt.load_config(CONFIG.parent / "ch5" / "case1_s1.yaml")
     print(

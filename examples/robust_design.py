@@ -37,7 +37,7 @@ import suspopt
 from suspopt import streaming
 from suspopt.config.loader import edit_config, set_path
 from suspopt.kepsilon import pareto_picks
-from suspopt.optimise.run import optimise
+from suspopt.optimisation.run import optimise
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs" / "robust"
 

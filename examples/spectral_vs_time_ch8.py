@@ -23,7 +23,7 @@ import numpy as np
 
 import suspopt
 from suspopt.integrator import compiled_available
-from suspopt.optimise.run import optimise
+from suspopt.optimisation.run import optimise
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs" / "ch8"
 

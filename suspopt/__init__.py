@@ -27,8 +27,9 @@ _EXPORTS = {
     "build_vehicle": "vehicle",
     "modal_analysis": "vehicle",
     "frequency_response": "vehicle",
-    "Problem": "optimise",
-    "OptimisationResult": "optimise",
+    "Problem": "optimisation",
+    "OptimisationResult": "optimisation",
+    "optimise": "optimisation.run",
     "kesort": "kepsilon",
     "KEpsilonSort": "kepsilon",
     "pareto_picks": "kepsilon",
@@ -47,7 +48,7 @@ if TYPE_CHECKING:
     from .errors import ConfigError, InputError
     from .kepsilon import KEpsilonSort, kesort, pareto_picks
     from .memory import reuse_memory
-    from .optimise import OptimisationResult, Problem
+    from .optimisation import OptimisationResult, Problem
     from .simulation import Result, simulate
     from .templates import load_template
     from .user_metrics import metric

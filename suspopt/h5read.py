@@ -50,7 +50,7 @@ PROBE_BYTES_PER_SECOND = 50e6
 PROBE_MEMORY = 64 << 20
 PROBE_MEMORY_PER_BYTE = 8
 #: Lowest objective value a file may hold: minus the optimiser's penalty value
-#: (:data:`suspopt.optimise.problem.PENALTY`, what a failed design gets). No objective of a
+#: (:data:`suspopt.optimisation.problem.PENALTY`, what a failed design gets). No objective of a
 #: simulation comes near it; a damaged file's -1e308 broke the figures and the knee.
 LOWEST_OBJECTIVE = -1.0e10
 #: Files this process has probed: (device, inode, size, modification time).

@@ -10,11 +10,11 @@ numbers 0 ... n-1, units ``1``), ``units`` and other attributes as xarray reads 
 HDF5 (a list of texts, one entry as the entry itself), and the root's attributes
 (provenance: ``suspopt_version``, ``created``, ``command``, ``config``, ``seed``) under the
 group's own. So ``Result.to_xarray()`` needs no file (:meth:`suspopt.Result.to_xarray`,
-:meth:`suspopt.optimise.OptimisationResult.to_xarray`), and :func:`frame` makes a Dataset a
+:meth:`suspopt.optimisation.OptimisationResult.to_xarray`), and :func:`frame` makes a Dataset a
 tidy pandas DataFrame.
 
 :func:`simulation_tables` declares a ``suspopt simulate`` file (docs/guide/results.md);
-the optimisation's groups are declared in :mod:`suspopt.optimise.output`.
+the optimisation's groups are declared in :mod:`suspopt.optimisation.output`.
 """
 
 from __future__ import annotations

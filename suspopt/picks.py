@@ -334,7 +334,7 @@ def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSe
     picked (:func:`read_picks`: optimise, kesort or analyse), each once, in the order first
     named. They keep their stored main objectives and, from an optimise file, their
     constraints; from any other file ``G`` is None and they are evaluated again."""
-    from .optimise.problem import Problem
+    from .optimisation.problem import Problem
     from .selection import ParetoSet, read_pareto
 
     if not picks:

@@ -2,7 +2,7 @@
 
 1. :func:`read_pareto` reads a ``suspopt optimise`` file (``/pareto/X`` physical values,
    ``/pareto/F``, ``/pareto/G`` with ``names`` and ``units``; root attribute ``config``, the
-   YAML text: layout in :mod:`suspopt.optimise.run`).
+   YAML text: layout in :mod:`suspopt.optimisation.run`).
 2. :func:`evaluate_pareto` gives every design its objectives, main then supplementary, under
    a config: the file's own, or another one with the same design variables (the same designs
    with a CDF controller: the thesis's "pseudo Pareto fronts", Sec 7.2.2, Fig. 7.4b). When
@@ -60,7 +60,7 @@ from .errors import require
 from .files import listed
 from .io import atomic_h5, write_attrs, write_dataset
 from .kepsilon import KEpsilonSort, kesort, pareto_picks
-from .optimise.problem import PENALTY, Problem
+from .optimisation.problem import PENALTY, Problem
 
 __all__ = [
     "ParetoSet",

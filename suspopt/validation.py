@@ -82,7 +82,7 @@ def _check_optimisation(cfg: Config) -> None:
     """:func:`check_config`'s checks of the optimisation: its problem, then, each on its
     own, the stability limit at the corners of the bounds, the scenarios and the
     optimiser."""
-    from .optimise import Problem, build_optimiser
+    from .optimisation import Problem, build_optimiser
     from .params import ParamView
     from .seat import build_attachments
     from .vehicle import build_vehicle
@@ -109,11 +109,11 @@ def _check_optimisation(cfg: Config) -> None:
 
 def check_scenarios(cfg: Config, problem) -> None:
     """What :func:`check_config` checks of the config, for every scenario group of
-    ``problem`` (:mod:`suspopt.optimise.scenarios`): its road and time grid, the memory of
+    ``problem`` (:mod:`suspopt.optimisation.scenarios`): its road and time grid, the memory of
     its road, and RK4's
     stability limit at the corners of the design variables' bounds under each of its
     scenarios; reported at the scenario's key."""
-    from .optimise.scenarios import Group
+    from .optimisation.scenarios import Group
     from .params import ParamView
     from .seat import build_attachments
     from .simulation import check_memory, prepare

@@ -65,7 +65,7 @@ def tiny(text: str, duration: float, population: int = 10, generations: int = 2)
 def optimised_front(folder: Path, name: str, duration: float, **budget) -> tuple[Path, Path]:
     """Optimise a tiny version of the bundled config ``name`` (e.g. ``ch8/pareto_ps_class_a``)
     in ``folder``; return (config path, Pareto file). The front has two designs or more."""
-    from suspopt.optimise import optimise
+    from suspopt.optimisation import optimise
 
     path = folder / f"{name.replace('/', '_')}.yaml"
     path.write_text(tiny((CONFIGS / f"{name}.yaml").read_text(), duration, **budget))

@@ -71,7 +71,7 @@ def one_error(capsys, *args) -> str:
 def front(tmp_path_factory) -> Path:
     """A tiny Pareto front of the PS seat (the spectral starter config), seven designs or so."""
     from suspopt import load_config
-    from suspopt.optimise import optimise
+    from suspopt.optimisation import optimise
 
     folder = tmp_path_factory.mktemp("front")
     config = folder / "spectral.yaml"
@@ -164,7 +164,7 @@ def test_stored_objectives_beyond_the_range_are_bad_input(tmp_path, capsys, fron
 
 def test_the_lowest_objective_a_file_may_hold_is_minus_the_penalty():
     from suspopt.h5read import LOWEST_OBJECTIVE
-    from suspopt.optimise.problem import PENALTY
+    from suspopt.optimisation.problem import PENALTY
 
     assert LOWEST_OBJECTIVE == -PENALTY
 

@@ -46,7 +46,7 @@ def walk(tmp_path_factory):
     """A robust front, and a kesort file of it that left out its first two designs (as
     ``--builds`` leaves out designs too few of whose builds are feasible)."""
     import suspopt
-    from suspopt.optimise import optimise
+    from suspopt.optimisation import optimise
     from suspopt.selection import load_design_sets, select, write_selection
 
     folder = tmp_path_factory.mktemp("ids")

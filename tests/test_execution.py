@@ -19,7 +19,7 @@ from conftest import CONFIGS, TINY, write
 import suspopt
 from suspopt import execution
 from suspopt._entry import main
-from suspopt.optimise import optimise
+from suspopt.optimisation import optimise
 
 pytestmark = pytest.mark.slow
 distributed = pytest.importorskip("distributed")

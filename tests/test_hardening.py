@@ -474,7 +474,7 @@ def test_a_population_whose_pairs_exceed_memory_is_refused_before_allocating(tmp
 
 
 def test_large_evaluations_run_in_batches_of_bounded_memory(monkeypatch):
-    from suspopt.optimise import problem as problem_module
+    from suspopt.optimisation import problem as problem_module
 
     cfg = suspopt.load_config(CONFIGS / "ch5/case1_s1.yaml")
     cfg.simulation.duration = 0.6
@@ -583,7 +583,7 @@ def test_the_librarys_writers_refuse_a_folder_the_system_cannot_look_up(tmp_path
     with pytest.raises(suspopt.ConfigError, match=r"cannot inspect it \(File name too long\)"):
         with atomic_file(tmp_path / LONG / "out.h5") as stream:
             stream.write(b"never")
-    from suspopt.optimise.output import read_checkpoint  # (optimise(..., resume=True))
+    from suspopt.optimisation.output import read_checkpoint  # (optimise(..., resume=True))
 
     with pytest.raises(suspopt.ConfigError, match=r"--resume: .*: cannot inspect it \(File name"):
         read_checkpoint(tmp_path / LONG, None, None)
@@ -923,7 +923,7 @@ def test_the_librarys_writers_refuse_their_own_inputs_too(front, tmp_path):
     import hashlib
 
     from suspopt.analyse.pseudo import pseudo_fronts, road_variants, write_pseudo_fronts
-    from suspopt.optimise import optimise
+    from suspopt.optimisation import optimise
     from suspopt.selection import load_design_sets, read_pareto, select, write_selection
 
     config, out = front

@@ -14,7 +14,7 @@ import suspopt
 from suspopt.cli import app
 from suspopt.config.loader import load_config_text
 from suspopt.kepsilon import k_eps_levels, kesort, normalise_objectives, pareto_picks
-from suspopt.optimise import optimise
+from suspopt.optimisation import optimise
 from suspopt.selection import load_design_sets, select
 
 # --- the levels, by hand ------------------------------------------------------------------------

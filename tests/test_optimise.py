@@ -18,7 +18,7 @@ import suspopt
 from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
 from suspopt.config.optimise import ALGORITHMS
-from suspopt.optimise import (
+from suspopt.optimisation import (
     PENALTY,
     Gradient,
     Hybrid,
@@ -30,7 +30,7 @@ from suspopt.optimise import (
     minimize,
     optimise,
 )
-from suspopt.optimise.algorithms import pymoo_algorithm, termination
+from suspopt.optimisation.algorithms import pymoo_algorithm, termination
 from suspopt.params import numeric_paths
 
 # --- analytic problems: the algorithm layer needs no vehicle -----------------------------------
@@ -218,7 +218,7 @@ class Mixed(PymooProblem):
 def test_every_registered_pymoo_algorithm_is_seeded_and_resumes_by_replay(name, monkeypatch):
     """Each algorithm draws only from the run's Generator, and replaying its evaluated batches
     (the data-only checkpoint) rebuilds it exactly: no design is evaluated again."""
-    from suspopt.optimise.run import _Recorder
+    from suspopt.optimisation.run import _Recorder
 
     n_obj = 1 if ALGORITHMS[name].single_objective else 3
     problem = Mixed(n_obj)
@@ -372,7 +372,7 @@ def test_bad_optimisation_input_names_key_and_line(case):
 def test_the_output_is_rewritten_at_most_every_few_seconds_and_at_the_end(
     tmp_path, monkeypatch, seconds, writes
 ):
-    from suspopt.optimise import run as run_module
+    from suspopt.optimisation import run as run_module
 
     monkeypatch.setattr(run_module, "REWRITE_SECONDS", seconds)
     real, generations = run_module._write, []
@@ -387,7 +387,7 @@ def test_the_output_is_rewritten_at_most_every_few_seconds_and_at_the_end(
 
 
 def test_an_error_that_stops_a_run_leaves_the_last_completed_generation(tmp_path, monkeypatch):
-    from suspopt.optimise import run as run_module
+    from suspopt.optimisation import run as run_module
 
     monkeypatch.setattr(run_module, "REWRITE_SECONDS", 1e9)  # nothing but the first written
 
@@ -554,7 +554,7 @@ def test_a_budget_smaller_than_one_step_still_writes_a_result(tmp_path, optimise
 
 def test_a_value_within_one_percent_of_its_search_range_is_at_the_bound():
     from suspopt.config.optimise import DesignVariable
-    from suspopt.optimise.bounds import at_bounds, bounds_note
+    from suspopt.optimisation.bounds import at_bounds, bounds_note
 
     variables = [
         DesignVariable(name="c", path="vehicle.corners.F1.damper.c", lower=0.0, upper=100.0),
@@ -657,7 +657,7 @@ def test_the_front_is_set_against_the_configs_own_design():
     from types import SimpleNamespace
 
     from suspopt.cli.optimisation import _baseline_line
-    from suspopt.optimise import Solutions
+    from suspopt.optimisation import Solutions
 
     own = Solutions(np.zeros((1, 1)), np.array([[1.0, 1.0]]), np.array([[-1.0]]))
     F = np.array([[0.5, 1.0], [1.0, 1.0], [0.2, 0.2], [0.5, 2.0], [0.9, 0.9]])

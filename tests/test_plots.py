@@ -343,7 +343,7 @@ def test_one_objective_or_a_weighted_sum_draws_the_best_value():
 
 @pytest.mark.slow
 def test_plot_optimisation_draws_a_run(tmp_path):
-    from suspopt.optimise import optimise
+    from suspopt.optimisation import optimise
 
     path = tmp_path / "ps.yaml"
     path.write_text(tiny((CONFIGS / "ch8/pareto_ps_class_a.yaml").read_text(), 1.5))

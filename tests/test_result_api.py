@@ -33,7 +33,7 @@ def quarter(tmp_path_factory):
 
 
 def _optimised(folder: Path, text: str):
-    from suspopt.optimise import optimise
+    from suspopt.optimisation import optimise
 
     return optimise(load_config_text(text, Path("case.yaml")), folder / "front.h5")
 

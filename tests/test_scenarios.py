@@ -12,8 +12,8 @@ from suspopt import streaming
 from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
 from suspopt.config.scenarios import Quantile
-from suspopt.optimise import Problem
-from suspopt.optimise.scenarios import aggregate
+from suspopt.optimisation import Problem
+from suspopt.optimisation.scenarios import aggregate
 from suspopt.seat import passenger_mass_change
 
 TEMPLATE = (ROOT / "suspopt" / "templates" / "optimise.yaml").read_text()
@@ -243,7 +243,7 @@ def test_validate_checks_stability_in_each_scenario(tmp_path):
 
 
 def test_the_pareto_file_holds_every_scenario(tmp_path):
-    from suspopt.optimise import optimise
+    from suspopt.optimisation import optimise
 
     text = BASE.replace("population: 50 ", "population: 8 ").replace(
         "generations: 20 ", "generations: 2 "
@@ -461,7 +461,7 @@ def test_a_scenario_road_too_large_for_memory_is_bad_input(monkeypatch):
 
 @pytest.mark.slow
 def test_resume_continues_a_robust_run_bit_for_bit(tmp_path):
-    from suspopt.optimise import optimise
+    from suspopt.optimisation import optimise
 
     text = BASE.replace("population: 50 ", "population: 6 ").replace(
         "generations: 20 ", "generations: 3 "

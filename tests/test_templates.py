@@ -11,7 +11,7 @@ import pytest
 
 import suspopt
 from suspopt.config.loader import load_config_text
-from suspopt.optimise import optimise
+from suspopt.optimisation import optimise
 from suspopt.templates import template_description, template_names, template_text
 from suspopt.validation import check_config
 

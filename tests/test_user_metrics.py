@@ -220,7 +220,7 @@ def test_a_decorated_metric_is_simulated_and_optimised_from_python(tmp_path):
     expected = peak_jerk(result.signals["body.heave_acc"], result.time)
     np.testing.assert_array_equal(result.metrics["py_jerk.body.heave_acc"], expected)
 
-    from suspopt.optimise import optimise
+    from suspopt.optimisation import optimise
 
     limit = {"name": "jerk_max", "metric": "py_jerk", "signal": "body.heave_acc", "max": 1e3}
     cfg.constraints = [*cfg.constraints, limit]

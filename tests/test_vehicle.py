@@ -214,8 +214,8 @@ def test_the_entry_points_name_the_object_they_want_when_given_another(load, tmp
     'simulation'")."""
     from suspopt.analyse.transmissibility import seat_transmissibility
     from suspopt.config.loader import load_config_text
-    from suspopt.optimise.problem import Problem
-    from suspopt.optimise.run import optimise
+    from suspopt.optimisation.problem import Problem
+    from suspopt.optimisation.run import optimise
     from suspopt.params import sweep
     from suspopt.seat import passenger_mass_change, seat_constraints
 

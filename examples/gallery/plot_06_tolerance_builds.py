@@ -21,7 +21,7 @@ import yaml
 
 import suspopt
 from suspopt.analyse.builds import builds
-from suspopt.optimise import optimise
+from suspopt.optimisation import optimise
 from suspopt.picks import read_front
 
 # %%

@@ -7,7 +7,7 @@ template: ISO 8608 classes A, B and C, each at its Sec 8.1.2 speed (120, 85 and 
 times 75, 95 and 115 kg on the seat (Sec 8.4.3's 95 ± 20 kg). NSGA-II minimises the worst
 RC_se (Eq 8.1) and the worst X_ST (Eq 8.2) over the scenarios (``over_scenarios: max``),
 each design evaluated under all nine in one batch per road
-(``suspopt.optimise.scenarios``) by the spectral method. The thesis optimises on one
+(``suspopt.optimisation.scenarios``) by the spectral method. The thesis optimises on one
 road with one passenger (class A, 95 kg): that nominal front is run too, and each front's
 designs are evaluated the other way, so that both are drawn in nominal and in worst-case
 terms.
@@ -21,7 +21,7 @@ import numpy as np
 
 import suspopt
 from suspopt.analyse.scenarios import read_scenarios
-from suspopt.optimise import optimise
+from suspopt.optimisation import optimise
 
 # %%
 # The robust and the nominal fronts

@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import suspopt
-from suspopt.optimise import optimise
+from suspopt.optimisation import optimise
 
 # %%
 # The metric

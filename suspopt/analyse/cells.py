@@ -17,7 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..optimise.problem import PENALTY
+from ..optimisation.problem import PENALTY
 
 __all__ = [
     "NOT_COMPUTED",

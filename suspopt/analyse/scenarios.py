@@ -3,7 +3,7 @@
 A ``suspopt optimise`` file of a config with a ``scenarios:`` section holds every design's
 objectives and constraint margins under every scenario (``/pareto/scenarios/F (N, S, m)``,
 ``G (N, S, k)``, the combined values in ``/pareto/F`` and ``G``;
-:mod:`suspopt.optimise.scenarios`). This analysis reads them, simulates nothing, and reports
+:mod:`suspopt.optimisation.scenarios`). This analysis reads them, simulates nothing, and reports
 for the front's picks (:func:`suspopt.kepsilon.pareto_picks`: each objective's edge and the
 knee, taken on the combined objectives; or the designs ``--pick`` names) each objective's
 combined value, its smallest, mean and largest value over the scenarios, the scenario where

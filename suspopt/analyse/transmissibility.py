@@ -61,7 +61,7 @@ from ..design_ids import front_ids
 from ..files import is_hdf5
 from ..io import atomic_h5, write_attrs, write_dataset
 from ..metrics import coherence, transmissibility, weighted_rms
-from ..optimise import Problem
+from ..optimisation import Problem
 from ..params import ParamView
 from ..picks import read_front
 from ..seat import (

@@ -283,7 +283,7 @@ def against_baseline(names, values, baseline, feasible: bool) -> str:
     of the optimiser's penalty values is a design that failed to simulate."""
     import math
 
-    from ..optimise.problem import PENALTY
+    from ..optimisation.problem import PENALTY
 
     old_values = [float(old) for old in baseline]
     if any(old >= PENALTY for old in old_values):

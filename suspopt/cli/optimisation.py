@@ -37,7 +37,7 @@ def _baseline_line(result) -> str | None:
     objective's change for one optimum; the design's objectives and how many designs of a
     front dominate it (feasible, no objective worse, one better)."""
 
-    from ..optimise.problem import PENALTY
+    from ..optimisation.problem import PENALTY
 
     own = result.baseline
     if own is None:
@@ -154,7 +154,7 @@ def optimise(
 
 def _scenarios_line(cfg, output: Path) -> None:
     """How each objective combined over the config's scenarios, and where their values are."""
-    from ..optimise import Problem
+    from ..optimisation import Problem
 
     problem = Problem.from_config(cfg)
     assert problem.scenarios is not None
@@ -215,7 +215,7 @@ def _optimise(
     sets: list[str],
 ) -> None:
     from ..io import WriteError, check_replace
-    from ..optimise import optimise as run
+    from ..optimisation import optimise as run
     from ..params import apply_sets
     from ..validation import check_config
 
@@ -248,7 +248,7 @@ def _optimise(
     line = _baseline_line(result)
     if line is not None:
         out.print(line)
-    from ..optimise.bounds import bounds_note
+    from ..optimisation.bounds import bounds_note
 
     note = bounds_note(result.var_names, cfg.design_variables, result.X)
     if note is not None:

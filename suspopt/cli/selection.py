@@ -89,9 +89,9 @@ def _kesort_tables(sel) -> list[Table]:
 
 def _optimum_bounds_note(sel) -> str | None:
     """Which design variables of the k-ε optimum lie at a bound of its own set's config
-    (:func:`suspopt.optimise.bounds.bounds_note`), or None (none does, or the config's
+    (:func:`suspopt.optimisation.bounds.bounds_note`), or None (none does, or the config's
     design variables are not the set's)."""
-    from ..optimise.bounds import bounds_note
+    from ..optimisation.bounds import bounds_note
 
     design_set = sel.sets[int(sel.source[sel.chosen])]
     variables = design_set.config.design_variables
@@ -134,7 +134,7 @@ def _with_supplementary(cfg, X, variables: list[str], F, names: list[str]):
     objectives evaluated under ``cfg`` beside its main ones ``F (1, m)``: (F, names)."""
     import numpy as np
 
-    from ..optimise.problem import Problem
+    from ..optimisation.problem import Problem
 
     problem = Problem.from_config(cfg)
     if sorted(variables) != sorted(problem.var_names):

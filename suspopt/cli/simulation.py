@@ -182,7 +182,7 @@ def _under_scenario(cfg, params, picked, name: str):
     import dataclasses
     import difflib
 
-    from ..optimise.scenarios import Group, ScenarioSet
+    from ..optimisation.scenarios import Group, ScenarioSet
 
     scenarios = ScenarioSet.from_config(cfg)
     where = cfg.source if cfg.source is not None else "the config"
@@ -345,7 +345,7 @@ def _pick_objectives(picked, cfg, result, params):
     ``params``: ``(F (P, m + s), names, units)``."""
     import numpy as np
 
-    from ..optimise import Problem
+    from ..optimisation import Problem
 
     problem = Problem.from_config(cfg)
     F, _, S = problem.values(result, params, len(picked.rows), supplementary=True)

@@ -16,7 +16,7 @@ scenario, ``nominal``, unless ``nominal: false``.
 Scenarios that change only numbers the simulator reads per design (masses, stiffnesses,
 ``c_max``, the passenger) run as extra columns of one batch; a change of the ``road`` or
 ``simulation`` section (class, speed, seed, length, bump height) makes a scenario group of
-its own (:mod:`suspopt.optimise.scenarios`).
+its own (:mod:`suspopt.optimisation.scenarios`).
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ Figures of the thesis they correspond to:
   Welch PSD and the ISO 2631-1 weighted r.m.s. of its accelerations against the comfort
   reactions (Annex C.2.3), one or several designs (``suspopt simulate --plot``; the figure
   :func:`result_figure`, which ``Result.plot()`` returns);
-- :func:`plot_optimisation`: an :class:`suspopt.optimise.OptimisationResult`'s front (or
+- :func:`plot_optimisation`: an :class:`suspopt.optimisation.OptimisationResult`'s front (or
   best value) and its history per generation (``suspopt optimise --plot``; the figure
   :func:`optimisation_result_figure`, which ``OptimisationResult.plot()`` returns).
 """

@@ -421,17 +421,17 @@ def pareto_set_figure(pareto, picks: Mapping[str, int] | None = None):
 
 def plot_optimisation(result, path: str | Path) -> Path:
     """Draw :func:`optimisation_result_figure` of a
-    :class:`suspopt.optimise.OptimisationResult` to ``path`` (.png or .svg; ``suspopt
+    :class:`suspopt.optimisation.OptimisationResult` to ``path`` (.png or .svg; ``suspopt
     optimise --plot``)."""
     path = check_path(path)
     return save(optimisation_result_figure(result), path)
 
 
 def optimisation_result_figure(result, picks: Mapping[str, int] | None = None):
-    """The figure of a :class:`suspopt.optimise.OptimisationResult`
+    """The figure of a :class:`suspopt.optimisation.OptimisationResult`
     (:func:`optimisation_figure`), unsaved: the front or the best value, and the history per
     generation; ``picks`` (name -> row of the front, e.g. :func:`suspopt.pareto_picks`)
-    starred and named on the front. :meth:`suspopt.optimise.OptimisationResult.plot` and
+    starred and named on the front. :meth:`suspopt.optimisation.OptimisationResult.plot` and
     ``suspopt optimise --plot`` (:func:`plot_optimisation`) draw it."""
     from ..errors import require_like
 
@@ -440,7 +440,7 @@ def optimisation_result_figure(result, picks: Mapping[str, int] | None = None):
         "OptimisationResult",
         ("F", "G", "history", "weights"),
         "result",
-        "from suspopt.optimise.optimise(cfg, path)",
+        "from suspopt.optimise(cfg, path)",
     )
     _check_picks(picks, len(np.atleast_2d(result.F)))
     history = result.history

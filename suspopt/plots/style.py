@@ -40,7 +40,7 @@ PSD_DECADES = 6.0
 COMFORT_WEIGHTING = "Wk"
 #: Fewest line heights between two comfort-level labels (closer ones are left out).
 LABEL_GAP = 1.1
-#: Objectives at or above this are failed designs (suspopt.optimise.problem.PENALTY).
+#: Objectives at or above this are failed designs (suspopt.optimisation.problem.PENALTY).
 FAILED_VALUE = 1e10
 
 

@@ -145,12 +145,12 @@ def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
 
 def _search_bounds(table, data: dict[str, Any], notes: list[str]) -> None:
     """The design variables' search ranges (``variable_bounds``: lower and upper, None where
-    unknown) and which designs lie at a bound (:func:`suspopt.optimise.bounds.table_bounds`):
+    unknown) and which designs lie at a bound (:func:`suspopt.optimisation.bounds.table_bounds`):
     ``at_bound``, one text per variable of one character per design, ``-`` at the lower
     bound, ``+`` at the upper, ``.`` neither (N bytes a variable, where lists of numbers
     would take a 20,000-design page past its size limit). A stored config that does not
     load leaves them out, with a note."""
-    from ..optimise.bounds import table_bounds
+    from ..optimisation.bounds import table_bounds
 
     try:
         lower, upper, at = table_bounds(table)

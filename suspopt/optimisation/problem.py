@@ -310,7 +310,7 @@ class Problem(_PymooProblem):
         simulation that keeps no signal it does not need (:func:`suspopt.streaming.reduce`);
         with scenarios, one simulation per scenario group, the values of every scenario
         ``FS (P, S, m)``, ``GS (P, S, k)`` (NaN where a scenario failed) and F, G, S their
-        aggregates (:func:`suspopt.optimise.scenarios.aggregate`); else FS, GS are None."""
+        aggregates (:func:`suspopt.optimisation.scenarios.aggregate`); else FS, GS are None."""
         params = self.params(X)
         terms = self._objectives + self._constraints
         terms += self._supplementary if supplementary else []

@@ -7,7 +7,7 @@ reports the optimum's values without saying which lie at a bound.
 
 A value is *at* a bound when it lies within :data:`AT_BOUND` of the variable's search range
 of it: the range of the value, or of its ``log10`` for a variable with ``scale: log`` (the
-space the optimiser searches, :class:`~suspopt.optimise.Problem`). An optimiser rarely lands
+space the optimiser searches, :class:`~suspopt.optimisation.Problem`). An optimiser rarely lands
 on a bound exactly (a GA's offspring approach it), so 1 % of the range counts as at it.
 """
 

@@ -64,7 +64,7 @@ def write_pareto(h5, problem: Problem, optimum, weights) -> None:
 
 def baseline_tables(problem: Problem, baseline) -> list[Table]:
     """``/baseline/X, F, G`` (one row each, as ``/pareto``'s): the config's own design
-    (:func:`suspopt.optimise.run.config_design`), evaluated as the run's designs are."""
+    (:func:`suspopt.optimisation.run.config_design`), evaluated as the run's designs are."""
     values = {"X": baseline.X, "F": baseline.F, "G": baseline.G}
     return [
         Table(key, values[key], units, ("design", dim), names=names)

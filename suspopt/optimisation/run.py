@@ -1,6 +1,6 @@
 """``optimise(cfg, output)``: the run behind ``suspopt optimise``, checkpointed to HDF5.
 
-The run builds :class:`~suspopt.optimise.problem.Problem` and the optimiser of the config,
+The run builds :class:`~suspopt.optimisation.problem.Problem` and the optimiser of the config,
 then advances one generation at a time. After the first generation, and then after a
 generation at least :data:`REWRITE_SECONDS` after the last rewrite, it rewrites ``output``
 (atomically, :func:`suspopt.io.atomic_h5`) with the optimum so far, the history and a
@@ -182,12 +182,26 @@ def optimise(
 ) -> OptimisationResult:
     """Optimise ``cfg`` and write ``output`` (HDF5, layout in the module docstring).
 
-    ``resume`` continues from the checkpoint in ``output``, which must have been written for
-    the same config text, or for one that differs only in the budget
-    (``optimiser.generations``, ``max_evaluations``; :func:`!.output.read_checkpoint`): a
-    finished run resumed with a longer budget goes on to the longer run's result. Raises
-    ConfigError for bad input before any simulation, and KeyboardInterrupt only when
-    interrupted before the first generation completed.
+    Parameters
+    ----------
+    cfg : Config
+        The study, with its ``design_variables``, ``objectives`` and ``optimiser``.
+    output : str or Path
+        The HDF5 file written after every generation (and its checkpoint).
+    resume : bool
+        Continue from the checkpoint in ``output``, written for the same config or one that
+        differs only in the budget (a finished run goes on to the longer run's result).
+    callback : callable, optional
+        Called with each generation's :class:`Progress`.
+    command : str, optional
+        The command line recorded in the file (default this process's).
+
+    Returns
+    -------
+    OptimisationResult
+        The optimum or Pareto set (X in the variables' SI units, F and G with units) and the
+        history. ConfigError for bad input before any simulation; KeyboardInterrupt only
+        before the first generation completed.
     """
     output = Path(output)
     check_not_input(output, config_inputs(cfg))  # (before any simulation, not at a write)
