@@ -18,7 +18,7 @@ __all__ = ["OptimisationResult"]
 
 @dataclass
 class OptimisationResult:
-    """The optimum (or Pareto set) of a run, as :func:`suspopt.optimisation.optimise` returns it
+    """The optimum (or Pareto set) of a run, as :func:`suspopt.optimise` returns it
     (its file's layout: :mod:`!suspopt.optimisation.run`).
 
     :meth:`to_xarray`, :meth:`to_dataframe` and :meth:`plot` give it as an xarray Dataset, a

@@ -192,7 +192,7 @@ def optimise(
         Continue from the checkpoint in ``output``, written for the same config or one that
         differs only in the budget (a finished run goes on to the longer run's result).
     callback : callable, optional
-        Called with each generation's :class:`Progress`.
+        Called with each generation's ``Progress`` (its number, evaluations, best values).
     command : str, optional
         The command line recorded in the file (default this process's).
 
