@@ -30,6 +30,8 @@ _EXPORTS = {
     "Problem": "optimisation",
     "OptimisationResult": "optimisation",
     "optimise": "optimisation.run",
+    "load_design_sets": "selection",
+    "open_dataset": "h5read",
     "kesort": "kepsilon",
     "KEpsilonSort": "kepsilon",
     "pareto_picks": "kepsilon",
@@ -46,6 +48,7 @@ __getattr__, __dir__ = lazy_names(__name__, globals(), _EXPORTS, __all__)
 if TYPE_CHECKING:
     from .config import Config, config_schema, load_config
     from .errors import ConfigError, InputError
+    from .h5read import open_dataset
     from .kepsilon import KEpsilonSort, kesort, pareto_picks
     from .memory import reuse_memory
     from .optimisation import OptimisationResult, Problem

@@ -490,10 +490,21 @@ def open_dataset(path: str | Path, group: str | None = None):
     under the group's own, which win where both have one. ``suspopt.layout.as_dataset``
     gives the same Dataset from a result in memory (``Result.to_xarray()``).
     ``open_dataset(p, "pareto")["F"].to_pandas()`` is the Pareto front's objectives as a
-    pandas DataFrame. A file that is missing, not HDF5 or damaged is a ConfigError naming it
-    (:class:`!H5Reader`), a group the file lacks a KeyError listing the
-    groups it has. Needs xarray and h5netcdf, dependencies of suspopt (a
-    ModuleNotFoundError naming them where they cannot be imported)."""
+    pandas DataFrame.
+
+    Parameters
+    ----------
+    path : str or Path
+        A file suspopt wrote.
+    group : str, optional
+        The group, e.g. ``"pareto"`` (default the root).
+
+    Returns
+    -------
+    xarray.Dataset
+        Its variables with their ``units``. A file that is missing, not HDF5 or damaged is a
+        ConfigError naming it, a group the file lacks a KeyError listing the groups it has.
+    """
     try:
         import h5netcdf  # noqa: F401
         import xarray

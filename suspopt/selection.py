@@ -373,12 +373,24 @@ def _relative_gap(a: np.ndarray, b: np.ndarray) -> float:
 def load_design_sets(
     files: Sequence[str | Path], configs: Sequence[str | Path] = (), labels: Sequence[str] = ()
 ) -> list[DesignSet]:
-    """Read and evaluate Pareto files for :func:`!select`, as ``suspopt kesort`` takes them.
+    """Read and evaluate Pareto files for :func:`suspopt.selection.select`, as ``suspopt kesort``
+    takes them.
 
-    ``configs``: none (each file's own), one (for every file) or one per file. ``labels``: none
-    or one per file; files with the same label form one case. Default labels are the config's
-    name when one is given, else the file's, made unique (``name#2``) so that only labels you
-    give merge files.
+    Parameters
+    ----------
+    files : sequence of str or Path
+        The ``optimise`` files (their ``/pareto``).
+    configs : sequence of str or Path
+        None (each file's own config), one (for every file) or one per file.
+    labels : sequence of str
+        None, or one per file; files with the same label form one case. Default: the
+        config's name when one is given, else the file's, made unique (``name#2``), so
+        that only labels you give merge files.
+
+    Returns
+    -------
+    list of DesignSet
+        Each file's designs with their main and supplementary objectives (SI units).
     """
     files = [Path(f) for f in listed(files)]
     configs, labels = listed(configs), [str(label) for label in listed(labels)]
@@ -459,7 +471,7 @@ def select(
     P_step: float = 0.01,
 ) -> Selection:
     """Pool ``sets`` and sort them by k-ε optimality (see the module docstring); ``eps``,
-    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`!suspopt.kepsilon.kesort`.
+    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`suspopt.kesort`.
     ConfigError when the sets have different objectives or no design is left to sort."""
     sets = [
         require(s, DesignSet, f"sets[{i}]", "from load_design_sets(paths)")
