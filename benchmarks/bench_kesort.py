@@ -22,7 +22,7 @@ import tracemalloc
 import numpy as np
 
 import suspopt
-from suspopt.kepsilon import k_eps_levels
+from suspopt.choosing.kepsilon import k_eps_levels
 
 
 def measure(call):

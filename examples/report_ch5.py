@@ -31,7 +31,7 @@ from report_common import (
 )
 
 from suspopt import plots
-from suspopt.selection import read_pareto
+from suspopt.choosing.selection import read_pareto
 
 # --- Chapter 5 ---------------------------------------------------------------------------------
 

@@ -27,7 +27,7 @@ from report_common import (
     span,
 )
 
-from suspopt.selection import read_pareto
+from suspopt.choosing.selection import read_pareto
 
 # --- Chapter 6 ---------------------------------------------------------------------------------
 

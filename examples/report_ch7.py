@@ -28,7 +28,7 @@ from report_common import (
 
 import suspopt
 from suspopt.analyse.cdf import c_max_share
-from suspopt.selection import read_pareto
+from suspopt.choosing.selection import read_pareto
 
 # --- Chapter 7 ---------------------------------------------------------------------------------
 

@@ -174,7 +174,7 @@ class _Chapter8(Chapter):
         )
         doc.para(
             "Edge 1 is the front's small-X_ST end (its highest RC_se, `best_X_ST`), Edge 2",
-            "the large-X_ST end (`best_RC_se`), Mid the knee (`suspopt.kepsilon.pareto_picks`).",
+            "the large-X_ST end (`best_RC_se`), Mid the knee (`suspopt.choosing.kepsilon.pareto_picks`).",
             "Percentage cells: ours, the thesis's, and their difference in points.",
         )
 

@@ -15,8 +15,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import mdtables as md
 
 import suspopt
+from suspopt.choosing.selection import read_pareto
 from suspopt.config.metrics import MetricSpec
-from suspopt.selection import read_pareto
 
 THESIS = md.thesis_values()
 CHAPTERS = {

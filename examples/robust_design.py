@@ -10,7 +10,7 @@ and engine:
   120/85/50 km/h x 75/95/115 kg on the isolator), worst-case RC_se and X_ST, every constraint
   in every scenario.
 
-From each front it takes the knee (:func:`suspopt.kepsilon.pareto_picks`: the design nearest
+From each front it takes the knee (:func:`suspopt.choosing.kepsilon.pareto_picks`: the design nearest
 the utopia point once the objectives are scaled to the front's range) and evaluates both
 knees under every scenario with the robust problem's own evaluator
 (:meth:`suspopt.Problem.scenario_values`), and simulates them in the time domain for the
@@ -35,8 +35,8 @@ import numpy as np
 
 import suspopt
 from suspopt import streaming
+from suspopt.choosing.kepsilon import pareto_picks
 from suspopt.config.loader import edit_config, set_path
-from suspopt.kepsilon import pareto_picks
 from suspopt.optimisation.run import optimise
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs" / "robust"

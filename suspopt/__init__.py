@@ -30,11 +30,11 @@ _EXPORTS = {
     "Problem": "optimisation",
     "OptimisationResult": "optimisation",
     "optimise": "optimisation.run",
-    "load_design_sets": "selection",
+    "load_design_sets": "choosing.selection",
     "open_dataset": "h5read",
-    "kesort": "kepsilon",
-    "KEpsilonSort": "kepsilon",
-    "pareto_picks": "kepsilon",
+    "kesort": "choosing.kepsilon",
+    "KEpsilonSort": "choosing.kepsilon",
+    "pareto_picks": "choosing.kepsilon",
     "reuse_memory": "memory",
     "metric": "user_metrics",
 }
@@ -46,10 +46,10 @@ __getattr__, __dir__ = lazy_names(__name__, globals(), _EXPORTS, __all__)
 
 
 if TYPE_CHECKING:
+    from .choosing.kepsilon import KEpsilonSort, kesort, pareto_picks
     from .config import Config, config_schema, load_config
     from .errors import ConfigError, InputError
     from .h5read import open_dataset
-    from .kepsilon import KEpsilonSort, kesort, pareto_picks
     from .memory import reuse_memory
     from .optimisation import OptimisationResult, Problem
     from .simulation import Result, simulate

@@ -99,13 +99,13 @@ def find_id(ids: Sequence[str], pick: str) -> int | None:
 
 
 def selection_ids(selection) -> np.ndarray:
-    """The ids ``(N,)`` of the designs of a :class:`suspopt.selection.Selection`
+    """The ids ``(N,)`` of the designs of a :class:`suspopt.choosing.selection.Selection`
     (:func:`pooled_ids` of its fronts' labels, sources and rows): ``/kesort/id``."""
     return pooled_ids([s.label for s in selection.sets], selection.source, selection.row)
 
 
 def front_ids(pareto) -> list[str]:
-    """The ids of the designs of a :class:`suspopt.selection.ParetoSet`: those it was read
+    """The ids of the designs of a :class:`suspopt.choosing.selection.ParetoSet`: those it was read
     with (``ids``), else the rows of the file they were picked from (``source_rows``), else
     its own row numbers (a whole front)."""
     if pareto.ids is not None:
@@ -115,7 +115,7 @@ def front_ids(pareto) -> list[str]:
 
 
 def picked_note(pareto) -> list[str]:
-    """The note of a report on the designs of a :class:`suspopt.selection.ParetoSet` picked
+    """The note of a report on the designs of a :class:`suspopt.choosing.selection.ParetoSet` picked
     from a file (``--pick``): each by its id and the names it was picked by; none for a
     whole front."""
     if pareto.source_rows is None:
@@ -139,7 +139,7 @@ def describe_ids(ids: Sequence[str], most: int = 8) -> str:
 
 
 def id_marks(pareto, marks) -> dict[str, int]:
-    """``marks`` (a pick's name -> its row in the :class:`suspopt.selection.ParetoSet`
+    """``marks`` (a pick's name -> its row in the :class:`suspopt.choosing.selection.ParetoSet`
     ``pareto``) with each name followed by the design's id, as a figure labels them:
     ``knee (design 13)``."""
     ids = front_ids(pareto)

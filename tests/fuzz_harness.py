@@ -2154,8 +2154,8 @@ def worker_main(folder: Path, memory: int, limit: float, skip_after_timeout: boo
     from typer.testing import CliRunner
 
     import suspopt.analyse
+    import suspopt.choosing.selection  # noqa: F401
     import suspopt.optimisation  # noqa: F401 - imported before the clock starts
-    import suspopt.selection  # noqa: F401
     import suspopt.simulation  # noqa: F401
     from suspopt.cli import app
 

@@ -13,8 +13,8 @@ from conftest import CONFIGS, optimised_front
 from typer.testing import CliRunner
 
 from suspopt.analyse.builds import builds, draw_builds
+from suspopt.choosing.selection import read_pareto
 from suspopt.cli import app
-from suspopt.selection import read_pareto
 
 pytestmark = pytest.mark.cli
 
@@ -672,7 +672,7 @@ def test_kesort_as_built_of_pooled_fronts_takes_each_sets_own_builds(ps_front, p
     """Pooled fronts sorted as built: each set's values are the percentiles of its own
     builds file, and each case's sort ranks them too (its levels are those of the case's
     designs sorted alone on the same values)."""
-    from suspopt.kepsilon import kesort
+    from suspopt.choosing.kepsilon import kesort
 
     front, _ = ps_front
     twin, out = tmp_path / "twin.h5", tmp_path / "ke.h5"
@@ -755,7 +755,7 @@ def test_select_refuses_as_built_values_that_do_not_fit_its_sets(ps_front):
     named."""
     from dataclasses import replace
 
-    from suspopt.selection import load_design_sets, select
+    from suspopt.choosing.selection import load_design_sets, select
 
     front, _ = ps_front
     (s,) = load_design_sets([front])

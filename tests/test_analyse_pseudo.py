@@ -23,11 +23,11 @@ from typer.testing import CliRunner
 import suspopt
 import suspopt.analyse.pseudo
 from suspopt.analyse.pseudo import controller_variants, mass_variants
+from suspopt.choosing.selection import evaluate_pareto, read_pareto
 from suspopt.cli import app
 from suspopt.config.loader import load_config_text
 from suspopt.params import ParamView
 from suspopt.seat import build_seat
-from suspopt.selection import evaluate_pareto, read_pareto
 
 
 def run(*args):
@@ -276,7 +276,7 @@ def test_the_library_takes_one_path_or_road_as_a_list_of_one(ps_front):
     front's and no changes at all gave a front of nothing."""
     from suspopt.analyse.models import compare_models
     from suspopt.analyse.pseudo import pseudo_fronts, road_variants
-    from suspopt.selection import load_design_sets
+    from suspopt.choosing.selection import load_design_sets
 
     _, path = ps_front
     pareto = read_pareto(path)

@@ -12,8 +12,8 @@ from conftest import CONFIGS, optimised_front
 from typer.testing import CliRunner
 
 import suspopt
+from suspopt.choosing.kepsilon import pareto_picks
 from suspopt.cli import app
-from suspopt.kepsilon import pareto_picks
 from suspopt.seat import build_seat
 
 PASSENGER = CONFIGS / "ch8" / "ps_class_a_passenger.yaml"

@@ -26,8 +26,8 @@ def test_an_edited_config_records_its_values_and_reads_back_the_same(kind):
 
 
 def test_an_optimisation_of_an_edited_config_stores_the_edited_config(tmp_path):
+    from suspopt.choosing.picks import read_front
     from suspopt.optimisation import optimise
-    from suspopt.picks import read_front
 
     cfg = suspopt.load_template("kesort")
     cfg.optimiser.population, cfg.optimiser.generations = 8, 2

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from suspopt._entry import main
-from suspopt.picks import read_picks, read_table
+from suspopt.choosing.picks import read_picks, read_table
 
 TEMPLATE = Path(__file__).resolve().parents[1] / "suspopt" / "templates" / "robust.yaml"
 
@@ -46,8 +46,8 @@ def walk(tmp_path_factory):
     """A robust front, and a kesort file of it that left out its first two designs (as
     ``--builds`` leaves out designs too few of whose builds are feasible)."""
     import suspopt
+    from suspopt.choosing.selection import load_design_sets, select, write_selection
     from suspopt.optimisation import optimise
-    from suspopt.selection import load_design_sets, select, write_selection
 
     folder = tmp_path_factory.mktemp("ids")
     config = folder / "robust.yaml"

@@ -48,7 +48,7 @@ def printed_table(stdout: str, title: str) -> tuple[list[str], dict[str, list[st
 @pytest.fixture(scope="module")
 def kesort_file(tmp_path_factory):
     """A kesort file of a tiny Ch. 7 SH-2 front (main f1-f2, supplementary f3-f6)."""
-    from suspopt.selection import load_design_sets, select, write_selection
+    from suspopt.choosing.selection import load_design_sets, select, write_selection
 
     folder = tmp_path_factory.mktemp("loop")
     _, front = optimised_front(folder, "ch7/sh_2", 1.0, population=10, generations=3)
@@ -136,7 +136,7 @@ def test_the_library_takes_picks_as_the_command_line_does(kesort_file):
     """``read_picks`` takes one string as ``--pick`` does (it was read letter by letter:
     "no such pick k"), and no pick is a ConfigError (an IndexError before);
     ``design_config`` names the designs it holds for an index it lacks."""
-    from suspopt.picks import design_config, read_picks
+    from suspopt.choosing.picks import design_config, read_picks
 
     _, ke = kesort_file
     assert read_picks(ke, "chosen,knee").names == ["chosen", "knee"]
@@ -155,8 +155,8 @@ def test_the_library_takes_picks_as_the_command_line_does(kesort_file):
 def test_the_selection_functions_name_the_object_they_want(tmp_path):
     """``select`` of file names, ``write_selection`` of no selection and ``design_config`` of
     no picks were AttributeErrors from inside ("'str' object has no attribute 'names'")."""
-    from suspopt.picks import design_config
-    from suspopt.selection import select, write_selection
+    from suspopt.choosing.picks import design_config
+    from suspopt.choosing.selection import select, write_selection
 
     with pytest.raises(TypeError, match=r"sets\[0\] must be a DesignSet \(from load_design_sets"):
         select("front.h5")

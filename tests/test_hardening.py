@@ -923,8 +923,8 @@ def test_the_librarys_writers_refuse_their_own_inputs_too(front, tmp_path):
     import hashlib
 
     from suspopt.analyse.pseudo import pseudo_fronts, road_variants, write_pseudo_fronts
+    from suspopt.choosing.selection import load_design_sets, read_pareto, select, write_selection
     from suspopt.optimisation import optimise
-    from suspopt.selection import load_design_sets, read_pareto, select, write_selection
 
     config, out = front
     digests = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (config, out)}

@@ -18,12 +18,12 @@ from suspopt.analyse import models, transmissibility
 from suspopt.analyse.builds import builds as draw_and_evaluate
 from suspopt.analyse.builds import write_builds
 from suspopt.analyse.pseudo import pseudo_fronts, road_variants, write_pseudo_fronts
+from suspopt.choosing.picks import read_front
+from suspopt.choosing.selection import load_design_sets, read_pareto, select, write_selection
 from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
 from suspopt.export import write_csv
 from suspopt.io import is_suspopt_output, open_dataset, write_dataset, write_simulation
-from suspopt.picks import read_front
-from suspopt.selection import load_design_sets, read_pareto, select, write_selection
 
 K = [4.0e4, 6.0e4]  # two designs: the design axis is not a single row
 

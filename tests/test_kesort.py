@@ -11,11 +11,11 @@ from conftest import TINY
 from typer.testing import CliRunner
 
 import suspopt
+from suspopt.choosing.kepsilon import k_eps_levels, kesort, normalise_objectives, pareto_picks
+from suspopt.choosing.selection import load_design_sets, select
 from suspopt.cli import app
 from suspopt.config.loader import load_config_text
-from suspopt.kepsilon import k_eps_levels, kesort, normalise_objectives, pareto_picks
 from suspopt.optimisation import optimise
-from suspopt.selection import load_design_sets, select
 
 # --- the levels, by hand ------------------------------------------------------------------------
 
@@ -166,7 +166,7 @@ def test_auto_P_asks_only_which_solution_leads_and_agrees_with_sorting_every_P(k
     the leading solutions: the same P and the same bits as sorting the whole set at every
     P, in a fraction of the pairs (a tie no P breaks, as a design pooled twice, made every
     P of the grid a whole sort; benchmarks/bench_kesort.py times both)."""
-    ke = importlib.import_module("suspopt.kepsilon")
+    ke = importlib.import_module("suspopt.choosing.kepsilon")
 
     rng = np.random.default_rng(8)
     if kind == "pooled twice":

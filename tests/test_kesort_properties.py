@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from suspopt.kepsilon import k_eps_levels, kesort, pareto_picks
+from suspopt.choosing.kepsilon import k_eps_levels, kesort, pareto_picks
 
 FINITE = st.floats(allow_nan=False, allow_infinity=False)
 #: values from a damaged file, and everyday ones, mixed
@@ -113,7 +113,7 @@ def test_the_leader_found_from_bounds_is_the_whole_sorts(F, eps, tie_tol, probe,
     """``_Merits.unique_top`` with bounds from a handful of columns (loose ones: most
     solutions must then be compared exactly): whether one solution leads, and which, as
     the whole sort says."""
-    ke = importlib.import_module("suspopt.kepsilon")
+    ke = importlib.import_module("suspopt.choosing.kepsilon")
     merits = ke._Merits(F, np.full(F.shape[1], eps))
     probe = np.unique([p % len(F) for p in probe])
     unique, near = merits.unique_top(tie_tol, probe, chunk_bytes=batch * 24 * len(F))

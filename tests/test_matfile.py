@@ -20,12 +20,12 @@ from typer.testing import CliRunner
 import suspopt
 from suspopt.analyse.builds import builds as draw_and_evaluate
 from suspopt.analyse.builds import write_builds
+from suspopt.choosing.selection import load_design_sets, read_pareto, select, write_selection
 from suspopt.cli import app
 from suspopt.config import ConfigError
 from suspopt.config.loader import load_config_text
 from suspopt.io import is_suspopt_output, write_simulation
 from suspopt.matfile import MAX_NAME, read_mat, write_mat
-from suspopt.selection import load_design_sets, read_pareto, select, write_selection
 
 VALID = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 

@@ -191,7 +191,10 @@ def test_each_plot_names_the_result_it_draws_when_given_another(sweep, tmp_path)
     for draw, needle in (
         (plots.plot_simulation, r"result must be a Result \(from suspopt.simulate\(cfg\)\)"),
         (plots.plot_optimisation, r"result must be a OptimisationResult \(from suspopt.optimise"),
-        (plots.plot_kesort, r"selection must be a Selection \(from suspopt.selection.select"),
+        (
+            plots.plot_kesort,
+            r"selection must be a Selection \(from suspopt.choosing.selection.select",
+        ),
     ):
         for wrong in (sweep.config, "front.h5", None):
             if draw is plots.plot_simulation and wrong is None:

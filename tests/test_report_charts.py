@@ -110,7 +110,7 @@ def test_the_spectrum_has_the_plot_estimators_resolution_and_shows_the_body_mode
     spaced 1/(its segment) Hz, within the figures' band; the body's heave mode lies among the
     drawn points; the value axis spans at most
     PSD_DECADES decades below the highest value, and every drawn point of the highest."""
-    from suspopt.picks import read_picks
+    from suspopt.choosing.picks import read_picks
     from suspopt.simulation import prepare
     from suspopt.vehicle import modal_analysis
 
@@ -192,7 +192,7 @@ def test_the_time_histories_merge_only_identical_curves(page, shown):
     assert names == [", ".join(f"design {ids[signals['rows'][k]]}" for k in g) for g in groups]
     assert x_range[0] <= signals["time"][0] and x_range[1] >= signals["time"][-1]
     import suspopt
-    from suspopt.picks import read_picks
+    from suspopt.choosing.picks import read_picks
 
     picked = read_picks(page.with_name("picks.h5"), [str(signals["rows"][0])])
     y = suspopt.simulate(picked.config, picked.params()).signals["seat.acc"][0]

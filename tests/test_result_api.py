@@ -193,7 +193,7 @@ def test_optimisation_plot_draws_the_front_and_marks_the_picks(front):
 
 
 def test_a_pareto_set_read_from_its_file_plots_its_front_history_and_marks(front):
-    from suspopt.selection import read_pareto
+    from suspopt.choosing.selection import read_pareto
 
     pareto = read_pareto(front.path)
     fig = pareto.plot()

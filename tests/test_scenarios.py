@@ -271,7 +271,7 @@ def test_the_pareto_file_holds_every_scenario(tmp_path):
         assert np.array_equal(G[:, :-1], GS[:, :, :-1].max(axis=1))
         assert h5["pareto/scenarios/F"].attrs["units"][0] == h5["pareto/F"].attrs["units"][0]
     # kesort sorts on the aggregates
-    from suspopt.selection import read_pareto
+    from suspopt.choosing.selection import read_pareto
 
     assert read_pareto(out).F.shape == F.shape
 

@@ -21,8 +21,8 @@ import yaml
 
 import suspopt
 from suspopt.analyse.builds import builds
+from suspopt.choosing.picks import read_front
 from suspopt.optimisation import optimise
-from suspopt.picks import read_front
 
 # %%
 # A front with toleranced parts

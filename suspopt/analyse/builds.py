@@ -11,7 +11,7 @@ tolerances`` takes it: :func:`!.tolerances.variable_tolerances`): uniformly, or 
 ``--distribution normal`` from a normal distribution of standard deviation 1/3 cut at ±1
 (the band is ±3 σ: a process of capability 1, its parts outside the band rejected), by
 the inverse of its distribution function. All builds of all designs are evaluated under
-the stored config in one call (:func:`suspopt.selection.evaluate_pareto`).
+the stored config in one call (:func:`suspopt.choosing.selection.evaluate_pareto`).
 It reports, per design, the spread of each objective's change over its builds (5th to 95th
 percentile, ``100 (f_built - f_stored)/f_stored``) and the share of builds that meet every
 constraint. The thesis has no such analysis; it is ours.
@@ -38,7 +38,7 @@ build (NaN objectives) counts as not feasible and is left out of the percentiles
 
 ``--pick knee,best_f1,...`` builds only those designs (names or row numbers, as ``simulate
 --pick`` takes them, from an optimise, kesort or analyse file:
-:func:`suspopt.picks.read_front`): the file's ``/pareto`` then holds the picked designs,
+:func:`suspopt.choosing.picks.read_front`): the file's ``/pareto`` then holds the picked designs,
 their picks by name and ``source_row``.
 
 HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text;
@@ -72,14 +72,14 @@ from pathlib import Path
 
 import numpy as np
 
+from ..choosing.builds_file import feasible_builds
+from ..choosing.picks import read_front
+from ..choosing.selection import DesignSet, ParetoSet, evaluate_pareto
 from ..config.optimise import batches as config_batches
 from ..design_ids import front_ids, id_marks
 from ..errors import ConfigError
 from ..io import atomic_h5, write_dataset
 from ..params import MAX_SWEEP_DESIGNS
-from ..picks import read_front
-from ..selection import DesignSet, ParetoSet, evaluate_pareto
-from .builds_file import feasible_builds
 from .cells import (
     NOT_COMPUTED,
     NOT_COMPUTED_NOTE,

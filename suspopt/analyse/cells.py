@@ -73,7 +73,7 @@ def change_span(name: str, changes) -> str:
 def stored_reference(F, stored) -> np.ndarray:
     """(N, m + s) what the changes of an analysis of a front are measured from: the file's
     main objectives ``F (N, m)``, then the supplementary ones of ``stored`` (the front's
-    designs re-simulated under the stored config: :class:`~suspopt.selection.DesignSet`);
+    designs re-simulated under the stored config: :class:`~suspopt.choosing.selection.DesignSet`);
     NaN in the row of a design that failed (the file holds the optimiser's penalty values
     for it, or its re-simulation failed), whose change cannot be computed."""
     reference = np.hstack([F, stored.F[:, F.shape[1] :]])

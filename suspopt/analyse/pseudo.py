@@ -20,9 +20,9 @@ ones they were optimised for and compares the objectives ("pseudo" Pareto fronts
   (e.g. ``c_min``, ``c_max``) are then applied on top. ``configs/ch7/sh_2_cdf.yaml`` and
   ``sh_add_2_cdf.yaml`` give SH-2-CDF and SH-ADD-2-CDF from the SH-2 and SH-ADD-2 fronts.
 
-The Pareto file is read and its designs evaluated by :mod:`suspopt.selection` (the code
+The Pareto file is read and its designs evaluated by :mod:`suspopt.choosing.selection` (the code
 ``suspopt kesort`` uses): each change is ONE batched simulation of all N designs
-(:func:`~suspopt.selection.evaluate_pareto`). The change of each objective is
+(:func:`~suspopt.choosing.selection.evaluate_pareto`). The change of each objective is
 ``100 (f_changed - f_stored) / f_stored`` in % (Tables 8.12-8.13: positive when the objective
 grows). A design whose simulation fails under the change gets NaN objectives and
 ``failed = 1`` (the optimiser's penalty values are not reported). A change that cannot be
@@ -65,15 +65,15 @@ from typing import Any
 import numpy as np
 
 from .. import plots
+from ..choosing.picks import read_front
+from ..choosing.selection import DesignSet, ParetoSet, evaluate_pareto
 from ..config import Config, ConfigError
 from ..config.loader import edit_config, line_of, set_path
 from ..design_ids import front_ids, id_marks
 from ..files import Unreadable, listed, status
 from ..io import atomic_h5, write_attrs, write_dataset
-from ..picks import read_front
 from ..plots.runs import evenly_spaced
 from ..seat import build_seat, passenger_mass_change
-from ..selection import DesignSet, ParetoSet, evaluate_pareto
 from . import cells
 from .registry import KINDS, Kind, Report, relative_change
 
@@ -131,7 +131,7 @@ class PseudoFronts:
 
     @property
     def picks(self) -> dict[str, int]:
-        """The edges and knee of the stored front (:func:`suspopt.kepsilon.pareto_picks`,
+        """The edges and knee of the stored front (:func:`suspopt.choosing.kepsilon.pareto_picks`,
         Fig. 8.21; Tables 8.12-8.13 report the edges), or the picks given (``--pick``)."""
         return self.pareto.marks()
 
@@ -493,7 +493,7 @@ def plot_pseudo_fronts(
 def table_designs(N: int, picked: Mapping[int, list[str]]) -> list[tuple[int, str]]:
     """The rows of a table of a front of ``N`` designs: at most :data:`_TABLE_ROWS` evenly
     spaced, and every design ``picked`` names (row -> its picks:
-    :meth:`~suspopt.selection.ParetoSet.marks_by_row`); (row, the names of its picks), in
+    :meth:`~suspopt.choosing.selection.ParetoSet.marks_by_row`); (row, the names of its picks), in
     order."""
     rows = sorted(set(evenly_spaced(N, _TABLE_ROWS)) | set(picked))
     return [(k, ", ".join(picked.get(k, []))) for k in rows]
@@ -521,7 +521,7 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
         rows.append(row)
     shown = p.picked_note() or [
         f"{len(rows)} of {len(p.X)} designs of {p.path.name}, sorted by {names[0]}, with "
-        f"the edges and knee of the front (suspopt.kepsilon.pareto_picks, Fig. 8.21)"
+        f"the edges and knee of the front (suspopt.choosing.kepsilon.pareto_picks, Fig. 8.21)"
     ]
     notes = [
         f"{shown[0]}; change = (f - f_stored)/f_stored (Tables 8.12-8.13)",
@@ -551,7 +551,7 @@ def run_variants(
     pick: Sequence[str] | None = None,
 ) -> tuple[Report, PseudoFronts]:
     """The analysis ``kind`` of the Pareto file ``source`` (or of its designs ``pick``:
-    :func:`suspopt.picks.read_front`) under the ``variants`` made of it: written, drawn,
+    :func:`suspopt.choosing.picks.read_front`) under the ``variants`` made of it: written, drawn,
     and its report (and the fronts, for more notes)."""
     if plot is not None:
         plots.check_path(plot)

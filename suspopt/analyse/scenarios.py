@@ -4,7 +4,7 @@ A ``suspopt optimise`` file of a config with a ``scenarios:`` section holds ever
 objectives and constraint margins under every scenario (``/pareto/scenarios/F (N, S, m)``,
 ``G (N, S, k)``, the combined values in ``/pareto/F`` and ``G``;
 :mod:`suspopt.optimisation.scenarios`). This analysis reads them, simulates nothing, and reports
-for the front's picks (:func:`suspopt.kepsilon.pareto_picks`: each objective's edge and the
+for the front's picks (:func:`suspopt.choosing.kepsilon.pareto_picks`: each objective's edge and the
 knee, taken on the combined objectives; or the designs ``--pick`` names) each objective's
 combined value, its smallest, mean and largest value over the scenarios, the scenario where
 it is largest, and in how many scenarios the design holds every constraint; and for the
@@ -24,11 +24,11 @@ from pathlib import Path
 import numpy as np
 
 from .. import plots
+from ..choosing.kepsilon import pareto_picks
+from ..choosing.selection import read_pareto
 from ..errors import ConfigError
 from ..h5read import H5Reader
 from ..io import atomic_h5, text_array, write_dataset
-from ..kepsilon import pareto_picks
-from ..selection import read_pareto
 from .registry import KINDS, Kind, Report
 
 __all__ = ["run", "read_scenarios"]
@@ -143,12 +143,12 @@ def run(
 
 def _picks(source: Path, F: np.ndarray, names: list[str], pick: Picks) -> dict[str, int]:
     """The designs reported, name -> row: the front's edges and knee
-    (:func:`suspopt.kepsilon.pareto_picks`), or those ``pick`` names (``--pick``: names of the
+    (:func:`suspopt.choosing.kepsilon.pareto_picks`), or those ``pick`` names (``--pick``: names of the
     file's table or design ids, its rows, comma-separated or repeated; an id is named
     ``design ID``), each name once."""
     if not pick:
         return pareto_picks(F, names)
-    from ..picks import read_table, split_picks
+    from ..choosing.picks import read_table, split_picks
 
     table = read_table(source)
     chosen: dict[str, int] = {}

@@ -31,11 +31,11 @@ from typing import Any
 
 import numpy as np
 
+from ..choosing.selection import ParetoSet
 from ..design_ids import front_ids
 from ..errors import ConfigError
 from ..files import listed
 from ..params import field_range
-from ..selection import ParetoSet
 from .cells import NOT_COMPUTED, percent
 from .pseudo import PseudoFronts, Variant, run_variants
 from .registry import KINDS, Kind, Report

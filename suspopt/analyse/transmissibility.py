@@ -16,10 +16,10 @@ floor's acceleration as input, as in Fig. 8.26 (``T = z̈_head / z̈_s``). The s
 transmissibility of Fig. 2.18b is the ``seat`` entry.
 
 For a Pareto file (``suspopt optimise`` output, Sec 8.4.4, Fig. 8.26), the same for the
-Pareto-theory picks of its front (:func:`suspopt.kepsilon.pareto_picks`, Fig. 8.21): the edges
+Pareto-theory picks of its front (:func:`suspopt.choosing.kepsilon.pareto_picks`, Fig. 8.21): the edges
 ``best_<objective>`` (the thesis's Edge 1 and Edge 2: in Ch. 8 ``best_X_ST`` and
 ``best_RC_se``) and the ``knee`` (its Mid), simulated in one batch; with ``pick``
-(``--pick``), the designs it names, of any result file (:func:`suspopt.picks.read_front`:
+(``--pick``), the designs it names, of any result file (:func:`suspopt.choosing.picks.read_front`:
 ``analyse transmissibility choice.h5 --pick chosen``). The thesis adds the
 passenger and keeps only the seat's 13.6 kg as the seat mass; ``with_`` (``--with FILE.yaml``)
 does that: the ``seat.mass`` and ``seat.passenger`` of that file (e.g.
@@ -55,6 +55,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import plots
+from ..choosing.picks import read_front
+from ..choosing.selection import ParetoSet
 from ..config import Config, ConfigError, load_config
 from ..config.loader import require_config
 from ..design_ids import front_ids
@@ -63,7 +65,6 @@ from ..io import atomic_h5, write_attrs, write_dataset
 from ..metrics import coherence, transmissibility, weighted_rms
 from ..optimisation import Problem
 from ..params import ParamView
-from ..picks import read_front
 from ..seat import (
     CONSTRAINT_UNITS,
     base_transmissibility,
@@ -72,7 +73,6 @@ from ..seat import (
     natural_frequencies,
     seat_constraints,
 )
-from ..selection import ParetoSet
 from ..simulation import simulate
 from .pseudo import config_with, read_sections
 from .registry import KINDS, Kind, Report
@@ -193,9 +193,9 @@ def seat_transmissibility(
 
 
 def front_designs(pareto: ParetoSet) -> FrontDesigns:
-    """The edges and the knee of ``pareto``'s front (:func:`suspopt.kepsilon.pareto_picks`),
+    """The edges and the knee of ``pareto``'s front (:func:`suspopt.choosing.kepsilon.pareto_picks`),
     each design once, in the order of the picks; of designs picked from a file
-    (:func:`suspopt.picks.read_front`), every one, by the names it was picked by (``design
+    (:func:`suspopt.choosing.picks.read_front`), every one, by the names it was picked by (``design
     ID`` for an id)."""
     cfg = pareto.config()
     problem = Problem.from_config(cfg)
@@ -439,7 +439,7 @@ def _run_front(
         f"Wk r.m.s. {name}.acc [m/s^2]",
     ]
     shown = pareto.picked_note() or [
-        "picks of the front (suspopt.kepsilon.pareto_picks, Fig. 8.21): the edges "
+        "picks of the front (suspopt.choosing.kepsilon.pareto_picks, Fig. 8.21): the edges "
         "best_<objective> and the knee"
     ]
     notes = [
@@ -465,7 +465,7 @@ def run(
 ) -> Report:
     """The ``transmissibility`` analysis of ``source``: a YAML config with a seat, or a Pareto
     file (then ``with_`` may give the passenger, module docstring), or with ``pick`` those
-    designs of a result file (:func:`suspopt.picks.read_front`)."""
+    designs of a result file (:func:`suspopt.choosing.picks.read_front`)."""
     if plot is not None:
         plots.check_path(plot)
     if is_hdf5(source):

@@ -220,8 +220,8 @@ def export(
                 for path in written:
                     out.print(f"wrote {path}")
                 return
+            from ..choosing.picks import design_config, read_picks, split_picks
             from ..io import atomic_file
-            from ..picks import design_config, read_picks, split_picks
             from ..signature import signed_config
 
             assert output is not None  # (one of the three is given: checked above)
@@ -252,9 +252,9 @@ def _one_output(output, csv, mat, fmu, road: str) -> Path | None:
 def _export_fmu(source: Path, pick: list[str], fmu: Path, road: str, force: bool) -> None:
     """``export SOURCE --fmu FILE.fmu``: the picks of a result file, or a config's own design
     (:mod:`suspopt.fmu`); every target claimed and checked before any is written."""
+    from ..choosing.picks import split_picks
     from ..fmu.export import check_pick_targets, export_fmu, export_picks
     from ..fmu.model import ROAD_MODES
-    from ..picks import split_picks
     from ..signature import CONFIG_SUFFIXES
 
     if road not in ROAD_MODES:

@@ -191,7 +191,7 @@ def _as_built(
 
     import numpy as np
 
-    from ..analyse.builds_file import as_built_objectives, feasible_builds
+    from ..choosing.builds_file import as_built_objectives, feasible_builds
 
     if not builds:
         return sets, []
@@ -317,8 +317,8 @@ def _kesort(
 ) -> None:  # fmt: skip
     import importlib.util
 
-    from ..kepsilon import check_options
-    from ..selection import load_design_sets, select, write_selection
+    from ..choosing.kepsilon import check_options
+    from ..choosing.selection import load_design_sets, select, write_selection
 
     if plot is not None:
         if plot.suffix.lower() not in (".png", ".svg"):

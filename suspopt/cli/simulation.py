@@ -151,7 +151,7 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
     from ..params import apply_sets, sweep
 
     if is_hdf5(source):
-        from ..picks import read_picks, split_picks
+        from ..choosing.picks import read_picks, split_picks
 
         if not pick:
             base.fail(
@@ -177,7 +177,7 @@ def _inputs(source: Path, pick, sets, sweeps, zipped):
 def _under_scenario(cfg, params, picked, name: str):
     """The config and designs of ``simulate --scenario NAME``: the scenario's road and time
     grid, its per-design values over the designs' own; the picks' stored objectives become
-    that scenario's (:func:`suspopt.picks.stored_scenario_values`), or NaN where there are
+    that scenario's (:func:`suspopt.choosing.picks.stored_scenario_values`), or NaN where there are
     none."""
     import dataclasses
     import difflib
@@ -208,7 +208,7 @@ def _under_scenario(cfg, params, picked, name: str):
     P = len(next(iter(params.values()))) if params else 1
     params = scenarios.columns(alone, dict(params or {}), P) or None
     if picked is not None:
-        from ..picks import stored_scenario_values
+        from ..choosing.picks import stored_scenario_values
 
         stored, note = stored_scenario_values(picked, s, scenarios.names)
         if note:

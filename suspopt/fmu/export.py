@@ -85,7 +85,7 @@ def export_fmu(
     Parameters
     ----------
     cfg : Config
-        The design's config (:func:`suspopt.picks.design_config` of a pick, or a config).
+        The design's config (:func:`suspopt.choosing.picks.design_config` of a pick, or a config).
     path : str or Path
         The FMU to write (``.fmu``), replaced only if suspopt wrote it, or with ``force``.
     road : str
@@ -138,7 +138,7 @@ def export_picks(
 ) -> list[Exported]:
     """The designs ``picks`` of the result file ``source``, one FMU each: ``path`` for one
     pick, ``<stem>-<pick>.fmu`` beside it for several (:func:`pick_path`)."""
-    from ..picks import design_config, read_picks
+    from ..choosing.picks import design_config, read_picks
 
     picked = read_picks(source, picks)
     several = len(picked.names) > 1

@@ -21,7 +21,7 @@ import numpy as np
 from ..config.optimise import DesignVariable
 
 if TYPE_CHECKING:
-    from ..picks import DesignTable
+    from ..choosing.picks import DesignTable
 
 __all__ = ["AT_BOUND", "at_bounds", "bounds_note", "table_bounds"]
 
@@ -80,7 +80,7 @@ def bounds_note(
 
 def table_bounds(table: DesignTable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(lower (n,), upper (n,), at (N, n))`` of the design table of a result file
-    (:func:`suspopt.picks.read_table`): each variable's search range from the configs the
+    (:func:`suspopt.choosing.picks.read_table`): each variable's search range from the configs the
     file stored (the widest over the sets of a kesort file; NaN for a variable none of them
     has), and :func:`at_bounds` of each design against its own config's variables (0 where
     its config lacks the variable). ConfigError when a stored config does not load."""

@@ -25,7 +25,7 @@ Figures of the thesis they correspond to:
 - :func:`scenario_spread`: a robust front's picks under each scenario (ours);
 - :func:`transmissibilities`: seat transmissibility and STHT (Eq 2.86, Figs. 2.18b, 8.26);
 - :func:`plot_kesort`: the k-ε levels over a front (Figs. 6.7, 7.5, 7.6), from a
-  :class:`suspopt.selection.Selection`;
+  :class:`suspopt.choosing.selection.Selection`;
 - :func:`plot_simulation`: a :class:`suspopt.simulation.Result`'s signals over time, their
   Welch PSD and the ISO 2631-1 weighted r.m.s. of its accelerations against the comfort
   reactions (Annex C.2.3), one or several designs (``suspopt simulate --plot``; the figure

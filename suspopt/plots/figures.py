@@ -180,7 +180,7 @@ def _mark_optima(ax, x: np.ndarray, y: np.ndarray, s) -> None:
 
 def plot_kesort(selection, path: str | Path) -> Path:
     """The k-ε levels over the front (Fig. 6.7, 7.5, 7.6) of a
-    :class:`suspopt.selection.Selection`.
+    :class:`suspopt.choosing.selection.Selection`.
 
     Left: the first two objectives (the main ones of Ch. 6-7, Fig. 7.5a/7.6), one marker per
     case, coloured by the pool's k-ε level; the pool's optimum is a star, each case's own
@@ -198,7 +198,7 @@ def plot_kesort(selection, path: str | Path) -> Path:
         "Selection",
         ("F_sorted", "sort", "units", "names"),
         "selection",
-        "from suspopt.selection.select(sets)",
+        "from suspopt.choosing.selection.select(sets)",
     )
     path = check_path(path)
     F, levels, units = s.F_sorted, s.sort.k_eps, s.units

@@ -397,8 +397,8 @@ def _check_picks(picks: Mapping[str, int] | None, N: int) -> None:
 
 
 def pareto_set_figure(pareto, picks: Mapping[str, int] | None = None):
-    """The figure of :func:`optimisation_figure` for a :class:`suspopt.selection.ParetoSet`
-    read from a file (:meth:`suspopt.selection.ParetoSet.plot`), unsaved: its front, with
+    """The figure of :func:`optimisation_figure` for a :class:`suspopt.choosing.selection.ParetoSet`
+    read from a file (:meth:`suspopt.choosing.selection.ParetoSet.plot`), unsaved: its front, with
     the file's ``/history`` (hypervolume and feasible share per generation) where it holds
     one, else empty history panels; ``picks`` (name -> row of the set) starred and named."""
     from ..h5read import H5Reader

@@ -2,7 +2,7 @@
 
 :func:`build_report` reads the result files of ``suspopt optimise``, ``kesort``, ``analyse
 roads|masses|controllers|tolerances`` and ``analyse transmissibility`` of a Pareto file, the files that
-hold a design table (:func:`suspopt.picks.read_table`; each a *study*: :func:`collect`), and writes
+hold a design table (:func:`suspopt.choosing.picks.read_table`; each a *study*: :func:`collect`), and writes
 one self-contained HTML page (:mod:`.page`): every script and style inline, plotly.js
 included (plotly, a dependency), so it opens offline in any
 browser and makes no network request. Per study:
@@ -92,8 +92,8 @@ def _list(a) -> Any:
 def collect(path: str | Path, with_signals: Sequence[str] = ()) -> Study:
     """The study of one result file (module docstring); ConfigError naming the file for
     anything that is not a suspopt front, or a ``with_signals`` row it does not have."""
+    from ..choosing.picks import read_table
     from ..h5read import H5Reader
-    from ..picks import read_table
 
     path, with_signals = Path(path), listed(with_signals)
     table = read_table(path)
@@ -270,8 +270,8 @@ def _builds(h5, N: int, n: int, m: int) -> dict[str, Any]:
 def _signals(path: Path, table, rows: list[int], notes: list[str]) -> dict[str, Any]:
     """Time histories and spectra of the designs ``rows``, simulated in one batch per config
     of the table (each design with its own config)."""
+    from ..choosing.picks import read_picks
     from ..metrics.spectral import record_psd
-    from ..picks import read_picks
     from ..plots.runs import default_signals
     from ..plots.style import PSD_BAND, spectrum_limits
     from ..simulation import simulate

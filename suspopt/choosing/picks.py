@@ -11,7 +11,7 @@ A *design table* is the table of designs a result file holds, with their variabl
 - ``suspopt analyse transmissibility`` of a front: ``/designs`` (its edges and knee).
 
 A *pick* names one row of it: ``knee``, ``best_<objective>`` (the edges of the front,
-:func:`suspopt.kepsilon.pareto_picks`, or the ones the file stored), ``chosen`` (the k-ε
+:func:`suspopt.choosing.kepsilon.pareto_picks`, or the ones the file stored), ``chosen`` (the k-ε
 optimum of a kesort file) or a design's id (:mod:`suspopt.design_ids`: its row in the front
 it came from, ``NAME:ROW`` in a kesort file of several fronts), which names the same design
 in every file that holds it. :func:`read_picks` resolves picks into
@@ -28,12 +28,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .config import Config, ConfigError
-from .config.loader import edit_config, load_config_text, set_path
-from .config.road import FileRoad, resolve_road_file
-from .errors import require, type_name
-from .files import listed
-from .params import ParamView
+from ..config import Config, ConfigError
+from ..config.loader import edit_config, load_config_text, set_path
+from ..config.road import FileRoad, resolve_road_file
+from ..errors import require, type_name
+from ..files import listed
+from ..params import ParamView
 
 if TYPE_CHECKING:
     from .selection import ParetoSet
@@ -73,7 +73,7 @@ class DesignTable:
     def resolve(self, pick: str, option: str = "--pick") -> int:
         """The row of ``pick`` (a name or a design id); ConfigError, naming the command-line
         ``option`` it came from, listing the choices."""
-        from .design_ids import describe_ids, find_id
+        from ..design_ids import describe_ids, find_id
 
         if pick in self.picks:
             return self.picks[pick]
@@ -124,7 +124,7 @@ class Picked:
     def labels(self) -> list[str]:
         """Each design as a figure names it: the pick and its id (``knee (design 13)``), the
         id alone where the pick was the id."""
-        from .design_ids import find_id
+        from ..design_ids import find_id
 
         return [
             f"design {i}" if find_id([i], name) == 0 else f"{name} (design {i})"
@@ -143,8 +143,8 @@ def split_picks(given: list[str]) -> list[str]:
 def read_table(path: str | Path) -> DesignTable:
     """The design table of an optimise, kesort or analyse file (module docstring);
     ConfigError naming the file and the dataset for anything else."""
-    from .design_ids import table_ids
-    from .h5read import H5Reader
+    from ..design_ids import table_ids
+    from ..h5read import H5Reader
     from .kepsilon import pareto_picks
 
     path = Path(path)
@@ -285,7 +285,7 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
     """Design ``i`` of ``picked`` written into its config: the values in place, a road file
     made absolute (the config leaves the file's folder), and a comment block saying where
     it came from. Returns the config and its YAML text."""
-    from ._version import __version__
+    from .._version import __version__
 
     require(picked, Picked, "picked", "from read_picks(path, picks)")
     if isinstance(i, bool) or not isinstance(i, (int, np.integer)):
@@ -328,13 +328,13 @@ def design_config(picked: Picked, i: int = 0) -> tuple[Config, str]:
 
 def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSet:
     """The front a front analysis takes: with no ``picks``, the Pareto set of a ``suspopt
-    optimise`` file (:func:`suspopt.selection.read_pareto`); with ``picks`` (``--pick`` as
+    optimise`` file (:func:`suspopt.choosing.selection.read_pareto`); with ``picks`` (``--pick`` as
     ``simulate`` takes them: ``knee``, ``best_<objective>``, ``chosen``, row numbers;
     comma-separated or repeated), those designs alone, from any file whose designs can be
     picked (:func:`read_picks`: optimise, kesort or analyse), each once, in the order first
     named. They keep their stored main objectives and, from an optimise file, their
     constraints; from any other file ``G`` is None and they are evaluated again."""
-    from .optimisation.problem import Problem
+    from ..optimisation.problem import Problem
     from .selection import ParetoSet, read_pareto
 
     if not picks:
@@ -393,7 +393,7 @@ def read_front(path: str | Path, picks: Sequence[str] | None = None) -> ParetoSe
 
 def _stores_constraints(path: Path) -> bool:
     """Whether the file ``path`` has ``/pareto/G`` (a ``suspopt optimise`` output)."""
-    from .h5read import H5Reader
+    from ..h5read import H5Reader
 
     with H5Reader(path) as h5:
         return "pareto/G" in h5.file
@@ -411,7 +411,7 @@ def stored_scenario_values(
     holds the config kesort evaluated it with (otherwise its values are not the ones it was
     sorted on). NaN where no value is stored (a front of no scenarios, a supplementary
     objective, a front moved away; the note says which)."""
-    from .h5read import H5Reader
+    from ..h5read import H5Reader
 
     stored = np.full_like(picked.F, np.nan)
     origins = _origins(picked)
@@ -450,7 +450,7 @@ def _origins(picked: Picked):
     picked, rows in that front's /pareto)`` per front (``front`` None where a kesort
     file's front is not found; ``config text`` the kesort file's for the set, to check);
     None for a table that is neither /pareto nor /kesort."""
-    from .h5read import H5Reader
+    from ..h5read import H5Reader
 
     everything = np.arange(len(picked.rows))
     if picked.table == "pareto":

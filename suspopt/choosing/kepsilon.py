@@ -144,7 +144,7 @@ def _objectives(F) -> np.ndarray:
 def _names(names: Sequence[str] | None, m: int) -> tuple[str, ...]:
     if names is None:
         return tuple(f"f{j + 1}" for j in range(m))
-    from .files import listed
+    from ..files import listed
 
     names = listed(names)  # ("RC": one name, not two)
     if len(names) != m:

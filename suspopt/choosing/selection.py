@@ -11,9 +11,9 @@
    objective code; otherwise the file's ``F`` and ``G`` are used as they are.
 3. :func:`!select` pools the sets (Fig. 7.6), keeps the case each design came from, drops the
    designs whose simulation failed (and, unless asked, the infeasible ones), sorts the pool
-   and each case alone by k-ε optimality (:func:`!suspopt.kepsilon.kesort`; Fig. 7.5: the
+   and each case alone by k-ε optimality (:func:`!suspopt.choosing.kepsilon.kesort`; Fig. 7.5: the
    optimum of each case, Fig. 7.6: the optimum among all; each sort normalises over its own
-   designs, Eq 7.11-7.12) and takes the Pareto-theory picks (:func:`~suspopt.kepsilon.pareto_picks`).
+   designs, Eq 7.11-7.12) and takes the Pareto-theory picks (:func:`~suspopt.choosing.kepsilon.pareto_picks`).
 4. :func:`write_selection` writes ``/kesort`` atomically (:func:`suspopt.io.atomic_h5`).
 
 A *case* is a label: the sets of several files carry one label to form one case (Ch. 6 Part A
@@ -53,14 +53,14 @@ from typing import Any
 
 import numpy as np
 
-from .config import Config, ConfigError, load_config
-from .config.loader import load_config_text
-from .design_ids import picked_note, selection_ids
-from .errors import require
-from .files import listed
-from .io import atomic_h5, write_attrs, write_dataset
+from ..config import Config, ConfigError, load_config
+from ..config.loader import load_config_text
+from ..design_ids import picked_note, selection_ids
+from ..errors import require
+from ..files import listed
+from ..io import atomic_h5, write_attrs, write_dataset
+from ..optimisation.problem import PENALTY, Problem
 from .kepsilon import KEpsilonSort, kesort, pareto_picks
-from .optimisation.problem import PENALTY, Problem
 
 __all__ = [
     "ParetoSet",
@@ -83,7 +83,7 @@ class ParetoSet:
     """A Pareto set as ``suspopt optimise`` wrote it: ``X (N, n)`` physical values,
     ``F (N, m)``, ``G (N, k)``, their names and units, and the config's YAML text.
 
-    Designs picked from a file (:func:`suspopt.picks.read_front`) have ``picked``, each
+    Designs picked from a file (:func:`suspopt.choosing.picks.read_front`) have ``picked``, each
     pick's name -> its row here, ``source_rows (N,)``, their rows in the file's table, and
     ``ids``, their ids (:func:`suspopt.design_ids.front_ids`); ``G`` is None where the file
     does not store their constraints (they are evaluated again)."""
@@ -112,13 +112,13 @@ class ParetoSet:
         (:func:`!suspopt.plots.pareto_set_figure`), with the file's ``/history`` where it
         has one; ``picks`` (name -> row here) starred and named, default :meth:`marks`.
         Returns a matplotlib Figure."""
-        from .plots import pareto_set_figure
+        from ..plots import pareto_set_figure
 
         return pareto_set_figure(self, self.marks() if picks is None else picks)
 
     def marks(self) -> dict[str, int]:
         """The designs a report names: the picks given (``--pick``; a row number names
-        none), or the edges and knee of the front (:func:`suspopt.kepsilon.pareto_picks`)."""
+        none), or the edges and knee of the front (:func:`suspopt.choosing.kepsilon.pareto_picks`)."""
         if self.picked is not None:
             return dict(self.picked)
         return pareto_picks(self.F, self.obj_names)
@@ -233,7 +233,7 @@ class Selection:
 def read_pareto(path: str | Path) -> ParetoSet:
     """Read a ``suspopt optimise`` output; ConfigError naming the file and the dataset or
     attribute if it is not one (:class:`suspopt.h5read.H5Reader`)."""
-    from .h5read import H5Reader
+    from ..h5read import H5Reader
 
     path = Path(path)
     data = {}
@@ -373,7 +373,7 @@ def _relative_gap(a: np.ndarray, b: np.ndarray) -> float:
 def load_design_sets(
     files: Sequence[str | Path], configs: Sequence[str | Path] = (), labels: Sequence[str] = ()
 ) -> list[DesignSet]:
-    """Read and evaluate Pareto files for :func:`suspopt.selection.select`, as ``suspopt kesort``
+    """Read and evaluate Pareto files for :func:`suspopt.choosing.selection.select`, as ``suspopt kesort``
     takes them.
 
     Parameters

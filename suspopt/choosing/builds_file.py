@@ -29,7 +29,7 @@ def _read(path: str | Path, front: str | Path, read: Callable[..., T]) -> T:
     (``D`` its number of designs), once the file is found to hold the builds of every design
     of that front; ConfigError naming ``--builds PATH`` otherwise."""
     from ..h5read import H5Reader
-    from ..selection import read_pareto
+    from .selection import read_pareto
 
     own = read_pareto(front).X
     with H5Reader(path, where=f"--builds {path}") as h5:
