@@ -102,12 +102,14 @@ def _unknown(
 class _Place:
     """Where a pydantic location lies in the models: its key path (``loc``), the field at its
     end and the model holding that field (None when the path leaves the models), and where
-    in the original location a union's member label stood (None if there is none)."""
+    in the original location a union's member label stood (None if there is none); the
+    ``annotation`` the path arrives at (None when it leaves the models)."""
 
     loc: tuple
     field: Any = None
     model: Any = None
     member_at: int | None = None
+    annotation: Any = None
 
 
 def _unwrap(annotation: Any) -> Any:
@@ -194,7 +196,7 @@ def _place(root: type, loc: tuple) -> _Place:
         else:
             place.model = place.field = annotation = None
         kept.append(part)
-    place.loc = tuple(kept)
+    place.loc, place.annotation = tuple(kept), annotation
     return place
 
 
@@ -376,25 +378,7 @@ def _allowed(raw_loc: tuple, root: type) -> list[str]:
 
 def _section_at(root: type, loc: tuple) -> Any:
     """The model of the section at the pydantic location ``loc`` (None if none)."""
-    annotation: Any = root
-    for part in loc:
-        if isinstance(part, str) and part.startswith("function-"):
-            continue
-        annotation = _unwrap(annotation)
-        if _is_union(annotation):
-            what, member = _member(annotation, part)
-            if what:
-                annotation = member
-                continue
-        origin = get_origin(annotation)
-        if _is_model(annotation):
-            field = annotation.model_fields.get(part)
-            annotation = field.annotation if field is not None else None
-        elif origin in (list, tuple, dict):
-            annotation = get_args(annotation)[-1] if get_args(annotation) else None
-        else:
-            return None
-    annotation = _unwrap(annotation)
+    annotation = _unwrap(_place(root, loc).annotation)
     return annotation if _is_model(annotation) else None
 
 
