@@ -31,6 +31,9 @@ _EXPORTS = {
     "OptimisationResult": "optimisation",
     "optimise": "optimisation.run",
     "load_design_sets": "choosing.selection",
+    "select": "choosing.selection",
+    "run_analysis": "analyse",
+    "Analysis": "analyse",
     "open_dataset": "h5read",
     "kesort": "choosing.kepsilon",
     "KEpsilonSort": "choosing.kepsilon",
@@ -46,7 +49,9 @@ __getattr__, __dir__ = lazy_names(__name__, globals(), _EXPORTS, __all__)
 
 
 if TYPE_CHECKING:
+    from .analyse import Analysis, run_analysis
     from .choosing.kepsilon import KEpsilonSort, kesort, pareto_picks
+    from .choosing.selection import load_design_sets, select
     from .config import Config, config_schema, load_config
     from .errors import ConfigError, InputError
     from .h5read import open_dataset

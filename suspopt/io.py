@@ -23,11 +23,12 @@ descriptor it was created with (a link planted at that name is never followed), 
 disk (``fsync``), then renamed over the target, and the folder synced. A killed or failed
 write leaves the target as it was.
 
-Root attributes of every HDF5 file: ``suspopt_version``, ``created`` (UTC ISO 8601),
-``command``, ``config`` (the YAML text) and ``seed`` (the config's random seed, -1 when it
-draws nothing); of a command's output (a :func:`claim` with a guard) also ``request`` and,
-with a figure, ``plot`` (:mod:`suspopt.replacing`, which says what such a file may be
-replaced by). Every dataset carries a ``units`` attribute.
+Root attributes of every HDF5 file (:data:`suspopt.formats.ROOT_ATTRIBUTES`):
+``suspopt_version``, ``created`` (UTC ISO 8601), ``command``, ``config`` (the YAML text) and
+``seed`` (the config's random seed, -1 when it draws nothing); of a command's output (a
+:func:`claim` with a guard) also ``request`` and, with a figure, ``plot``
+(:mod:`suspopt.replacing`, which says what such a file may be replaced by). Every dataset
+carries a ``units`` attribute, and is made as its file's format declares it (:func:`put`).
 
 **Dimensions** (:func:`write_dataset`, the one writer of every dataset): each axis of a dataset
 is attached to an HDF5 dimension scale, the netCDF-4 way, so that xarray (engine
@@ -59,6 +60,7 @@ import numpy as np
 from ._version import __version__
 from .config import Config, ConfigError
 from .files import Unreadable, link_kind, status
+from .formats import FileFormat
 from .h5read import open_dataset  # (suspopt.io.open_dataset, as docs/guide/results.md reads it)
 from .locks import take_lock, take_notes, this_command
 from .replacing import (
@@ -82,6 +84,7 @@ __all__ = [
     "is_output",
     "atomic_file",
     "atomic_h5",
+    "put",
     "commit",
     "check_replace",
     "config_inputs",
@@ -491,12 +494,31 @@ def write_dataset(
 
 
 def write_tables(group, tables) -> None:
-    """Write each :class:`suspopt.layout.Table` of ``tables`` into ``group``
+    """Write each :class:`suspopt.formats.Table` of ``tables`` into ``group``
     (:func:`write_dataset`)."""
     for t in tables:
         write_dataset(
             group, t.name, t.data, t.units, dims=t.dims, coords=t.coords, names=t.names, **t.attrs
         )
+
+
+def put(
+    fmt: FileFormat,
+    group,
+    name: str,
+    data,
+    units: str | Sequence[str] | None = None,
+    names: Sequence[str] | None = None,
+    coords: dict | None = None,
+    **attrs,
+):
+    """Create ``group[name]`` holding ``data`` as the file format ``fmt`` declares it: its
+    dimensions and fixed unit from the declaration, ``units`` only where the declaration
+    leaves them to the run (:meth:`suspopt.formats.FileFormat.table`); return the dataset."""
+    t = fmt.table(group.name, name, data, units, names=names, coords=coords, attrs=attrs)
+    return write_dataset(
+        group, t.name, t.data, t.units, dims=t.dims, coords=coords, names=t.names, **t.attrs
+    )
 
 
 def write_simulation(
@@ -507,20 +529,11 @@ def write_simulation(
     command: str | None = None,
     extra=None,
 ) -> Path:
-    """Write a simulation ``Result`` (docs/guide/results.md), its groups as
-    :func:`suspopt.layout.simulation_tables` declares them.
-
-    ``/time (T,)`` [s] and ``/design (P,)`` (row numbers) are the dimension scales ``time``
-    and ``design``; ``/signals/<name> (design, time)``, ``/metrics/<name> (design,)``,
-    ``/diverged_at (design,)`` [s] (NaN where the design did not diverge), ``/designs/X
-    (design, variable)`` with attrs ``names`` (the parameters' dotted paths; also the scale
-    ``/designs/variable``) and ``units`` (each one's unit, from its config field) when design
-    parameters were given, ``/modal/frequency (design, mode)`` [Hz] with attr ``dominant``
-    (design 0's DOF of most energy per mode), ``/modal/label (design, mode)`` (what each mode
-    is) and ``/modal/energy_share (design, mode, dof)`` (each DOF's share of each mode's
-    kinetic energy, attr ``dofs``, scale ``/modal/dof``): :func:`suspopt.vehicle.modal_analysis`.
-    ``/modal/mode`` numbers the modes. ``extra(h5)`` adds the caller's groups (the picks)
-    before ``/modal``.
+    """Write a simulation ``Result`` as its format declares it
+    (:data:`suspopt.formats.SIMULATE`, through :func:`suspopt.layout.simulation_tables`):
+    ``signals`` (default every signal; float32 where asked), its metrics, when each design
+    diverged, the design parameters when there are some and the modes.
+    ``extra(h5)`` adds the caller's groups (the picks) before ``/modal``.
     """
     from .layout import simulation_tables
 

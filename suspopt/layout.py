@@ -13,36 +13,21 @@ group's own. So ``Result.to_xarray()`` needs no file (:meth:`suspopt.Result.to_x
 :meth:`suspopt.optimisation.OptimisationResult.to_xarray`), and :func:`frame` makes a Dataset a
 tidy pandas DataFrame.
 
-:func:`simulation_tables` declares a ``suspopt simulate`` file (docs/guide/results.md);
-the optimisation's groups are declared in :mod:`suspopt.optimisation.output`.
+:func:`simulation_tables` makes the tables of a ``suspopt simulate`` file and
+:mod:`suspopt.optimisation.output` those of an optimisation's, each dataset as its file's
+format declares it (:mod:`suspopt.formats`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping, Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from .formats import SIMULATE, Table
+
 __all__ = ["Table", "simulation_tables", "as_dataset", "group_name", "group_dataset", "frame"]
-
-
-@dataclass(frozen=True)
-class Table:
-    """One dataset of a group: ``data`` with its ``units`` (one, or one per column), the
-    names of its axes ``dims`` (``(name,)``: it is that dimension's scale), ``coords`` (a
-    dimension's values where the group makes its scale), ``names`` (the columns' names:
-    the attribute ``names`` and the last dimension's coordinate) and other ``attrs``
-    (:func:`suspopt.io.write_dataset`)."""
-
-    name: str
-    data: Any
-    units: str | Sequence[str]
-    dims: tuple[str, ...]
-    coords: Mapping[str, Sequence] | None = None
-    names: Sequence[str] | None = None
-    attrs: Mapping[str, Any] = field(default_factory=dict)
 
 
 def simulation_tables(
@@ -59,23 +44,19 @@ def simulation_tables(
     names = list(result.signals) if signals is None else list(signals)
     dtype = np.float32 if float32 else np.float64
     wanted = (lambda g: True) if only is None else (lambda g: g in only)
+    t = SIMULATE.table
     groups: dict[str, list[Table]] = {
         "": [
-            Table("time", result.time, "s", ("time",)),
-            Table("design", np.arange(len(result.diverged_at)), "1", ("design",)),
-            Table("diverged_at", result.diverged_at, "s", ("design",)),
+            t("", "time", result.time),
+            t("", "design", np.arange(len(result.diverged_at))),
+            t("", "diverged_at", result.diverged_at),
         ],
         "signals": [
-            Table(
-                n,
-                np.asarray(result.signals[n], dtype=dtype),
-                result.signal_unit(n),
-                ("design", "time"),
-            )
+            t("signals", n, np.asarray(result.signals[n], dtype=dtype), result.signal_unit(n))
             for n in (names if wanted("signals") else [])
         ],
         "metrics": [
-            Table(n, np.asarray(v), result.metric_units[n], ("design",))
+            t("metrics", n, np.asarray(v), result.metric_units[n])
             for n, v in result.metrics.items()
         ],
     }
@@ -91,7 +72,7 @@ def _designs(result) -> list[Table]:
 
     X = np.column_stack([result.designs[k] for k in result.designs])
     units = [field_unit(result.config, k) for k in result.designs]
-    return [Table("X", X, units, ("design", "variable"), names=list(result.designs))]
+    return [SIMULATE.table("designs", "X", X, units, names=list(result.designs))]
 
 
 def _modal(model) -> list[Table]:
@@ -100,23 +81,11 @@ def _modal(model) -> list[Table]:
 
     modes = modal_analysis(model)
     dofs = list(modes.dof_names)
+    t = SIMULATE.table
     return [
-        Table(
-            "frequency",
-            modes.frequency,
-            "Hz",
-            ("design", "mode"),
-            attrs={"dominant": list(modes.dominant[0])},
-        ),
-        Table("label", modes.label, "1", ("design", "mode")),
-        Table(
-            "energy_share",
-            modes.energy,
-            "1",
-            ("design", "mode", "dof"),
-            coords={"dof": dofs},
-            attrs={"dofs": dofs},
-        ),
+        t("modal", "frequency", modes.frequency, attrs={"dominant": list(modes.dominant[0])}),
+        t("modal", "label", modes.label),
+        t("modal", "energy_share", modes.energy, coords={"dof": dofs}, attrs={"dofs": dofs}),
     ]
 
 

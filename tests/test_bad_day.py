@@ -203,7 +203,7 @@ def test_the_analyses_as_a_library_raise_no_runtime_warning(tmp_path, front):
         for value in (1e308, 1e-308, 0.0):
             path = damaged(front, tmp_path, "lib", value)
             for kind, options in [("masses", {}), ("tolerances", {}), ("builds", {"samples": 3})]:
-                report = kinds[kind].run(path, **options)
+                report = kinds[kind].run(path, **options).report()
                 cells = [c for row in report.rows for c in row] + report.notes
                 assert not [c for c in cells if "inf" in c or "nan %" in c], cells
 

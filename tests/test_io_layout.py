@@ -54,10 +54,9 @@ def files(tmp_path_factory):
     builds = write_builds(d / "builds.h5", draw_and_evaluate(pareto, 4, tolerance=10.0, seed=1))
     knee = read_front(ke, ["chosen", "knee"])  # (designs picked from a kesort file)
     picked = write_builds(d / "picked.h5", draw_and_evaluate(knee, 3, tolerance="C_v=5", seed=1))
-    transmissibility.run(front, output=d / "stht.h5")
-    models.run(
-        [CONFIGS / "ch3/part1a_qc_bump.yaml", CONFIGS / "ch3/part1a_hc1_bump.yaml"],
-        output=d / "models.h5",
+    transmissibility.run(front).write(d / "stht.h5")
+    models.run([CONFIGS / "ch3/part1a_qc_bump.yaml", CONFIGS / "ch3/part1a_hc1_bump.yaml"]).write(
+        d / "models.h5"
     )
     return {
         "sim": sim,

@@ -18,6 +18,7 @@ MAX_FUNCTION_LINES = 80
 
 
 def test_no_function_over_80_lines():
+    """80 lines of code at most (a docstring not counted)."""
     too_long = []
     for path in sorted((ROOT / "suspopt").rglob("*.py")):
         text = path.read_text()
@@ -25,6 +26,9 @@ def test_no_function_over_80_lines():
         for node in ast.walk(ast.parse(text)):
             if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
                 lines = node.end_lineno - node.lineno + 1
+                first = node.body[0]  # (the docstring is not code: a public one is long)
+                if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant):
+                    lines -= first.end_lineno - first.lineno + 1
                 if lines > MAX_FUNCTION_LINES:
                     too_long.append(f"{where}:{node.lineno} {node.name}: {lines} lines")
     assert not too_long, too_long

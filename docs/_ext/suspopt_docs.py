@@ -354,6 +354,54 @@ def commands_rst() -> str:
     return "\n".join(lines)
 
 
+def formats_rst() -> str:
+    """Every file format of :data:`suspopt.formats.FORMATS` as reStructuredText: per kind, what
+    writes it, its root attributes and a table of its groups and datasets."""
+    from suspopt.formats import FORMATS, ROOT_ATTRIBUTES, Data
+
+    lines = ["Root attributes of every file", "~" * 31, ""]
+    lines += [".. list-table::", "   :header-rows: 1", "   :widths: 20 80", ""]
+    lines += ["   * - attribute", "     - what it holds"]
+    for key, doc in ROOT_ATTRIBUTES.items():
+        lines += [f"   * - ``{key}``", f"     - {_escaped(doc)}"]
+    lines.append("")
+    for fmt in FORMATS.values():
+        title = f"{fmt.kind} files"
+        lines += [_escaped(title), "~" * (2 * len(title) + 4), ""]
+        lines += [f"Written by ``{fmt.written_by}``. {_escaped(fmt.doc)}", ""]
+        if fmt.attrs:
+            attrs = "; ".join(f"``{k}``: {v}" for k, v in fmt.attrs.items())
+            lines += [f"Root attributes besides those of every file: {attrs}.", ""]
+        if fmt.read_by:
+            reads = ", ".join(f"``suspopt {c.split(' FILE')[0]}``" for c in fmt.read_by)
+            lines += [f"Read by {reads}.", ""]
+        lines += [
+            ".. list-table::",
+            "   :header-rows: 1",
+            "   :widths: 30 22 10 38",
+            "",
+            "   * - path",
+            "     - dimensions",
+            "     - unit",
+            "     - what it holds",
+        ]
+        for node in fmt.nodes:
+            is_data = isinstance(node, Data)
+            doc = node.doc + (f" (when: {node.when})" if node.when else "")
+            if node.attrs:
+                doc += "; attributes " + "; ".join(f"``{k}``: {v}" for k, v in node.attrs.items())
+            unit = (node.units if node.units is not None else "from the run") if is_data else " "
+            dims = f"({', '.join(node.axes)})" if is_data else "group"
+            lines += [
+                f"   * - ``/{node.path}``",
+                f"     - {dims}",
+                f"     - {_escaped(unit)}",
+                f"     - {_escaped(doc)}",
+            ]
+        lines.append("")
+    return "\n".join(lines)
+
+
 def setup(app: Any) -> dict:
     from docutils.parsers.rst import Directive
     from docutils.statemachine import StringList
@@ -385,6 +433,19 @@ def setup(app: Any) -> dict:
             nested_parse_with_titles(self.state, StringList(text.splitlines()), holder)
             return holder.children
 
+    class Formats(Directive):
+        has_content = False
+
+        def run(self):
+            from docutils import nodes
+
+            holder = nodes.section()
+            holder.document = self.state.document
+            text = formats_rst()
+            nested_parse_with_titles(self.state, StringList(text.splitlines()), holder)
+            return holder.children
+
+    app.add_directive("suspopt-formats", Formats)
     app.add_directive("suspopt-config-reference", ConfigReference)
     app.add_directive("suspopt-commands", Commands)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -41,24 +41,10 @@ build (NaN objectives) counts as not feasible and is left out of the percentiles
 :func:`suspopt.choosing.picks.read_front`): the file's ``/pareto`` then holds the picked designs,
 their picks by name and ``source_row``.
 
-HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text;
-``analysis = "builds"``, ``source`` and ``seed``):
-
-- ``/pareto``: the stored front, as :mod:`.pseudo` writes it (X, F, feasible, picks, S);
-- ``/builds`` with attributes ``samples`` and ``distribution``; ``/builds/tolerance
-  (variable,)`` [%] each variable's tolerance; ``/builds/batch (variable,)`` the batch of
-  each (text: its name, empty for a variable drawn alone);
-  ``/builds/X (sample, design, variable)`` the built designs (the variables' units),
-  ``F (sample, design, objective)``, ``S (sample, design, supplementary)`` (if any),
-  ``change (sample, design, objective)`` [%], ``feasible`` and ``failed (sample, design)``
-  [1];
-- ``/builds/G (sample, design, constraint)`` the builds' constraints (``g <= 0`` is met;
-  their units; the config's constraints, if it has any);
-- ``/builds/F_p05``, ``F_median``, ``F_p95 (design, objective)``: each objective's 5th
-  percentile, median and 95th percentile over the builds; ``feasible_share (design,)`` [1];
-  ``contribution (design, variable, objective)`` [1]: the share of the objective's variance
-  over the design's builds that goes with the variable (their squared correlation; the
-  variables are drawn independently, so it is the share a linear fit gives each).
+The file's layout is declared once, in :data:`suspopt.formats.BUILDS`. Its
+``contribution`` is the share of an objective's variance over a design's builds that goes
+with a variable: their squared correlation (the variables are drawn independently, so it is
+the share a linear fit gives each).
 """
 
 from __future__ import annotations
@@ -78,7 +64,8 @@ from ..choosing.selection import DesignSet, ParetoSet, evaluate_pareto
 from ..config.optimise import batches as config_batches
 from ..design_ids import front_ids, id_marks
 from ..errors import ConfigError
-from ..io import atomic_h5, write_dataset
+from ..formats import BUILDS
+from ..io import atomic_h5, put
 from ..params import MAX_SWEEP_DESIGNS
 from .cells import (
     NOT_COMPUTED,
@@ -90,7 +77,7 @@ from .cells import (
     stored_reference,
 )
 from .pseudo import is_comfort, table_designs, write_stored_front
-from .registry import KINDS, Kind, Report, relative_change
+from .registry import KINDS, Analysis, Kind, Report, analysis, relative_change
 from .tolerances import (
     Tolerances,
     bands,
@@ -378,32 +365,27 @@ def write_builds(path: str | Path, b: Builds, command: str | None = None) -> Pat
     p, m = b.pareto, b.m
     names, units = b.stored.names, b.stored.units
     with atomic_h5(path, p.config(), command, inputs=[("the input", p.path)]) as h5:
-        write_stored_front(h5, "builds", p, b.stored)
+        write_stored_front(h5, BUILDS, "builds", p, b.stored)
         h5.attrs["seed"] = b.seed
         g = h5.create_group("builds")
         g.attrs["samples"] = len(b.X)
         g.attrs["distribution"] = b.distribution
-        three = ("sample", "design")
-        write_dataset(g, "X", b.X, list(p.var_units), three + ("variable",), names=p.var_names)
-        write_dataset(g, "tolerance", b.tolerance, "%", ("variable",))
-        write_dataset(g, "batch", b.batch_of, "1", ("variable",))
-        write_dataset(g, "F", b.F[..., :m], units[:m], three + ("objective",), names=names[:m])
+        put(BUILDS, g, "X", b.X, list(p.var_units), names=p.var_names)
+        put(BUILDS, g, "tolerance", b.tolerance)
+        put(BUILDS, g, "batch", b.batch_of)
+        put(BUILDS, g, "F", b.F[..., :m], units[:m], names=names[:m])
         if len(names) > m:
-            extra = names[m:]
-            write_dataset(g, "S", b.F[..., m:], units[m:], three + ("supplementary",), names=extra)
-        change = b.change[..., :m]
-        write_dataset(g, "change", change, ["%"] * m, three + ("objective",), names=names[:m])
+            put(BUILDS, g, "S", b.F[..., m:], units[m:], names=names[m:])
+        put(BUILDS, g, "change", b.change[..., :m], ["%"] * m, names=names[:m])
         if b.constraint_names:
             k = list(b.constraint_names)
-            write_dataset(g, "G", b.G, list(b.constraint_units), three + ("constraint",), names=k)
-        write_dataset(g, "feasible", b.feasible.astype(np.int8), "1", three)
-        write_dataset(g, "failed", b.failed.astype(np.int8), "1", three)
+            put(BUILDS, g, "G", b.G, list(b.constraint_units), names=k)
+        put(BUILDS, g, "feasible", b.feasible.astype(np.int8))
+        put(BUILDS, g, "failed", b.failed.astype(np.int8))
         for key, values in zip(("F_p05", "F_median", "F_p95"), b.percentiles(b.F[..., :m])):
-            write_dataset(g, key, values, units[:m], ("design", "objective"), names=names[:m])
-        write_dataset(g, "feasible_share", b.feasible.mean(axis=0), "1", ("design",))
-        r2 = b.contributions[..., :m]
-        dims = ("design", "variable", "objective")
-        write_dataset(g, "contribution", r2, "1", dims, names=names[:m])
+            put(BUILDS, g, key, values, units[:m], names=names[:m])
+        put(BUILDS, g, "feasible_share", b.feasible.mean(axis=0))
+        put(BUILDS, g, "contribution", b.contributions[..., :m], names=names[:m])
     return Path(path)
 
 
@@ -555,32 +537,31 @@ def plot_builds(b: Builds, path: str | Path, title: str) -> Path:
 
 def run_builds(
     source: Path,
-    output: Path | None = None,
-    plot: Path | None = None,
     tolerance: Tolerances = None,
     samples: int | None = SAMPLES,
     seed: int | None = None,
     distribution: str | None = None,
     pick: Sequence[str] | None = None,
     batch: Sequence[str] | None = None,
-) -> Report:
+) -> Analysis:
     """``suspopt analyse builds PARETO.h5 [--samples 100] [--tolerance 10] [--tolerance
     NAME=T] [--seed S] [--distribution uniform|normal] [--pick NAMES] [--batch NAME,NAME]``
-    (module docstring)."""
-    from .. import plots
-
-    if plot is not None:
-        plots.check_path(plot)
+    (module docstring); nothing written."""
     pareto = read_front(Path(source), pick)
     b = builds(
         pareto, samples, tolerance=tolerance, seed=seed, distribution=distribution, batch=batch
     )
     title = f"builds: {pareto.path.name} as built to {bands(pareto.var_names, b.tolerance)}"
-    if output is not None:
-        write_builds(output, b)
-    if plot is not None:
-        plot_builds(b, plot, title)
-    return _report(b, title)
+    return analysis(
+        "builds",
+        title,
+        b,
+        pareto.config(),
+        [pareto.path],
+        lambda path, command: write_builds(path, b, command),
+        lambda path: plot_builds(b, path, title),
+        lambda: _report(b, title),
+    )
 
 
 KINDS["builds"] = Kind(

@@ -13,29 +13,35 @@ the mean power the dampers dissipate (Eq 2.92, summed over corners). Each is rep
 thesis's reduction ``(X_base - X_CDF) / X_base * 100 %`` (Sec 4.3): positive means smaller
 with the CDF strategy. The share achieved is counted after the first fit (``t >= learn_time``).
 
-HDF5 (``output``): ``/cdf_sensitivity/c_max_share (S,)`` (the dimension scale of the sweep),
-``achieved_share``, ``base_share``, ``final_threshold (c_max_share, corner)`` (scale
-``corner``: the semi-active corners), ``base/<M>`` (one value), ``cdf/<M>`` and
-``reduction/<M>`` [%] over ``c_max_share``; every dataset with ``units``.
+The file's layout: :data:`suspopt.formats.CDF_SENSITIVITY`.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from .. import plots
-from ..config import load_config
+from ..config import Config, load_config
 from ..errors import require
-from ..io import atomic_h5, write_dataset
+from ..formats import CDF_SENSITIVITY
+from ..io import atomic_h5, put
 from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
 from ..result import Result
 from ..simulation import simulate
 from .cells import NOT_COMPUTED, NOT_COMPUTED_NOTE, percent
-from .registry import KINDS, Kind, Report, relative_change
+from .registry import KINDS, Analysis, Kind, Report, analysis, relative_change
 
-__all__ = ["SHARES", "METRIC_UNITS", "c_max_share", "semi_active_metrics", "run"]
+__all__ = [
+    "SHARES",
+    "METRIC_UNITS",
+    "CdfSensitivity",
+    "c_max_share",
+    "semi_active_metrics",
+    "run",
+]
 
 #: C_max shares of the sweep (the thesis's 20-70 %, Sec 4.3 item 4).
 SHARES = np.round(np.arange(0.20, 0.7001, 0.05), 2)
@@ -117,34 +123,61 @@ def _check(cfg) -> None:
         )
 
 
-def _write(
-    output: Path, cfg, active: list[str], laws: list[str], tables: dict, threshold, unit: str
-) -> None:
-    """``/cdf_sensitivity``: the shares asked for and achieved, the final thresholds (in the
-    laws' condition unit) and the metrics of the base law, with the CDF threshold and their
-    reduction [%] (layout: docs/guide/analyses.md)."""
-    with atomic_h5(output, cfg) as h5:
+@dataclass
+class CdfSensitivity:
+    """The sweep of :func:`run`: the config's adaptive threshold at each C_max share of
+    :data:`SHARES` against the base law. ``base`` (metric -> value, with ``share``), ``cdf``
+    (metric -> one value per share, with ``share``: the share achieved), ``reduction``
+    (metric -> [%] per share), units :data:`METRIC_UNITS`; ``threshold (shares, corners)``
+    each semi-active corner's final threshold in ``unit``, ``active`` those corners,
+    ``laws`` their laws."""
+
+    source: Path
+    config: Config
+    base: dict[str, float]
+    cdf: dict[str, np.ndarray]
+    reduction: dict[str, np.ndarray]
+    threshold: np.ndarray
+    unit: str
+    active: list[str]
+    laws: list[str]
+
+    @property
+    def title(self) -> str:
+        spec = self.config.control.threshold  # type: ignore[union-attr]
+        assert spec is not None  # (run checks it)
+        return (
+            f"CDF sensitivity: {' / '.join(self.laws)} on {self.source.name} "
+            f"({spec.distribution} fit, T_learn {spec.learn_time:g} s)"
+        )
+
+
+def _write(output: Path, d: CdfSensitivity, command: str | None) -> Path:
+    """``/cdf_sensitivity`` (:data:`suspopt.formats.CDF_SENSITIVITY`): the shares asked for
+    and achieved, the final thresholds (in the laws' condition unit) and the metrics of the
+    base law, with the CDF threshold and their reduction [%]."""
+    cfg = d.config
+    with atomic_h5(output, cfg, command) as h5:
         grp = h5.create_group("cdf_sensitivity")
-        grp.attrs["laws"] = ",".join(laws)
-        grp.attrs["distribution"] = cfg.control.threshold.distribution
-        grp.attrs["corners"] = ",".join(active)
-        share = ("c_max_share",)
-        write_dataset(grp, "c_max_share", SHARES, "1", dims=share)
-        write_dataset(grp, "achieved_share", tables["cdf"]["share"], "1", dims=share)
-        write_dataset(grp, "base_share", tables["base"]["share"], "1")
-        dims = ("c_max_share", "corner")
-        write_dataset(grp, "final_threshold", threshold, unit, dims=dims, coords={"corner": active})
-        for key, values in tables.items():
+        grp.attrs["laws"] = ",".join(d.laws)
+        grp.attrs["distribution"] = cfg.control.threshold.distribution  # type: ignore[union-attr]
+        grp.attrs["corners"] = ",".join(d.active)
+        put(CDF_SENSITIVITY, grp, "c_max_share", SHARES)
+        put(CDF_SENSITIVITY, grp, "achieved_share", d.cdf["share"])
+        put(CDF_SENSITIVITY, grp, "base_share", d.base["share"])
+        put(CDF_SENSITIVITY, grp, "final_threshold", d.threshold, d.unit,
+            coords={"corner": d.active})  # fmt: skip
+        for key, values in (("base", d.base), ("cdf", d.cdf), ("reduction", d.reduction)):
             group = grp.create_group(key)
             for name, m_unit in METRIC_UNITS.items():
-                units = "%" if key == "reduction" else m_unit
-                write_dataset(group, name, values[name], units, dims=() if key == "base" else share)
+                unit = None if key == "reduction" else m_unit
+                put(CDF_SENSITIVITY, group, name, values[name], unit)
+    return output
 
 
-def run(source: Path, output: Path | None = None, plot: Path | None = None) -> Report:
-    """Sweep the C_max share 20-70 % against the base law (module docstring)."""
-    if plot is not None:
-        plots.check_path(plot)
+def run(source: Path) -> Analysis:
+    """Sweep the C_max share 20-70 % against the base law (module docstring); nothing
+    written."""
     cfg = load_config(source)
     _check(cfg)
     assert cfg.control is not None and cfg.control.threshold is not None  # (_check)
@@ -156,44 +189,58 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
     result = simulate(cfg, params={path + "c_max_share": shares, path + "learn_time": learn})
     values = semi_active_metrics(result, share_after=spec.learn_time)
     base = {k: v[0] for k, v in values.items()}
-    reduction = {k: 0.0 - relative_change(values[k][1:], base[k]) for k in METRIC_UNITS}
     corners = result.model.corners
     active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]
-    laws = sorted({getattr(cfg.vehicle.corners[c].damper, "law", "") for c in active})
-    threshold = np.stack([result.signals[f"control_threshold.{c}"][1:, -1] for c in active], axis=1)
-    unit = result.signal_unit(f"control_threshold.{active[0]}")
-    title = (
-        f"CDF sensitivity: {' / '.join(laws)} on {source.name} "
-        f"({spec.distribution} fit, T_learn {spec.learn_time:g} s)"
+    d = CdfSensitivity(
+        source=Path(source),
+        config=cfg,
+        base=base,
+        cdf={k: v[1:] for k, v in values.items()},
+        reduction={k: 0.0 - relative_change(values[k][1:], base[k]) for k in METRIC_UNITS},
+        threshold=np.stack(
+            [result.signals[f"control_threshold.{c}"][1:, -1] for c in active], axis=1
+        ),
+        unit=result.signal_unit(f"control_threshold.{active[0]}"),
+        active=active,
+        laws=sorted({getattr(cfg.vehicle.corners[c].damper, "law", "") for c in active}),
+    )
+    return analysis(
+        "cdf-sensitivity",
+        d.title,
+        d,
+        cfg,
+        [Path(source)],
+        lambda out, command: _write(out, d, command),
+        lambda out: _plot(d, out),
+        lambda: _table(d),
     )
 
-    if output is not None:
-        tables = {
-            "base": base,
-            "cdf": {k: v[1:] for k, v in values.items()},
-            "reduction": reduction,
-        }
-        _write(output, cfg, active, laws, tables, threshold, unit)
-    if plot is not None:
-        plots.sensitivity(
-            plot,
-            title,
-            100 * SHARES,
-            "C_max share requested (1 - N) [%]",
-            [{"SW": reduction["SW"]}, {k: reduction[k] for k in ("RC", "ST", "TD", "DE")}],
-            "reduction vs base law [%]",
-            marker=100 * base["share"],
-            marker_label="base law's share",
-        )
 
+def _plot(d: CdfSensitivity, path: Path) -> Path:
+    """The reduction of SW, and of RC, ST, TD and DE, against the share asked for."""
+    return plots.sensitivity(
+        path,
+        d.title,
+        100 * SHARES,
+        "C_max share requested (1 - N) [%]",
+        [{"SW": d.reduction["SW"]}, {k: d.reduction[k] for k in ("RC", "ST", "TD", "DE")}],
+        "reduction vs base law [%]",
+        marker=100 * d.base["share"],
+        marker_label="base law's share",
+    )
+
+
+def _table(d: CdfSensitivity) -> Report:
+    """Each share asked for: achieved, the final thresholds and the reductions."""
+    base, laws = d.base, d.laws
     rows = [
         [
             f"{100 * s:.0f}",
             f"{100 * a:.1f}",
             " ".join(f"{x:.3g}" for x in thr),
-            *(percent(reduction[k][i], suffix="") for k in METRIC_UNITS),
+            *(percent(d.reduction[k][i], suffix="") for k in METRIC_UNITS),
         ]
-        for i, (s, a, thr) in enumerate(zip(SHARES, values["share"][1:], threshold))
+        for i, (s, a, thr) in enumerate(zip(SHARES, d.cdf["share"], d.threshold))
     ]
     notes = [
         f"base law ({' / '.join(laws)}): C_max share {100 * base['share']:.1f} %, "
@@ -205,11 +252,11 @@ def run(source: Path, output: Path | None = None, plot: Path | None = None) -> R
     if any(NOT_COMPUTED in row for row in rows):
         notes.append(NOT_COMPUTED_NOTE)
     return Report(
-        title=title,
+        title=d.title,
         columns=[
             "C_max share [%]",
             "achieved [%]",
-            f"final T [{unit}]",
+            f"final T [{d.unit}]",
             *(f"{k} [%]" for k in METRIC_UNITS),
         ],
         rows=rows,

@@ -25,19 +25,7 @@ against QC's 7.92 is printed +50 %). A per-corner metric of a corner the referen
 compared with the reference's only corner when the reference is a quarter car (it stands for
 every wheel, as the thesis compares HC2's and FC's rear travel with QC's), else not at all.
 
-HDF5 layout (every dataset has ``units``; root attributes as every suspopt file, with
-``config`` the reference's YAML text, plus ``analysis`` = models, ``models`` (labels, the
-config files' names) and ``reference``):
-
-- ``/models/<label>/``: attributes ``source``, ``config`` (YAML text), ``preset``, ``road``;
-  ``time (T,)`` [s], ``signals/<name> (T,)``, ``psd/frequency (F,)`` [Hz], ``psd/<name> (F,)``
-  [(unit)^2/Hz], ``modal/frequency (n,)`` [Hz] with attributes ``dominant`` and ``label``;
-- ``/comparison/value/<metric> (M,)`` in the metric's unit and
-  ``/comparison/difference/<metric> (M,)`` [%], over the models in the order of ``models``
-  (NaN where a model lacks the metric).
-- dimensions (:func:`suspopt.io.write_dataset`): each model's ``time`` and
-  ``psd/frequency``, ``modal/mode`` (numbering its modes), and ``/comparison/model`` (the
-  labels, as the attribute ``models``).
+The file's layout: :data:`suspopt.formats.MODELS`.
 """
 
 from __future__ import annotations
@@ -52,13 +40,14 @@ from .. import plots
 from ..config import Config, ConfigError, load_config
 from ..config.metrics import MetricSpec
 from ..files import listed
-from ..io import atomic_h5, write_attrs, write_dataset
+from ..formats import MODELS
+from ..io import atomic_h5, put, write_attrs
 from ..metrics.spectral import PSD_SEGMENT, record_psd
 from ..simulation import Result, simulate
 from ..specs import METRICS, evaluate_spec
 from ..vehicle import modal_analysis
 from .cells import NOT_COMPUTED_NOTE, percent
-from .registry import KINDS, Kind, Report, relative_change
+from .registry import KINDS, Analysis, Kind, Report, analysis, relative_change
 
 __all__ = [
     "ModelResponse",
@@ -282,39 +271,25 @@ def write_models(path: str | Path, comparison: ModelComparison, command: str | N
                 preset=m.config.vehicle.preset,
                 road=m.config.road.kind,
             )
-            write_dataset(g, "time", m.time, "s", dims=("time",))
+            put(MODELS, g, "time", m.time)
             sig = g.create_group("signals")
             for name, values in m.signals.items():
-                write_dataset(sig, name, values, m.units[name], dims=("time",))
+                put(MODELS, sig, name, values, m.units[name])
             spectra = g.create_group("psd")
-            write_dataset(spectra, "frequency", m.psd_frequency, "Hz", dims=("frequency",))
+            put(MODELS, spectra, "frequency", m.psd_frequency)
             for name, values in m.psd.items():
-                write_dataset(spectra, name, values, m.units[f"PSD of {name}"], dims=("frequency",))
-            write_dataset(
-                g.create_group("modal"),
-                "frequency",
-                m.natural_frequency,
-                "Hz",
-                dims=("mode",),
-                dominant=list(m.dominant),
-                label=list(m.mode_label),
-            )
+                put(MODELS, spectra, name, values, m.units[f"PSD of {name}"])
+            modal = g.create_group("modal")
+            put(MODELS, modal, "frequency", m.natural_frequency, dominant=list(m.dominant),
+                label=list(m.mode_label))  # fmt: skip
         comparison_group = h5.create_group("comparison")
-        write_dataset(comparison_group, "model", labels, "1", dims=("model",))
+        put(MODELS, comparison_group, "model", labels)
         value = comparison_group.create_group("value")
         difference = comparison_group.create_group("difference")
         for name in comparison.metric_names:
-            write_dataset(
-                value,
-                name,
-                comparison.value[name],
-                comparison.metric_units[name],
-                dims=("model",),
-                models=labels,
-            )
-            write_dataset(
-                difference, name, comparison.difference[name], "%", dims=("model",), models=labels
-            )
+            unit = comparison.metric_units[name]
+            put(MODELS, value, name, comparison.value[name], unit, models=labels)
+            put(MODELS, difference, name, comparison.difference[name], models=labels)
     return Path(path)
 
 
@@ -340,22 +315,27 @@ def _cell(value: float) -> str:
     return "-" if np.isnan(value) else f"{value:.4g}"
 
 
-def run(
-    sources: Sequence[Path],
-    output: Path | None = None,
-    plot: Path | None = None,
-    reference: Path | None = None,
-) -> Report:
-    """``suspopt analyse models A.yaml B.yaml ... [--reference A.yaml]``."""
-    if plot is not None:
-        plots.check_path(plot)
+def run(sources: Sequence[Path], reference: Path | None = None) -> Analysis:
+    """``suspopt analyse models A.yaml B.yaml ... [--reference A.yaml]``: the configs
+    compared (:func:`compare_models`); nothing written."""
     comparison = compare_models(sources, reference)
     models, ref = comparison.models, comparison.models[comparison.reference]
     title = f"models: {', '.join(m.label for m in models)} (reference {ref.label})"
-    if output is not None:
-        write_models(output, comparison)
-    if plot is not None:
-        plot_models(comparison, plot, title)
+    return analysis(
+        "models",
+        title,
+        comparison,
+        ref.config,
+        [m.source for m in models],
+        lambda path, command: write_models(path, comparison, command),
+        lambda path: plot_models(comparison, path, title),
+        lambda: _table(comparison, title),
+    )
+
+
+def _table(comparison: ModelComparison, title: str) -> Report:
+    """The table of ``comparison``: each metric of each model and its change."""
+    models, ref = comparison.models, comparison.models[comparison.reference]
     columns = ["metric", "unit"] + [f"{m.label} (Δ %)" for m in models]
     rows, shown_na = [], False
     for name in comparison.metric_names:

@@ -33,24 +33,8 @@ values show as ``failed``). Nothing is computed with a floating-point warning. T
 no supplementary objectives (Eq 7.7-7.10 in Ch. 7), so when the config has some, the stored
 designs are simulated once more with the stored config for theirs, to compare them too.
 
-HDF5 layout (root attributes as every suspopt file, ``config`` = the stored config's text, plus
-``analysis`` (the kind) and ``source`` (the Pareto file)); every dataset has ``units`` (one per
-column for X, F, S, as ``suspopt optimise`` writes them; X, F, S also ``names``):
-
-- ``/pareto/X (N, n)``, ``/pareto/F (N, m)``: the stored front, ``/pareto/feasible (N,)``,
-  ``/pareto/id (N,)`` the designs' ids (:mod:`suspopt.design_ids`; ``source_row`` their rows
-  in the file given, with ``--pick``), and ``/pareto/S (N, s)``, its supplementary objectives
-  re-simulated (if the config has any);
-- ``/pseudo`` with attribute ``labels``; per change ``/pseudo/<label>/``: ``F (N, m)``,
-  ``S (N, s)`` (if any), ``change (N, m)`` and ``S_change (N, s)`` [%], ``feasible (N,)``,
-  ``failed (N,)`` [1], and ``X (N, n)`` when the change alters the designs' own values;
-  attributes ``label``, ``config`` (the changed config's YAML text) and the change
-  (``road_class`` or ``road_source``; ``load_mass`` [kg] and ``mass_change`` [kg];
-  ``controller_source``).
-- dimensions (:func:`suspopt.io.write_dataset`), in ``/pareto`` and in each
-  ``/pseudo/<label>``: ``design`` (row numbers of the stored front), ``variable``,
-  ``objective`` and ``supplementary`` (the names of the columns of X, F and change, S and
-  S_change).
+The file's layout is declared once, in :data:`suspopt.formats.PSEUDO` (its ``/pareto``, the
+front analysed, is that of every analysis of a front).
 """
 
 from __future__ import annotations
@@ -71,11 +55,12 @@ from ..config import Config, ConfigError
 from ..config.loader import edit_config, line_of, set_path
 from ..design_ids import front_ids, id_marks
 from ..files import Unreadable, listed, status
-from ..io import atomic_h5, write_attrs, write_dataset
+from ..formats import PSEUDO, FileFormat
+from ..io import atomic_h5, put, write_attrs
 from ..plots.runs import evenly_spaced
 from ..seat import build_seat, passenger_mass_change
 from . import cells
-from .registry import KINDS, Kind, Report, relative_change
+from .registry import KINDS, Analysis, Kind, Report, analysis, relative_change
 
 __all__ = [
     "Variant",
@@ -401,60 +386,50 @@ def pseudo_fronts(kind: str, pareto: ParetoSet, variants: Sequence[Variant]) -> 
     return PseudoFronts(kind=kind, pareto=pareto, stored=stored, variants=list(variants), sets=sets)
 
 
-def _columns(group, name: str, data, dim: str, names, units) -> None:
-    """``data (N, len(names))`` over the dimensions ``design`` and ``dim`` (the names)."""
-    write_dataset(group, name, data, list(units), dims=("design", dim), names=names)
-
-
-def write_stored_front(h5, kind: str, pareto: ParetoSet, stored: DesignSet) -> None:
+def write_stored_front(
+    h5, fmt: FileFormat, kind: str, pareto: ParetoSet, stored: DesignSet
+) -> None:
     """The root attributes ``analysis`` and ``source`` and the group ``/pareto`` of an
-    analysis of the front ``pareto`` (module docstring), ``stored`` its designs evaluated
-    under the stored config."""
+    analysis of the front ``pareto`` (``fmt``: the file's format), ``stored`` its designs
+    evaluated under the stored config."""
     m, names, units = pareto.F.shape[1], stored.names, stored.units
     h5.attrs["analysis"] = kind
     h5.attrs["source"] = str(pareto.path)
     grp = h5.create_group("pareto")
-    _columns(grp, "X", pareto.X, "variable", pareto.var_names, pareto.var_units)
-    _columns(grp, "F", pareto.F, "objective", names[:m], units[:m])
-    write_dataset(grp, "feasible", stored.feasible.astype(np.int8), "1", dims=("design",))
+    put(fmt, grp, "X", pareto.X, list(pareto.var_units), names=pareto.var_names)
+    put(fmt, grp, "F", pareto.F, list(units[:m]), names=names[:m])
+    put(fmt, grp, "feasible", stored.feasible.astype(np.int8))
     picks = grp.create_group("picks")
     for key, row in pareto.marks().items():
-        write_dataset(picks, key, row, "1")
+        put(fmt, picks, key, row)
     if pareto.source_rows is not None:  # (designs picked from the file)
-        write_dataset(grp, "source_row", pareto.source_rows, "1", dims=("design",))
-    write_dataset(grp, "id", front_ids(pareto), "1", dims=("design",))
+        put(fmt, grp, "source_row", pareto.source_rows)
+    put(fmt, grp, "id", front_ids(pareto))
     if len(names) > m:
-        _columns(grp, "S", stored.F[:, m:], "supplementary", names[m:], units[m:])
+        put(fmt, grp, "S", stored.F[:, m:], list(units[m:]), names=names[m:])
 
 
 def write_pseudo_fronts(path: str | Path, fronts: PseudoFronts, command: str | None = None) -> Path:
-    """Write ``fronts`` with the layout of the module docstring (atomically)."""
+    """Write ``fronts`` as :data:`suspopt.formats.PSEUDO` declares it (atomically)."""
     p, m = fronts.pareto, fronts.m
     names, units = fronts.stored.names, fronts.stored.units
     with atomic_h5(path, p.config(), command, inputs=[("the input", p.path)]) as h5:
-        write_stored_front(h5, fronts.kind, p, fronts.stored)
+        write_stored_front(h5, PSEUDO, fronts.kind, p, fronts.stored)
         pseudo = h5.create_group("pseudo")
         write_attrs(pseudo, labels=[v.label for v in fronts.variants])
         for i, (variant, s) in enumerate(zip(fronts.variants, fronts.sets)):
             g = pseudo.create_group(variant.label.replace("/", "_"))
             write_attrs(g, label=variant.label, config=variant.config.text, **variant.attrs)
             values, change = fronts.values(i), fronts.change(i)
-            _columns(g, "F", values[:, :m], "objective", names[:m], units[:m])
-            _columns(g, "change", change[:, :m], "objective", names[:m], ["%"] * m)
+            put(PSEUDO, g, "F", values[:, :m], list(units[:m]), names=names[:m])
+            put(PSEUDO, g, "change", change[:, :m], ["%"] * m, names=names[:m])
             if len(names) > m:
-                _columns(g, "S", values[:, m:], "supplementary", names[m:], units[m:])
-                _columns(
-                    g,
-                    "S_change",
-                    change[:, m:],
-                    "supplementary",
-                    names[m:],
-                    ["%"] * (len(names) - m),
-                )
+                put(PSEUDO, g, "S", values[:, m:], list(units[m:]), names=names[m:])
+                put(PSEUDO, g, "S_change", change[:, m:], ["%"] * (len(names) - m), names=names[m:])
             if variant.X is not None:
-                _columns(g, "X", variant.X, "variable", p.var_names, p.var_units)
-            write_dataset(g, "feasible", s.feasible.astype(np.int8), "1", dims=("design",))
-            write_dataset(g, "failed", s.failed.astype(np.int8), "1", dims=("design",))
+                put(PSEUDO, g, "X", variant.X, list(p.var_units), names=p.var_names)
+            put(PSEUDO, g, "feasible", s.feasible.astype(np.int8))
+            put(PSEUDO, g, "failed", s.failed.astype(np.int8))
     return Path(path)
 
 
@@ -544,25 +519,26 @@ def _report(fronts: PseudoFronts, title: str) -> Report:
 def run_variants(
     kind: str,
     source: Path,
-    output: Path | None,
-    plot: Path | None,
     variants: Callable[[ParetoSet], list[Variant]],
     what: str,
     pick: Sequence[str] | None = None,
-) -> tuple[Report, PseudoFronts]:
+) -> Analysis:
     """The analysis ``kind`` of the Pareto file ``source`` (or of its designs ``pick``:
-    :func:`suspopt.choosing.picks.read_front`) under the ``variants`` made of it: written, drawn,
-    and its report (and the fronts, for more notes)."""
-    if plot is not None:
-        plots.check_path(plot)
+    :func:`suspopt.choosing.picks.read_front`) under the ``variants`` made of it
+    (:func:`pseudo_fronts`); nothing written."""
     pareto = read_front(source, pick)
     fronts = pseudo_fronts(kind, pareto, variants(pareto))
     title = f"{kind}: {pareto.path.name} {what}"
-    if output is not None:
-        write_pseudo_fronts(output, fronts)
-    if plot is not None:
-        plot_pseudo_fronts(fronts, plot, title)
-    return _report(fronts, title), fronts
+    return analysis(
+        kind,
+        title,
+        fronts,
+        pareto.config(),
+        [pareto.path],
+        lambda path, command: write_pseudo_fronts(path, fronts, command),
+        lambda path: plot_pseudo_fronts(fronts, path, title),
+        lambda: _report(fronts, title),
+    )
 
 
 def _pseudo_kind(
@@ -572,15 +548,9 @@ def _pseudo_kind(
     ``make`` gives, the command-line option ``option`` passed to it as ``keyword``
     (:func:`run_variants`)."""
 
-    def run(
-        source: Path,
-        output: Path | None = None,
-        plot: Path | None = None,
-        pick: Sequence[str] | None = None,
-        **given: Any,
-    ) -> Report:
+    def run(source: Path, pick: Sequence[str] | None = None, **given: Any) -> Analysis:
         chosen = {keyword: given[option]} if option in given else {}
-        return run_variants(kind, source, output, plot, partial(make, **chosen), what, pick)[0]
+        return run_variants(kind, source, partial(make, **chosen), what, pick)
 
     run.__name__ = run.__qualname__ = f"run_{kind}"
     run.__doc__ = (

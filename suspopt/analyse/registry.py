@@ -1,17 +1,21 @@
 """What every analysis kind shares: its :class:`Kind` entry in :data:`KINDS` (filled by the
-module that implements it), the :class:`Report` it returns, the help's :data:`SUMMARIES` and
-:func:`relative_change`. Re-exported by :mod:`suspopt.analyse`."""
+module that implements it), the :class:`Analysis` it returns, the :class:`Report` table that
+shows it, the help's :data:`SUMMARIES` and :func:`relative_change`. Re-exported by
+:mod:`suspopt.analyse`."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import numpy as np
 
-__all__ = ["Report", "Kind", "KINDS", "SUMMARIES", "relative_change"]
+    from ..config import Config
+
+__all__ = ["Analysis", "Report", "Kind", "KINDS", "SUMMARIES", "relative_change"]
 
 
 @dataclass
@@ -24,15 +28,91 @@ class Report:
     notes: list[str] = field(default_factory=list)
 
 
-@dataclass(frozen=True)
-class Kind:
-    """An analysis kind: ``run(source | sources, output, plot, **options)``.
+@dataclass
+class Analysis:
+    """What an analysis computed, before anything is written or shown.
 
-    ``many``: ``run`` takes a list of sources (else exactly one path); ``options``: the names
-    of the keyword options ``run`` accepts besides ``output`` and ``plot``.
+    Attributes
+    ----------
+    kind : str
+        The analysis kind (``builds``, ``roads`` ...).
+    title : str
+        What it is of, in one line (the table's and the figure's title).
+    data : object
+        The kind's own result, with its units: ``suspopt.analyse.models.ModelComparison``,
+        ``suspopt.analyse.pseudo.PseudoFronts``, ``suspopt.analyse.builds.Builds``,
+        ``suspopt.analyse.transmissibility.SeatTransmissibility``,
+        ``suspopt.analyse.cdf.CdfSensitivity`` or
+        ``suspopt.analyse.scenarios.ScenarioSpread``.
+    config : Config
+        The config it ran (provenance; the written file's root attribute ``config``).
+    sources : list of Path
+        The files it read.
+    writer : callable
+        The kind's writer of its file, ``(path, command) -> path``, bound to ``data``
+        (what :meth:`write` calls).
+    drawer : callable or None
+        Its figure, ``(path) -> path`` (what :meth:`plot` calls; None: it draws none).
+    tabulate : callable
+        Its table, ``() -> Report`` (what :meth:`report` calls).
+
+    Computing it wrote nothing. :meth:`write` writes its HDF5 file (the kind's format in
+    :mod:`suspopt.formats`), :meth:`plot` draws its figure and :meth:`report` makes its
+    table; the command line calls them as ``-o``, ``--plot`` and its output ask.
     """
 
-    run: Callable[..., Report]
+    kind: str
+    title: str
+    data: Any
+    config: Config
+    sources: list[Path]
+    writer: Callable[[Path, str | None], Path] = field(repr=False)
+    drawer: Callable[[Path], Path] | None = field(repr=False)
+    tabulate: Callable[[], Report] = field(repr=False)
+
+    def write(self, path: str | Path, command: str | None = None) -> Path:
+        """Write the HDF5 file ``path`` (atomically; ``command`` the root attribute
+        ``command``, default this process's command line); return its path."""
+        return self.writer(Path(path), command)
+
+    def plot(self, path: str | Path) -> Path:
+        """Draw the figure ``path`` (``.png`` or ``.svg``); return its path."""
+        from .. import plots
+
+        plots.check_path(path)
+        if self.drawer is None:
+            raise ValueError(f"analyse {self.kind} draws no figure")
+        return self.drawer(Path(path))
+
+    def report(self) -> Report:
+        """The table (formatted cells) and notes that ``suspopt analyse`` prints."""
+        return self.tabulate()
+
+
+def analysis(
+    kind: str,
+    title: str,
+    data: Any,
+    config: Config,
+    sources: Sequence[str | Path],
+    writer: Callable[[Path, str | None], Path],
+    drawer: Callable[[Path], Path] | None,
+    tabulate: Callable[[], Report],
+) -> Analysis:
+    """An :class:`Analysis` (its sources as paths)."""
+    return Analysis(kind, title, data, config, [Path(s) for s in sources], writer, drawer, tabulate)
+
+
+@dataclass(frozen=True)
+class Kind:
+    """An analysis kind: ``run(source | sources, **options) -> Analysis``, which computes and
+    writes nothing.
+
+    ``many``: ``run`` takes a list of sources (else exactly one path); ``options``: the names
+    of the keyword options ``run`` accepts.
+    """
+
+    run: Callable[..., Analysis]
     many: bool = False
     options: tuple[str, ...] = ()
 

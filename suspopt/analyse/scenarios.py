@@ -10,28 +10,27 @@ combined value, its smallest, mean and largest value over the scenarios, the sce
 it is largest, and in how many scenarios the design holds every constraint; and for the
 whole front, how many designs hold every constraint in every scenario.
 
-HDF5 layout (root attributes as every suspopt file, ``config`` the stored config's text,
-``analysis = "scenarios"``, ``source`` the Pareto file): ``/scenarios/pick`` (names),
-``row (picks,)`` [1], ``F (picks, S, m)`` in the objectives' units (per column),
-``holds (picks, S)`` [1] (1 where every constraint holds), ``scenario`` (names).
+The file's layout: :data:`suspopt.formats.SCENARIOS`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from .. import plots
 from ..choosing.kepsilon import pareto_picks
-from ..choosing.selection import read_pareto
+from ..choosing.selection import ParetoSet, read_pareto
 from ..errors import ConfigError
+from ..formats import SCENARIOS
 from ..h5read import H5Reader
-from ..io import atomic_h5, text_array, write_dataset
-from .registry import KINDS, Kind, Report
+from ..io import atomic_h5, put
+from .registry import KINDS, Analysis, Kind, Report, analysis
 
-__all__ = ["run", "read_scenarios"]
+__all__ = ["run", "read_scenarios", "ScenarioSpread"]
 
 #: ``--pick`` as the analyses take it: names or row numbers, or None for the front's picks
 Picks = Sequence[str] | None
@@ -65,31 +64,90 @@ def read_scenarios(path: Path):
     return pareto, names, FS, GS
 
 
-def run(
-    source: Path, output: Path | None = None, plot: Path | None = None, *, pick: Picks = None
-) -> Report:
+@dataclass
+class ScenarioSpread:
+    """A robust front's picks under each of its scenarios: ``pareto`` (the front), ``names``
+    (the S scenarios), ``FS (N, S, m)`` every design's objectives under each (their units:
+    ``units``), ``holds (N, S)`` whether it meets every constraint there, ``picks`` (name ->
+    row), ``rules`` (each objective's ``over_scenarios`` rule, "" where the file has none)."""
+
+    source: Path
+    pareto: ParetoSet
+    names: list[str]
+    FS: np.ndarray
+    holds: np.ndarray
+    units: list[str]
+    picks: dict[str, int]
+    rules: list[str]
+
+
+def run(source: Path, *, pick: Picks = None) -> Analysis:
     """The picks of a robust front under every scenario, or the designs ``pick`` names
-    (:func:`_picks`; module docstring)."""
-    if plot is not None:
-        plots.check_path(plot)
+    (:func:`_picks`; module docstring); nothing simulated, nothing written."""
+    source = Path(source)
     pareto, names, FS, GS = read_scenarios(source)
-    cfg = pareto.config()
     with H5Reader(source) as h5:
         units = h5.labels("pareto/F", "units", pareto.F.shape[1])
-    picks = _picks(source, pareto.F, pareto.obj_names, pick)
-    rows_of = list(picks.values())
-    holds = (GS <= 0).all(axis=2)  # (N, S)
-    rules = _rules(source, len(pareto.obj_names))
+    spread = ScenarioSpread(
+        source,
+        pareto,
+        names,
+        FS,
+        (GS <= 0).all(axis=2),
+        list(units),
+        _picks(source, pareto.F, pareto.obj_names, pick),
+        _rules(source, len(pareto.obj_names)),
+    )
+    return analysis(
+        "scenarios",
+        f"{source.name}: the picks under {len(names)} scenarios",
+        spread,
+        pareto.config(),
+        [source],
+        lambda path, command: _write(path, spread, command),
+        lambda path: _plot(spread, path),
+        lambda: _table(spread),
+    )
+
+
+def _write(output: Path, s: ScenarioSpread, command: str | None) -> Path:
+    """The picks' rows of ``s`` (:data:`suspopt.formats.SCENARIOS`), atomically."""
+    rows_of = list(s.picks.values())
+    with atomic_h5(output, s.pareto.config(), command) as h5:
+        h5.attrs.update(analysis="scenarios", source=str(s.source))
+        group = h5.create_group("scenarios")
+        put(SCENARIOS, group, "scenario", s.names)
+        put(SCENARIOS, group, "pick", list(s.picks))
+        put(SCENARIOS, group, "row", np.array(rows_of))
+        put(SCENARIOS, group, "F", s.FS[rows_of], s.units, names=s.pareto.obj_names,
+            over_scenarios=s.rules)  # fmt: skip
+        put(SCENARIOS, group, "holds", s.holds[rows_of].astype(np.int8))
+    return output
+
+
+def _plot(s: ScenarioSpread, path: Path) -> Path:
+    """Each objective of each pick over the scenarios (:func:`suspopt.plots.scenario_spread`)."""
+    objectives = [
+        (name, unit, {f"{pick} (design {row})": s.FS[row, :, j] for pick, row in s.picks.items()})
+        for j, (name, unit) in enumerate(zip(s.pareto.obj_names, s.units))
+    ]
+    title = f"{s.source.name}: the front's picks under each scenario"
+    return plots.scenario_spread(path, title, s.names, objectives)
+
+
+def _table(s: ScenarioSpread) -> Report:
+    """Each pick's objectives: combined, min, mean, max over the scenarios, the worst one."""
+    pareto, names, holds = s.pareto, s.names, s.holds
     table = []
-    for pick, row in picks.items():
-        for j, (name, unit) in enumerate(zip(pareto.obj_names, units)):
-            values = FS[row, :, j]
+    for pick, row in s.picks.items():
+        for j, (name, unit) in enumerate(zip(pareto.obj_names, s.units)):
+            values = s.FS[row, :, j]
             table.append(
                 [
                     pick if j == 0 else "",
                     str(row) if j == 0 else "",
                     f"{name} [{unit}]",
-                    f"{pareto.F[row, j]:.4g}" + (f" ({rules[j]})" if rules[j] else ""),
+                    f"{pareto.F[row, j]:.4g}" + (f" ({s.rules[j]})" if s.rules[j] else ""),
                     f"{np.nanmin(values):.4g}",
                     f"{np.nanmean(values):.4g}",
                     f"{np.nanmax(values):.4g}",
@@ -104,36 +162,8 @@ def run(
         "combined: the value /pareto/F holds (each objective's over_scenarios); min, mean, "
         "max: over the scenarios",
     ]
-    if output is not None:
-        with atomic_h5(output, cfg) as h5:
-            h5.attrs.update(analysis="scenarios", source=str(source))
-            group = h5.create_group("scenarios")
-            write_dataset(group, "scenario", names, "1", dims=("scenario",))
-            write_dataset(group, "pick", list(picks), "1", dims=("pick",))
-            write_dataset(group, "row", np.array(rows_of), "1", dims=("pick",))
-            write_dataset(
-                group, "F", FS[rows_of], units, dims=("pick", "scenario", "objective"),
-                names=pareto.obj_names,
-            )  # fmt: skip
-            write_dataset(group, "holds", holds[rows_of].astype(np.int8), "1",
-                          dims=("pick", "scenario"))  # fmt: skip
-            group["F"].attrs["over_scenarios"] = text_array(rules)
-    if plot is not None:
-        plots.scenario_spread(
-            plot,
-            f"{source.name}: the front's picks under each scenario",
-            names,
-            [
-                (
-                    name,
-                    unit,
-                    {f"{pick} (design {row})": FS[row, :, j] for pick, row in picks.items()},
-                )
-                for j, (name, unit) in enumerate(zip(pareto.obj_names, units))
-            ],
-        )
     return Report(
-        title=f"{source.name}: the picks under {len(names)} scenarios",
+        title=f"{s.source.name}: the picks under {len(names)} scenarios",
         columns=["pick", "design", "objective", "combined", "min", "mean", "max",
                  "worst scenario", "feasible in"],
         rows=table,

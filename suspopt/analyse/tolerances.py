@@ -38,7 +38,7 @@ from ..files import listed
 from ..params import field_range
 from .cells import NOT_COMPUTED, percent
 from .pseudo import PseudoFronts, Variant, run_variants
-from .registry import KINDS, Kind, Report
+from .registry import KINDS, Analysis, Kind, Report
 
 __all__ = [
     "TOLERANCE",
@@ -202,26 +202,27 @@ def _held_notes(variants: Sequence[Variant]) -> list[str]:
 
 
 def run_tolerances(
-    source: Path,
-    output: Path | None = None,
-    plot: Path | None = None,
-    tolerance: Tolerances = None,
-    pick: Sequence[str] | None = None,
-) -> Report:
+    source: Path, tolerance: Tolerances = None, pick: Sequence[str] | None = None
+) -> Analysis:
     """``suspopt analyse tolerances PARETO.h5 [--tolerance 10] [--tolerance NAME=T] [--pick
-    NAMES]`` (module docstring)."""
+    NAMES]`` (module docstring); nothing written."""
     variants = partial(tolerance_variants, tolerance=tolerance)
-    report, fronts = run_variants(
+    done = run_variants(
         "tolerances",
         Path(source),
-        output,
-        plot,
         variants,
         "with each design variable off by its tolerance in turn",
         pick,
     )
-    report.notes += [_largest_changes(fronts), *_held_notes(fronts.variants)]
-    return report
+    fronts, table = done.data, done.tabulate
+
+    def tabulate() -> Report:
+        report = table()
+        report.notes += [_largest_changes(fronts), *_held_notes(fronts.variants)]
+        return report
+
+    done.tabulate = tabulate
+    return done
 
 
 KINDS["tolerances"] = Kind(run_tolerances, options=("tolerance", "pick"))

@@ -27,23 +27,10 @@ does that: the ``seat.mass`` and ``seat.passenger`` of that file (e.g.
 designs' ``X_ST`` (their ``K_v = m g / X_ST`` follows the load), PS and NSS4 keep their
 stiffnesses, as in Sec 8.4.3.
 
-HDF5 layout (every dataset has a ``units`` attribute; root attributes as every suspopt file):
-
-- ``/linear/frequency (F,)`` [Hz], ``/linear/<dof> (P, F)`` [-];
-- ``/simulated/frequency (F2,)`` [Hz], ``/simulated/<dof> (P, F2)`` [-],
-  ``/simulated/coherence/<dof> (P, F2)`` [-];
-- ``/statics/static_deflection (P,)`` [m] (X_ST);
-- ``/modal/frequency (P, m)`` [Hz]: undamped, floor held still, attr ``dof_names``;
-- ``/constraints/<name> (P,)`` (:func:`suspopt.seat.seat_constraints`, ``g <= 0`` feasible);
-- ``/weighted_rms/<signal> (P,)`` [m/s^2]: ISO 2631-1 Wk r.m.s. of ``seat.acc`` and
-  ``head.acc`` in the simulation;
-- for a Pareto file, ``/designs/X (P, n)`` and ``/designs/F (P, m)`` (with ``names``, one unit
-  per column), ``/designs/row (P,)`` [1] (the rows of the file's ``/pareto``), ``/designs/id
-  (P,)`` [1] (the designs' ids, :mod:`suspopt.design_ids`) and the attribute ``picks`` of
-  ``/designs`` (each design's pick names, e.g. ``best_X_ST``, ``knee``).
-- dimensions (:func:`suspopt.io.write_dataset`): ``/design (P,)`` (row numbers), the
-  ``frequency`` of ``/linear`` and of ``/simulated``, ``/modal/mode`` (numbering the modes),
-  ``/designs/variable`` and ``/designs/objective`` (the names of the columns of X and F).
+The file's layout: :data:`suspopt.formats.TRANSMISSIBILITY` (``/modal/frequency``:
+undamped, the floor held still; ``/constraints/<name>``:
+:func:`suspopt.seat.seat_constraints`, ``g <= 0`` feasible; ``/weighted_rms/<signal>``: the
+ISO 2631-1 Wk r.m.s. of ``seat.acc`` and ``head.acc`` in the simulation).
 """
 
 from __future__ import annotations
@@ -61,7 +48,8 @@ from ..config import Config, ConfigError, load_config
 from ..config.loader import require_config
 from ..design_ids import front_ids
 from ..files import is_hdf5
-from ..io import atomic_h5, write_attrs, write_dataset
+from ..formats import TRANSMISSIBILITY
+from ..io import atomic_h5, put, write_attrs
 from ..metrics import coherence, transmissibility, weighted_rms
 from ..optimisation import Problem
 from ..params import ParamView
@@ -75,7 +63,7 @@ from ..seat import (
 )
 from ..simulation import simulate
 from .pseudo import config_with, read_sections
-from .registry import KINDS, Kind, Report
+from .registry import KINDS, Analysis, Kind, Report, analysis
 
 __all__ = [
     "SeatTransmissibility",
@@ -262,48 +250,32 @@ def write_transmissibility(
     they were picked from a front."""
     with atomic_h5(path, cfg, command) as h5:
         h5.attrs["seat_kind"] = data.kind
-        write_dataset(h5, "design", np.arange(len(data.static_deflection)), "1", dims=("design",))
+        T = TRANSMISSIBILITY
+        put(T, h5, "design", np.arange(len(data.static_deflection)))
         lin, sim = h5.create_group("linear"), h5.create_group("simulated")
-        write_dataset(lin, "frequency", data.linear_frequency, "Hz", dims=("frequency",))
-        write_dataset(sim, "frequency", data.simulated_frequency, "Hz", dims=("frequency",))
+        put(T, lin, "frequency", data.linear_frequency)
+        put(T, sim, "frequency", data.simulated_frequency)
         coh = sim.create_group("coherence")
-        spectrum = ("design", "frequency")
         for j, name in enumerate(data.dof_names):
-            write_dataset(lin, name, data.linear[..., j], "-", dims=spectrum)
-            write_dataset(sim, name, data.simulated[..., j], "-", dims=spectrum)
-            write_dataset(coh, name, data.coherence[..., j], "-", dims=spectrum)
-        write_dataset(
-            h5.create_group("statics"),
-            "static_deflection",
-            data.static_deflection,
-            "m",
-            dims=("design",),
-        )
-        write_dataset(
-            h5.create_group("modal"),
-            "frequency",
-            data.natural_frequency,
-            "Hz",
-            dims=("design", "mode"),
-            dof_names=list(data.dof_names),
-        )
+            put(T, lin, name, data.linear[..., j])
+            put(T, sim, name, data.simulated[..., j])
+            put(T, coh, name, data.coherence[..., j])
+        put(T, h5.create_group("statics"), "static_deflection", data.static_deflection)
+        put(T, h5.create_group("modal"), "frequency", data.natural_frequency,
+            dof_names=list(data.dof_names))  # fmt: skip
         con = h5.create_group("constraints")
         for name, values in data.constraints.items():
-            write_dataset(con, name, values, CONSTRAINT_UNITS[name], dims=("design",))
+            put(T, con, name, values, CONSTRAINT_UNITS[name])
         rms = h5.create_group("weighted_rms")
         for name, values in data.weighted_rms.items():
-            write_dataset(rms, name, values, "m/s^2", dims=("design",))
+            put(T, rms, name, values)
         if designs is not None:
             grp = h5.create_group("designs")
             write_attrs(grp, picks=[", ".join(p) for p in designs.picks])
-            write_dataset(grp, "row", designs.rows, "1", dims=("design",))
-            write_dataset(grp, "id", designs.ids, "1", dims=("design",))
-            for key, values, units, dim, names in (
-                ("X", designs.X, designs.var_units, "variable", designs.var_names),
-                ("F", designs.F, designs.obj_units, "objective", designs.obj_names),
-            ):
-                dims = ("design", dim)
-                write_dataset(grp, key, values, list(units), dims=dims, names=names)
+            put(T, grp, "row", designs.rows)
+            put(T, grp, "id", designs.ids)
+            put(T, grp, "X", designs.X, list(designs.var_units), names=designs.var_names)
+            put(T, grp, "F", designs.F, list(designs.obj_units), names=designs.obj_names)
     return Path(path)
 
 
@@ -382,13 +354,7 @@ def _peak(f: np.ndarray, values: np.ndarray, valid: np.ndarray | None = None):
     return values[i], f[i]
 
 
-def _run_front(
-    source: Path,
-    output: Path | None,
-    plot: Path | None,
-    with_: Sequence[Path],
-    pick: Sequence[str] | None,
-) -> Report:
+def _run_front(source: Path, with_: Sequence[Path], pick: Sequence[str] | None) -> Analysis:
     """The picks of a Pareto file, or the designs ``pick`` names (module docstring)."""
     if len(with_) > 1:
         raise ConfigError("analyse transmissibility takes one --with FILE.yaml")
@@ -402,10 +368,26 @@ def _run_front(
             raise
         raise ConfigError(f"{pareto.path}: /pareto/X: {exc}") from None
     title = f"{data.kind.upper()} front of {pareto.path.name}"
-    if output is not None:
-        write_transmissibility(output, data, cfg, designs=designs)
-    if plot is not None:
-        plot_front_transmissibility(data, designs, plot, title)
+    return analysis(
+        "transmissibility",
+        title,
+        data,
+        cfg,
+        [pareto.path, *with_],
+        lambda path, command: write_transmissibility(path, data, cfg, command, designs),
+        lambda path: plot_front_transmissibility(data, designs, path, title),
+        lambda: _front_table(data, designs, pareto, title, with_),
+    )
+
+
+def _front_table(
+    data: SeatTransmissibility,
+    designs: FrontDesigns,
+    pareto: ParetoSet,
+    title: str,
+    with_: Sequence[Path],
+) -> Report:
+    """The table of a front's designs: their objectives, X_ST, peaks and r.m.s."""
     name = "head" if "head" in data.dof_names else "seat"
     label = "STHT" if name == "head" else "seat TR"
     j = data.dof_names.index(name)
@@ -456,29 +438,31 @@ def _run_front(
     return Report(title=f"transmissibility - {title}", columns=columns, rows=rows, notes=notes)
 
 
-def run(
-    source: Path,
-    output: Path | None = None,
-    plot: Path | None = None,
-    with_: Sequence[Path] = (),
-    pick: Sequence[str] | None = None,
-) -> Report:
+def run(source: Path, with_: Sequence[Path] = (), pick: Sequence[str] | None = None) -> Analysis:
     """The ``transmissibility`` analysis of ``source``: a YAML config with a seat, or a Pareto
     file (then ``with_`` may give the passenger, module docstring), or with ``pick`` those
-    designs of a result file (:func:`suspopt.choosing.picks.read_front`)."""
-    if plot is not None:
-        plots.check_path(plot)
+    designs of a result file (:func:`suspopt.choosing.picks.read_front`); nothing written."""
     if is_hdf5(source):
-        return _run_front(Path(source), output, plot, with_, pick)
+        return _run_front(Path(source), with_, pick)
     for given, option in ((with_, "--with"), (pick, "--pick")):
         if given:
             raise ConfigError(f"analyse transmissibility {source}: {option} is for a result file")
     cfg = load_config(source)
     data = seat_transmissibility(cfg)
-    if output is not None:
-        write_transmissibility(output, data, cfg)
-    if plot is not None:
-        plot_transmissibility(data, plot)
+    return analysis(
+        "transmissibility",
+        f"transmissibility - {data.kind.upper()} seat ({Path(source).name})",
+        data,
+        cfg,
+        [Path(source)],
+        lambda path, command: write_transmissibility(path, data, cfg, command),
+        lambda path: plot_transmissibility(data, path),
+        lambda: _config_table(data, Path(source)),
+    )
+
+
+def _config_table(data: SeatTransmissibility, source: Path) -> Report:
+    """The table of one config's seat: X_ST, its modes, peaks, r.m.s. and constraints."""
     rows = [
         ["static deflection X_ST", "mm", f"{1e3 * data.static_deflection[0]:.2f}"],
         ["natural frequencies", "Hz", ", ".join(f"{f:.2f}" for f in data.natural_frequency[0])],
@@ -506,7 +490,7 @@ def run(
     if "head" not in data.dof_names:
         notes.append("no passenger: STHT needs seat.passenger (e.g. passenger: {})")
     return Report(
-        title=f"transmissibility - {data.kind.upper()} seat ({Path(source).name})",
+        title=f"transmissibility - {data.kind.upper()} seat ({source.name})",
         columns=["quantity", "unit", "value"],
         rows=rows,
         notes=notes,

@@ -2,7 +2,7 @@
 
 1. :func:`read_pareto` reads a ``suspopt optimise`` file (``/pareto/X`` physical values,
    ``/pareto/F``, ``/pareto/G`` with ``names`` and ``units``; root attribute ``config``, the
-   YAML text: layout in :mod:`suspopt.optimisation.run`).
+   YAML text: :data:`suspopt.formats.OPTIMISE`).
 2. :func:`evaluate_pareto` gives every design its objectives, main then supplementary, under
    a config: the file's own, or another one with the same design variables (the same designs
    with a CDF controller: the thesis's "pseudo Pareto fronts", Sec 7.2.2, Fig. 7.4b). When
@@ -19,29 +19,8 @@
 A *case* is a label: the sets of several files carry one label to form one case (Ch. 6 Part A
 pools the optima of C1-C4).
 
-HDF5 layout, every dataset with a ``units`` attribute (one per column for F and X):
-
-- ``/kesort/F (N, m)`` main + supplementary objectives, ``names``; ``/kesort/X (N, n)``
-  physical design variables, ``names`` (the union over the cases; NaN where a case has no such
-  variable); ``/kesort/k_eps (N,)``, ``/kesort/k (N,)`` (k-optimality), ``/kesort/chosen``
-  (index of the pool's optimum), ``/kesort/ties``; ``/kesort/case (N,)`` labels,
-  ``/kesort/source (N,)`` (the Pareto set it came from: index into ``/kesort/sets``),
-  ``/kesort/row (N,)`` (its row in that file's ``/pareto``), ``/kesort/id (N,)`` (its id:
-  :mod:`suspopt.design_ids`), ``/kesort/feasible (N,)``; ``/kesort/picks/<best_f1 ...
-  knee>`` (indices); ``/kesort/sets/{file, label, config}``: each Pareto set's file, case
-  label and the YAML text of the config that evaluated it.
-- ``/kesort/F_as_built (N, m)`` (``kesort --as-built Q``): the values the designs were
-  sorted and picked on, each objective's ``percentile`` (its attribute, [%]) over the
-  design's builds; ``F`` then holds their nominal values.
-- attributes of ``/kesort``: ``epsilon (m,)`` in the objectives' units, ``P`` (NaN for an
-  absolute ε), ``P_auto``, ``normalisation``, ``unique``, ``cases`` (the labels in order).
-- with several cases, ``/kesort/cases/<label>/`` holds the sort of that case alone:
-  ``rows`` (its designs' indices in ``/kesort``), ``k_eps``, ``k`` (over ``rows``),
-  ``chosen`` and ``ties`` (indices in ``/kesort``), ``picks/<key>``, with the same attributes.
-- root attributes: those of :func:`~suspopt.io.atomic_h5`, with the first set's config.
-- dimensions (:func:`suspopt.io.write_dataset`): ``/kesort/design`` (row numbers: the pool's
-  index), ``/kesort/objective`` and ``/kesort/variable`` (the names of the columns of F and
-  X), ``/kesort/tie``, ``/kesort/sets/set``; in a case, ``rows`` itself and ``case_tie``.
+The file's layout is declared once, in :data:`suspopt.formats.KESORT` (the docs' format
+page is made from it).
 """
 
 from __future__ import annotations
@@ -58,7 +37,8 @@ from ..config.loader import load_config_text
 from ..design_ids import picked_note, selection_ids
 from ..errors import require
 from ..files import listed
-from ..io import atomic_h5, write_attrs, write_dataset
+from ..formats import KESORT
+from ..io import atomic_h5, put, write_attrs
 from ..optimisation.problem import PENALTY, Problem
 from .kepsilon import KEpsilonSort, kesort, pareto_picks
 
@@ -373,7 +353,7 @@ def _relative_gap(a: np.ndarray, b: np.ndarray) -> float:
 def load_design_sets(
     files: Sequence[str | Path], configs: Sequence[str | Path] = (), labels: Sequence[str] = ()
 ) -> list[DesignSet]:
-    """Read and evaluate Pareto files for :func:`suspopt.choosing.selection.select`, as ``suspopt kesort``
+    """Read and evaluate Pareto files for :func:`suspopt.select`, as ``suspopt kesort``
     takes them.
 
     Parameters
@@ -470,9 +450,39 @@ def select(
     P_range=(0.01, 1.0),
     P_step: float = 0.01,
 ) -> Selection:
-    """Pool ``sets`` and sort them by k-ε optimality (see the module docstring); ``eps``,
-    ``P``, ``normalise``, ``P_range`` and ``P_step`` go to :func:`suspopt.kesort`.
-    ConfigError when the sets have different objectives or no design is left to sort."""
+    """Pool ``sets`` and sort them by k-ε optimality (the module docstring): what ``suspopt
+    kesort`` runs.
+
+    Parameters
+    ----------
+    sets : sequence of DesignSet
+        The design sets (:func:`suspopt.load_design_sets`); sets of one label form one
+        case.
+    eps : float or array_like, optional
+        Absolute thresholds ``ε`` in the objectives' units (SI), one value or ``(m,)``.
+    P : float or "auto", optional
+        Threshold as a share [-] of each objective's largest normalised value (default
+        ``auto``).
+    normalise : {"max", "minmax"}
+        Normalisation of the objectives before the thresholds.
+    feasible_only : bool
+        Leave out the infeasible designs (the failed ones are always left out).
+    P_range : (float, float)
+        The range [-] searched for ``P = "auto"``.
+    P_step : float
+        Step [-] of that search.
+
+    Returns
+    -------
+    Selection
+        The pooled designs, their sort, the sort of each case and the picks;
+        :func:`suspopt.choosing.selection.write_selection` writes it.
+
+    Raises
+    ------
+    suspopt.InputError
+        When the sets have different objectives or no design is left to sort.
+    """
     sets = [
         require(s, DesignSet, f"sets[{i}]", "from load_design_sets(paths)")
         for i, s in enumerate(listed(sets))
@@ -580,16 +590,15 @@ def _write_sort(group, sort: KEpsilonSort, rows: np.ndarray | None, picks: dict[
     """k_eps, k, chosen, ties and picks of one sort; indices in the pool (``rows`` maps a
     case's own indices to the pool's and is the dimension of its k_eps and k)."""
     index = (lambda i: i) if rows is None else (lambda i: rows[i])
-    design, tie = ("design", "tie") if rows is None else ("rows", "case_tie")
     if rows is not None:
-        write_dataset(group, "rows", rows, "1", dims=("rows",))
-    write_dataset(group, "k_eps", sort.k_eps, "1", dims=(design,))
-    write_dataset(group, "k", sort.k, "1", dims=(design,))
-    write_dataset(group, "chosen", int(index(sort.chosen)), "1")
-    write_dataset(group, "ties", np.asarray(index(sort.ties), dtype=int), "1", dims=(tie,))
+        put(KESORT, group, "rows", rows)
+    put(KESORT, group, "k_eps", sort.k_eps)
+    put(KESORT, group, "k", sort.k)
+    put(KESORT, group, "chosen", int(index(sort.chosen)))
+    put(KESORT, group, "ties", np.asarray(index(sort.ties), dtype=int))
     grp = group.create_group("picks")
     for key, value in picks.items():
-        write_dataset(grp, key, int(value), "1")
+        put(KESORT, grp, key, int(value))
     write_attrs(
         group,
         epsilon=sort.epsilon,
@@ -601,23 +610,22 @@ def _write_sort(group, sort: KEpsilonSort, rows: np.ndarray | None, picks: dict[
 
 
 def write_selection(path: str | Path, selection: Selection, command: str | None = None) -> Path:
-    """Write ``/kesort`` (module docstring) to a new HDF5 file, atomically."""
+    """Write ``/kesort`` (its format: ``suspopt.formats.KESORT``) to a new HDF5 file,
+    atomically."""
     s = require(selection, Selection, "selection", "from select(sets)")
     inputs = [("the input", d.source) for d in s.sets]  # (the fronts it sorted)
     with atomic_h5(path, s.sets[0].config, command, inputs=inputs) as h5:
         grp = h5.create_group("kesort")
-        write_dataset(grp, "F", s.F, s.units, dims=("design", "objective"), names=s.names)
+        put(KESORT, grp, "F", s.F, s.units, names=s.names)
         if s.F_as_built is not None:
-            write_dataset(
-                grp, "F_as_built", s.F_as_built, s.units, dims=("design", "objective"),
-                names=s.names, percentile=s.as_built,
-            )  # fmt: skip
-        write_dataset(grp, "X", s.X, s.var_units, dims=("design", "variable"), names=s.var_names)
-        write_dataset(grp, "case", list(s.case), "1", dims=("design",))
-        write_dataset(grp, "source", s.source, "1", dims=("design",))
-        write_dataset(grp, "row", s.row, "1", dims=("design",))
-        write_dataset(grp, "id", list(selection_ids(s)), "1", dims=("design",))
-        write_dataset(grp, "feasible", s.feasible, "1", dims=("design",))
+            put(KESORT, grp, "F_as_built", s.F_as_built, s.units, names=s.names,
+                percentile=s.as_built)  # fmt: skip
+        put(KESORT, grp, "X", s.X, s.var_units, names=s.var_names)
+        put(KESORT, grp, "case", list(s.case))
+        put(KESORT, grp, "source", s.source)
+        put(KESORT, grp, "row", s.row)
+        put(KESORT, grp, "id", list(selection_ids(s)))
+        put(KESORT, grp, "feasible", s.feasible)
         _write_sort(grp, s.sort, None, s.picks)
         write_attrs(grp, cases=list(s.cases))
         sets = grp.create_group("sets")
@@ -626,7 +634,7 @@ def write_selection(path: str | Path, selection: Selection, command: str | None 
             ("label", [d.label for d in s.sets]),
             ("config", [d.config.text for d in s.sets]),
         ):
-            write_dataset(sets, key, values, "1", dims=("set",))
+            put(KESORT, sets, key, values)
         if s.case_sorts:
             cases = grp.create_group("cases")
             for label, cs in s.case_sorts.items():

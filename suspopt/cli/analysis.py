@@ -161,7 +161,12 @@ def analyse(
     inputs += [("--road", Path(r)) for r in road or []] + [("--with", w) for w in with_ or []]
     with run.outputs(output, plot, inputs=inputs):
         try:
-            report = spec.run(sources if spec.many else sources[0], output, plot, **options)
+            done = spec.run(sources if spec.many else sources[0], **options)
+            if output is not None:
+                done.write(output)
+            if plot is not None:
+                done.plot(plot)
+            report = done.report()
         except (ConfigError, FileNotFoundError, ValueError) as exc:
             base.fail(str(exc))
     _show(report, output, plot, full)

@@ -220,25 +220,19 @@ def _under_scenario(cfg, params, picked, name: str):
 def _picks_writer(picked, objectives):
     """Writes the picks' names, rows, ids (:mod:`suspopt.design_ids`) and objectives (new and
     stored) beside the signals."""
-    from ..io import write_dataset
+    from ..formats import SIMULATE
+    from ..io import put
 
     def extra(h5) -> None:
         F, names, units = objectives
         designs = h5.require_group("designs")
         designs.attrs["source"] = str(picked.source)
-        write_dataset(designs, "pick", list(picked.names), "1", dims=("design",))
-        write_dataset(designs, "row", picked.rows, "1", dims=("design",))
-        write_dataset(designs, "id", list(picked.ids), "1", dims=("design",))
+        put(SIMULATE, designs, "pick", list(picked.names))
+        put(SIMULATE, designs, "row", picked.rows)
+        put(SIMULATE, designs, "id", list(picked.ids))
         group = h5.create_group("objectives")
-        write_dataset(group, "F", F, units, dims=("design", "objective"), names=names)
-        write_dataset(
-            group,
-            "stored_F",
-            picked.F,
-            picked.obj_units,
-            dims=("design", "stored_objective"),
-            names=picked.obj_names,
-        )
+        put(SIMULATE, group, "F", F, units, names=names)
+        put(SIMULATE, group, "stored_F", picked.F, picked.obj_units, names=picked.obj_names)
 
     return extra
 

@@ -1,4 +1,4 @@
-"""The groups of an optimisation's HDF5 output (layout: docs/guide/results.md): the optimum
+"""The groups of an optimisation's HDF5 output (its format: :data:`suspopt.formats.OPTIMISE`): the optimum
 ``/pareto``, the ``/history`` per generation and the data-only ``/checkpoint`` that a
 ``--resume`` replays."""
 
@@ -10,27 +10,39 @@ import numpy as np
 
 from ..config import Config, ConfigError
 from ..files import Unreadable, status
-from ..io import write_dataset, write_tables
-from ..layout import Table
+from ..formats import OPTIMISE, Table
+from ..io import put, write_tables
 from .problem import Problem
 
 #: Format of the ``/checkpoint`` group: every evaluated design and its objectives, in batches.
 CHECKPOINT_FORMAT = "replay-1"
 
 
-def _tables(problem: Problem, x_units):
-    """(name, columns, units, dimension, names) of the design, objective and constraint tables."""
+def _columns(problem: Problem, x_units):
+    """(name, columns, units, names) of the design, objective and constraint tables."""
     return (
-        ("X", problem.n_var, x_units, "variable", problem.var_names),
-        ("F", problem.n_obj, problem.obj_units, "objective", problem.obj_names),
-        (
-            "G",
-            problem.n_ieq_constr,
-            problem.constraint_units,
-            "constraint",
-            problem.constraint_names,
-        ),
+        ("X", problem.n_var, x_units, problem.var_names),
+        ("F", problem.n_obj, problem.obj_units, problem.obj_names),
+        ("G", problem.n_ieq_constr, problem.constraint_units, problem.constraint_names),
     )
+
+
+def _xfg(group: str, problem: Problem, values, rules=None) -> list[Table]:
+    """X, F and G of ``group`` (``pareto``, ``baseline``; physical variables, SI units) as
+    the optimise file format declares them, F's and G's rule over the scenarios
+    (``over_scenarios``) when ``rules`` has them."""
+    rules = rules or {}
+    return [
+        OPTIMISE.table(
+            group,
+            key,
+            values[key],
+            units,
+            names=names,
+            attrs={"over_scenarios": rules[key]} if key in rules else {},
+        )
+        for key, _, units, names in _columns(problem, problem.var_units)
+    ]
 
 
 def pareto_tables(problem: Problem, optimum) -> list[Table]:
@@ -38,17 +50,7 @@ def pareto_tables(problem: Problem, optimum) -> list[Table]:
     units), F's and G's rule over the scenarios (``over_scenarios``) in a robust run."""
     values = {"X": optimum.X, "F": optimum.F, "G": optimum.G}
     rules = dict(zip("FG", problem.aggregation())) if problem.scenarios is not None else {}
-    return [
-        Table(
-            key,
-            values[key],
-            units,
-            ("design", dim),
-            names=names,
-            attrs={"over_scenarios": rules[key]} if key in rules else {},
-        )
-        for key, _, units, dim, names in _tables(problem, problem.var_units)
-    ]
+    return _xfg("pareto", problem, values, rules)
 
 
 def write_pareto(h5, problem: Problem, optimum, weights) -> None:
@@ -65,11 +67,7 @@ def write_pareto(h5, problem: Problem, optimum, weights) -> None:
 def baseline_tables(problem: Problem, baseline) -> list[Table]:
     """``/baseline/X, F, G`` (one row each, as ``/pareto``'s): the config's own design
     (:func:`suspopt.optimisation.run.config_design`), evaluated as the run's designs are."""
-    values = {"X": baseline.X, "F": baseline.F, "G": baseline.G}
-    return [
-        Table(key, values[key], units, ("design", dim), names=names)
-        for key, _, units, dim, names in _tables(problem, problem.var_units)
-    ]
+    return _xfg("baseline", problem, {"X": baseline.X, "F": baseline.F, "G": baseline.G})
 
 
 def write_baseline(h5, problem: Problem, baseline) -> None:
@@ -84,35 +82,26 @@ def scenario_tables(problem: Problem, X) -> list[Table]:
     aggregates, each column's rule in the attribute ``over_scenarios``."""
     assert problem.scenarios is not None
     FS, GS = problem.scenario_values(X)
+    t = OPTIMISE.table
     tables = [
-        Table("scenario", problem.scenarios.names, "1", ("scenario",)),
-        Table("weight", problem.scenarios.weights, "1", ("scenario",)),
+        t("pareto/scenarios", "scenario", problem.scenarios.names),
+        t("pareto/scenarios", "weight", problem.scenarios.weights),
     ]
-    for (key, _, units, dim, columns), data in zip(
-        _tables(problem, problem.var_units)[1:], (FS, GS)
-    ):
-        tables.append(Table(key, data, units, ("design", "scenario", dim), names=columns))
+    for (key, _, units, columns), data in zip(_columns(problem, problem.var_units)[1:], (FS, GS)):
+        tables.append(t("pareto/scenarios", key, data, units, names=columns))
     return tables
 
 
 def history_tables(history: dict, best_names, best_units) -> list[Table]:
     """``/history``: per generation the best objectives (or weighted sum), the hypervolume,
     the evaluations, the time [s] and the feasible share."""
-    units = {
-        "generation": "1",
-        "hypervolume": "1",
-        "evaluations": "1",
-        "time": "s",
-        "feasible": "1",
-    }
-    tables = [Table("generation", history["generation"], "1", ("generation",))]
+    tables = [OPTIMISE.table("history", "generation", history["generation"])]
     for key, values in history.items():
         if key == "best":
             best = np.reshape(values, (len(values), len(best_names)))  # (zero generations too)
-            dims = ("generation", "objective")
-            tables.append(Table(key, best, best_units, dims, names=best_names))
+            tables.append(OPTIMISE.table("history", key, best, best_units, names=best_names))
         elif key != "generation":
-            tables.append(Table(key, values, units[key], ("generation",)))
+            tables.append(OPTIMISE.table("history", key, values))
     return tables
 
 
@@ -127,11 +116,12 @@ def write_checkpoint(h5, problem: Problem, batches: list, generations: int) -> N
     the run (data only: nothing in it is code)."""
     checkpoint = h5.create_group("checkpoint")
     checkpoint.attrs.update(format=CHECKPOINT_FORMAT, generations=generations)
-    for j, (key, columns, units, dim, names) in enumerate(_tables(problem, problem.search_units)):
+    for j, (key, columns, units, names) in enumerate(_columns(problem, problem.search_units)):
         data = np.concatenate([b[j] for b in batches]) if batches else np.empty((0, columns))
-        write_dataset(checkpoint, key, data, units, dims=("evaluation", dim), coords={dim: names})
+        dim = OPTIMISE.data(f"checkpoint/{key}").axes[-1]
+        put(OPTIMISE, checkpoint, key, data, units, coords={dim: names})
     sizes = np.array([len(b[0]) for b in batches], dtype=np.int64)
-    write_dataset(checkpoint, "batches", sizes, "1", dims=("batch",))
+    put(OPTIMISE, checkpoint, "batches", sizes)
 
 
 def read_checkpoint(output: Path, cfg: Config, problem: Problem):

@@ -10,38 +10,20 @@ last completed generation with ``status = "interrupted"``; an error that stops t
 lost Dask scheduler) first rewrites it from the last completed generation, ``status =
 "running"``. Nothing here prints: progress goes to ``callback(Progress)``.
 
-HDF5 layout (the public contract, docs/architecture.md#public-contract), every dataset with a
-``units`` attribute (one per column for X, F, G and best):
-
-- ``/pareto/X (N, n)`` physical values, ``/pareto/F (N, m)``, ``/pareto/G (N, k)`` (G <= 0
-  feasible), each with ``names``: the best design (one objective) or the non-dominated set,
-  sorted by the first objective. With a weighted sum, F holds the main objectives (not the
-  sum) and ``/pareto`` has the attribute ``weights``.
-- ``/history/<name> (generations,)``: ``generation``, ``best`` (generations, m: the lowest
-  feasible value of each objective, NaN while none is feasible; the weighted sum with
-  weights), ``hypervolume`` (of the non-dominated feasible designs among all evaluated so
-  far, so it never falls; objectives normalised by the first feasible generation's ideal
-  and nadir points, reference point 1.1 in each; NaN for one objective),
-  ``evaluations``, ``time`` [s], ``feasible`` (share of the generation's designs).
-- ``/checkpoint``: every batch of designs the optimiser had evaluated when the file was
-  written, as data: ``X (E, n)`` search coordinates, ``F (E, m)``, ``G (E, k)`` (the problem's
-  objectives and constraints, before any weighted sum) and ``batches (B,)`` their sizes in
-  order; attributes ``format`` and ``generations``. ``--resume`` rebuilds the run by running
-  the optimiser again from the seed for that many generations with each batch answered from
-  the file (no simulation), checks that it asks for exactly the stored designs and arrives at
-  the stored history, then goes on; so it continues bit for bit, and nothing read from the
-  file is ever executed (there is no pickle).
-- ``/baseline/X, F, G`` (one row each, names and units as ``/pareto``'s): the config's
-  own design (the values its design variables' fields hold), evaluated once when the run
-  ends (not when interrupted), outside the budget: where the optimum stands against the
-  design it started from. Absent where a design variable's field holds no value.
-- dimensions (:func:`suspopt.io.write_dataset`): ``/pareto/{design, variable, objective,
-  constraint}`` (row numbers; the names of the columns of X, F, G), ``/history/generation``
-  and ``/history/objective`` (the columns of ``best``), ``/checkpoint/{evaluation, variable,
-  objective, constraint, batch}``.
-- root attributes: those of ``atomic_h5`` plus ``status`` (running, finished, interrupted,
-  or failed: every design of the optimum failed to simulate), ``algorithm``,
-  ``optimiser_seed``, ``generations``, ``evaluations``.
+The file's layout is declared once, in :data:`suspopt.formats.OPTIMISE` (the public
+contract, docs/architecture.md#public-contract). What it does not say: ``/pareto`` is the best
+design (one objective) or the non-dominated set, sorted by the first objective; with a
+weighted sum F holds the main objectives, not the sum. ``/history/best`` is the lowest
+feasible value of each objective (NaN while none is feasible; the weighted sum with
+weights), ``hypervolume`` that of the non-dominated feasible designs evaluated so far (so it
+never falls; objectives normalised by the first feasible generation's ideal and nadir points,
+reference point 1.1 in each; NaN for one objective). ``--resume`` rebuilds the run from
+``/checkpoint`` by running the optimiser again from the seed for the stored generations with
+each batch answered from the file (no simulation), checks that it asks for exactly the stored
+designs and arrives at the stored history, then goes on: it continues bit for bit, and
+nothing read from the file is ever executed (there is no pickle). ``/baseline`` is absent
+where a design variable's field holds no value; ``status`` ``failed`` means every design of
+the optimum failed to simulate.
 """
 
 from __future__ import annotations
