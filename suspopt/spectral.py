@@ -352,19 +352,22 @@ def reduce(
     system = _Linear(cfg, pv, model, attachments)
     integrands = _integrands(system, requests, grid)
     variances = _converged(pv.P, integrands, system, requests, (low, high), points)
+    from .metrics.stats import moment_value
+
     values = {}
     for spec, ns in requests:
         for name in ns:
             var = variances[(id(spec), name)]
-            if spec.metric in ("var", "dissipated_power"):
+            # the moments' state of a zero-mean response of variance var (a linear response
+            # to a zero-mean road), made a statistic by the metrics' own arithmetic
+            state = (1, np.zeros_like(var), var, np.nan, np.nan)
+            if spec.metric == "dissipated_power":
                 value = var
-            elif spec.metric == "mean":
-                value = np.zeros_like(var)  # (a linear response to a zero-mean road)
             elif spec.metric == "dynamic_tyre_load":
                 corner = model.corners.index(name.rsplit(".", 1)[1])
-                value = np.sqrt(var) / model.static_tyre_load[:, 0, corner]
+                value = moment_value("std", state) / model.static_tyre_load[:, 0, corner]
             else:
-                value = np.sqrt(var)
+                value = moment_value("std" if spec.metric == "rms_weighted" else spec.metric, state)
             values[(id(spec), name)] = value
     from .result import signal_table
 

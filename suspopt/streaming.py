@@ -7,24 +7,17 @@ steps as a whole run, bit for bit), computes each window's signals with the one 
 (:class:`suspopt.result.Result` over the window) and lets each metric take what it needs
 from them, as its :class:`suspopt.specs.MetricDef` says (``stream``):
 
-- ``moments`` (variance, standard deviation, r.m.s., mean): each block of :data:`BLOCK`
-  samples' count, mean and sum of squared deviations (two passes over the block), merged
-  into the running ones in time order (the pairwise update of Chan, Golub and LeVeque); a
-  design's values depend on :data:`BLOCK` (a constant), not on its batch or the window, and
-  agree with the statistic of the whole signal to rounding (about 1e-15 relative,
-  ``tests/test_streaming.py``);
-- ``extremes`` (maximum, minimum, largest magnitude, range) and ``window_max`` (a maximum over
-  time of a value per sample, such as the spring usage of Eq 5.3): the largest (smallest) of
-  the windows' values, exactly the whole signal's;
+- ``moments`` (variance, standard deviation, r.m.s., mean) and ``extremes`` (maximum,
+  minimum, largest magnitude, range): the running state of
+  :func:`suspopt.metrics.stats.moments` carried from window to window, so every value is the
+  whole signal's, bit for bit; ``window_max`` (a maximum over time of a value per sample, such
+  as the spring usage of Eq 5.3): the largest of the windows' values;
 - ``weighted`` (the ISO 2631 weighted r.m.s., VDV, MTVV and crest factor, Eq 2.78-2.83): the
   weighting's recursive filter (:func:`suspopt.metrics.iso2631.weighting_filter`) runs on
-  from window to window with its state, which gives the whole signal's weighted samples bit
-  for bit; the sums of ``a_w²`` and ``a_w⁴`` are the blocks of
-  :func:`~suspopt.metrics.iso2631.block_sums` added in time order, as the whole-signal metrics
-  add them (a window holds whole blocks: :data:`BLOCK` is a multiple of ``SUM_BLOCK``), and
-  the largest ``|a_w|`` and the MTVV (the running r.m.s. from the running sum of ``a_w²`` and
-  its last ``τ fs`` values) follow the whole signal's arithmetic: every weighted metric is the
-  whole run's, bit for bit;
+  from window to window with its state, and so do the power sums
+  (:func:`~suspopt.metrics.iso2631.power_state`) and the running r.m.s. of the MTVV
+  (:func:`~suspopt.metrics.iso2631.running_state`): every weighted metric is the whole run's,
+  bit for bit;
 - ``keep`` (the transient metrics, the dissipated power, the dynamic tyre load, the switch
   count): the signals they read are kept whole and the metric is computed once at the end,
   exactly as on a whole run.
@@ -36,20 +29,16 @@ row. The numpy engine computes every row anyway.
 
 On the compiled engine (without a controller) the kernel itself forms every signal that is
 affine in a sample (:func:`suspopt.affine.affine_signals` probes the signal table: travel,
-tyre deflection, accelerations...) and reduces it as it integrates: moments by Welford's
-update, extremes, the weighting filter and its sums, and a ``window_max`` metric that its
-extremes give (:class:`suspopt.specs.MetricDef`'s ``extremes``: the spring usage of Eq 5.3);
-those rows are neither recorded nor passed through numpy
-(:mod:`suspopt.integrator.accumulators`). Its values agree with the whole run's metrics to
-rounding (about 1e-15 relative), not to the bit, and a design's values still do not depend
-on its batch, block, window or thread. The MTVV, the ``keep`` metrics and signals that are
-not affine are reduced from the windows as below.
-
-With numba installed, the block moments, the weighting filter and the weighted sums run as
-compiled loops over each window (:func:`suspopt.loops.compiled_reductions`): the same
-arithmetic in the same order, so the same bits as the numpy code beside them
-(``tests/test_reductions.py``), one pass over each row instead of several whole-array
-passes and their temporaries.
+tyre deflection, accelerations...) and reduces it as it integrates, by the same steps
+(:mod:`suspopt.loops._compiled`: the moments and extremes, the weighting filter and its
+sums), and a ``window_max`` metric that its extremes give
+(:class:`suspopt.specs.MetricDef`'s ``extremes``: the spring usage of Eq 5.3); those rows are
+neither recorded nor passed through numpy (:mod:`suspopt.integrator.accumulators`), and its
+state is taken over as the windows' would be. Its values agree with the whole run's metrics
+to rounding (about 1e-15 relative: it forms the signal as ``e + Σ c x``, the signal table
+in its own order), and a design's values do not depend on its batch, block, window or
+thread. The MTVV, the ``keep`` metrics and signals that are not affine are reduced from the
+windows as above.
 
 Memory therefore holds one window of every signal and state, the MTVV's last ``τ fs``
 values, and the kept signals; with no ``keep`` metric it grows with the designs, not with the
@@ -69,8 +58,8 @@ from .specs import METRICS
 
 __all__ = ["reduce", "Reduced", "BLOCK", "window_width", "recorded_rows"]
 
-#: Samples of one block of the moments' merge, and the least of one window (a multiple of
-#: :data:`suspopt.integrator.WINDOW_MULTIPLE`).
+#: The least samples of one window (a multiple of
+#: :data:`suspopt.integrator.WINDOW_MULTIPLE` and of the weighted sums' ``SUM_BLOCK``).
 BLOCK = 256
 #: Memory of one window's states and signals [bytes]: a window is as many whole blocks as
 #: fit (a few designs: the whole run at once), at least one.
@@ -78,175 +67,71 @@ WINDOW_BYTES = 64 << 20
 
 
 class _Moments:
-    """Count, mean and sum of squared deviations of each design's samples, (P,) each."""
+    """The streamed moments and extremes of each design's samples
+    (:func:`suspopt.metrics.stats.moments`), from which :meth:`value` gives a statistic."""
 
     def __init__(self) -> None:
-        self.n = 0
-        self.mean: Any = 0.0
-        self.m2: Any = 0.0
+        self.state: tuple | None = None
 
     def add(self, x: np.ndarray) -> None:
-        """The samples ``x (P, T)`` that follow: each block of :data:`BLOCK` samples' own
-        mean and squared deviations (two passes), merged into the running ones in time
-        order (a window holds whole blocks, but for the run's last)."""
-        x = np.ascontiguousarray(x)
-        for m, mean, m2 in _block_moments(x):
-            if self.n == 0:
-                self.n, self.mean, self.m2 = m, mean, m2
-                continue
-            n = self.n + m
-            delta = mean - self.mean
-            self.mean = self.mean + delta * (m / n)
-            self.m2 = self.m2 + m2 + np.square(delta) * (self.n * m / n)
-            self.n = n
+        """The samples ``x (P, T)`` that follow."""
+        from .metrics.stats import moments
+
+        self.state = moments(x, self.state)
 
     def value(self, metric: str) -> np.ndarray:
-        var = self.m2 / self.n
-        if metric == "var":
-            return var
-        if metric == "std":
-            return np.sqrt(var)
-        if metric == "mean":
-            return self.mean
-        return np.sqrt(var + np.square(self.mean))  # rms
+        from .metrics.stats import moment_value
+
+        assert self.state is not None  # (every window adds to it)
+        return moment_value(metric, self.state)
 
 
-def _block_moments(x: np.ndarray) -> list[tuple[int, np.ndarray, np.ndarray]]:
-    """``(count, mean (P,), sum of squared deviations (P,))`` of each block of :data:`BLOCK`
-    samples of ``x (P, T)`` (the last one shorter), in time order: numpy's mean and squared
-    deviations of each block, or the compiled loops' (the same bits) when numba is
-    installed."""
-    from .loops import compiled_reductions
-
-    P, T = x.shape
-    loops = compiled_reductions()
-    if loops is not None and x.dtype == np.float64:
-        nb = -(-T // BLOCK)
-        means, squares = np.empty((P, nb)), np.empty((P, nb))
-        loops.block_moments(x, BLOCK, means, squares)
-        counts = [min(BLOCK, T - b * BLOCK) for b in range(nb)]
-        return [(counts[b], means[:, b], squares[:, b]) for b in range(nb)]
-    whole = T - T % BLOCK
-    parts = []
-    if whole:
-        blocks = x[:, :whole].reshape(P, -1, BLOCK)
-        means = np.mean(blocks, axis=-1)
-        squares = np.sum(np.square(blocks - means[:, :, None]), axis=-1)
-        parts = [(BLOCK, means[:, b], squares[:, b]) for b in range(means.shape[1])]
-    if whole < T:
-        rest = x[:, whole:]
-        mean = np.mean(rest, axis=-1)
-        parts.append((T - whole, mean, np.sum(np.square(rest - mean[:, None]), axis=-1)))
-    return parts
-
-
-class _Extremes:
-    """The largest and smallest sample of each design, (P,) each (NaN stays NaN)."""
-
-    def __init__(self) -> None:
-        self.high: Any = None
-        self.low: Any = None
-
-    def add(self, x: np.ndarray) -> None:
-        high, low = np.max(x, axis=-1), np.min(x, axis=-1)
-        first = self.high is None
-        self.high = high if first else np.maximum(self.high, high)
-        self.low = low if first else np.minimum(self.low, low)
-
-    def value(self, metric: str) -> np.ndarray:
-        if metric == "max":
-            return self.high
-        if metric == "min":
-            return self.low
-        if metric == "max_abs":
-            return np.maximum(np.abs(self.high), np.abs(self.low))
-        return self.high - self.low  # peak_to_peak
+#: The extremes are the moments' own state (one pass gives both).
+_Extremes = _Moments
 
 
 class _Weighted:
     """One signal under one ISO 2631 weighting as the windows arrive (module docstring):
-    the filter's state, the count, the sums of ``a_w²`` and ``a_w⁴`` and the largest
-    ``|a_w|`` (P,) each, and for each MTVV window ``τ`` [s] the running sum of ``a_w²``, its
-    last ``τ fs`` values and the largest running r.m.s. so far."""
+    the filter's state, the weighted power sums (:func:`suspopt.metrics.iso2631.power_state`)
+    and for each MTVV window ``τ`` [s] the running state of Eq 2.80
+    (:func:`~suspopt.metrics.iso2631.running_state`) and the largest running r.m.s. so far."""
 
     def __init__(self, weighting: str | None) -> None:
         self.weighting = weighting
         self.taus: set[float] = set()
         self.fs = 0.0
-        self.n = 0
-        self.squares: Any = 0.0
-        self.fourth: Any = 0.0
-        self.peak: Any = None
+        self.sums: tuple | None = None
         self.filter: Any = None
         self.state: Any = None
         self.running: dict[float, list[Any]] = {}
 
     def add(self, x: np.ndarray, time: np.ndarray) -> None:
-        from .metrics.iso2631 import weighting_filter
+        from .metrics.iso2631 import power_state, running_state, weighting_filter
 
-        if self.n == 0:
+        if self.sums is None:
             self.fs = 1.0 / (time[1] - time[0])  # the output rate, as the whole run's metric
             self.filter = weighting_filter(self.weighting, self.fs)
         aw = np.asarray(x, dtype=float)  # read only: the filter's output is a new array
         if self.filter is not None:
             aw, self.state = self.filter.apply(aw, self.state)
-        self.n += aw.shape[-1]
-        with np.errstate(over="ignore", invalid="ignore"):  # a diverging design: inf, NaN
-            squares, fourth, peak = _power_sums(aw)
-            # the blocks added in time order: the whole signal's sums, bit for bit
-            for block in squares.T:
-                self.squares = self.squares + block
-            for block in fourth.T:
-                self.fourth = self.fourth + block
-            if self.taus:
+        self.sums = power_state(aw, self.sums)
+        if self.taus:
+            with np.errstate(over="ignore", invalid="ignore"):  # a diverging design
                 squared = np.square(aw)  # (once for every MTVV window)
                 for tau in self.taus:
-                    self._running(tau, squared)
-        self.peak = peak if self.peak is None else np.maximum(self.peak, peak)
-
-    def _running(self, tau: float, squared: np.ndarray) -> None:
-        """Eq 2.80 over this window, from the running sum: the arithmetic of
-        :func:`suspopt.metrics.iso2631.running_rms` on the whole signal."""
-        width = max(1, round(tau * self.fs))
-        P = squared.shape[0]
-        total, history, largest = self.running.get(tau, (np.zeros(P), np.zeros((P, width)), None))
-        summed = np.cumsum(np.concatenate([total[:, None], squared], axis=-1), axis=-1)[:, 1:]
-        energy = summed / self.fs
-        joined = np.concatenate([history, energy], axis=-1)
-        lagged = joined[:, : energy.shape[-1]]
-        rms = np.sqrt(np.maximum(energy - lagged, 0.0) / (width / self.fs))
-        top = np.max(rms, axis=-1)
-        largest = top if largest is None else np.maximum(largest, top)
-        self.running[tau] = [summed[:, -1], joined[:, joined.shape[-1] - width :], largest]
+                    state, largest = self.running.get(tau, (None, None))
+                    rms, state = running_state(squared, self.fs, tau, state)
+                    top = np.max(rms, axis=-1)
+                    largest = top if largest is None else np.maximum(largest, top)
+                    self.running[tau] = [state, largest]
 
     def value(self, spec) -> np.ndarray:
-        rms = np.sqrt(self.squares / self.n)
-        if spec.metric == "rms_weighted":
-            return rms
-        if spec.metric == "vdv":
-            return (self.fourth / self.fs) ** 0.25
+        from .metrics.iso2631 import weighted_value
+
         if spec.metric == "mtvv":
-            return self.running[spec.tau][2]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return self.peak / rms  # crest factor
-
-
-def _power_sums(aw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`~suspopt.metrics.iso2631.block_sums` of ``aw²`` and of ``aw⁴`` (P, blocks) and
-    the largest ``|aw|`` (P,) of ``aw (P, T)``: numpy's, or the compiled loops' (the same
-    bits, one pass) when numba is installed."""
-    from .loops import compiled_reductions
-    from .metrics.iso2631 import SUM_BLOCK, block_sums
-
-    loops = compiled_reductions()
-    if loops is None or aw.dtype != np.float64 or aw.ndim != 2:
-        squared = np.square(aw)
-        return block_sums(squared), block_sums(np.square(squared)), np.max(np.abs(aw), axis=-1)
-    P, T = aw.shape
-    nb = -(-T // SUM_BLOCK)
-    squares, fourth, peak = np.empty((P, nb)), np.empty((P, nb)), np.empty(P)
-    loops.power_sums(np.ascontiguousarray(aw), SUM_BLOCK, squares, fourth, peak)
-    return squares, fourth, peak
+            return self.running[spec.tau][1]
+        assert self.sums is not None  # (every window adds to them)
+        return weighted_value(spec.metric, self.sums, self.fs)
 
 
 class _Kept:
@@ -494,18 +379,13 @@ class _Streams:
             two = np.stack(kernel.moments(index[name], P)[2:], axis=-1)
             record = _Kept({name: two}, np.zeros(2), cfg, model)
             self.window_max[(id(spec), name)] = METRICS[spec.metric].compute(spec, record, name)
-        for streams, name in self.handed:
-            mean, m2, high, low = kernel.moments(index[name], P)
-            if streams is self.moments:
-                moment = streams[name] = _Moments()
-                moment.n, moment.mean, moment.m2 = samples, mean, m2
-            else:
-                extreme = streams[name] = _Extremes()
-                extreme.high, extreme.low = high, low
+        for streams, name in self.handed:  # (the kernel's state: the same steps)
+            moment = streams[name] = _Moments()
+            moment.state = (samples, *kernel.moments(index[name], P))
         for p, key in enumerate(kernel.pair_keys):
             weighted = self.weighted[key] = _Weighted(key[1])
-            weighted.n, weighted.fs = samples, kernel.fs
-            weighted.squares, weighted.fourth, weighted.peak = kernel.weighted(p, P)
+            weighted.fs = kernel.fs
+            weighted.sums = (samples, *kernel.weighted(p, P))
 
     def add(self, window) -> None:
         """One window's Result."""

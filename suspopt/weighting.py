@@ -217,43 +217,25 @@ class WeightingFilter:
     ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
         """Weighted signal of ``a`` (time on the last axis, any unit: the output has it) and
         the filter's state after it; ``state`` continues a signal cut into pieces (default: at
-        rest). Pieces give the bits of the whole signal filtered at once. With numba
-        installed the same arithmetic runs compiled, one pass per row
-        (:func:`suspopt.loops.compiled_reductions`), to the same bits."""
+        rest). Pieces give the bits of the whole signal filtered at once. The arithmetic is
+        the one every engine uses, compiled (:func:`suspopt.loops._compiled.weight_rows`:
+        the FIR taps, then each section in transposed direct form II)."""
         from .loops import compiled_reductions
 
         a = np.asarray(a, dtype=float)
         if state is None:
             state = self.initial_state(a.shape[:-1])
-        loops = compiled_reductions()
-        if loops is None or a.size == 0:
-            return self._apply_numpy(a, state)
         history, poles = state
+        if a.size == 0:
+            return a.copy(), (np.array(history, dtype=float), np.array(poles, dtype=float))
         lead, n, m = a.shape[:-1], a.shape[-1], len(self.numerator) - 1
         rows = np.ascontiguousarray(a.reshape(-1, n))
         history = np.array(history, dtype=float).reshape(rows.shape[0], m)
         poles = np.array(poles, dtype=float).reshape(len(self.sections), rows.shape[0], 2)
         out = np.empty_like(rows)
-        loops.weight_rows(self.numerator, self.sections, rows, history, poles, out)
+        compiled_reductions().weight_rows(self.numerator, self.sections, rows, history, poles, out)
         shaped = (history.reshape(*lead, m), poles.reshape(len(self.sections), *lead, 2))
         return out.reshape(a.shape), shaped
-
-    def _apply_numpy(
-        self, a: np.ndarray, state: tuple[np.ndarray, np.ndarray]
-    ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
-        """:meth:`apply` in numpy and scipy (``a`` a float array, ``state`` given)."""
-        from scipy.signal import sosfilt
-
-        history, poles = state
-        # the FIR as a sum of shifted copies in a fixed order (scipy's lfilter with a state
-        # rounds differently at the cuts): pieces give the whole signal's bits
-        m, n = len(self.numerator) - 1, a.shape[-1]
-        x = np.concatenate([history, a], axis=-1)
-        out = self.numerator[0] * x[..., m:]
-        for k, c in enumerate(self.numerator[1:], start=1):
-            out = out + c * x[..., m - k : m - k + n]
-        out, poles = sosfilt(self.sections, out, axis=-1, zi=poles)
-        return out, (x[..., x.shape[-1] - m :], poles)
 
 
 def _cascade(numerator: np.ndarray, zi: np.ndarray, stages: np.ndarray) -> np.ndarray:

@@ -2258,13 +2258,13 @@ def _compile_the_kernel() -> None:
     problem = suspopt.Problem.from_config(cfg)
     problem.evaluate(((problem.xl + problem.xu) / 2)[None], return_values_of=["F", "G"])
     # the streamed reductions' loops (suspopt.loops._compiled), as an evaluation calls them
-    from suspopt import streaming
-    from suspopt.metrics.iso2631 import weighting_filter
+    from suspopt.metrics.iso2631 import power_state, weighting_filter
+    from suspopt.metrics.stats import moments
 
     x = np.ones((2, 300))
     weighting_filter("Wk", 1000.0).apply(x)
-    streaming._block_moments(x)
-    streaming._power_sums(x)
+    moments(x)
+    power_state(x)
 
 
 def _command_name(args: list[str]) -> str:

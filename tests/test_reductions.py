@@ -1,27 +1,24 @@
-"""The compiled loops of the reductions (:mod:`suspopt.loops._compiled`) against the
-numpy arithmetic they replace, bit for bit, on hostile signals:
+"""The streamed metrics' one arithmetic (:mod:`suspopt.loops._compiled`) against independent
+references, on hostile signals:
 
-- the pairwise sum against ``np.sum`` for every length a block may have;
-- the weighting filter against :meth:`WeightingFilter._apply_numpy` for every weighting, from
-  rest and from a state, in pieces down to one sample, over leading shapes of any rank, with
-  NaN, infinities and huge values; its state after each piece too;
-- the streamed block moments and power sums against their numpy branches;
-- an optimisation's objectives and constraints with and without the compiled loops.
+- the weighting filter against its FIR written here in numpy and ``scipy.signal.sosfilt``,
+  bit for bit, for every weighting, from rest and from a state, in pieces down to one sample,
+  over leading shapes of any rank, with NaN, infinities and huge values; its state after each
+  piece too;
+- the moments and the weighted power sums against numpy's statistics to rounding, and in
+  pieces against the whole record bit for bit;
+- the kernel's reductions call the same steps: a signal the compiled kernel forms itself has
+  the bits of the same samples reduced in memory.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import CONFIGS
+from scipy.signal import sosfilt
 
-import suspopt
-import suspopt.loops as metric_loops
-from suspopt import streaming
-from suspopt.metrics.iso2631 import weighting_filter
-
-pytest.importorskip("numba")
-from suspopt.loops import _compiled as _reductions  # noqa: E402  (needs numba)
+from suspopt.metrics.iso2631 import power_state, weighted_value, weighting_filter
+from suspopt.metrics.stats import moment_value, moments
 
 WEIGHTINGS = ("Wk", "Wd", "Wf", "Wc", "We", "Wj")
 #: numpy's warnings on the hostile values (NaN, infinities), which both sides propagate
@@ -37,28 +34,26 @@ def _hostile(rng, shape) -> np.ndarray:
     return x
 
 
-@pytest.fixture
-def numpy_only(monkeypatch):
-    """The callers' numpy arithmetic: no compiled loops."""
-    monkeypatch.setattr(metric_loops, "compiled_reductions", lambda: None)
+def _reference(f, a, state):
+    """The weighting filter by numpy and scipy: the FIR as the sum of shifted copies in its
+    fixed order, then ``sosfilt`` with its state."""
+    history, poles = state
+    m, n = len(f.numerator) - 1, a.shape[-1]
+    x = np.concatenate([history, a], axis=-1)
+    out = f.numerator[0] * x[..., m:]
+    for k, c in enumerate(f.numerator[1:], start=1):
+        out = out + c * x[..., m - k : m - k + n]
+    out, poles = sosfilt(f.sections, out, axis=-1, zi=poles)
+    return out, (x[..., x.shape[-1] - m :], poles)
 
 
 def _same(a, b) -> bool:
     return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True)
 
 
-def test_the_pairwise_sum_is_numpys_for_every_block_length():
-    rng = np.random.default_rng(1)
-    for n in [*range(0, 300), 511, 512, 513, 1000, 1024, 1500, _reductions.LONGEST]:
-        x = rng.standard_normal(n) * 10.0 ** rng.uniform(-6, 6, n)
-        assert _reductions._pairwise(x, 0, n) == np.sum(x), n
-        if n > 20:  # a run that starts inside the array
-            assert _reductions._pairwise(x, 7, n - 9) == np.sum(x[7 : n - 2]), n
-
-
 @pytest.mark.parametrize("weighting", WEIGHTINGS)
 @pytest.mark.parametrize("fs", [500.0, 1000.0, 2000.0])
-def test_the_compiled_filter_is_the_numpy_filter_bit_for_bit(weighting, fs):
+def test_the_filter_is_numpy_and_scipys_filter_bit_for_bit(weighting, fs):
     f = weighting_filter(weighting, fs)
     rng = np.random.default_rng(len(weighting) + int(fs))
     m, s = len(f.numerator) - 1, len(f.sections)
@@ -71,14 +66,14 @@ def test_the_compiled_filter_is_the_numpy_filter_bit_for_bit(weighting, fs):
         piece = a[:, t : t + width]
         t += width
         out_c, state_c = f.apply(piece, state_c)
-        out_n, state_n = f._apply_numpy(piece, state_n)
+        out_n, state_n = _reference(f, piece, state_n)
         assert _same(out_c, out_n) and _same(state_c[0], state_n[0])
         assert _same(state_c[1], state_n[1])
     whole_c = f.apply(a[:, :t])[0]
-    assert _same(whole_c, f._apply_numpy(a[:, :t], f.initial_state((37,)))[0])
+    assert _same(whole_c, _reference(f, a[:, :t], f.initial_state((37,)))[0])
 
 
-def test_the_compiled_filter_keeps_any_leading_shape_and_leaves_the_callers_state():
+def test_the_filter_keeps_any_leading_shape_and_leaves_the_callers_state():
     f = weighting_filter("Wk", 1000.0)
     rng = np.random.default_rng(3)
     a = _hostile(rng, (2, 3, 5, 300))
@@ -86,52 +81,78 @@ def test_the_compiled_filter_keeps_any_leading_shape_and_leaves_the_callers_stat
     poles = rng.standard_normal((len(f.sections), 2, 3, 5, 2))
     kept = (history.copy(), poles.copy())
     out_c, (h_c, p_c) = f.apply(a, (history, poles))
-    out_n, (h_n, p_n) = f._apply_numpy(a, (history, poles))
+    out_n, (h_n, p_n) = _reference(f, a, (history, poles))
     assert out_c.shape == a.shape and h_c.shape == history.shape and p_c.shape == poles.shape
     assert _same(out_c, out_n) and _same(h_c, h_n) and _same(p_c, p_n)
     assert _same(history, kept[0]) and _same(poles, kept[1])  # (not written in place)
 
 
-@pytest.mark.parametrize("T", [1, 7, 255, 256, 257, 700, 1500])
-def test_the_streamed_block_sums_are_numpys(T, monkeypatch):
-    rng = np.random.default_rng(T)
-    x = _hostile(rng, (13, T))
-    compiled = streaming._block_moments(x), streaming._power_sums(x)
-    monkeypatch.setattr(metric_loops, "compiled_reductions", lambda: None)
-    with np.errstate(invalid="ignore", over="ignore"):
-        reference = streaming._block_moments(x), streaming._power_sums(x)
-    assert [m for m, _, _ in compiled[0]] == [m for m, _, _ in reference[0]]
-    for (_, mean_c, m2_c), (_, mean_n, m2_n) in zip(compiled[0], reference[0]):
-        assert _same(mean_c, mean_n) and _same(m2_c, m2_n)
-    for got, want in zip(compiled[1], reference[1]):
-        assert _same(got, want)
-
-
-def _evaluated(cfg, X):
-    problem = suspopt.Problem.from_config(cfg)
-    return problem.evaluate(problem.xl + X * (problem.xu - problem.xl),
-                            return_values_of=["F", "G"])  # fmt: skip
-
-
-@pytest.mark.parametrize("name", ["ch5/case1_s1.yaml", "ch6/part_b.yaml"])
-def test_an_optimisations_values_are_the_same_bits_without_the_compiled_loops(name, monkeypatch):
-    cfg = suspopt.load_config(CONFIGS / name)
-    cfg.simulation.duration = 1.2
-    monkeypatch.setattr(streaming, "WINDOW_BYTES", 1)  # windows of one block: 5, the last short
-    X = np.random.default_rng(5).random((6, len(cfg.design_variables)))
-    compiled = _evaluated(cfg, X)
-    monkeypatch.setattr(metric_loops, "compiled_reductions", lambda: None)
-    reference = _evaluated(cfg, X)
-    assert all(_same(a, b) for a, b in zip(compiled, reference))
-
-
 @pytest.mark.parametrize("rows", [(), (1,), (3,)])
-def test_fewer_rows_than_lanes_filter_as_numpy_does(rows):
-    """A single record (1-D) and fewer rows than :data:`~_reductions.LANES`: the lanes are
-    as many as the rows (no scratch 32 times a long record's size), the same bits."""
+def test_fewer_rows_than_lanes_filter_as_the_reference_does(rows):
+    """A single record (1-D) and fewer rows than :data:`~_compiled.LANES`: the lanes are as
+    many as the rows (no scratch 32 times a long record's size), the same bits."""
     f = weighting_filter("Wd", 800.0)
     a = _hostile(np.random.default_rng(11), (*rows, 2000))
     out_c, (h_c, p_c) = f.apply(a)
-    out_n, (h_n, p_n) = f._apply_numpy(a, f.initial_state(rows))
+    out_n, (h_n, p_n) = _reference(f, a, f.initial_state(rows))
     assert out_c.shape == a.shape and h_c.shape == h_n.shape and p_c.shape == p_n.shape
     assert _same(out_c, out_n) and _same(h_c, h_n) and _same(p_c, p_n)
+
+
+@pytest.mark.parametrize("T", [1, 7, 255, 256, 257, 700, 1500])
+def test_the_moments_and_power_sums_are_numpys_to_rounding_and_pieces_the_whole(T):
+    rng = np.random.default_rng(T)
+    x = rng.standard_normal((37, T)) * 3.0 + 1.5
+    state = moments(x)
+    for statistic, reference in (
+        ("var", np.var(x, axis=-1)),
+        ("std", np.std(x, axis=-1)),
+        ("mean", np.mean(x, axis=-1)),
+        ("rms", np.sqrt(np.mean(np.square(x), axis=-1))),
+    ):
+        assert np.allclose(moment_value(statistic, state), reference, rtol=1e-13, atol=0)
+    assert _same(moment_value("max", state), np.max(x, axis=-1))
+    assert _same(moment_value("min", state), np.min(x, axis=-1))
+    sums = power_state(x)
+    assert np.allclose(
+        weighted_value("rms_weighted", sums, 100.0), np.sqrt(np.mean(x**2, axis=-1)), rtol=1e-13
+    )
+    assert np.allclose(
+        weighted_value("vdv", sums, 100.0), (np.sum(x**4, axis=-1) / 100.0) ** 0.25, rtol=1e-13
+    )
+    assert _same(sums[2], np.max(np.abs(x), axis=-1))
+    cut = [0, 1, min(T, 256), min(T, 300), T]  # (pieces across a block's end)
+    moment, powered = None, None
+    for a, b in zip(cut[:-1], cut[1:]):
+        if b > a:
+            moment, powered = moments(x[:, a:b], moment), power_state(x[:, a:b], powered)
+    assert all(_same(u, v) for u, v in zip(moment, state))
+    assert _same(powered[1], sums[1]) and _same(powered[2], sums[2])
+
+
+def test_a_nan_or_an_infinity_stays_as_numpy_keeps_it():
+    x = _hostile(np.random.default_rng(5), (4, 300))
+    x[2] = np.linspace(-1, 1, 300)
+    x[3] = 0.0
+    x[3, 10] = np.nan
+    state, sums = moments(x), power_state(x)
+    assert _same(moment_value("max", state), np.max(x, axis=-1))
+    assert _same(moment_value("min", state), np.min(x, axis=-1))
+    assert np.isnan(moment_value("var", state)[[0, 3]]).all()
+    assert _same(sums[2], np.max(np.abs(x), axis=-1))
+    assert np.isfinite(weighted_value("rms_weighted", sums, 1.0)[2])
+
+
+def test_the_kernels_reductions_are_the_steps_of_the_metrics():
+    """The kernel's ``accumulate`` and the lane loop generated for a network call the steps of
+    :mod:`suspopt.loops._compiled` by name: none spells their arithmetic again."""
+    import inspect
+
+    from suspopt.integrator import _accumulate
+
+    text = inspect.getsource(_accumulate.accumulate) + inspect.getsource(_accumulate._weigh)
+    generated = _accumulate.source(np.array([1, 0, 1, 256, 0, 0, 1, 1, 5]), 2, 2, 16)
+    for body in (text, generated):
+        for step in ("welford(", "extremes(", "tap(", "section(", "powers(", "carry("):
+            assert step in body, step
+        assert "d * (" not in body and "* sq" not in body  # (Welford's, the fourth powers)

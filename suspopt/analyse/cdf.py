@@ -28,7 +28,7 @@ from ..config import Config, load_config
 from ..errors import require
 from ..formats import CDF_SENSITIVITY
 from ..io import atomic_h5, put
-from ..metrics import damper_switches, mean_dissipated_power, weighted_rms
+from ..metrics import damper_switches, mean_dissipated_power, rms, weighted_rms
 from ..result import Result
 from ..simulation import simulate
 from .cells import NOT_COMPUTED, NOT_COMPUTED_NOTE, percent
@@ -83,12 +83,8 @@ def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarra
     return {
         "SW": np.sum([damper_switches(sig[f"damper_state.{c}"]) for c in active], axis=0),
         "RC": weighted_rms(sig["body.heave_acc"], cfg.simulation.output_rate, "Wk"),
-        "ST": np.mean(
-            [np.sqrt(np.mean(sig[f"travel.{c}"] ** 2, axis=-1)) for c in corners], axis=0
-        ),
-        "TD": np.mean(
-            [np.sqrt(np.mean(sig[f"tyre_deflection.{c}"] ** 2, axis=-1)) for c in corners], axis=0
-        ),
+        "ST": np.mean([rms(sig[f"travel.{c}"]) for c in corners], axis=0),
+        "TD": np.mean([rms(sig[f"tyre_deflection.{c}"]) for c in corners], axis=0),
         "DE": np.sum(
             [
                 mean_dissipated_power(sig[f"damper_force.{c}"], sig[f"travel_vel.{c}"], t)

@@ -62,6 +62,8 @@ def _summary_table(result, picked=None) -> Table:
     max travel and tyre deflection per corner."""
     import numpy as np
 
+    from ..metrics.stats import max_abs, maximum, rms
+
     table, shown = _columns(result, picked, f"{result.model.preset} - key results")
     _design_rows(table, result, picked, shown)
     sig = result.signals
@@ -70,19 +72,15 @@ def _summary_table(result, picked=None) -> Table:
         table.add_row(label, unit, *(f"{values[p]:.4g}" for p in shown))
 
     heave, acc = sig["body.heave"], sig["body.heave_acc"]
-    row("peak body heave", "mm", 1e3 * np.max(heave, axis=-1))
+    row("peak body heave", "mm", 1e3 * maximum(heave))
     row("time of peak body heave", "s", result.time[np.argmax(heave, axis=-1)])
-    row("peak |body heave acc|", "m/s^2", np.max(np.abs(acc), axis=-1))
+    row("peak |body heave acc|", "m/s^2", max_abs(acc))
     row("time of peak |body heave acc|", "s", result.time[np.argmax(np.abs(acc), axis=-1)])
-    row("RMS body heave acc", "m/s^2", np.sqrt(np.mean(acc**2, axis=-1)))
+    row("RMS body heave acc", "m/s^2", rms(acc))
     for c in result.model.corners:
-        row(f"max |travel| {c}", "mm", 1e3 * np.max(np.abs(sig[f"travel.{c}"]), axis=-1))
+        row(f"max |travel| {c}", "mm", 1e3 * max_abs(sig[f"travel.{c}"]))
     for c in result.model.corners:
-        row(
-            f"max |tyre deflection| {c}",
-            "mm",
-            1e3 * np.max(np.abs(sig[f"tyre_deflection.{c}"]), axis=-1),
-        )
+        row(f"max |tyre deflection| {c}", "mm", 1e3 * max_abs(sig[f"tyre_deflection.{c}"]))
     return table
 
 

@@ -6,13 +6,14 @@ sample by sample, and its running statistics, lane by lane, as the integration r
 plus its terms in turn (``e + c_1 x_1 + c_2 x_2 + ...``: rows of the buffered samples or the
 road's inputs at that instant), then
 
-- the moments by Welford's update, ``d = x - m; m += d / j; M2 += d (x - m)`` with ``1/j``
-  (``j`` the sample's count) computed once per sample;
-- the largest and smallest value (a NaN stays, as ``np.max`` keeps it);
-- for each (signal, weighting) pair, the weighting's filter (the arithmetic of
-  :func:`suspopt.loops._compiled.weight_rows`: the FIR correction, then each section in transposed
-  direct form II), the sums of ``a_w²`` and ``a_w⁴`` over each block of ``SUM_BLOCK`` samples
-  added to their totals at the block's end, and the largest ``|a_w|``.
+- its moments and extremes, the weighting filter of each (signal, weighting) pair, the
+  pair's sums of ``a_w²`` and ``a_w⁴`` (over each block of ``SUM_BLOCK`` samples, carried
+  into their totals at the block's end) and its largest ``|a_w|``: each by the step that
+  every engine and the whole-record metrics use (:mod:`suspopt.loops._compiled`:
+  :func:`~suspopt.loops._compiled.welford` with ``1/j`` computed once per sample,
+  :func:`~suspopt.loops._compiled.extremes`, :func:`~suspopt.loops._compiled.tap`,
+  :func:`~suspopt.loops._compiled.section`, :func:`~suspopt.loops._compiled.powers`,
+  :func:`~suspopt.loops._compiled.carry`), compiled into the lane loops.
 
 ``red = (ri, coef, acc, filt, zs)``: ``ri`` the indices (``[S, K, Wn, SUM_BLOCK]``, then
 ``(signal, source)`` of each of the K terms, then ``(signal, filter offset, M, sections,
@@ -27,7 +28,7 @@ the road input ``-m - 1`` under the lane's road. With ``S = 0`` nothing is done.
 
 On the fused path (:mod:`._fused`: blocks of :data:`._fused.LANES` designs, one road) the
 kernel calls instead a function generated for the accumulators' structure (:func:`fused`,
-:func:`source`): the same operations in the same order, each sample's whole work in one
+:func:`source`): the same steps, called by name, in the same order, each sample's whole work in one
 loop over the lanes with every row's offset a constant, which the compiler vectorises (the
 general loops above pay a loop's set-up and overlap checks per operation, 16 lanes at a
 time). Both give the same bits (``tests/test_accumulators.py``). Only integers from the
@@ -40,6 +41,7 @@ import numba
 import numpy as np
 
 from .. import _numba_cache
+from ..loops._compiled import carry, extremes, powers, section, tap, welford
 from . import _fused
 
 _numba_cache.prepare()  # (cached for the machine, damaged files compiled again: suspopt._numba_cache)
@@ -82,23 +84,16 @@ def accumulate(rec, j0, count, lr, blk, state):
             o = PER_SIGNAL * s
             for b in range(B):
                 x = acc[o, b]
-                d = x - acc[o + 1, b]
-                mean = acc[o + 1, b] + d * w
-                acc[o + 1, b] = mean
-                acc[o + 2, b] = acc[o + 2, b] + d * (x - mean)
-                h, lo = acc[o + 3, b], acc[o + 4, b]
-                acc[o + 3, b] = h if h != h or x <= h else x
-                acc[o + 4, b] = lo if lo != lo or x >= lo else x
+                acc[o + 1, b], acc[o + 2, b] = welford(x, w, acc[o + 1, b], acc[o + 2, b])
+                acc[o + 3, b], acc[o + 4, b] = extremes(x, acc[o + 3, b], acc[o + 4, b])
         for p in range(Wn):
             q = 4 + 2 * K + 5 * p
             _weigh(acc, filt, ri[q], ri[q + 1], ri[q + 2], ri[q + 3], ri[q + 4], B)
             if (j + 1) % sum_block == 0:
                 r = ri[q + 4] + ri[q + 2] + 2 * ri[q + 3] + 1
                 for b in range(B):
-                    acc[r + 1, b] = acc[r + 1, b] + acc[r, b]
-                    acc[r, b] = 0.0
-                    acc[r + 3, b] = acc[r + 3, b] + acc[r + 2, b]
-                    acc[r + 2, b] = 0.0
+                    acc[r, b], acc[r + 1, b] = carry(acc[r, b], acc[r + 1, b])
+                    acc[r + 2, b], acc[r + 3, b] = carry(acc[r + 2, b], acc[r + 3, b])
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -109,11 +104,11 @@ def _weigh(acc, filt, s, f, M, NS, r, B):
     v, y = PER_SIGNAL * s, r + M + 2 * NS  # (the signal's row, the weighted sample's)
     c = filt[f]
     for b in range(B):
-        acc[y, b] = c * acc[v, b]
+        acc[y, b] = tap(0.0, c, acc[v, b])
     for k in range(1, M + 1):
         c = filt[f + k]
         for b in range(B):
-            acc[y, b] = acc[y, b] + c * acc[r + k - 1, b]
+            acc[y, b] = tap(acc[y, b], c, acc[r + k - 1, b])
     for k in range(M - 1, 0, -1):
         for b in range(B):
             acc[r + k, b] = acc[r + k - 1, b]
@@ -124,18 +119,13 @@ def _weigh(acc, filt, s, f, M, NS, r, B):
         o, z = f + M + 1 + 6 * i, r + M + 2 * i
         b0, b1, b2, a1, a2 = filt[o], filt[o + 1], filt[o + 2], filt[o + 4], filt[o + 5]
         for b in range(B):
-            u = acc[y, b]
-            x = b0 * u + acc[z, b]
-            acc[z, b] = b1 * u - a1 * x + acc[z + 1, b]
-            acc[z + 1, b] = b2 * u - a2 * x
-            acc[y, b] = x
+            acc[y, b], acc[z, b], acc[z + 1, b] = section(
+                acc[y, b], acc[z, b], acc[z + 1, b], b0, b1, b2, a1, a2
+            )
     for b in range(B):
-        a = acc[y, b]
-        sq = a * a
-        acc[y + 1, b] = acc[y + 1, b] + sq
-        acc[y + 3, b] = acc[y + 3, b] + sq * sq
-        size, p = abs(a), acc[y + 5, b]
-        acc[y + 5, b] = p if p != p or size <= p else size
+        acc[y + 1, b], acc[y + 3, b], acc[y + 5, b] = powers(
+            acc[y, b], acc[y + 1, b], acc[y + 3, b], acc[y + 5, b]
+        )
 
 
 #: The generated function's C signature: ``accumulate(rec, acc, coef, filt, zs, j0, count)``,
@@ -164,43 +154,30 @@ def _lines(ri: np.ndarray, rows: int, inputs: int, L: int) -> tuple[list[str], l
     for s in range(S):
         o = PER_SIGNAL * s
         lines += [
-            f"d{s} = v{s} - {a(o + 1)}",
-            f"m{s} = {a(o + 1)} + d{s} * w",
-            f"{a(o + 1)} = m{s}",
-            f"{a(o + 2)} = {a(o + 2)} + d{s} * (v{s} - m{s})",
-            f"h{s} = {a(o + 3)}",
-            f"{a(o + 3)} = h{s} if h{s} != h{s} or v{s} <= h{s} else v{s}",
-            f"l{s} = {a(o + 4)}",
-            f"{a(o + 4)} = l{s} if l{s} != l{s} or v{s} >= l{s} else v{s}",
+            f"{a(o + 1)}, {a(o + 2)} = welford(v{s}, w, {a(o + 1)}, {a(o + 2)})",
+            f"{a(o + 3)}, {a(o + 4)} = extremes(v{s}, {a(o + 3)}, {a(o + 4)})",
         ]
     ends = []
     for p in range(Wn):
         s, f, M, NS, r = i[4 + 2 * K + 5 * p : 9 + 2 * K + 5 * p]
         y, top = f"y{p}", r + M + 2 * NS
-        lines.append(f"{y} = filt[{f}] * v{s}")
-        lines += [f"{y} = {y} + filt[{f + k}] * {a(r + k - 1)}" for k in range(1, M + 1)]
+        lines.append(f"{y} = tap(0.0, filt[{f}], v{s})")
+        lines += [f"{y} = tap({y}, filt[{f + k}], {a(r + k - 1)})" for k in range(1, M + 1)]
         lines += [f"{a(r + k)} = {a(r + k - 1)}" for k in range(M - 1, 0, -1)]
         lines += [f"{a(r)} = v{s}"] if M else []
         for q in range(NS):
             o, z = f + M + 1 + 6 * q, r + M + 2 * q
-            lines += [
-                f"x = filt[{o}] * {y} + {a(z)}",
-                f"{a(z)} = filt[{o + 1}] * {y} - filt[{o + 4}] * x + {a(z + 1)}",
-                f"{a(z + 1)} = filt[{o + 2}] * {y} - filt[{o + 5}] * x",
-                f"{y} = x",
-            ]
-        lines += [
-            f"sq = {y} * {y}",
-            f"{a(top + 1)} = {a(top + 1)} + sq",
-            f"{a(top + 3)} = {a(top + 3)} + sq * sq",
-            f"size, peak = abs({y}), {a(top + 5)}",
-            f"{a(top + 5)} = peak if peak != peak or size <= peak else size",
-        ]
+            coefficients = ", ".join(f"filt[{o + c}]" for c in (0, 1, 2, 4, 5))
+            lines.append(
+                f"{y}, {a(z)}, {a(z + 1)} = section({y}, {a(z)}, {a(z + 1)}, {coefficients})"
+            )
+        lines.append(
+            f"{a(top + 1)}, {a(top + 3)}, {a(top + 5)} = "
+            f"powers({y}, {a(top + 1)}, {a(top + 3)}, {a(top + 5)})"
+        )
         ends += [
-            f"{a(top + 2)} = {a(top + 2)} + {a(top + 1)}",
-            f"{a(top + 1)} = 0.0",
-            f"{a(top + 4)} = {a(top + 4)} + {a(top + 3)}",
-            f"{a(top + 3)} = 0.0",
+            f"{a(top + 1)}, {a(top + 2)} = carry({a(top + 1)}, {a(top + 2)})",
+            f"{a(top + 3)}, {a(top + 4)} = carry({a(top + 3)}, {a(top + 4)})",
         ]
     return lines, ends
 
@@ -221,7 +198,9 @@ def source(ri: np.ndarray, rows: int, inputs: int, L: int) -> str:
         body += [f"        if (j + 1) % {int(ri[3])} == 0:", f"            for b in range({L}):"]
         body += ["                " + line for line in ends]
     jit = f"@numba.cfunc({ACCUMULATE!r}, cache=True, nogil=True, error_model='numpy')"
-    head = ["import numba", "", "", jit, "def accumulate(rec, acc, coef, filt, zs, j0, count):"]
+    steps = "from suspopt.loops._compiled import carry, extremes, powers, section, tap, welford"
+    head = ["import numba", "", steps, "", "", jit]
+    head.append("def accumulate(rec, acc, coef, filt, zs, j0, count):")
     return "\n".join(head + body) + "\n"
 
 

@@ -10,11 +10,13 @@ and its weighted sums as the integration runs, so its rows are neither written t
 affine, and their coefficients, comes from the signal table itself
 (:func:`suspopt.affine.affine_signals` probes it), not from a second description.
 
-The kernel's arithmetic is its own (the terms in turn, Welford's update, sums in blocks of
-``SUM_BLOCK``): each value agrees with the whole run's metric to rounding (about 1e-15
-relative, ``tests/test_accumulators.py``), not to the bit, and a design's value does not
-depend on its batch, its block, the windows or the threads (each lane's arithmetic is its
-own). The numpy engine and signals that are not affine keep the numpy reductions.
+The kernel reduces by the steps every reduction uses (:mod:`suspopt.loops._compiled`), and
+its accumulators are the state of :func:`suspopt.metrics.stats.moments` and
+:func:`suspopt.metrics.iso2631.power_state`: each value agrees with the whole run's metric to
+rounding (about 1e-15 relative, ``tests/test_accumulators.py``: the signal is formed as its
+terms in turn, not by the signal table), and a design's value does not depend on its batch,
+its block, the windows or the threads (each lane's arithmetic is its own). The numpy engine
+and signals that are not affine are reduced from the windows.
 """
 
 from __future__ import annotations
@@ -117,10 +119,12 @@ class Accumulators:
         mean, m2, high, low = self._rows(PER_SIGNAL * s + 1, 4, P)
         return mean, m2, high, low
 
-    def weighted(self, p: int, P: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Pair ``p``'s sums of ``a_w²`` and ``a_w⁴`` and its largest ``|a_w|``, (P,) each."""
+    def weighted(self, p: int, P: int) -> tuple[np.ndarray, np.ndarray]:
+        """Pair ``p``'s sums ``(4, P)``, the block's and the total of ``a_w²`` then of
+        ``a_w⁴``, and its largest ``|a_w|`` (P,): the state of
+        :func:`suspopt.metrics.iso2631.power_state`."""
         part, total, part4, total4, peak = self._rows(self._pair_rows[p] + 1, 5, P)
-        return total + part, total4 + part4, peak
+        return np.stack([part, total, part4, total4]), peak
 
 
 def no_accumulators(blocks: int, B: int) -> tuple:

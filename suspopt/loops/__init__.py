@@ -1,7 +1,8 @@
-"""The compiled loops of the metrics' arithmetic (:mod:`._compiled`: the weighting filter of
-:mod:`suspopt.weighting`, the streamed block moments and power sums of
-:mod:`suspopt.streaming`, each the numpy arithmetic it replaces, to the same bits), where
-numba is installed."""
+"""The arithmetic of the streamed metrics, written once and compiled (:mod:`._compiled`):
+the running moments and extremes, the weighting filter and the weighted power sums, which
+the metrics (:mod:`suspopt.metrics.stats`, :mod:`suspopt.metrics.iso2631`), the weighting
+(:mod:`suspopt.weighting`), the numpy engine's windows (:mod:`suspopt.streaming`) and the
+compiled kernel (:mod:`suspopt.integrator._accumulate`) all call."""
 
 from __future__ import annotations
 
@@ -13,10 +14,10 @@ __all__ = ["compiled_reductions"]
 
 
 def compiled_reductions() -> Any:
-    """The module of compiled loops (:mod:`suspopt.loops._compiled`) when numba is installed,
-    else None; the callers then run their numpy arithmetic."""
+    """The module of the metrics' compiled arithmetic (:mod:`suspopt.loops._compiled`);
+    ImportError saying so when numba, a dependency, is missing."""
     if not compiled_available():
-        return None
+        raise ImportError("suspopt needs numba for its metrics: pip install numba")
     from . import _compiled
 
     return _compiled

@@ -1,25 +1,32 @@
-"""Compiled loops of the streamed reductions and of the weighting filter (imported only when
-numba is installed, through :func:`suspopt.loops.compiled_reductions`).
+"""The arithmetic of the streamed metrics, written once, compiled (through
+:func:`suspopt.loops.compiled_reductions`).
 
-Each function is the numpy arithmetic it replaces, operation for operation, so that both give
-the same bits (``tests/test_reductions.py`` checks it against numpy on hostile signals):
+Every streamed metric is reduced sample by sample by the steps below, wherever it runs: the
+compiled kernel calls them for the signals it forms itself (:mod:`suspopt.integrator._accumulate`,
+and the lane loop generated for a network, :func:`suspopt.integrator._accumulate.source`,
+which calls them by name), and the row loops here call them for a signal held in memory: a
+whole record (:mod:`suspopt.metrics.stats`, :mod:`suspopt.metrics.iso2631`) or a window of one
+on the numpy engine (:mod:`suspopt.streaming`). So a metric gives the same bits from the
+same samples on either engine and in any windows:
 
-- :func:`weight_rows`: :meth:`suspopt.weighting.WeightingFilter.apply` — the FIR correction
-  as the sum of shifted copies in its fixed order, then each second-order section in scipy's
-  transposed direct form II (``sosfilt``'s difference equations, sample by sample);
-- :func:`block_moments`: the block statistics of :class:`suspopt.streaming._Moments` — each
-  block's mean (``np.mean``: numpy's pairwise sum, divided by the count) and the sum of its
-  squared deviations;
-- :func:`power_sums`: :func:`suspopt.metrics.iso2631.block_sums` of ``a_w²`` and of
-  ``a_w⁴`` and the largest ``|a_w|`` of each row, in one pass (``np.max``'s NaN included).
+- :func:`welford`: one sample into the running mean and sum of squared deviations (Welford's
+  update, ``d = x - m; m += d w; M2 += d (x - m)`` with ``w = 1 / count``), from which the
+  variance, standard deviation, r.m.s. and mean follow
+  (:func:`suspopt.metrics.stats.moment_value`);
+- :func:`extremes`: the largest and smallest sample so far (a NaN stays, as ``np.max`` keeps
+  it);
+- :func:`tap` and :func:`section`: the ISO 2631-1 weighting filter
+  (:class:`suspopt.weighting.WeightingFilter`): the FIR correction as its taps in their fixed
+  order, then each second-order section in transposed direct form II (scipy's ``sosfilt``
+  difference equations);
+- :func:`powers` and :func:`carry`: the sums of ``a_w²`` and ``a_w⁴`` and the largest
+  ``|a_w|`` (Eq 2.78, 2.82, 2.83), each sum kept per block of ``SUM_BLOCK`` samples and
+  carried into its total at the block's end (:func:`suspopt.metrics.iso2631.weighted_value`).
 
-:data:`_pairwise` is numpy's pairwise summation (its ``pairwise_sum`` of a contiguous run:
-eight partial sums up to 128 values, halves above that, a start at zero), so a block summed
-here has the bits of ``np.sum`` of that block (numpy 2.x; the test compares them). One pass
-over each row instead of numpy's several whole-array passes and temporaries
-(``benchmarks/bench_reductions.py`` times both in one run). Single-threaded (no
-``prange``): they run in the caller's thread while the kernel may integrate the next window
-on every core (:func:`suspopt.integrator._ahead`).
+The row loops :func:`moment_rows`, :func:`weight_rows` and :func:`power_rows` continue a
+state given to them, so a record cut into windows gives the whole record's bits. They are
+single-threaded (no ``prange``): they run in the caller's thread while the kernel may
+integrate the next window on every core (:func:`suspopt.integrator._ahead`).
 """
 
 from __future__ import annotations
@@ -31,57 +38,53 @@ from .. import _numba_cache
 
 _numba_cache.prepare()  # (cached for the machine, damaged files compiled again: suspopt._numba_cache)
 _jit = numba.njit(cache=True, nogil=True)
+#: A step: compiled into its caller (the kernel's lane loops vectorise through it).
+_step = numba.njit(cache=True, nogil=True, inline="always")
 
 
-@_jit
-def _leaf(x, start, n):
-    """numpy's pairwise sum of ``x[start : start + n]`` for ``n <= 128``: one block of eight
-    partial sums (fewer than eight values: in turn, from zero)."""
-    if n < 8:
-        res = 0.0
-        for i in range(n):
-            res += x[start + i]
-        return res
-    r0, r1, r2, r3 = x[start], x[start + 1], x[start + 2], x[start + 3]
-    r4, r5, r6, r7 = x[start + 4], x[start + 5], x[start + 6], x[start + 7]
-    i = start + 8
-    stop = start + n - n % 8
-    while i < stop:
-        r0 += x[i]
-        r1 += x[i + 1]
-        r2 += x[i + 2]
-        r3 += x[i + 3]
-        r4 += x[i + 4]
-        r5 += x[i + 5]
-        r6 += x[i + 6]
-        r7 += x[i + 7]
-        i += 8
-    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < start + n:
-        res += x[i]
-        i += 1
-    return res
+@_step
+def welford(x, w, mean, m2):
+    """The running ``(mean, M2)`` after the sample ``x``, ``w = 1 / count`` (``count`` the
+    samples so far, ``x`` included)."""
+    d = x - mean
+    mean = mean + d * w
+    return mean, m2 + d * (x - mean)
 
 
-def _halves(part):
-    """The pairwise sum one level up from ``part`` (numpy splits a run of more than 128
-    values in two, the first a multiple of 8). Each level is its own function: numba's cache
-    of a recursive function crashes the process that loads it (numba 0.68)."""
-
-    def level(x, start, n):
-        if n <= 128:
-            return _leaf(x, start, n)
-        half = n // 2
-        half -= half % 8
-        return part(x, start, half) + part(x, start + half, n - half)
-
-    return _jit(level)
+@_step
+def extremes(x, high, low):
+    """The largest and smallest sample after ``x`` (a NaN, once met, stays)."""
+    return (high if high != high or x <= high else x), (low if low != low or x >= low else x)
 
 
-#: ``np.sum`` of ``x[start : start + n]`` (1-D, contiguous) in numpy's order, for ``n`` up to
-#: :data:`LONGEST` (four levels of halves above the 128-value blocks).
-_pairwise = _halves(_halves(_halves(_halves(_leaf))))
-LONGEST = 1920
+@_step
+def tap(y, c, x):
+    """One tap ``c x`` of the weighting's FIR correction added to ``y``, the taps in their
+    fixed order from the newest input (``y`` starts at 0)."""
+    return y + c * x
+
+
+@_step
+def section(u, z0, z1, b0, b1, b2, a1, a2):
+    """One second-order section ``[b0, b1, b2, 1, a1, a2]`` in transposed direct form II:
+    ``(output, state 0, state 1)`` after the input ``u``."""
+    x = b0 * u + z0
+    return x, b1 * u - a1 * x + z1, b2 * u - a2 * x
+
+
+@_step
+def powers(a, squares, fourth, peak):
+    """The running sums of ``a²`` and ``a⁴`` and the largest ``|a|`` after the weighted
+    sample ``a`` (a NaN stays the largest)."""
+    sq = a * a
+    size = abs(a)
+    return squares + sq, fourth + sq * sq, (peak if peak != peak or size <= peak else size)
+
+
+@_step
+def carry(part, total):
+    """A block's sum carried into the total: ``(0, total + part)``."""
+    return 0.0, total + part
 
 
 #: Rows the filter takes at once: their samples side by side, time-major, so that each
@@ -116,19 +119,17 @@ def weight_rows(numerator, sections, a, history, poles, out):
                 z[s, 1, i] = poles[s, r0 + i, 1]
         for t in range(T):
             for i in range(C):
-                y[t, i] = numerator[0] * x[M + t, i]
+                y[t, i] = tap(0.0, numerator[0], x[M + t, i])
             for k in range(1, M + 1):
                 for i in range(C):
-                    y[t, i] = y[t, i] + numerator[k] * x[M + t - k, i]
+                    y[t, i] = tap(y[t, i], numerator[k], x[M + t - k, i])
             for s in range(S):
                 b0, b1, b2 = sections[s, 0], sections[s, 1], sections[s, 2]
                 a1, a2 = sections[s, 4], sections[s, 5]
                 for i in range(C):
-                    u = y[t, i]
-                    v = b0 * u + z[s, 0, i]
-                    z[s, 0, i] = b1 * u - a1 * v + z[s, 1, i]
-                    z[s, 1, i] = b2 * u - a2 * v
-                    y[t, i] = v
+                    y[t, i], z[s, 0, i], z[s, 1, i] = section(
+                        y[t, i], z[s, 0, i], z[s, 1, i], b0, b1, b2, a1, a2
+                    )
         for i in range(c):
             for t in range(T):
                 out[r0 + i, t] = y[t, i]
@@ -140,51 +141,71 @@ def weight_rows(numerator, sections, a, history, poles, out):
 
 
 @_jit
-def block_moments(x, block, means, squares):
-    """Each row of ``x (R, T)`` in blocks of ``block`` samples (the last one shorter): the
-    block's mean into ``means (R, nb)`` and its sum of squared deviations into ``squares``
-    (``block`` at most :data:`LONGEST`)."""
-    if block > LONGEST:
-        raise ValueError("a block longer than the pairwise sum's levels")
-    R, T = x.shape
-    scratch = np.empty(block)
-    for r in range(R):
-        row = x[r]
-        for b in range(means.shape[1]):
-            start = b * block
-            m = min(block, T - start)
-            mean = _pairwise(row, start, m) / m
-            for i in range(m):
-                d = row[start + i] - mean
-                scratch[i] = d * d
-            means[r, b] = mean
-            squares[r, b] = _pairwise(scratch, 0, m)
+def _lanes(a, r0, c, scratch):
+    """Rows ``r0 .. r0 + c`` of ``a (R, T)`` into the time-major ``scratch (T, C)``."""
+    for i in range(c):
+        for t in range(a.shape[1]):
+            scratch[t, i] = a[r0 + i, t]
 
 
 @_jit
-def power_sums(aw, block, squares, fourth, peak):
-    """Each row of ``aw (R, T)``: the sums of ``aw²`` and of ``aw⁴`` over each ``block``
-    samples into ``squares, fourth (R, nb)`` and the largest ``|aw|`` into ``peak (R,)`` (NaN
-    when a sample is NaN; ``block`` at most :data:`LONGEST`)."""
-    if block > LONGEST:
-        raise ValueError("a block longer than the pairwise sum's levels")
+def moment_rows(x, count, mean, m2, high, low):
+    """Each row of ``x (R, T)`` after ``count`` samples into its running ``mean``, ``m2``,
+    ``high`` and ``low`` (R,) each, in place (:func:`welford`, :func:`extremes`), the rows
+    :data:`LANES` at a time side by side."""
+    R, T = x.shape
+    C = min(LANES, R)
+    lanes = np.empty((T, C))
+    state = np.empty((4, C))
+    for r0 in range(0, R, C):
+        c = min(C, R - r0)
+        _lanes(x, r0, c, lanes)
+        for i in range(C):  # (the last group's spare lanes: any finite state)
+            k = r0 + min(i, c - 1)
+            state[0, i], state[1, i], state[2, i], state[3, i] = mean[k], m2[k], high[k], low[k]
+        for t in range(T):
+            w = 1.0 / (count + t + 1)
+            for i in range(C):
+                v = lanes[t, i]
+                state[0, i], state[1, i] = welford(v, w, state[0, i], state[1, i])
+                state[2, i], state[3, i] = extremes(v, state[2, i], state[3, i])
+        for i in range(c):
+            mean[r0 + i], m2[r0 + i], high[r0 + i], low[r0 + i] = (
+                state[0, i],
+                state[1, i],
+                state[2, i],
+                state[3, i],
+            )
+
+
+@_jit
+def power_rows(aw, start, block, sums, peak):
+    """Each row of the weighted ``aw (R, T)``, whose first sample is sample ``start`` of its
+    record, into ``sums (4, R)`` (the block's and the total sum of ``a_w²``, the same of
+    ``a_w⁴``) and ``peak (R,)``, in place (:func:`powers`; a block's sums carried into the
+    totals at its end, :func:`carry`), the rows :data:`LANES` at a time side by side."""
     R, T = aw.shape
-    sq = np.empty(block)
-    quad = np.empty(block)
-    for r in range(R):
-        top = -np.inf
-        for b in range(squares.shape[1]):
-            start = b * block
-            m = min(block, T - start)
-            for i in range(m):
-                v = aw[r, start + i]
-                s = v * v
-                sq[i] = s
-                quad[i] = s * s
-                size = abs(v)
-                if not size <= top:  # noqa: SIM102  (a NaN stays: np.max's order of tests)
-                    if not np.isnan(top):
-                        top = size
-            squares[r, b] = _pairwise(sq, 0, m)
-            fourth[r, b] = _pairwise(quad, 0, m)
-        peak[r] = top
+    C = min(LANES, R)
+    lanes = np.empty((T, C))
+    state = np.empty((5, C))
+    for r0 in range(0, R, C):
+        c = min(C, R - r0)
+        _lanes(aw, r0, c, lanes)
+        for i in range(C):
+            k = r0 + min(i, c - 1)
+            for q in range(4):
+                state[q, i] = sums[q, k]
+            state[4, i] = peak[k]
+        for t in range(T):
+            for i in range(C):
+                state[0, i], state[2, i], state[4, i] = powers(
+                    lanes[t, i], state[0, i], state[2, i], state[4, i]
+                )
+            if (start + t + 1) % block == 0:
+                for i in range(C):
+                    state[0, i], state[1, i] = carry(state[0, i], state[1, i])
+                    state[2, i], state[3, i] = carry(state[2, i], state[3, i])
+        for i in range(c):
+            for q in range(4):
+                sums[q, r0 + i] = state[q, i]
+            peak[r0 + i] = state[4, i]

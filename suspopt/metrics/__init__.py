@@ -20,12 +20,13 @@ from .._lazy import lazy_names
 _MODULES = {
     "iso2631": (
         "WEIGHTINGS", "MTVV_RATIO_LIMIT", "VDV_RATIO_LIMIT", "COMFORT_REACTIONS", "SUM_BLOCK",
-        "weighting_response", "weighting_filter", "block_sums", "weight", "weighted_rms",
+        "weighting_response", "weighting_filter", "power_state", "weighted_value",
+        "running_state", "weight", "weighted_rms",
         "running_rms", "mtvv", "vdv", "crest_factor", "ratio_tests", "comfort_reaction"
     ),
     "stats": (
-        "STATISTICS", "var", "std", "rms", "maximum", "minimum", "max_abs", "mean",
-        "peak_to_peak", "suspension_travel_variance", "suspension_travel_max",
+        "STATISTICS", "moments", "moment_value", "var", "std", "rms", "maximum", "minimum",
+        "max_abs", "mean", "peak_to_peak", "suspension_travel_variance", "suspension_travel_max",
         "suspension_travel_max_abs", "tyre_deflection_variance", "tyre_deflection_max",
         "tyre_deflection_max_abs", "pitch_variance", "dynamic_tyre_load_ratio",
         "peak_dynamic_tyre_load_ratio", "peak_tyre_force"

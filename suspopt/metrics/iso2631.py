@@ -42,7 +42,9 @@ __all__ = [
     "weighting_response",
     "weighting_filter",
     "SUM_BLOCK",
-    "block_sums",
+    "power_state",
+    "weighted_value",
+    "running_state",
     "weight",
     "weighted_rms",
     "running_rms",
@@ -120,42 +122,57 @@ def weight(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
 
 SUM_BLOCK = 256
 """Samples per block of the weighted metrics' sums (r.m.s., VDV, crest factor): each block is
-summed on its own and the blocks are added in time order, so that a signal which arrives in
-windows of whole blocks (:mod:`suspopt.streaming`) gives the whole signal's bits."""
+summed on its own and carried into the total at its end (:func:`power_state`), as the
+compiled kernel sums the signals it forms itself."""
 
 
-def block_sums(x: np.ndarray) -> np.ndarray:
-    """Sums of ``x (..., T)`` over each :data:`SUM_BLOCK` samples, in time order:
-    ``(..., ceil(T / SUM_BLOCK))``, the last block shorter when ``T`` is not a multiple."""
-    T = x.shape[-1]
-    whole = T - T % SUM_BLOCK
-    parts = []
-    if whole:
-        parts.append(np.sum(x[..., :whole].reshape(*x.shape[:-1], -1, SUM_BLOCK), axis=-1))
-    if whole < T:
-        parts.append(np.sum(x[..., whole:], axis=-1, keepdims=True))
-    return np.concatenate(parts, axis=-1)
+def power_state(aw: np.ndarray, state: tuple | None = None) -> tuple:
+    """The streamed state of the weighted samples ``aw (..., T)``: ``(count, sums, peak)``,
+    ``sums (4, ...)`` the current block's and the total sum of ``a_w²``, the same of ``a_w⁴``
+    (:data:`SUM_BLOCK` samples a block), ``peak (...)`` the largest ``|a_w|``, after ``state``
+    (the samples before; default none). Sample by sample by the steps every engine uses
+    (:func:`suspopt.loops._compiled.powers`), so pieces give the whole record's bits.
+    :func:`weighted_value` makes a metric of it."""
+    from ..loops import compiled_reductions
+
+    a = np.asarray(aw, dtype=np.float64)
+    lead = a.shape[:-1]
+    if state is None:
+        count, sums, peak = 0, np.zeros((4, *lead)), np.full(lead, -np.inf)
+    else:
+        count, sums, peak = state[0], np.array(state[1], dtype=float), np.array(state[2], float)
+    flat_sums, flat_peak = sums.reshape(4, -1), peak.reshape(-1)
+    rows = np.ascontiguousarray(a.reshape(-1, a.shape[-1]))
+    compiled_reductions().power_rows(rows, count, SUM_BLOCK, flat_sums, flat_peak)
+    return count + a.shape[-1], flat_sums.reshape(4, *lead), flat_peak.reshape(lead)
 
 
-def _total(x: np.ndarray) -> np.ndarray:
-    """The sum over time of ``x``: its :func:`block_sums` added in time order."""
-    return np.cumsum(block_sums(x), axis=-1)[..., -1]
+def weighted_value(metric: str, state: tuple, fs: float) -> np.ndarray:
+    """The weighted metric ``metric`` of the weighted samples whose streamed state is
+    ``state`` (:func:`power_state`) at ``fs`` [Hz]: ``rms_weighted`` ``(Σ a_w² / n)^½``
+    (Eq 2.78), ``vdv`` ``(Σ a_w⁴ / fs)^¼`` (Eq 2.82), ``crest_factor`` ``max |a_w| / a_w``
+    (Eq 2.83, NaN for an all-zero signal)."""
+    count, sums, peak = state
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        if metric == "vdv":
+            return ((sums[3] + sums[2]) / fs) ** 0.25
+        rms = np.sqrt((sums[1] + sums[0]) / count)
+        return rms if metric == "rms_weighted" else peak / rms
 
 
-def _rms(aw: np.ndarray) -> np.ndarray:
-    return np.sqrt(_total(np.square(aw)) / aw.shape[-1])
-
-
-def _running_rms(aw: np.ndarray, fs: float, tau: float) -> np.ndarray:
-    window = max(1, round(tau * fs))
-    energy = np.cumsum(aw**2, axis=-1) / fs
-    lagged = np.zeros_like(energy)
-    lagged[..., window:] = energy[..., :-window]
-    return np.sqrt(np.maximum(energy - lagged, 0.0) / (window / fs))
-
-
-def _vdv(aw: np.ndarray, fs: float) -> np.ndarray:
-    return (_total(np.square(np.square(aw))) / fs) ** 0.25
+def running_state(squared: np.ndarray, fs: float, tau: float, state: tuple | None = None):
+    """Eq 2.80 over the squared weighted samples ``squared (..., T)`` that follow ``state``:
+    ``(running r.m.s. (..., T), state)``, the state being the running sum of ``a_w²`` and its
+    last ``τ fs`` values divided by ``fs`` (default: the record starts here, zero before)."""
+    width = max(1, round(tau * fs))
+    lead = squared.shape[:-1]
+    total, history = state if state is not None else (np.zeros(lead), np.zeros((*lead, width)))
+    summed = np.cumsum(np.concatenate([total[..., None], squared], axis=-1), axis=-1)[..., 1:]
+    energy = summed / fs
+    joined = np.concatenate([history, energy], axis=-1)
+    lagged = joined[..., : energy.shape[-1]]
+    rms = np.sqrt(np.maximum(energy - lagged, 0.0) / (width / fs))
+    return rms, (summed[..., -1], joined[..., joined.shape[-1] - width :])
 
 
 def weighted_rms(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
@@ -165,7 +182,7 @@ def weighted_rms(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
     seconds (``T = N/fs``), i.e. the mean of the squared samples. Returns ``a.shape[:-1]``.
     """
     a, fs = _check(a, fs)
-    return _rms(weight(a, fs, weighting))
+    return weighted_value("rms_weighted", power_state(weight(a, fs, weighting)), fs)
 
 
 def running_rms(a: np.ndarray, fs: float, weighting: str | None, tau: float = 1.0) -> np.ndarray:
@@ -176,7 +193,7 @@ def running_rms(a: np.ndarray, fs: float, weighting: str | None, tau: float = 1.
     record, where the signal is taken as zero (the vehicle at rest), so the series ramps up.
     """
     a, fs = _check(a, fs)
-    return _running_rms(weight(a, fs, weighting), fs, tau)
+    return running_state(np.square(weight(a, fs, weighting)), fs, tau)[0]
 
 
 def mtvv(a: np.ndarray, fs: float, weighting: str | None, tau: float = 1.0) -> np.ndarray:
@@ -194,7 +211,7 @@ def vdv(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
     Not divided by the duration. Rectangle rule over the samples, as :func:`weighted_rms`.
     """
     a, fs = _check(a, fs)
-    return _vdv(weight(a, fs, weighting), fs)
+    return weighted_value("vdv", power_state(weight(a, fs, weighting)), fs)
 
 
 def crest_factor(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
@@ -203,9 +220,7 @@ def crest_factor(a: np.ndarray, fs: float, weighting: str | None) -> np.ndarray:
     NaN for an all-zero signal. The basic method (r.m.s.) suffices while it is at most 9.
     """
     a, fs = _check(a, fs)
-    aw = weight(a, fs, weighting)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.max(np.abs(aw), axis=-1) / _rms(aw)
+    return weighted_value("crest_factor", power_state(weight(a, fs, weighting)), fs)
 
 
 def ratio_tests(
@@ -220,11 +235,12 @@ def ratio_tests(
     """
     a, fs = _check(a, fs)
     aw = weight(a, fs, weighting)
-    rms = _rms(aw)
+    sums = power_state(aw)
+    rms = weighted_value("rms_weighted", sums, fs)
     duration = aw.shape[-1] / fs
     with np.errstate(invalid="ignore", divide="ignore"):
-        mtvv_ratio = np.max(_running_rms(aw, fs, tau), axis=-1) / rms
-        vdv_ratio = _vdv(aw, fs) / (rms * duration**0.25)
+        mtvv_ratio = np.max(running_state(np.square(aw), fs, tau)[0], axis=-1) / rms
+        vdv_ratio = weighted_value("vdv", sums, fs) / (rms * duration**0.25)
     return {
         "mtvv_ratio": mtvv_ratio,
         "vdv_ratio": vdv_ratio,

@@ -14,6 +14,8 @@ import numpy as np
 
 __all__ = [
     "STATISTICS",
+    "moments",
+    "moment_value",
     "var",
     "std",
     "rms",
@@ -35,44 +37,99 @@ __all__ = [
 ]
 
 
+def moments(x: np.ndarray, state: tuple | None = None) -> tuple:
+    """The streamed state of the samples ``x (..., T)``: ``(count, mean, M2, high, low)``, the
+    arrays of shape ``x.shape[:-1]``, after ``state`` (the samples before ``x``; default
+    none). One pass per row, sample by sample, by the steps every engine uses
+    (:func:`suspopt.loops._compiled.welford`, :func:`~suspopt.loops._compiled.extremes`), so a
+    signal cut into pieces gives the whole signal's bits and the compiled kernel, reducing the
+    signals it forms itself, the same arithmetic. :func:`moment_value` makes a statistic of
+    it."""
+    from ..loops import compiled_reductions
+
+    a = np.asarray(x, dtype=np.float64)
+    if a.ndim == 0 or (a.shape[-1] == 0 and state is None):
+        raise ValueError("the signal must have a non-empty time axis (last axis)")
+    lead = a.shape[:-1]
+    if state is None:
+        count, kept = 0, np.zeros((4, *lead))
+        kept[2], kept[3] = -np.inf, np.inf  # (the largest and smallest sample: none yet)
+    else:
+        count, kept = state[0], np.array(np.stack(state[1:]), dtype=np.float64)
+    rows = kept.reshape(4, -1)
+    mean, m2, high, low = rows[0], rows[1], rows[2], rows[3]  # (views: written in place)
+    flat = np.ascontiguousarray(a.reshape(-1, a.shape[-1]))
+    compiled_reductions().moment_rows(flat, count, mean, m2, high, low)
+    kept = rows.reshape(4, *lead)
+    return count + a.shape[-1], kept[0], kept[1], kept[2], kept[3]
+
+
+def moment_value(statistic: str, state: tuple) -> np.ndarray:
+    """The statistic ``statistic`` (a key of :data:`STATISTICS`) of the samples whose
+    streamed state is ``state`` (:func:`moments`): ``var = M2 / n`` (Eq 2.87), ``std`` its
+    root, ``mean``, ``rms = (var + mean²)^½``, ``max``, ``min``, ``max_abs`` the larger
+    magnitude of the two, ``peak_to_peak`` their difference."""
+    return np.asarray(_value(statistic, *state))[()]  # (a scalar for one signal)
+
+
+def _value(statistic: str, count: int, mean, m2, high, low):
+    if statistic in ("var", "std", "rms"):
+        variance = m2 / count
+        if statistic == "var":
+            return variance
+        return np.sqrt(variance if statistic == "std" else variance + np.square(mean))
+    if statistic == "mean":
+        return mean
+    if statistic == "max":
+        return high
+    if statistic == "min":
+        return low
+    if statistic == "max_abs":
+        return np.maximum(np.abs(high), np.abs(low))
+    if statistic == "peak_to_peak":
+        return high - low
+    raise ValueError(f"no statistic {statistic!r}; available: {', '.join(STATISTICS)}")
+
+
 def var(x: np.ndarray) -> np.ndarray:
     """Population variance ``(1/n) Σ (x_j - x̄)²`` along time (thesis Eq 2.87, 2.89, 2.91)."""
-    return np.var(x, axis=-1)
+    return moment_value("var", moments(x))
 
 
 def std(x: np.ndarray) -> np.ndarray:
     """Population standard deviation along time, the square root of :func:`var`."""
-    return np.std(x, axis=-1)
+    return moment_value("std", moments(x))
 
 
 def rms(x: np.ndarray) -> np.ndarray:
-    """Root mean square ``[(1/n) Σ x_j²]^½`` along time (mean not removed)."""
-    return np.sqrt(np.mean(np.square(x), axis=-1))
+    """Root mean square ``[(1/n) Σ x_j²]^½`` along time (mean not removed), as
+    ``(var + mean²)^½``."""
+    return moment_value("rms", moments(x))
 
 
 def maximum(x: np.ndarray) -> np.ndarray:
     """Largest (signed) sample along time (thesis Eq 2.88, 2.90: ``MAX``)."""
-    return np.max(x, axis=-1)
+    return moment_value("max", moments(x))
 
 
 def minimum(x: np.ndarray) -> np.ndarray:
     """Smallest (signed) sample along time."""
-    return np.min(x, axis=-1)
+    return moment_value("min", moments(x))
 
 
 def max_abs(x: np.ndarray) -> np.ndarray:
     """Largest magnitude ``max_j |x_j|`` along time."""
-    return np.max(np.abs(x), axis=-1)
+    return moment_value("max_abs", moments(x))
 
 
 def mean(x: np.ndarray) -> np.ndarray:
     """Arithmetic mean along time."""
-    return np.mean(x, axis=-1)
+    return moment_value("mean", moments(x))
 
 
 def peak_to_peak(x: np.ndarray) -> np.ndarray:
     """Range ``max - min`` along time."""
-    return np.ptp(x, axis=-1)
+    return moment_value("peak_to_peak", moments(x))
 
 
 STATISTICS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
