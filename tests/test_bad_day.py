@@ -455,3 +455,21 @@ def test_a_run_killed_mid_run_is_named_by_the_next_one(tmp_path, capsys):
         found["who"],
     ), line
     assert sorted(p.name for p in tmp_path.iterdir()) == ["front.h5", "study.yaml"]
+
+
+def test_a_command_run_in_a_folder_that_is_gone_exits_2_with_one_line(tmp_path):
+    """A shell left in a removed folder: one line, exit 2 (numba, compiling there, raised a
+    FileNotFoundError from deep inside)."""
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    script = (
+        "import os, sys\n"
+        f"os.rmdir({str(gone)!r})\n"
+        "from suspopt._entry import main\n"
+        f"sys.exit(main(['simulate', {str(ROOT / 'configs' / 'quickstart.yaml')!r}]))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], cwd=gone, capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == "error: the current folder no longer exists; cd to one that does\n"
