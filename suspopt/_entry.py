@@ -74,11 +74,6 @@ def main(argv: list[str] | None = None, leaving: bool = False) -> int:
     if found_term == signal.SIG_DFL:
         signal.signal(signal.SIGTERM, _Interrupts.handler)
     try:
-        try:  # (numba cannot compile in a folder that is gone: a traceback at the first run)
-            os.getcwd()
-        except FileNotFoundError:
-            sys.stderr.write("error: the current folder no longer exists; cd to one that does\n")
-            return 2
         warnings.showwarning = _one_line_warning
         warnings.simplefilter("default")  # each place once
         import typer

@@ -221,6 +221,12 @@ def prepare() -> None:
     with _prepared:
         if _done:
             return
+        try:  # (numba cannot compile in a folder that is gone: it raised from deep inside)
+            os.getcwd()
+        except FileNotFoundError:
+            from .errors import InputError
+
+            raise InputError("the current folder no longer exists; cd to one that does") from None
         heal()
         from numba.core import caching, event
 

@@ -29,6 +29,8 @@ from .errors import Problems
 from .network import Network
 
 __all__ = [
+    "nonlinear_part",
+    "check_exact",
     "MIN_STEPS_PER_BUMP",
     "MIN_STEPS_PER_WAVE",
     "check_steps",
@@ -130,6 +132,46 @@ def full_network(model, attachments) -> Network:
 
 #: Directions per pass of :func:`_rk4_radius` (its grid takes 300 complex numbers each).
 _RADIUS_CHUNK = 20_000
+
+
+def nonlinear_part(cfg: Config, model, controller, network) -> tuple[tuple, str] | None:
+    """``(config key, why)`` when the run of ``model`` (``network`` its whole network) is not
+    linear for the chosen designs (a controller, a tyre that lifts off, a non-linear element),
+    else None."""
+    if controller is not None:
+        return ("control",), "a semi-active controller switches the damping"
+    if cfg.vehicle.tyre_lift_off:
+        return ("vehicle", "tyre_lift_off"), "a tyre that lifts off is not linear"
+    for g in network.groups:
+        if g.extra is None:
+            continue
+        law = g.extra_law
+        if law is not None and law[0] == "poly3" and all(not np.any(p) for p in law[1]):
+            continue  # a cubic term of zero in every design
+        if g.name == "suspension" and law is not None:
+            corner = model.corners[int(np.flatnonzero(np.any(law[1][2] != 0, axis=(1, 2)))[0])]
+            path = f"vehicle.corners.{corner}.spring.cubic"
+            where = [i for i, v in enumerate(cfg.design_variables) if v.path == path]
+            key = ("design_variables", where[0]) if where else tuple(path.split("."))
+            return key, f"the Duffing spring {path} > 0 is not linear"
+        if cfg.seat is not None:
+            return ("seat", "kind"), f"the {cfg.seat.kind} seat's mechanism is not linear"
+        return ("vehicle",), f"the non-linear part of {g.name!r} is not linear"
+    return None
+
+
+def check_exact(cfg: Config, prepared) -> None:
+    """ConfigError at ``simulation.method`` when it is ``exact`` and the run of ``prepared``
+    (designs, model, controller, attachments) is not linear (:func:`nonlinear_part`)."""
+    if cfg.simulation.method != "exact":
+        return
+    _, model, controller, attachments = prepared
+    found = nonlinear_part(cfg, model, controller, full_network(model, attachments))
+    if found is not None:
+        raise cfg.error(
+            ("simulation", "method"),
+            f"exact needs a linear model without a controller: {found[1]}; use method time",
+        )
 
 
 def _rk4_radius(direction: np.ndarray) -> np.ndarray:

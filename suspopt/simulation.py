@@ -16,7 +16,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from . import memory
-from .checks import check_steps, full_network
+from .checks import check_exact, check_steps, full_network
 from .config import Config
 from .config.loader import require_config
 from .controller import build_controller
@@ -58,6 +58,13 @@ class Prepared(NamedTuple):
     attachments: list[Attachment]
 
 
+def stepper(cfg: Config) -> str:
+    """What integrates ``cfg``'s runs: ``exact`` for ``simulation.method: exact`` (the exact
+    stepper of a linear network, :mod:`suspopt.integrator.exact`), else its
+    ``simulation.engine``."""
+    return "exact" if cfg.simulation.method == "exact" else cfg.simulation.engine
+
+
 def prepare(cfg: Config, params: Mapping[str, Any] | None = None) -> Prepared:
     """Designs, model, controller and attachments of a run, after the checks that need no
     integration (so that bad input fails before any): the time grid and the road against
@@ -77,6 +84,7 @@ def build_run(cfg: Config, params: Mapping[str, Any] | None = None) -> Prepared:
     checked against the signals the run will have (:func:`check_signals`)."""
     prepared = assemble(cfg, params)
     check_signals(cfg, prepared)
+    check_exact(cfg, prepared)
     return prepared
 
 
@@ -231,7 +239,6 @@ def _run(cfg: Config, prepared: Prepared, roads: Sequence[Any] | None = None) ->
     (:mod:`suspopt.execution`) in chunks when that is not ``local``."""
     from . import execution
 
-    sim = cfg.simulation
     pv, model, controller, attachments = prepared
     run, z, zd, t_grid = _setup(cfg, pv, model, controller, attachments, roads)
     chunked = pv.P > 1 and pv.params and not roads and not execution.is_local(cfg.execution)
@@ -240,7 +247,7 @@ def _run(cfg: Config, prepared: Prepared, roads: Sequence[Any] | None = None) ->
         designs = [{k: np.asarray(v)[r] for k, v in pv.params.items()} for r in rows]
         traj = _joined(execution.map_chunks(_chunk_trajectory, cfg, designs, cfg.execution))
     else:
-        traj = integrate(run, sim.engine)
+        traj = integrate(run, stepper(cfg))
     return _result(cfg, pv, model, controller, attachments, run, (z, zd, t_grid), traj)
 
 
@@ -316,6 +323,12 @@ def _setup(
     z, zd = np.stack([u for u, _ in inputs], axis=1), np.stack([v for _, v in inputs], axis=1)
     times, jumps = _edges(cfg, model, roads, asm.P)
     edges = None
+    if times.size and sim.method == "exact":
+        raise cfg.error(
+            ("simulation", "method"),
+            f"exact needs a road without steps between the integration steps; road kind "
+            f"{roads[0].kind!r} has some; use method time",
+        )
     if times.size:
 
         def at(t: np.ndarray, left: bool) -> np.ndarray:
@@ -364,7 +377,7 @@ def _chunk_trajectory(cfg: Config, params: dict[str, np.ndarray]) -> Trajectory:
     it travels as arrays)."""
     pv, model, controller, attachments = prepare(cfg, params)
     run, _, _, _ = _setup(cfg, pv, model, controller, attachments)
-    traj = integrate(run, cfg.simulation.engine)
+    traj = integrate(run, stepper(cfg))
     damping = traj.damping
     if isinstance(damping, Held):
         damping = Held(damping.values, damping.index)

@@ -68,29 +68,12 @@ _N0 = 0.1
 
 
 def _nonlinear(cfg: Config, model, controller, network) -> tuple[tuple, str] | None:
-    """``(config key, why)`` when the run is not linear for the chosen designs, else None."""
-    if controller is not None:
-        return ("control",), "a semi-active controller switches the damping"
-    if cfg.road.kind != "iso8608":
+    """``(config key, why)`` when the run is not linear on a random road, else None."""
+    from .checks import nonlinear_part
+
+    if cfg.road.kind != "iso8608" and controller is None:
         return ("road", "kind"), f"road kind {cfg.road.kind!r} is not a random ISO 8608 road"
-    if cfg.vehicle.tyre_lift_off:
-        return ("vehicle", "tyre_lift_off"), "a tyre that lifts off is not linear"
-    for g in network.groups:
-        if g.extra is None:
-            continue
-        law = g.extra_law
-        if law is not None and law[0] == "poly3" and all(not np.any(p) for p in law[1]):
-            continue  # a cubic term of zero in every design
-        if g.name == "suspension" and law is not None:
-            corner = model.corners[int(np.flatnonzero(np.any(law[1][2] != 0, axis=(1, 2)))[0])]
-            path = f"vehicle.corners.{corner}.spring.cubic"
-            where = [i for i, v in enumerate(cfg.design_variables) if v.path == path]
-            key = ("design_variables", where[0]) if where else tuple(path.split("."))
-            return key, f"the Duffing spring {path} > 0 is not linear"
-        if cfg.seat is not None:
-            return ("seat", "kind"), f"the {cfg.seat.kind} seat's mechanism is not linear"
-        return ("vehicle",), f"the non-linear part of {g.name!r} is not linear"
-    return None
+    return nonlinear_part(cfg, model, controller, network)
 
 
 def check(cfg: Config, specs: Sequence[tuple[Any, tuple]]) -> None:

@@ -292,7 +292,9 @@ def _kernel_streams(cfg: Config, setup, streams: _Streams):
     from .integrator import compiled_runs
 
     pv, model, attachments, run, road = setup
-    if run.controller is not None or not compiled_runs(run, cfg.simulation.engine):
+    from .simulation import stepper
+
+    if run.controller is not None or not compiled_runs(run, stepper(cfg)):
         return None
     from .affine import kernel_accumulators
 
@@ -443,7 +445,7 @@ def reduce(
     config's road (robust design, one batch for several roads on one time grid). A run with
     a controller is one window (its hold keeps records over the run)."""
     from . import integrator
-    from .simulation import _result, _setup, check_memory, prepare, with_engine
+    from .simulation import _result, _setup, check_memory, prepare, stepper, with_engine
 
     pv, model, controller, attachments = prepare(cfg, params)
     cfg = with_engine(cfg, pv.P, evaluation=True)
@@ -463,7 +465,7 @@ def reduce(
     if kernel is not None and not streams.numpy_reads():
         kernel.alone, width = True, None  # (no record, nothing held per sample: one call)
     table = diverged = engine = None
-    for first, traj in integrator.windows(run, cfg.simulation.engine, width, recorded, kernel):
+    for first, traj in integrator.windows(run, stepper(cfg), width, recorded, kernel):
         window = _result(cfg, pv, model, controller, attachments, run, (z, zd, t_grid), traj, first)
         table, diverged, engine = window._table, traj.diverged_at, traj.engine
         streams.add(window)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .checks import check_stability, check_steps
+from .checks import check_exact, check_stability, check_steps
 from .config import Config
 from .errors import FAILED, ConfigError
 
@@ -64,6 +64,7 @@ def check_config(cfg: Config, optimisation: bool = True):
     if prepared is FAILED:
         found.raise_if_any()
     signals = found.attempt(check_signals, cfg, prepared) is not FAILED
+    found.attempt(check_exact, cfg, prepared)
     pv, model, controller, attachments = prepared
     found.attempt(check_stability, cfg, pv, model, attachments)
     written = (

@@ -45,12 +45,15 @@ class Simulation(Section):
         "compiled (numba: every vehicle, seat, road and controller; a non-linear element "
         "without a compiled law runs on numpy); the two agree to rounding",
     )
-    method: Literal["time", "spectral"] = Field(
+    method: Literal["time", "exact", "spectral"] = Field(
         "time",
-        description="how objectives and constraints are evaluated: time (integrated over "
-        "duration) or spectral (stationary statistics by the frequency integral over the "
-        "road's band; a linear model on an iso8608 road; var, std, rms, mean, rms_weighted, "
-        "dissipated_power and dynamic_tyre_load only); simulate always integrates in time",
+        description="how runs are integrated and objectives evaluated: time (RK4 over "
+        "duration), exact (a linear model without a controller: each design's exact "
+        "transition over a step, the road linear between the steps, at any dt; "
+        "suspopt.integrator.exact) or spectral (stationary statistics by the frequency "
+        "integral over the road's band; a linear model on an iso8608 road; var, std, rms, "
+        "mean, rms_weighted, dissipated_power and dynamic_tyre_load only; simulate "
+        "integrates it in time)",
     )
 
     @model_validator(mode="after")

@@ -121,7 +121,8 @@ def auto_engine(steps: int, designs: int, evaluation: bool) -> str:
 
 
 def integrate(run: Run, engine: str = "numpy") -> Trajectory:
-    """Classical RK4 of ``run`` (:class:`Run`) on ``engine`` (module docstring). A
+    """Classical RK4 of ``run`` (:class:`Run`) on ``engine`` (module docstring; ``exact``:
+    the exact stepper of a linear network, :mod:`.exact`). A
     ``compiled`` request without numba is a ``RuntimeError`` naming the install command (the
     config's checks turn it into bad input first)."""
     return next(windows(run, engine))[1]
@@ -145,6 +146,10 @@ def windows(
     (:func:`_ahead`), when the caller reads any recorded row. ``accumulators``
     (:class:`.accumulators.Accumulators`, compiled engine only): signals the kernel forms
     and reduces itself as it integrates, found in it after the last window."""
+    if engine == "exact":  # (simulation.method exact: the linear network's exact stepper)
+        from . import exact
+
+        return exact.windows(run, width, recorded)
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, not {engine!r}")
     if engine == "compiled" and not compiled_available():
@@ -162,7 +167,7 @@ def windows(
 def compiled_runs(run: Run, engine: str) -> bool:
     """Whether :func:`windows` runs ``run`` on the compiled engine (asked for, or ``auto``,
     with numba installed and the network covered)."""
-    if engine == "numpy" or not compiled_available():
+    if engine in ("numpy", "exact") or not compiled_available():
         return False
     from . import compiled
 

@@ -8,16 +8,21 @@ from __future__ import annotations
 
 from typing import Any
 
-from .._numba_cache import compiled_available
+from .._numba_cache import INSTALL_FAST, compiled_available
 
 __all__ = ["compiled_reductions"]
 
 
 def compiled_reductions() -> Any:
     """The module of the metrics' compiled arithmetic (:mod:`suspopt.loops._compiled`);
-    ImportError saying so when numba, a dependency, is missing."""
+    :class:`suspopt.InputError` (one line on the command line, exit 2) saying so when
+    numba, a dependency, cannot be imported."""
     if not compiled_available():
-        raise ImportError("suspopt needs numba for its metrics: pip install numba")
+        from ..errors import InputError
+
+        raise InputError(
+            f"suspopt's metrics need numba, which cannot be imported here: {INSTALL_FAST}"
+        )
     from . import _compiled
 
     return _compiled

@@ -29,6 +29,7 @@ import numpy as np
 from pymoo.core.problem import Problem as _PymooProblem
 
 from .. import execution, streaming
+from ..checks import check_exact
 from ..config import Config, ConfigError
 from ..config.loader import require_config
 from ..config.optimise import DesignVariable, batches
@@ -515,6 +516,7 @@ def _signals_at_bounds(cfg: Config):
         attachments = build_attachments(cfg, pv)
     except ConfigError as exc:
         raise _at_variable(cfg, str(exc)) from None
+    check_exact(cfg, (pv, model, controller, attachments))  # (simulation.method exact)
     table = signal_table(model, dict(getattr(controller, "units", {})), attachments)
 
     def unit_of(name: str) -> str:

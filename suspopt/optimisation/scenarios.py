@@ -232,7 +232,7 @@ def _group_config(cfg: Config, scenario: Scenario) -> tuple[str, Config]:
     shared = {p: v for p, v in scenario.sets.items() if _in(p, GROUP_SECTIONS) is not None}
     edited = _edited(cfg, scenario, shared) if shared else cfg
     parts: list[Any] = [edited.simulation, edited.control, edited.vehicle.gravity]
-    if cfg.simulation.method != "time":  # a batch of the spectral method has one road
+    if cfg.simulation.method == "spectral":  # a batch of the spectral method has one road
         parts.append(edited.road)
     elif isinstance(edited.road, (BumpStep, BumpHalfSine)):  # bumps of one batch share edges
         parts.append(edited.road.model_dump(mode="json", exclude={"height"}))
