@@ -402,50 +402,35 @@ def formats_rst() -> str:
     return "\n".join(lines)
 
 
+def _config_reference_rst() -> str:
+    from suspopt.config import config_schema
+
+    return reference_rst(config_schema())
+
+
 def setup(app: Any) -> dict:
+    from docutils import nodes
     from docutils.parsers.rst import Directive
     from docutils.statemachine import StringList
     from sphinx.util.nodes import nested_parse_with_titles
 
-    class ConfigReference(Directive):
-        has_content = False
+    def directive(make_text):
+        """A directive without content that parses the reStructuredText ``make_text()``
+        gives, its sections included."""
 
-        def run(self):
-            from docutils import nodes
+        class Generated(Directive):
+            has_content = False
 
-            from suspopt.config import config_schema
+            def run(self):
+                holder = nodes.section()
+                holder.document = self.state.document
+                lines = StringList(make_text().splitlines())
+                nested_parse_with_titles(self.state, lines, holder)
+                return holder.children
 
-            text = reference_rst(config_schema())
-            holder = nodes.section()
-            holder.document = self.state.document
-            nested_parse_with_titles(self.state, StringList(text.splitlines()), holder)
-            return holder.children
+        return Generated
 
-    class Commands(Directive):
-        has_content = False
-
-        def run(self):
-            from docutils import nodes
-
-            holder = nodes.section()
-            holder.document = self.state.document
-            text = commands_rst()
-            nested_parse_with_titles(self.state, StringList(text.splitlines()), holder)
-            return holder.children
-
-    class Formats(Directive):
-        has_content = False
-
-        def run(self):
-            from docutils import nodes
-
-            holder = nodes.section()
-            holder.document = self.state.document
-            text = formats_rst()
-            nested_parse_with_titles(self.state, StringList(text.splitlines()), holder)
-            return holder.children
-
-    app.add_directive("suspopt-formats", Formats)
-    app.add_directive("suspopt-config-reference", ConfigReference)
-    app.add_directive("suspopt-commands", Commands)
+    app.add_directive("suspopt-formats", directive(formats_rst))
+    app.add_directive("suspopt-config-reference", directive(_config_reference_rst))
+    app.add_directive("suspopt-commands", directive(commands_rst))
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
