@@ -31,6 +31,7 @@ from .network import Network
 __all__ = [
     "nonlinear_part",
     "check_exact",
+    "stepped_road",
     "MIN_STEPS_PER_BUMP",
     "MIN_STEPS_PER_WAVE",
     "check_steps",
@@ -165,6 +166,8 @@ def check_exact(cfg: Config, prepared) -> None:
     (designs, model, controller, attachments) is not linear (:func:`nonlinear_part`)."""
     if cfg.simulation.method != "exact":
         return
+    from .road import road_edges
+
     _, model, controller, attachments = prepared
     found = nonlinear_part(cfg, model, controller, full_network(model, attachments))
     if found is not None:
@@ -172,6 +175,17 @@ def check_exact(cfg: Config, prepared) -> None:
             ("simulation", "method"),
             f"exact needs a linear model without a controller: {found[1]}; use method time",
         )
+    if road_edges(cfg.road, model.offsets, model.sides)[0].size:
+        raise stepped_road(cfg, cfg.road.kind)
+
+
+def stepped_road(cfg: Config, kind: str):
+    """The error of ``simulation.method: exact`` on a road of ``kind`` with steps."""
+    return cfg.error(
+        ("simulation", "method"),
+        f"exact needs a road without steps between the integration steps; road kind "
+        f"{kind!r} has some; use method time",
+    )
 
 
 def _rk4_radius(direction: np.ndarray) -> np.ndarray:

@@ -16,7 +16,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from . import memory
-from .checks import check_exact, check_steps, full_network
+from .checks import check_exact, check_steps, full_network, stepped_road
 from .config import Config
 from .config.loader import require_config
 from .controller import build_controller
@@ -323,12 +323,8 @@ def _setup(
     z, zd = np.stack([u for u, _ in inputs], axis=1), np.stack([v for _, v in inputs], axis=1)
     times, jumps = _edges(cfg, model, roads, asm.P)
     edges = None
-    if times.size and sim.method == "exact":
-        raise cfg.error(
-            ("simulation", "method"),
-            f"exact needs a road without steps between the integration steps; road kind "
-            f"{roads[0].kind!r} has some; use method time",
-        )
+    if times.size and sim.method == "exact":  # (a scenario's road: the config's is checked)
+        raise stepped_road(cfg, roads[0].kind)
     if times.size:
 
         def at(t: np.ndarray, left: bool) -> np.ndarray:
