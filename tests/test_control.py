@@ -736,3 +736,23 @@ def test_the_c_max_share_of_a_time_outside_the_run_or_of_passive_dampers_is_refu
             c_max_share(wrong)
         with pytest.raises(TypeError, match=r"result must be a Result \(from suspopt.simulate"):
             semi_active_metrics(wrong)
+
+
+def test_the_semi_active_metrics_take_a_run_read_back_from_its_file(tmp_path):
+    """``examples/ch4_tables.py`` reads a stored run back (config, time, signals, corners)
+    and asks its metrics: the same values as of the result itself (the reproduction's report
+    failed on it when the metrics asked for a ``Result`` by its class)."""
+    from types import SimpleNamespace
+
+    from suspopt.analyse.cdf import semi_active_metrics
+    from suspopt.io import read_simulation_signals, write_simulation
+
+    cfg = suspopt.load_config(CONFIGS / "ch4" / "sh_2_bump.yaml")
+    cfg.simulation.duration = 2.0
+    result = suspopt.simulate(cfg)
+    time, signals = read_simulation_signals(write_simulation(tmp_path / "run.h5", result))
+    run = SimpleNamespace(config=cfg, time=time, signals=signals,
+                          model=SimpleNamespace(corners=result.model.corners))  # fmt: skip
+    stored, direct = semi_active_metrics(run), semi_active_metrics(result)
+    assert stored.keys() == direct.keys()
+    assert all(np.array_equal(stored[k], direct[k]) for k in direct)

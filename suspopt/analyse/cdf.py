@@ -25,11 +25,10 @@ import numpy as np
 
 from .. import plots
 from ..config import Config, load_config
-from ..errors import require
+from ..errors import require_like
 from ..formats import CDF_SENSITIVITY
 from ..io import atomic_h5, put
 from ..metrics import damper_switches, mean_dissipated_power, rms, weighted_rms
-from ..result import Result
 from ..simulation import simulate
 from .cells import NOT_COMPUTED, NOT_COMPUTED_NOTE, percent
 from .registry import KINDS, Analysis, Kind, Report, analysis, relative_change
@@ -49,10 +48,17 @@ SHARES = np.round(np.arange(0.20, 0.7001, 0.05), 2)
 METRIC_UNITS = {"SW": "1", "RC": "m/s^2", "ST": "m", "TD": "m", "DE": "W"}
 
 
+def _a_result(result) -> None:
+    """TypeError unless ``result`` holds what a simulation's ``suspopt.Result`` does (a run
+    read back from its file, as ``examples/ch4_tables.py`` makes, is one too)."""
+    require_like(result, "Result", ("config", "signals", "time", "model"), "result",
+                 "from suspopt.simulate(cfg)")  # fmt: skip
+
+
 def c_max_share(result, share_after: float = 0.0) -> np.ndarray:
     """The mean damper state (the C_max share of the on-off laws) over the samples at
     ``t >= share_after``, averaged over the semi-active corners, (P,)."""
-    require(result, Result, "result", "from suspopt.simulate(cfg)")
+    _a_result(result)
     cfg, sig = result.config, result.signals
     active = [
         c for c in result.model.corners if cfg.vehicle.corners[c].damper.kind == "semi_active"
@@ -76,7 +82,7 @@ def semi_active_metrics(result, share_after: float = 0.0) -> dict[str, np.ndarra
 
     SW counts state changes between output samples, so ``simulation.output_dt`` must not exceed
     ``control.sample_time`` (every sample seen)."""
-    require(result, Result, "result", "from suspopt.simulate(cfg)")
+    _a_result(result)
     cfg, sig, t = result.config, result.signals, result.time
     corners = result.model.corners
     active = [c for c in corners if cfg.vehicle.corners[c].damper.kind == "semi_active"]
