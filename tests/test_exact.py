@@ -98,3 +98,26 @@ def test_a_model_that_is_not_linear_or_a_stepped_road_is_refused_at_its_key(name
         errors = [ln for ln in res.output.splitlines() if ln.startswith("error:")]
         assert res.exit_code == 2 and len(errors) == 1, res.output
         assert "simulation.method: exact needs a " in errors[0] and why in errors[0]
+
+
+def test_the_exact_stepper_has_no_rk4_stability_limit(tmp_path):
+    """A stiff design RK4 cannot step at dt (``validate`` and ``simulate --sweep`` refuse it
+    under method time) runs under method exact, its states finite."""
+    from typer.testing import CliRunner
+
+    from suspopt.cli import app
+
+    text = (CONFIGS / CASES["QC"]).read_text()
+    text = text.replace("simulation: {duration: 60.0,", "simulation: {duration: 1.0,")
+    sweep = ["--sweep", "vehicle.corners.F1.spring.linear=1e9:1e10:2"]
+    for method, code in (("time", 2), ("exact", 0)):
+        path = tmp_path / f"{method}.yaml"
+        path.write_text(text.replace("simulation: {", f"simulation: {{method: {method}, "))
+        out = tmp_path / f"{method}.h5"
+        res = CliRunner().invoke(app, ["simulate", str(path), *sweep, "-o", str(out)])
+        assert res.exit_code == code, res.output
+    import h5py
+
+    with h5py.File(tmp_path / "exact.h5") as h5:
+        assert np.isfinite(h5["signals/body.heave"][()]).all()
+        assert np.isnan(h5["diverged_at"][()]).all()
