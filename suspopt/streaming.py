@@ -86,10 +86,6 @@ class _Moments:
         return moment_value(metric, self.state)
 
 
-#: The extremes are the moments' own state (one pass gives both).
-_Extremes = _Moments
-
-
 class _Weighted:
     """One signal under one ISO 2631 weighting as the windows arrive (module docstring):
     the filter's state, the weighted power sums (:func:`suspopt.metrics.iso2631.power_state`)
@@ -325,8 +321,9 @@ class _Streams:
                            for n in names})  # fmt: skip
 
         self.requests = requests
-        self.moments = {name: _Moments() for name in streamed("moments")}
-        self.extremes = {name: _Extremes() for name in streamed("extremes")}
+        # (one state per signal gives its moments and its extremes)
+        both = sorted({*streamed("moments"), *streamed("extremes")})
+        self.moments = {name: _Moments() for name in both}
         self.weighted = _weighted(requests)
         self.maxima = [(spec, n) for spec, names in requests
                        if METRICS[spec.metric].stream == "window_max" for n in names]  # fmt: skip
@@ -336,7 +333,7 @@ class _Streams:
         self.pieces: dict[str, list[np.ndarray]] = {name: [] for name in sorted(kept)}
         self.times: list[np.ndarray] = []
         self.kernel: Any = None  # (:meth:`hand_over`)
-        self.handed: list[tuple[dict, str]] = []
+        self.handed: list[str] = []
         self.by_extremes: list[tuple[Any, str]] = []
 
     def kernel_candidates(self, model) -> tuple[list[str], list[tuple[str, Any]]]:
@@ -346,7 +343,7 @@ class _Streams:
         may reduce itself."""
         self.by_extremes = [(spec, name) for spec, name in self.maxima
                             if _by_extremes(spec, model, name)]  # fmt: skip
-        names = set(self.moments) | set(self.extremes) | {n for _, n in self.by_extremes}
+        names = set(self.moments) | {n for _, n in self.by_extremes}
         return sorted(names), [key for key, w in self.weighted.items() if not w.taus]
 
     def hand_over(self, kernel) -> None:
@@ -356,9 +353,8 @@ class _Streams:
         self.kernel = kernel
         names = {s.name for s in kernel.signals}
         for s in kernel.signals:
-            for streams in (self.moments, self.extremes):
-                if streams.pop(s.name, None) is not None:
-                    self.handed.append((streams, s.name))
+            if self.moments.pop(s.name, None) is not None:
+                self.handed.append(s.name)
         for key in kernel.pair_keys:
             del self.weighted[key]
         self.by_extremes = [(spec, n) for spec, n in self.by_extremes if n in names]
@@ -367,7 +363,7 @@ class _Streams:
     def numpy_reads(self) -> list[str]:
         """The signals the windows' reductions read (those not handed to the kernel)."""
         return sorted(
-            set(self.moments) | set(self.extremes) | {name for name, _ in self.weighted}
+            set(self.moments) | {name for name, _ in self.weighted}
             | {name for _, name in self.maxima} | set(self.pieces)
         )  # fmt: skip
 
@@ -381,8 +377,8 @@ class _Streams:
             two = np.stack(kernel.moments(index[name], P)[2:], axis=-1)
             record = _Kept({name: two}, np.zeros(2), cfg, model)
             self.window_max[(id(spec), name)] = METRICS[spec.metric].compute(spec, record, name)
-        for streams, name in self.handed:  # (the kernel's state: the same steps)
-            moment = streams[name] = _Moments()
+        for name in self.handed:  # (the kernel's state: the same steps)
+            moment = self.moments[name] = _Moments()
             moment.state = (samples, *kernel.moments(index[name], P))
         for p, key in enumerate(kernel.pair_keys):
             weighted = self.weighted[key] = _Weighted(key[1])
@@ -395,8 +391,6 @@ class _Streams:
         self.times.append(window.time)
         for name, moment in self.moments.items():
             moment.add(signals[name])
-        for name, extreme in self.extremes.items():
-            extreme.add(signals[name])
         for (name, _), accumulator in self.weighted.items():
             accumulator.add(signals[name], window.time)
         for spec, name in self.maxima:
@@ -418,10 +412,8 @@ class _Streams:
             stream = METRICS[spec.metric].stream
             for name in names:
                 key = (id(spec), name)
-                if stream == "moments":
+                if stream in ("moments", "extremes"):
                     values[key] = self.moments[name].value(spec.metric)
-                elif stream == "extremes":
-                    values[key] = self.extremes[name].value(spec.metric)
                 elif stream == "weighted":
                     values[key] = self.weighted[(name, spec.weighting)].value(spec)
                 elif stream == "window_max":

@@ -68,12 +68,13 @@ def _matrices(run: Run) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return A, B, np.linalg.pinv(E)
 
 
-def discretised(run: Run) -> tuple[np.ndarray, ...]:
+def discretised(run: Run, matrices: tuple | None = None) -> tuple[np.ndarray, ...]:
     """``(Φ, Γ0, Γ1, A_acc, B_acc)`` of every design (module docstring): ``(P, N, N)``,
-    ``(P, N, m)`` twice, and the acceleration rows of ``A`` and ``B_w``."""
+    ``(P, N, m)`` twice, and the acceleration rows of ``A`` and ``B_w``; ``matrices`` the
+    run's :func:`_matrices` when the caller has them."""
     from scipy.linalg import expm
 
-    A, B, _ = _matrices(run)
+    A, B, _ = _matrices(run) if matrices is None else matrices
     P, N, m = B.shape
     dt = run.dt
     M = np.zeros((P, N + 2 * m, N + 2 * m))
@@ -88,10 +89,9 @@ def discretised(run: Run) -> tuple[np.ndarray, ...]:
     return phi, gamma0, gamma1, np.ascontiguousarray(A[:, n:]), np.ascontiguousarray(B[:, n:])
 
 
-def _inputs(run: Run) -> np.ndarray:
+def _inputs(run: Run, pinv: np.ndarray) -> np.ndarray:
     """The road's inputs ``w (n_steps + 1, m, G)`` at the steps (the offsets' whole steps,
-    mapped back by ``E⁺``)."""
-    _, _, pinv = _matrices(run)
+    mapped back by ``pinv = E⁺``)."""
     offsets = run.offsets[::2, :, :, 0]  # (n_steps + 1, 2R, G)
     return np.ascontiguousarray(np.einsum("mr,krg->kmg", pinv, offsets))
 
@@ -221,8 +221,9 @@ def windows(
     n, P = asm.n, asm.P
     n_out, width = run.window(width)
     blocks = -(-P // LANES)
-    phi, g0, g1, a_acc, b_acc = (_lanes(a, blocks) for a in discretised(run))
-    w = _inputs(run)
+    matrices = _matrices(run)
+    phi, g0, g1, a_acc, b_acc = (_lanes(a, blocks) for a in discretised(run, matrices))
+    w = _inputs(run, matrices[2])
     G = w.shape[2]
     road = _lanes(np.repeat(np.arange(G), P // G).astype(np.int64), blocks)
     y = np.zeros((blocks, 2 * n, LANES))

@@ -149,10 +149,28 @@ def _lanes(a, r0, c, scratch):
 
 
 @_jit
-def moment_rows(x, count, mean, m2, high, low):
-    """Each row of ``x (R, T)`` after ``count`` samples into its running ``mean``, ``m2``,
-    ``high`` and ``low`` (R,) each, in place (:func:`welford`, :func:`extremes`), the rows
-    :data:`LANES` at a time side by side."""
+def _load(rows, r0, c, state):
+    """Columns ``r0 .. r0 + c`` of ``rows (Q, R)`` into ``state (Q, C)``; the spare lanes
+    of a last, part-filled group take the last row's (a finite state, never written back)."""
+    for i in range(state.shape[1]):
+        k = r0 + min(i, c - 1)
+        for q in range(rows.shape[0]):
+            state[q, i] = rows[q, k]
+
+
+@_jit
+def _store(state, r0, c, rows):
+    """The first ``c`` lanes of ``state (Q, C)`` back into columns ``r0 ..`` of ``rows``."""
+    for i in range(c):
+        for q in range(rows.shape[0]):
+            rows[q, r0 + i] = state[q, i]
+
+
+@_jit
+def moment_rows(x, count, rows):
+    """Each row of ``x (R, T)`` after ``count`` samples into its running mean, M2, largest
+    and smallest sample, ``rows (4, R)`` in place (:func:`welford`, :func:`extremes`), the
+    rows of ``x`` :data:`LANES` at a time side by side."""
     R, T = x.shape
     C = min(LANES, R)
     lanes = np.empty((T, C))
@@ -160,30 +178,22 @@ def moment_rows(x, count, mean, m2, high, low):
     for r0 in range(0, R, C):
         c = min(C, R - r0)
         _lanes(x, r0, c, lanes)
-        for i in range(C):  # (the last group's spare lanes: any finite state)
-            k = r0 + min(i, c - 1)
-            state[0, i], state[1, i], state[2, i], state[3, i] = mean[k], m2[k], high[k], low[k]
+        _load(rows, r0, c, state)
         for t in range(T):
             w = 1.0 / (count + t + 1)
             for i in range(C):
                 v = lanes[t, i]
                 state[0, i], state[1, i] = welford(v, w, state[0, i], state[1, i])
                 state[2, i], state[3, i] = extremes(v, state[2, i], state[3, i])
-        for i in range(c):
-            mean[r0 + i], m2[r0 + i], high[r0 + i], low[r0 + i] = (
-                state[0, i],
-                state[1, i],
-                state[2, i],
-                state[3, i],
-            )
+        _store(state, r0, c, rows)
 
 
 @_jit
-def power_rows(aw, start, block, sums, peak):
+def power_rows(aw, start, block, rows):
     """Each row of the weighted ``aw (R, T)``, whose first sample is sample ``start`` of its
-    record, into ``sums (4, R)`` (the block's and the total sum of ``a_w²``, the same of
-    ``a_w⁴``) and ``peak (R,)``, in place (:func:`powers`; a block's sums carried into the
-    totals at its end, :func:`carry`), the rows :data:`LANES` at a time side by side."""
+    record, into ``rows (5, R)`` in place: the block's and the total sum of ``a_w²``, the
+    same of ``a_w⁴``, the largest ``|a_w|`` (:func:`powers`; a block's sums carried into the
+    totals at its end, :func:`carry`), the rows of ``aw`` :data:`LANES` at a time."""
     R, T = aw.shape
     C = min(LANES, R)
     lanes = np.empty((T, C))
@@ -191,11 +201,7 @@ def power_rows(aw, start, block, sums, peak):
     for r0 in range(0, R, C):
         c = min(C, R - r0)
         _lanes(aw, r0, c, lanes)
-        for i in range(C):
-            k = r0 + min(i, c - 1)
-            for q in range(4):
-                state[q, i] = sums[q, k]
-            state[4, i] = peak[k]
+        _load(rows, r0, c, state)
         for t in range(T):
             for i in range(C):
                 state[0, i], state[2, i], state[4, i] = powers(
@@ -205,7 +211,4 @@ def power_rows(aw, start, block, sums, peak):
                 for i in range(C):
                     state[0, i], state[1, i] = carry(state[0, i], state[1, i])
                     state[2, i], state[3, i] = carry(state[2, i], state[3, i])
-        for i in range(c):
-            for q in range(4):
-                sums[q, r0 + i] = state[q, i]
-            peak[r0 + i] = state[4, i]
+        _store(state, r0, c, rows)

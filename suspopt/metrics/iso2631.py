@@ -137,14 +137,16 @@ def power_state(aw: np.ndarray, state: tuple | None = None) -> tuple:
 
     a = np.asarray(aw, dtype=np.float64)
     lead = a.shape[:-1]
+    kept = np.zeros((5, *lead))
     if state is None:
-        count, sums, peak = 0, np.zeros((4, *lead)), np.full(lead, -np.inf)
+        count, kept[4] = 0, -np.inf  # (the largest |a_w|: none yet)
     else:
-        count, sums, peak = state[0], np.array(state[1], dtype=float), np.array(state[2], float)
-    flat_sums, flat_peak = sums.reshape(4, -1), peak.reshape(-1)
-    rows = np.ascontiguousarray(a.reshape(-1, a.shape[-1]))
-    compiled_reductions().power_rows(rows, count, SUM_BLOCK, flat_sums, flat_peak)
-    return count + a.shape[-1], flat_sums.reshape(4, *lead), flat_peak.reshape(lead)
+        count, kept[:4], kept[4] = state
+    rows = kept.reshape(5, -1)
+    flat = np.ascontiguousarray(a.reshape(-1, a.shape[-1]))
+    compiled_reductions().power_rows(flat, count, SUM_BLOCK, rows)  # (in place)
+    kept = rows.reshape(5, *lead)
+    return count + a.shape[-1], kept[:4], kept[4]
 
 
 def weighted_value(metric: str, state: tuple, fs: float) -> np.ndarray:

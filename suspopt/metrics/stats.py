@@ -57,9 +57,8 @@ def moments(x: np.ndarray, state: tuple | None = None) -> tuple:
     else:
         count, kept = state[0], np.array(np.stack(state[1:]), dtype=np.float64)
     rows = kept.reshape(4, -1)
-    mean, m2, high, low = rows[0], rows[1], rows[2], rows[3]  # (views: written in place)
     flat = np.ascontiguousarray(a.reshape(-1, a.shape[-1]))
-    compiled_reductions().moment_rows(flat, count, mean, m2, high, low)
+    compiled_reductions().moment_rows(flat, count, rows)  # (in place)
     kept = rows.reshape(4, *lead)
     return count + a.shape[-1], kept[0], kept[1], kept[2], kept[3]
 
